@@ -1,0 +1,139 @@
+//! The assembly model: named parts with meshes in their assembled pose, units and the up axis.
+
+use crate::error::{GeomError, Result};
+use crate::math::{aabb_of, Aabb, Axis};
+use crate::mesh::Mesh;
+use std::path::PathBuf;
+
+/// One part of an assembly, its mesh baked in its assembled pose (world frame, metres).
+#[derive(Clone, Debug)]
+pub struct Part {
+    /// The part's name (node, mesh or file name; unique within the assembly).
+    pub name: String,
+    /// The surface, world frame, metres.
+    pub mesh: Mesh,
+    /// Base parts stay in place and are never removed.
+    pub fixed: bool,
+    /// Metadata from the file (`extras.asp` of a glTF node: voxels, grasp points, ...).
+    pub extras: serde_json::Value,
+}
+
+/// The unit the model was given in; asp works in metres and reports in this unit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Units {
+    /// Short name, e.g. `m`, `mm`, `in`.
+    pub name: String,
+    /// How many metres one model unit is.
+    pub metres: f64,
+}
+
+impl Units {
+    /// Metres.
+    pub fn metres() -> Self {
+        Units { name: "m".into(), metres: 1.0 }
+    }
+
+    /// Parses `m`, `cm`, `mm`, `in`, `ft` or a plain number of metres per unit.
+    pub fn parse(s: &str) -> Option<Self> {
+        let metres = match s.trim().to_ascii_lowercase().as_str() {
+            "m" | "meter" | "metre" | "meters" | "metres" => 1.0,
+            "cm" => 0.01,
+            "mm" => 0.001,
+            "um" | "µm" => 1e-6,
+            "in" | "inch" => 0.0254,
+            "ft" | "foot" => 0.3048,
+            other => other.parse::<f64>().ok().filter(|v| *v > 0.0 && v.is_finite())?,
+        };
+        Some(Units { name: s.trim().to_string(), metres })
+    }
+
+    /// Converts a length in metres to model units.
+    pub fn from_metres(&self, metres: f64) -> f64 {
+        metres / self.metres
+    }
+}
+
+/// An assembled product: its parts in their assembled poses.
+#[derive(Clone, Debug)]
+pub struct Assembly {
+    /// The parts, in file order; indices into this list identify parts everywhere in asp.
+    pub parts: Vec<Part>,
+    /// The unit of the input file.
+    pub units: Units,
+    /// The up axis; gravity points the other way.
+    pub up: Axis,
+    /// Where the model came from (for messages and the plan's `model` field).
+    pub source: PathBuf,
+}
+
+impl Assembly {
+    /// Number of parts.
+    pub fn len(&self) -> usize {
+        self.parts.len()
+    }
+
+    /// Whether there are no parts.
+    pub fn is_empty(&self) -> bool {
+        self.parts.is_empty()
+    }
+
+    /// The box around every part.
+    pub fn aabb(&self) -> Option<Aabb> {
+        aabb_of(self.parts.iter().flat_map(|p| p.mesh.vertices.iter().copied()))
+    }
+
+    /// The length of the bounding box diagonal, in metres: the model's size.
+    pub fn diagonal(&self) -> f32 {
+        self.aabb().map(|b| (b.maxs - b.mins).length()).unwrap_or(0.0)
+    }
+
+    /// The index of the part called `name`.
+    pub fn part_index(&self, name: &str) -> Option<usize> {
+        self.parts.iter().position(|p| p.name == name)
+    }
+
+    /// Marks the named parts as fixed; an unknown name is an error that lists the known ones.
+    pub fn set_fixed<S: AsRef<str>>(&mut self, names: &[S]) -> Result<()> {
+        for name in names {
+            let name = name.as_ref();
+            let i = self.part_index(name).ok_or_else(|| GeomError::Assembly {
+                path: self.source.clone(),
+                reason: format!(
+                    "--fixed names no part '{name}' (parts: {})",
+                    self.parts.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
+                ),
+            })?;
+            self.parts[i].fixed = true;
+        }
+        Ok(())
+    }
+
+    /// Makes part names unique by appending `_2`, `_3`, ... to repeats.
+    pub fn dedupe_names(&mut self) {
+        let mut seen = std::collections::HashMap::<String, usize>::new();
+        for p in &mut self.parts {
+            let n = seen.entry(p.name.clone()).or_insert(0);
+            *n += 1;
+            if *n > 1 {
+                p.name = format!("{}_{}", p.name, n);
+            }
+        }
+    }
+
+    /// Checks what every planner needs: at least one part, finite non-empty meshes.
+    pub fn validate(&self) -> Result<()> {
+        let err = |reason: String| GeomError::Assembly { path: self.source.clone(), reason };
+        if self.parts.is_empty() {
+            return Err(err("the model has no parts (empty scene)".into()));
+        }
+        for p in &self.parts {
+            if p.mesh.triangles.is_empty() {
+                return Err(err(format!("part '{}' has no triangles", p.name)));
+            }
+            if !p.mesh.is_finite() {
+                return Err(err(format!("part '{}' has NaN or infinite vertex coordinates", p.name)));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,13 @@
+#![doc = include_str!("../README.md")]
+
+pub mod assembly;
+pub mod error;
+// pub mod io; (enabled when the loaders land)
+pub mod math;
+pub mod mesh;
+pub mod partset;
+
+pub use assembly::{Assembly, Part, Units};
+pub use error::{GeomError, Result};
+pub use mesh::Mesh;
+pub use partset::PartSet;

@@ -1,0 +1,147 @@
+//! `PartSet`: which parts are present in a disassembly state (a bitset, cheap to copy and hash).
+
+use smallvec::SmallVec;
+
+/// A set of part indices. Inline up to 256 parts, heap beyond.
+#[derive(Clone, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct PartSet {
+    words: SmallVec<[u64; 4]>,
+}
+
+impl PartSet {
+    /// The empty set with room for `n` parts.
+    pub fn empty(n: usize) -> Self {
+        PartSet { words: smallvec::smallvec![0; n.div_ceil(64).max(1)] }
+    }
+
+    /// The set {0, 1, ..., n-1}.
+    pub fn full(n: usize) -> Self {
+        let mut s = Self::empty(n);
+        for i in 0..n {
+            s.insert(i);
+        }
+        s
+    }
+
+    /// A set of the given indices, with room for `n` parts.
+    pub fn from_indices(n: usize, indices: impl IntoIterator<Item = usize>) -> Self {
+        let mut s = Self::empty(n);
+        for i in indices {
+            s.insert(i);
+        }
+        s
+    }
+
+    fn grow(&mut self, i: usize) {
+        if i / 64 >= self.words.len() {
+            self.words.resize(i / 64 + 1, 0);
+        }
+    }
+
+    /// Adds part `i`.
+    pub fn insert(&mut self, i: usize) {
+        self.grow(i);
+        self.words[i / 64] |= 1 << (i % 64);
+    }
+
+    /// Removes part `i`.
+    pub fn remove(&mut self, i: usize) {
+        if let Some(w) = self.words.get_mut(i / 64) {
+            *w &= !(1 << (i % 64));
+        }
+    }
+
+    /// This set without part `i`.
+    pub fn without(&self, i: usize) -> Self {
+        let mut s = self.clone();
+        s.remove(i);
+        s
+    }
+
+    /// Whether part `i` is in the set.
+    pub fn contains(&self, i: usize) -> bool {
+        self.words.get(i / 64).is_some_and(|w| w & (1 << (i % 64)) != 0)
+    }
+
+    /// Number of parts in the set.
+    pub fn len(&self) -> usize {
+        self.words.iter().map(|w| w.count_ones() as usize).sum()
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(&self) -> bool {
+        self.words.iter().all(|w| *w == 0)
+    }
+
+    /// Whether the two sets share a part.
+    pub fn intersects(&self, other: &PartSet) -> bool {
+        self.words.iter().zip(&other.words).any(|(a, b)| a & b != 0)
+    }
+
+    /// Whether every part of `self` is in `other`.
+    pub fn is_subset(&self, other: &PartSet) -> bool {
+        self.words.iter().enumerate().all(|(k, a)| a & !other.words.get(k).copied().unwrap_or(0) == 0)
+    }
+
+    /// Parts in both sets.
+    pub fn intersection(&self, other: &PartSet) -> PartSet {
+        let mut s = self.clone();
+        for (k, w) in s.words.iter_mut().enumerate() {
+            *w &= other.words.get(k).copied().unwrap_or(0);
+        }
+        s
+    }
+
+    /// Adds every part of `other`.
+    pub fn union_with(&mut self, other: &PartSet) {
+        if other.words.len() > self.words.len() {
+            self.words.resize(other.words.len(), 0);
+        }
+        for (k, w) in other.words.iter().enumerate() {
+            self.words[k] |= w;
+        }
+    }
+
+    /// The parts in increasing index order.
+    pub fn iter(&self) -> impl Iterator<Item = usize> + '_ {
+        self.words.iter().enumerate().flat_map(|(k, &w)| {
+            let mut w = w;
+            std::iter::from_fn(move || {
+                (w != 0).then(|| {
+                    let b = w.trailing_zeros() as usize;
+                    w &= w - 1;
+                    k * 64 + b
+                })
+            })
+        })
+    }
+}
+
+impl std::fmt::Debug for PartSet {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_set().entries(self.iter()).finish()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn set_operations() {
+        let mut s = PartSet::full(70);
+        assert_eq!(s.len(), 70);
+        s.remove(3);
+        s.remove(65);
+        assert!(!s.contains(3) && s.contains(64) && !s.contains(65));
+        let t = PartSet::from_indices(70, [3, 65, 69]);
+        assert!(t.intersects(&s));
+        assert_eq!(t.intersection(&s).iter().collect::<Vec<_>>(), vec![69]);
+        assert!(!t.is_subset(&s));
+        assert!(PartSet::from_indices(70, [69]).is_subset(&s));
+        let mut u = PartSet::empty(1);
+        u.union_with(&t);
+        assert_eq!(u, t);
+        assert_eq!(s.iter().count(), 68);
+    }
+}
