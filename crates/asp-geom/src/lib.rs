@@ -2,6 +2,7 @@
 
 pub mod assembly;
 pub mod error;
+pub mod feasibility;
 // pub mod io; (enabled when the loaders land)
 pub mod math;
 pub mod mesh;
@@ -9,5 +10,6 @@ pub mod partset;
 
 pub use assembly::{Assembly, Part, Units};
 pub use error::{GeomError, Result};
+pub use feasibility::{FeasibilityChecker, Motion, MotionKind, Outcome, Stability};
 pub use mesh::Mesh;
 pub use partset::PartSet;

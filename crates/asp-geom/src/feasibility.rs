@@ -1,0 +1,150 @@
+//! The feasibility vocabulary every planner speaks: motions, removal outcomes, stability, and
+//! the [`FeasibilityChecker`] trait that counts every test it runs.
+
+use crate::math::{Pose, Vec3};
+use crate::partset::PartSet;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// How a part leaves its assembled pose (removal) — world frame, metres, displacements of the
+/// part relative to its assembled pose.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Motion {
+    /// A straight line: unit `direction`, travelled `distance` until the part's bounds clear the
+    /// bounds of what remains.
+    Linear {
+        /// Unit removal direction.
+        direction: Vec3,
+        /// Travel in metres.
+        distance: f32,
+    },
+    /// A path of poses (translation + rotation), the first the identity.
+    Path {
+        /// Waypoints; consecutive poses are joined by interpolation.
+        poses: Vec<Pose>,
+    },
+}
+
+impl Motion {
+    /// The length of the translation part of the motion, in metres.
+    pub fn length(&self) -> f32 {
+        match self {
+            Motion::Linear { distance, .. } => *distance,
+            Motion::Path { poses } => {
+                poses.windows(2).map(|w| (w[1].translation - w[0].translation).length()).sum()
+            }
+        }
+    }
+}
+
+/// Which kind of motion a removal test may use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MotionKind {
+    /// Straight lines along the candidate directions (the fast test).
+    Linear,
+    /// A sampling-based path planner (RRT-Connect in SE(3)), seeded.
+    Path {
+        /// Seed of the planner's random choices.
+        seed: u64,
+    },
+}
+
+/// The answer to "can this part leave this state?".
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outcome {
+    /// The part leaves along `motion`, and what remains is stable.
+    Removed(Motion),
+    /// Every motion tried collides; `blockers` are the present parts that stopped it.
+    Collision {
+        /// The parts that block at least one tried motion.
+        blockers: PartSet,
+    },
+    /// The part could leave, but what remains is unstable: `floating` parts lose their support.
+    Unstable {
+        /// The parts left without support (empty when a physics check cannot say which).
+        floating: PartSet,
+        /// The motion the part would have used.
+        motion: Motion,
+    },
+}
+
+/// Whether a state stands.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Stability {
+    /// Every present part is supported.
+    Stable,
+    /// These parts are not supported.
+    Unstable {
+        /// The parts that would fall (or moved in simulation).
+        floating: PartSet,
+    },
+}
+
+/// Test counters (the thesis' measures of planning effort).
+#[derive(Debug, Default)]
+pub struct Counters {
+    /// Removal tests run.
+    pub removal_tests: AtomicU64,
+    /// Tests that failed because every motion collided.
+    pub failed_collision: AtomicU64,
+    /// Tests that failed because the remaining state was unstable.
+    pub failed_gravity: AtomicU64,
+    /// Calls of the path planner.
+    pub path_planner_calls: AtomicU64,
+}
+
+/// A copy of the counters at one moment.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct CounterSnapshot {
+    /// Removal tests run.
+    pub removal_tests: u64,
+    /// Tests that failed because every motion collided.
+    pub failed_collision: u64,
+    /// Tests that failed because the remaining state was unstable.
+    pub failed_gravity: u64,
+    /// Calls of the path planner.
+    pub path_planner_calls: u64,
+}
+
+impl Counters {
+    /// Records one test and its outcome.
+    pub fn record(&self, kind: MotionKind, outcome: &Outcome) {
+        self.removal_tests.fetch_add(1, Ordering::Relaxed);
+        if matches!(kind, MotionKind::Path { .. }) {
+            self.path_planner_calls.fetch_add(1, Ordering::Relaxed);
+        }
+        match outcome {
+            Outcome::Removed(_) => {}
+            Outcome::Collision { .. } => {
+                self.failed_collision.fetch_add(1, Ordering::Relaxed);
+            }
+            Outcome::Unstable { .. } => {
+                self.failed_gravity.fetch_add(1, Ordering::Relaxed);
+            }
+        }
+    }
+
+    /// The current values.
+    pub fn snapshot(&self) -> CounterSnapshot {
+        CounterSnapshot {
+            removal_tests: self.removal_tests.load(Ordering::Relaxed),
+            failed_collision: self.failed_collision.load(Ordering::Relaxed),
+            failed_gravity: self.failed_gravity.load(Ordering::Relaxed),
+            path_planner_calls: self.path_planner_calls.load(Ordering::Relaxed),
+        }
+    }
+}
+
+/// Removal test + stability, as a planner sees them. Implementations count every test they run.
+pub trait FeasibilityChecker: Send + Sync {
+    /// Number of parts (indices `0..num_parts()`).
+    fn num_parts(&self) -> usize;
+    /// Whether part `i` is a base part that is never removed.
+    fn is_fixed(&self, part: usize) -> bool;
+    /// Tests whether `part` can leave `state` (which contains it) with a motion of `kind`, and
+    /// whether `state` without it is stable. Counts the test.
+    fn test_removal(&self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome;
+    /// Whether `state` is stable (not counted as a removal test).
+    fn stability(&self, state: &PartSet) -> Stability;
+    /// The counters so far.
+    fn counters(&self) -> CounterSnapshot;
+}
