@@ -64,6 +64,9 @@ pub struct Assembly {
     pub up: Axis,
     /// Where the model came from (for messages and the plan's `model` field).
     pub source: PathBuf,
+    /// Non-fatal problems found while loading or preparing (skipped primitives, open meshes...),
+    /// one line each, naming the part.
+    pub warnings: Vec<String>,
 }
 
 impl Assembly {
