@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 pub mod assembly;
+pub mod distmap;
 pub mod error;
 pub mod feasibility;
 // pub mod io; (enabled when the loaders land)

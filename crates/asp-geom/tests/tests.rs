@@ -1,0 +1,3 @@
+//! Integration tests of asp-geom (one binary; modules in subfolders).
+
+mod distmap;
