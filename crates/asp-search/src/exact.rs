@@ -11,7 +11,7 @@
 use crate::error::{Result, SearchError};
 use crate::hypervolume::ParetoFront;
 use crate::objective::Memory;
-use crate::problem::Problem;
+use crate::mdp::Mdp;
 use asp_geom::distmap::MapState;
 use asp_geom::PartSet;
 use std::collections::HashMap;
@@ -58,7 +58,7 @@ struct Entry {
 }
 
 struct Dp<'p> {
-    problem: &'p Problem,
+    problem: &'p Mdp,
     memo: HashMap<Key, usize>,
     entries: Vec<Entry>,
     max_states: usize,
@@ -133,7 +133,7 @@ impl Dp<'_> {
 
 /// The exact Pareto front of `problem` (for one objective: the optimum) by dynamic programming,
 /// visiting at most `max_states` states.
-pub fn exact_front(problem: &Problem, max_states: usize) -> Result<ExactFront> {
+pub fn exact_front(problem: &Mdp, max_states: usize) -> Result<ExactFront> {
     let maps = problem.maps();
     let mut dp = Dp { problem, memo: HashMap::new(), entries: Vec::new(), max_states };
     let m = problem.num_objectives();
@@ -160,7 +160,7 @@ pub fn exact_front(problem: &Problem, max_states: usize) -> Result<ExactFront> {
 
 /// Every complete feasible disassembly sequence with its objective vector (depth-first, in
 /// increasing part order), at most `limit` of them.
-pub fn enumerate_sequences(problem: &Problem, limit: usize) -> Result<Vec<ExactSolution>> {
+pub fn enumerate_sequences(problem: &Mdp, limit: usize) -> Result<Vec<ExactSolution>> {
     let maps = problem.maps();
     let m = problem.num_objectives();
     let mut out = Vec::new();
@@ -179,7 +179,7 @@ pub fn enumerate_sequences(problem: &Problem, limit: usize) -> Result<Vec<ExactS
 }
 
 fn enumerate(
-    problem: &Problem,
+    problem: &Mdp,
     present: &PartSet,
     memories: &[Memory],
     seq: &mut Vec<usize>,

@@ -7,7 +7,7 @@ pub mod mcts;
 pub mod objective;
 pub mod pareto;
 pub mod policy;
-pub mod problem;
+pub mod mdp;
 pub mod search;
 
 pub use error::{Result, SearchError};
@@ -15,5 +15,5 @@ pub use mcts::Mcts;
 pub use objective::{Accessibility, DirectionChanges, Memory, Objective, PathLength};
 pub use pareto::ParetoMcts;
 pub use policy::{EpsilonGreedy, Policy, QFunction, RandomPolicy};
-pub use problem::Problem;
+pub use mdp::Mdp;
 pub use search::{SearchOutcome, SearchStatus, Solution};

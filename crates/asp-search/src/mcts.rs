@@ -12,7 +12,7 @@
 //! ```
 
 use crate::error::{Result, SearchError};
-use crate::problem::Problem;
+use crate::mdp::Mdp;
 use crate::search::{
     exploration_term, run, SearchBuilder, SearchOutcome, SearchSettings, SelectContext, Tree,
     Variant,
@@ -45,7 +45,7 @@ impl Mcts {
     }
 
     /// Searches for the sequence with the largest total of the problem's single objective.
-    pub fn solve(&self, problem: &Problem) -> Result<SearchOutcome> {
+    pub fn solve(&self, problem: &Mdp) -> Result<SearchOutcome> {
         if problem.num_objectives() != 1 {
             return Err(SearchError::config(format!(
                 "single-objective MCTS needs exactly one objective, got {}; use Pareto-MCTS",

@@ -15,7 +15,7 @@
 
 use crate::error::Result;
 use crate::hypervolume::ParetoFront;
-use crate::problem::{Problem, MAX_OBJECTIVES};
+use crate::mdp::{Mdp, MAX_OBJECTIVES};
 use crate::search::{
     exploration_term, run, SearchBuilder, SearchOutcome, SearchSettings, SelectContext, Tree,
     Variant,
@@ -51,7 +51,7 @@ impl ParetoMcts {
     }
 
     /// Searches for the Pareto front of the problem's objectives.
-    pub fn solve(&self, problem: &Problem) -> Result<SearchOutcome> {
+    pub fn solve(&self, problem: &Mdp) -> Result<SearchOutcome> {
         run::<FrontBackup>(problem, &self.settings)
     }
 }

@@ -4,7 +4,7 @@
 //! objectives), so a learned Q-function slots in by implementing that trait.
 
 use crate::objective::Memory;
-use crate::problem::Problem;
+use crate::mdp::Mdp;
 use asp_geom::distmap::MapState;
 use rand::{RngExt, SeedableRng};
 use std::fmt::Debug;
@@ -30,7 +30,7 @@ pub struct PolicyContext<'a, 'm> {
     /// The objectives' memories (e.g. the common directions `H`).
     pub memories: &'a [Memory],
     /// The problem (objectives, maps).
-    pub problem: &'a Problem,
+    pub problem: &'a Mdp,
 }
 
 /// Chooses one of the feasible `actions` (part indices, never empty) and returns its position

@@ -25,7 +25,7 @@ use crate::error::{Result, SearchError};
 use crate::hypervolume::ParetoFront;
 use crate::objective::Memory;
 use crate::policy::{rng_for, Policy, PolicyContext, RandomPolicy, SearchRng};
-use crate::problem::{Problem, MAX_OBJECTIVES};
+use crate::mdp::{Mdp, MAX_OBJECTIVES};
 use asp_geom::distmap::MapState;
 use asp_geom::{Motion, PartSet};
 use rand::RngExt;
@@ -442,7 +442,7 @@ struct Shared {
 }
 
 struct Worker<'p, V: Variant> {
-    problem: &'p Problem,
+    problem: &'p Mdp,
     settings: &'p SearchSettings,
     m: usize,
     n: usize,
@@ -461,7 +461,7 @@ struct Worker<'p, V: Variant> {
 }
 
 impl<'p, V: Variant> Worker<'p, V> {
-    fn new(problem: &'p Problem, settings: &'p SearchSettings, thread: usize, start: Instant) -> Self {
+    fn new(problem: &'p Mdp, settings: &'p SearchSettings, thread: usize, start: Instant) -> Self {
         let m = problem.num_objectives();
         let maps = problem.maps();
         let n = maps.num_parts();
@@ -794,7 +794,7 @@ fn front_value<P>(front: &ParetoFront<P>, reference: &[f64]) -> f64 {
 }
 
 /// Runs the search of variant `V` on `problem`.
-pub(crate) fn run<V: Variant>(problem: &Problem, settings: &SearchSettings) -> Result<SearchOutcome> {
+pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Result<SearchOutcome> {
     let m = problem.num_objectives();
     let reference = match &settings.reference {
         Some(r) if r.len() != m => {

@@ -13,12 +13,12 @@ pub const MAX_OBJECTIVES: usize = 8;
 
 /// Distance maps plus the objectives to maximise.
 #[derive(Clone, Debug)]
-pub struct Problem {
+pub struct Mdp {
     maps: Arc<DistanceMaps>,
     objectives: Vec<Arc<dyn Objective>>,
 }
 
-impl Problem {
+impl Mdp {
     /// A problem over `maps` with `objectives` (1 to [`MAX_OBJECTIVES`]).
     pub fn new(maps: Arc<DistanceMaps>, objectives: Vec<Arc<dyn Objective>>) -> Result<Self> {
         if objectives.is_empty() || objectives.len() > MAX_OBJECTIVES {
@@ -27,7 +27,7 @@ impl Problem {
                 objectives.len()
             )));
         }
-        Ok(Problem { maps, objectives })
+        Ok(Mdp { maps, objectives })
     }
 
     /// The distance maps.
