@@ -3,7 +3,7 @@
 pub mod assembly;
 pub mod error;
 pub mod feasibility;
-// pub mod io; (enabled when the loaders land)
+pub mod io;
 pub mod math;
 pub mod mesh;
 pub mod partset;
