@@ -722,3 +722,106 @@ fn unwritable_assemblies_are_errors() {
     );
     assert!(!path.exists(), "nothing written on error");
 }
+
+/// A deterministic pseudo-random sequence (64-bit LCG) for the corruption test.
+struct Lcg(u64);
+
+impl Lcg {
+    fn below(&mut self, n: usize) -> usize {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((self.0 >> 33) as usize) % n.max(1)
+    }
+}
+
+/// Sets a few fields of the document's accessors, views, nodes, meshes... to hostile values.
+fn corrupt_json(json: &mut Value, rng: &mut Lcg) {
+    let hostile = [
+        json!(0),
+        json!(-1),
+        json!(1),
+        json!(3),
+        json!(4294967295u64),
+        json!(1e30),
+        json!(null),
+        json!("x"),
+        json!(100000),
+        json!([0, 1]),
+        json!(5121),
+        json!(5126),
+        json!("VEC3"),
+        json!("SCALAR"),
+        json!("MAT4"),
+        json!({"count": 1}),
+    ];
+    let arrays = ["accessors", "bufferViews", "nodes", "meshes", "scenes", "buffers"];
+    let extra = ["byteStride", "sparse", "children", "matrix", "rotation", "mode", "indices", "byteOffset"];
+    for _ in 0..1 + rng.below(3) {
+        let array = arrays[rng.below(arrays.len())];
+        let len = json[array].as_array().map_or(0, Vec::len);
+        let item = &mut json[array][rng.below(len)];
+        let keys: Vec<String> = item.as_object().map(|o| o.keys().cloned().collect()).unwrap_or_default();
+        let key = match rng.below(3) {
+            0 => extra[rng.below(extra.len())].to_string(),
+            _ if keys.is_empty() => continue,
+            _ => keys[rng.below(keys.len())].clone(),
+        };
+        item[key.as_str()] = hostile[rng.below(hostile.len())].clone();
+    }
+}
+
+/// Random byte flips and hostile JSON values give errors, never panics.
+#[test]
+fn corrupted_files_never_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = std::fs::read(data("ikea/desk_hannes_0529.glb")).unwrap();
+    let json_length = u32::from_le_bytes(original[12..16].try_into().unwrap()) as usize;
+    let json: Value = serde_json::from_slice(&original[20..20 + json_length]).unwrap();
+    let bin = original[20 + json_length + 8..].to_vec();
+    let mut rng = Lcg(12345);
+    let path = dir.path().join("corrupted.glb");
+    for round in 0..600 {
+        let bytes = if round % 2 == 0 {
+            let mut bytes = original.clone();
+            for _ in 0..1 + rng.below(4) {
+                let at = rng.below(bytes.len());
+                bytes[at] = rng.below(256) as u8;
+            }
+            bytes
+        } else {
+            let mut json = json.clone();
+            corrupt_json(&mut json, &mut rng);
+            glb(json.to_string().into_bytes(), bin.clone())
+        };
+        std::fs::write(&path, &bytes).unwrap();
+        if let Err(e) = load(&path, &LoadOptions::default()) {
+            assert_message(&e.to_string(), "corrupted.glb", "");
+        }
+    }
+}
+
+#[test]
+fn sparse_accessors_substitute_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut f = Fixture::default();
+    let base = f.view(TRIANGLE.iter().flatten().flat_map(|c| c.to_le_bytes()).collect());
+    let sparse_indices = f.view([2u8, 0, 0, 0].to_vec());
+    let sparse_values = f.view([5.0f32, 6.0, 7.0].iter().flat_map(|c| c.to_le_bytes()).collect());
+    let sparse = json!({"count": 1, "indices": {"bufferView": sparse_indices, "componentType": 5121},
+                        "values": {"bufferView": sparse_values}});
+    let over_data = f.accessor(json!({"bufferView": base, "componentType": 5126, "count": 3, "type": "VEC3",
+                                      "min": [0, 0, 0], "max": [5, 6, 7], "sparse": sparse}));
+    let over_zeros = f.accessor(json!({"componentType": 5126, "count": 3, "type": "VEC3",
+                                       "min": [0, 0, 0], "max": [5, 6, 7], "sparse": sparse}));
+    for (accessor, first) in [(over_data, TRIANGLE[0]), (over_zeros, [0.0; 3])] {
+        let path = write_gltf(dir.path(), "sparse.gltf", &f, single_mesh(accessor, None));
+        let part = &load(&path, &LoadOptions::default()).unwrap().parts[0];
+        assert_eq!(part.mesh.vertices[0], Vec3::from_array(first));
+        assert_eq!(part.mesh.vertices[2], Vec3::new(5.0, 6.0, 7.0));
+    }
+    let mut bad = sparse.clone();
+    bad["count"] = json!(2);
+    let too_many = f.accessor(json!({"componentType": 5126, "count": 3, "type": "VEC3",
+                                     "min": [0, 0, 0], "max": [5, 6, 7], "sparse": bad}));
+    let path = write_gltf(dir.path(), "sparse.gltf", &f, single_mesh(too_many, None));
+    assert_message(&load_error(&path), "sparse.gltf", "read past the end");
+}
