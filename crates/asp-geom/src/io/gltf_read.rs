@@ -373,8 +373,12 @@ impl<'a> PartBuilder<'a> {
             }
             let (vertices, triangles) =
                 self.read_primitive(&primitive).map_err(|reason| format!("{context}: {reason}"))?;
+            // the running total is checked below, so the previous one fits in u32
             let base = local.vertices.len() as u32;
             local.vertices.extend(vertices);
+            if u32::try_from(local.vertices.len()).is_err() {
+                return Err(format!("{label}: more than 2^32 vertices"));
+            }
             local.triangles.extend(triangles.iter().map(|t| t.map(|i| i + base)));
         }
         if let Some(slot) = self.meshes.get_mut(mesh.index()) {
@@ -386,12 +390,9 @@ impl<'a> PartBuilder<'a> {
     fn read_primitive(&self, primitive: &Primitive) -> Res<(Vec<DVec3>, Vec<[u32; 3]>)> {
         let positions = primitive.get(&Semantic::Positions).ok_or("no position attribute")?;
         let vertices = read_positions(&positions, &self.buffers)?;
-        if u32::try_from(vertices.len()).is_err() {
-            return Err("too many vertices".into());
-        }
         let indices = match primitive.indices() {
             Some(accessor) => read_indices(&accessor, &self.buffers, vertices.len())?,
-            None => (0..vertices.len() as u32).collect(),
+            None => (0..vertices.len()).map(|i| i as u32).collect(),
         };
         Ok((vertices, triangulate(primitive.mode(), &indices)?))
     }
@@ -466,7 +467,7 @@ fn triangulate(mode: Mode, indices: &[u32]) -> Res<Vec<[u32; 3]>> {
 
 /// Largest element count accepted for an accessor that has no buffer view (sparse over zeros):
 /// such counts are not backed by file bytes, so a corrupted count must not exhaust memory.
-const MAX_ZERO_FILLED: usize = 1 << 24;
+const MAX_ZERO_FILLED: usize = 1 << 22;
 
 fn read_positions(accessor: &Accessor, buffers: &[Cow<[u8]>]) -> Res<Vec<DVec3>> {
     if accessor.dimensions() != Dimensions::Vec3 {
