@@ -1,3 +1,5 @@
-//! Integration tests of asp-geom (one binary; modules in subfolders).
+//! The one integration test binary of asp-geom.
 
 mod distmap;
+mod loaders;
+mod removal;

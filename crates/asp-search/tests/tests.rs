@@ -1,8 +1,10 @@
 //! Integration tests of asp-search (one binary; modules in subfolders).
 
+mod conformance;
 mod exact;
 mod fixtures;
 mod hypervolume;
 mod mcts;
 mod objectives;
 mod pareto;
+mod verify;
