@@ -81,7 +81,7 @@ pub struct PlanArgs {
     /// Stability criterion.
     #[arg(long, value_enum, default_value_t = StabilityArg::Contact)]
     pub stability: StabilityArg,
-    /// Seed of every random choice (random order, path planner).
+    /// Seed of every random choice (random order, path planner, optimisation).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Stop after this many removal tests.
@@ -102,6 +102,9 @@ pub struct PlanArgs {
     /// No progress bar, no warnings.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Optimisation (`--objective`): MCTS / Pareto-MCTS on distance maps.
+    #[command(flatten)]
+    pub optimise: crate::optimise::OptimiseArgs,
 }
 
 /// Parses the process arguments (exits with usage on error).

@@ -166,6 +166,78 @@ impl DirMask {
     }
 }
 
+/// A fixed-width set of part indices (up to 256) for the hot loop of [`MapState`]: the same
+/// idea as [`PartSet`], without its heap fallback, so every operation is a few word operations.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Bits([u64; 4]);
+
+impl Bits {
+    const EMPTY: Bits = Bits([0; 4]);
+
+    fn from_set(s: &PartSet) -> Bits {
+        let mut b = Bits::EMPTY;
+        for i in s.iter().filter(|&i| i < 256) {
+            b.insert(i);
+        }
+        b
+    }
+
+    fn to_set(self, n: usize) -> PartSet {
+        PartSet::from_indices(n, self.iter())
+    }
+
+    #[inline]
+    fn insert(&mut self, i: usize) {
+        self.0[i >> 6] |= 1 << (i & 63);
+    }
+
+    #[inline]
+    fn remove(&mut self, i: usize) {
+        self.0[i >> 6] &= !(1 << (i & 63));
+    }
+
+    #[inline]
+    fn contains(&self, i: usize) -> bool {
+        self.0[i >> 6] & (1 << (i & 63)) != 0
+    }
+
+    #[inline]
+    fn is_empty(&self) -> bool {
+        self.0 == [0; 4]
+    }
+
+    #[inline]
+    fn or_with(&mut self, o: &Bits) {
+        for (a, b) in self.0.iter_mut().zip(o.0) {
+            *a |= b;
+        }
+    }
+
+    #[inline]
+    fn and(&self, o: &Bits) -> Bits {
+        Bits([self.0[0] & o.0[0], self.0[1] & o.0[1], self.0[2] & o.0[2], self.0[3] & o.0[3]])
+    }
+
+    #[inline]
+    fn and_not(&self, o: &Bits) -> Bits {
+        Bits([self.0[0] & !o.0[0], self.0[1] & !o.0[1], self.0[2] & !o.0[2], self.0[3] & !o.0[3]])
+    }
+
+    #[inline]
+    fn iter(self) -> impl Iterator<Item = usize> {
+        self.0.into_iter().enumerate().flat_map(|(k, w)| {
+            let mut w = w;
+            std::iter::from_fn(move || {
+                (w != 0).then(|| {
+                    let b = w.trailing_zeros() as usize;
+                    w &= w - 1;
+                    k * 64 + b
+                })
+            })
+        })
+    }
+}
+
 /// The `N_M × N_M` directions sampled on the half sphere around the up axis.
 #[derive(Clone, Debug)]
 pub struct Hemisphere {
@@ -399,6 +471,7 @@ pub struct DistanceMaps {
     n: usize,
     hemisphere: Hemisphere,
     diagonal: f32,
+    contact_distance: f32,
     d_max: f32,
     tolerance: f32,
     stride: usize,
@@ -409,10 +482,16 @@ pub struct DistanceMaps {
     fixed: Vec<bool>,
     aabbs: Vec<Aabb>,
     geometry: Vec<PartGeometry>,
-    /// For part `i`: the parts `j` (never the floor) with a non-empty `blocked(i, j)`.
+    /// For part `i`: the parts `j` (never the floor) with a non-empty `blocked(i, j)`, the
+    /// most-blocking first.
     blockers: Vec<Vec<u16>>,
+    /// For part `i`: the padded rows `M(p_i, p_j)` of its blockers, in `blockers[i]` order,
+    /// contiguous (the hot loop of [`MapState::min_map`] streams through them).
+    blocker_rows: Vec<Vec<f32>>,
+    /// For part `i`: `blocked(i, j)` of its blockers, in `blockers[i]` order.
+    blocker_masks: Vec<Vec<DirMask>>,
     /// For part `k`: the parts `i` that `k` blocks somewhere (`k ∈ blockers[i]`).
-    blocks: Vec<PartSet>,
+    blocks: Vec<Bits>,
     /// For part `i`: the parts directly below it, touching (`M(p_j, p_i)(up) = 0`).
     supporters: Vec<Vec<u16>>,
     /// For part `j`: the parts it supports.
@@ -787,6 +866,7 @@ impl DistanceMaps {
             n,
             hemisphere,
             diagonal: diag,
+            contact_distance,
             d_max,
             tolerance,
             stride,
@@ -796,6 +876,8 @@ impl DistanceMaps {
             aabbs,
             geometry,
             blockers: Vec::new(),
+            blocker_rows: Vec::new(),
+            blocker_masks: Vec::new(),
             blocks: Vec::new(),
             supporters: Vec::new(),
             dependents: Vec::new(),
@@ -814,10 +896,22 @@ impl DistanceMaps {
         let n = self.n;
         let up = self.hemisphere.up_index();
         let support_tol = 2.0 * self.tolerance;
+        // Blockers that block the most directions first, so a part's blocked directions fill
+        // up after few of them (see `MapState::has_free_direction`).
         self.blockers = (0..n)
-            .map(|i| (0..n).filter(|&j| j != i && !self.blocked(i, j).is_empty()).map(|j| j as u16).collect())
+            .map(|i| {
+                let mut b: Vec<u16> =
+                    (0..n).filter(|&j| j != i && !self.blocked(i, j).is_empty()).map(|j| j as u16).collect();
+                b.sort_by_key(|&j| std::cmp::Reverse(self.blocked(i, j as usize).len()));
+                b
+            })
             .collect();
-        self.blocks = vec![PartSet::empty(n); n];
+        self.blocker_rows = (0..n)
+            .map(|i| self.blockers[i].iter().flat_map(|&j| self.padded_row(i, j as usize).to_vec()).collect())
+            .collect();
+        self.blocker_masks =
+            (0..n).map(|i| self.blockers[i].iter().map(|&j| self.blocked(i, j as usize)).collect()).collect();
+        self.blocks = vec![Bits::EMPTY; n];
         for i in 0..n {
             for &j in &self.blockers[i] {
                 self.blocks[j as usize].insert(i);
@@ -863,6 +957,12 @@ impl DistanceMaps {
     /// The diagonal of the assembly's bounding box (metres): its size.
     pub fn diagonal(&self) -> f32 {
         self.diagonal
+    }
+
+    /// The contact distance (metres): parts closer than this touch in the contact graph, and
+    /// the margin the collision world adds to removal travels.
+    pub fn contact_distance(&self) -> f32 {
+        self.contact_distance
     }
 
     /// The cap on distances, metres.
@@ -1022,11 +1122,20 @@ impl DistanceMaps {
     }
 
     fn clearance_in(&self, i: usize, state: &PartSet, free: DirMask) -> Option<(usize, f32)> {
+        self.clearance_among(i, state.iter(), free)
+    }
+
+    fn clearance_among(
+        &self,
+        i: usize,
+        present: impl Iterator<Item = usize>,
+        free: DirMask,
+    ) -> Option<(usize, f32)> {
         if free.is_empty() {
             return None;
         }
         let mut rest: Option<Aabb> = None;
-        for j in state.iter().filter(|&j| j != i && j < self.n) {
+        for j in present.filter(|&j| j != i && j < self.n) {
             let b = &self.aabbs[j];
             rest = Some(match rest {
                 None => *b,
@@ -1130,17 +1239,35 @@ fn cast_distance(moving: &TriMesh, fixed: &TriMesh, dir: Vec3, d_max: f32, erosi
 }
 
 /// A disassembly state over the distance maps, updated incrementally as parts leave: which
-/// parts are present, which are collision-free (monotone: removals only free parts), and the
-/// minimum maps `M̄(p_i, s)`, recomputed lazily for the parts a removal affected.
+/// parts are present, which are collision-free (monotone: removals only free parts), the
+/// minimum maps `M̄(p_i, s)` (recomputed lazily for the parts a removal affected), and for the
+/// [`Support::Below`] rule how many present supports each part has left.
 #[derive(Clone, Debug)]
 pub struct MapState<'m> {
     maps: &'m DistanceMaps,
-    present: PartSet,
-    free: PartSet,
-    unchecked: PartSet,
-    stale: PartSet,
+    all: DirMask,
+    present: Bits,
+    free: Bits,
+    unchecked: Bits,
+    stale: Bits,
     rows: Vec<f32>,
+    /// The free directions of each part, computed with its row (valid when the row is).
+    row_free: Vec<DirMask>,
+    /// For each present part not known to be free: present blockers that together block every
+    /// direction (a witness that it is stuck); it is re-checked only when one of them leaves.
+    covers: Vec<Bits>,
+    /// Present supports of each present part ([`UNCOUNTED`] for fixed parts and parts on the
+    /// floor, which always stand).
+    supports: Vec<u16>,
+    /// For each part: how many present parts rest on it alone.
+    critical: Vec<u16>,
+    /// The parts with `critical > 0` (their removal would drop another part).
+    holding: Bits,
+    /// The fixed parts.
+    fixed: Bits,
 }
+
+const UNCOUNTED: u16 = u16::MAX;
 
 impl<'m> MapState<'m> {
     /// The assembled state (every part present).
@@ -1148,11 +1275,18 @@ impl<'m> MapState<'m> {
         let n = maps.n;
         let mut s = MapState {
             maps,
-            present: PartSet::full(n),
-            free: PartSet::empty(n),
-            unchecked: PartSet::full(n),
-            stale: PartSet::full(n),
+            all: DirMask::first(maps.hemisphere.len()),
+            present: Bits::EMPTY,
+            free: Bits::EMPTY,
+            unchecked: Bits::EMPTY,
+            stale: Bits::EMPTY,
             rows: vec![0.0; n * maps.stride],
+            row_free: vec![DirMask::EMPTY; n],
+            covers: vec![Bits::EMPTY; n],
+            supports: vec![0; n],
+            critical: vec![0; n],
+            holding: Bits::EMPTY,
+            fixed: Bits::from_set(&PartSet::from_indices(n, (0..n).filter(|&i| maps.fixed[i]))),
         };
         s.reset(&PartSet::full(n));
         s
@@ -1160,10 +1294,41 @@ impl<'m> MapState<'m> {
 
     /// Moves to `present` (which must only name parts of the assembly); no allocation.
     pub fn reset(&mut self, present: &PartSet) {
-        self.present.clone_from(present);
-        self.free = PartSet::empty(self.maps.n);
-        self.unchecked.clone_from(present);
-        self.stale.clone_from(present);
+        self.reset_with_free(present, &PartSet::empty(self.maps.n));
+    }
+
+    /// Like [`MapState::reset`], with parts already known to be collision-free in `present` (or
+    /// in a state it came from): they are not re-checked.
+    pub fn reset_with_free(&mut self, present: &PartSet, free: &PartSet) {
+        let p = Bits::from_set(present);
+        self.present = p;
+        self.free = Bits::from_set(free).and(&p);
+        self.unchecked = p;
+        self.stale = p;
+        if self.maps.support == Support::Below {
+            let maps = self.maps;
+            self.critical.fill(0);
+            self.holding = Bits::EMPTY;
+            for i in p.iter() {
+                self.supports[i] = if maps.fixed[i] || maps.on_floor[i] {
+                    UNCOUNTED
+                } else {
+                    let mut count = 0;
+                    let mut last = 0;
+                    for &j in &maps.supporters[i] {
+                        if p.contains(j as usize) {
+                            count += 1;
+                            last = j as usize;
+                        }
+                    }
+                    if count == 1 {
+                        self.critical[last] += 1;
+                        self.holding.insert(last);
+                    }
+                    count
+                };
+            }
+        }
     }
 
     /// The maps.
@@ -1172,8 +1337,13 @@ impl<'m> MapState<'m> {
     }
 
     /// The present parts.
-    pub fn present(&self) -> &PartSet {
-        &self.present
+    pub fn present(&self) -> PartSet {
+        self.present.to_set(self.maps.n)
+    }
+
+    /// Whether part `i` is present.
+    pub fn contains(&self, i: usize) -> bool {
+        i < self.maps.n && self.present.contains(i)
     }
 
     /// Whether no part that can be removed (not fixed) is left.
@@ -1181,38 +1351,91 @@ impl<'m> MapState<'m> {
         self.present.iter().all(|i| self.maps.fixed[i])
     }
 
-    /// Removes part `k`, marking the parts it blocked for re-checking.
+    /// Removes part `k`, marking the parts whose minimum maps it shaped, re-checking the stuck
+    /// parts it helped block, and updating the support counts of the parts resting on it.
     pub fn remove(&mut self, k: usize) {
+        let maps = self.maps;
         self.present.remove(k);
         self.free.remove(k);
         self.unchecked.remove(k);
         self.stale.remove(k);
-        let blocks = &self.maps.blocks[k];
-        self.unchecked.union_with(blocks);
-        self.stale.union_with(blocks);
+        let blocks = &maps.blocks[k];
+        for i in blocks.and_not(&self.free).and(&self.present).iter() {
+            if self.covers[i].contains(k) {
+                self.unchecked.insert(i);
+            }
+        }
+        self.stale.or_with(blocks);
+        if maps.support == Support::Below {
+            if self.supports[k] == 1 {
+                if let Some(j) = self.single_support(k) {
+                    self.critical[j] -= 1;
+                    if self.critical[j] == 0 {
+                        self.holding.remove(j);
+                    }
+                }
+            }
+            for &i in &maps.dependents[k] {
+                let i = i as usize;
+                if !self.present.contains(i) || self.supports[i] == UNCOUNTED {
+                    continue;
+                }
+                self.supports[i] -= 1;
+                if self.supports[i] == 1 {
+                    if let Some(j) = self.single_support(i) {
+                        self.critical[j] += 1;
+                        self.holding.insert(j);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The one present part that `i` rests on, if any.
+    fn single_support(&self, i: usize) -> Option<usize> {
+        self.maps.supporters[i].iter().map(|&j| j as usize).find(|&j| self.present.contains(j))
     }
 
     fn refresh_free(&mut self) {
         if self.unchecked.is_empty() {
             return;
         }
-        let all = DirMask::first(self.maps.hemisphere.len());
-        for i in self.unchecked.iter() {
-            if !self.present.contains(i) || self.free.contains(i) {
-                continue;
-            }
-            if !all.and_not(self.blocked_now(i)).is_empty() {
+        let unchecked = std::mem::replace(&mut self.unchecked, Bits::EMPTY);
+        for i in unchecked.and(&self.present).and_not(&self.free).iter() {
+            if self.check_free(i) {
                 self.free.insert(i);
             }
         }
-        self.unchecked = PartSet::empty(self.maps.n);
+    }
+
+    /// Whether present part `i` has a free direction. When it has none, records the blockers
+    /// that fill every direction (taken most-covering first) as its cover.
+    fn check_free(&mut self, i: usize) -> bool {
+        let maps = self.maps;
+        let mut blocked = DirMask::EMPTY;
+        let mut cover = Bits::EMPTY;
+        for (&j, &b) in maps.blockers[i].iter().zip(&maps.blocker_masks[i]) {
+            let j = j as usize;
+            if self.present.contains(j) {
+                if !b.and_not(blocked).is_empty() {
+                    blocked = blocked.or(b);
+                    cover.insert(j);
+                    if blocked == self.all {
+                        self.covers[i] = cover;
+                        return false;
+                    }
+                }
+            }
+        }
+        true
     }
 
     fn blocked_now(&self, i: usize) -> DirMask {
+        let maps = self.maps;
         let mut blocked = DirMask::EMPTY;
-        for &j in &self.maps.blockers[i] {
+        for (&j, &b) in maps.blockers[i].iter().zip(&maps.blocker_masks[i]) {
             if self.present.contains(j as usize) {
-                blocked = blocked.or(self.maps.blocked(i, j as usize));
+                blocked = blocked.or(b);
             }
         }
         blocked
@@ -1220,7 +1443,11 @@ impl<'m> MapState<'m> {
 
     /// `B^M̄(p_i, s)`: the free directions of present part `i`.
     pub fn free_mask(&self, i: usize) -> DirMask {
-        DirMask::first(self.maps.hemisphere.len()).and_not(self.blocked_now(i))
+        if self.stale.contains(i) {
+            self.all.and_not(self.blocked_now(i))
+        } else {
+            self.row_free[i]
+        }
     }
 
     /// Whether present part `i` can leave without collision (eq. 6.5).
@@ -1230,9 +1457,9 @@ impl<'m> MapState<'m> {
     }
 
     /// The present parts that can leave without collision.
-    pub fn collision_free(&mut self) -> &PartSet {
+    pub fn collision_free(&mut self) -> PartSet {
         self.refresh_free();
-        &self.free
+        self.free.to_set(self.maps.n)
     }
 
     /// `M̄(p_i, s)` (eq. 6.4) of present part `i`, `N_M²` values.
@@ -1244,46 +1471,56 @@ impl<'m> MapState<'m> {
             let row = &mut self.rows[i * stride..(i + 1) * stride];
             row[..dcount].fill(maps.d_max);
             row[dcount..].fill(0.0);
-            for &j in &maps.blockers[i] {
+            let mut blocked = DirMask::EMPTY;
+            let rows = maps.blocker_rows[i].chunks_exact(stride);
+            for ((&j, other), mask) in maps.blockers[i].iter().zip(rows).zip(&maps.blocker_masks[i]) {
                 if self.present.contains(j as usize) {
-                    let other = maps.padded_row(i, j as usize);
-                    for (a, b) in row.chunks_exact_mut(8).zip(other.chunks_exact(8)) {
-                        for k in 0..8 {
-                            a[k] = a[k].min(b[k]);
-                        }
+                    for (a, b) in row.iter_mut().zip(other) {
+                        // a select, which vectorises to a packed minimum
+                        *a = if *b < *a { *b } else { *a };
                     }
+                    blocked = blocked.or(*mask);
                 }
             }
+            self.row_free[i] = self.all.and_not(blocked);
             self.stale.remove(i);
         }
         &self.rows[i * stride..i * stride + dcount]
     }
 
-    /// Whether removing `a` leaves a standing state (the gravity check). With
-    /// [`Support::Below`] it assumes the current state stands and re-checks only the parts `a`
-    /// supported; with [`Support::ContactGraph`] it walks the contact graph.
-    pub fn removal_keeps_stable(&self, a: usize) -> bool {
-        let maps = self.maps;
-        if maps.support == Support::ContactGraph {
-            let mut alive = self.present.clone();
-            alive.remove(a);
-            let reached = maps.linked(&alive);
-            return alive.iter().all(|i| reached.contains(i));
+    /// `Σ_{k,l} M̄_{k,l}(p_i, s)` of present part `i` (the accessibility reward, eq. 6.15),
+    /// summed in eight interleaved lanes.
+    pub fn min_map_sum(&mut self, i: usize) -> f64 {
+        self.min_map(i);
+        let stride = self.maps.stride;
+        let row = &self.rows[i * stride..(i + 1) * stride];
+        let mut lanes = [0.0f64; 8];
+        for chunk in row.chunks_exact(8) {
+            for (l, v) in lanes.iter_mut().zip(chunk) {
+                *l += *v as f64;
+            }
         }
-        maps.dependents[a].iter().all(|&i| {
-            let i = i as usize;
-            !self.present.contains(i)
-                || maps.fixed[i]
-                || maps.on_floor[i]
-                || maps.supporters[i]
-                    .iter()
-                    .any(|&j| j as usize != a && self.present.contains(j as usize))
-        })
+        lanes.iter().sum()
+    }
+
+    /// Whether removing `a` leaves a standing state (the gravity check). With
+    /// [`Support::Below`] it assumes the current state stands: no present part may rest on `a`
+    /// alone; with [`Support::ContactGraph`] it walks the contact graph.
+    pub fn removal_keeps_stable(&self, a: usize) -> bool {
+        match self.maps.support {
+            Support::Below => self.critical[a] == 0,
+            Support::ContactGraph => {
+                let mut alive = self.present;
+                alive.remove(a);
+                let reached = self.maps.linked(&alive.to_set(self.maps.n));
+                alive.iter().all(|i| reached.contains(i))
+            }
+        }
     }
 
     /// Whether every present part stands (by the maps' [`Support`] rule).
     pub fn is_stable(&self) -> bool {
-        self.maps.stability(&self.present) == Stability::Stable
+        self.maps.stability(&self.present()) == Stability::Stable
     }
 
     /// The feasible removals: present, not fixed, collision-free, and leaving a stable state.
@@ -1291,9 +1528,11 @@ impl<'m> MapState<'m> {
     pub fn feasible_actions(&mut self, out: &mut Vec<usize>) {
         out.clear();
         self.refresh_free();
-        for a in self.free.iter() {
-            if !self.maps.fixed[a] && self.removal_keeps_stable(a) {
-                out.push(a);
+        let candidates = self.free.and_not(&self.fixed);
+        match self.maps.support {
+            Support::Below => out.extend(candidates.and_not(&self.holding).iter()),
+            Support::ContactGraph => {
+                out.extend(candidates.iter().filter(|&a| self.removal_keeps_stable(a)))
             }
         }
     }
@@ -1301,7 +1540,7 @@ impl<'m> MapState<'m> {
     /// The removal motion of present part `i` (see [`DistanceMaps::clearance`]) as a direction
     /// index and a travel, or `None` when it is blocked.
     pub fn clearance(&self, i: usize) -> Option<(usize, f32)> {
-        self.maps.clearance_in(i, &self.present, self.free_mask(i))
+        self.maps.clearance_among(i, self.present.iter(), self.free_mask(i))
     }
 }
 
@@ -1507,7 +1746,7 @@ mod tests {
         s.remove(2);
         let after: f32 = s.min_map(1).iter().sum();
         assert!(after > before);
-        let direct = maps.min_map(1, s.present());
+        let direct = maps.min_map(1, &s.present());
         assert_eq!(s.min_map(1), direct.as_slice());
         s.feasible_actions(&mut acts);
         assert_eq!(acts, vec![1]);

@@ -95,7 +95,7 @@ impl Mdp {
         let mut motions = Vec::with_capacity(sequence.len());
         let mut actions = Vec::new();
         for (t, &p) in sequence.iter().enumerate() {
-            if p >= n || !state.present().contains(p) {
+            if p >= n || !state.contains(p) {
                 return Err(SearchError::Infeasible {
                     reason: format!("step {t}: part {p} is not present"),
                 });

@@ -52,7 +52,7 @@ impl Objective for Accessibility {
     }
 
     fn reward(&self, part: usize, state: &mut MapState<'_>, _memory: &mut Memory) -> f64 {
-        state.min_map(part).iter().map(|&v| v as f64).sum()
+        state.min_map_sum(part)
     }
 
     fn worst_total(&self, _maps: &DistanceMaps, _removals: usize) -> f64 {

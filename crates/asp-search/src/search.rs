@@ -322,6 +322,8 @@ pub(crate) struct Node {
     pub action: u16,
     pub status: Status,
     pub present: PartSet,
+    /// Parts known to be collision-free here (they stay so in every descendant).
+    pub free: PartSet,
     pub untried: PartSet,
 }
 
@@ -484,6 +486,7 @@ impl<'p, V: Variant> Worker<'p, V> {
                 Status::Open
             },
             present: full,
+            free: sim.collision_free(),
             untried: PartSet::from_indices(n, actions.iter().copied()),
         };
         let tree = Tree {
@@ -596,7 +599,8 @@ impl<'p, V: Variant> Worker<'p, V> {
 
         // Expansion: a random untried removal.
         let parent = node;
-        self.sim.reset(&self.tree.nodes[parent as usize].present);
+        let pn = &self.tree.nodes[parent as usize];
+        self.sim.reset_with_free(&pn.present, &pn.free);
         let mut memories = [Memory::default(); MAX_OBJECTIVES];
         memories[..m].copy_from_slice(self.tree.memory(parent));
         let mut ret = [0.0f64; MAX_OBJECTIVES];
@@ -629,7 +633,8 @@ impl<'p, V: Variant> Worker<'p, V> {
                 visits: 0,
                 action: action as u16,
                 status,
-                present: self.sim.present().clone(),
+                present: self.sim.present(),
+                free: self.sim.collision_free(),
                 untried: PartSet::from_indices(self.n, self.actions.iter().copied()),
             });
             self.tree.nodes[parent as usize].first_child = id;

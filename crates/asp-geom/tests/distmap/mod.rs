@@ -203,7 +203,7 @@ fn incremental_state_matches_direct_definitions() {
     loop {
         state.feasible_actions(&mut actions);
         // the feasible actions match the definitions on the plain maps
-        let present = state.present().clone();
+        let present = state.present();
         let direct: Vec<usize> = present
             .iter()
             .filter(|&p| maps.is_collision_free(p, &present))
