@@ -94,10 +94,10 @@ pub struct PlanArgs {
     #[arg(long)]
     pub no_path_planner: bool,
     /// Path planner iterations per call.
-    #[arg(long, default_value_t = 3000)]
+    #[arg(long, default_value_t = 1000)]
     pub rrt_iterations: usize,
     /// Path planner wall-time cap per call, seconds.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 0.25)]
     pub rrt_time: f64,
     /// No progress bar, no warnings.
     #[arg(long, short)]

@@ -17,9 +17,9 @@ use std::time::{Duration, Instant};
 /// Budget and resolution of the path planner.
 #[derive(Clone, Debug)]
 pub struct RrtConfig {
-    /// Iterations (sample + extend + connect) before giving up. Default 3000.
+    /// Iterations (sample + extend + connect) before giving up. Default 1000.
     pub max_iterations: usize,
-    /// Wall-time cap per call. Default 2 s.
+    /// Wall-time cap per call. Default 0.25 s.
     pub max_time: Duration,
     /// Longest tree edge as a fraction of the model's diagonal. Default 0.05.
     pub step_fraction: f32,
@@ -30,8 +30,8 @@ pub struct RrtConfig {
 impl Default for RrtConfig {
     fn default() -> Self {
         RrtConfig {
-            max_iterations: 3000,
-            max_time: Duration::from_secs(2),
+            max_iterations: 1000,
+            max_time: Duration::from_millis(250),
             step_fraction: 0.05,
             rotate: true,
         }
