@@ -66,6 +66,10 @@ pub struct PlanArgs {
     /// Parts closer than this (model units) are in contact for stability [default: 1e-3 × diagonal].
     #[arg(long)]
     pub contact_distance: Option<f64>,
+    /// Ignore collisions between parts that overlap in the input far beyond the tolerance
+    /// (warned) instead of stopping with an error.
+    #[arg(long)]
+    pub ignore_overlapping: bool,
     /// Clustered surface-normal directions tried besides the six axes (each with its opposite).
     #[arg(long, default_value_t = 10)]
     pub normals: usize,
@@ -94,10 +98,11 @@ pub struct PlanArgs {
     #[arg(long)]
     pub no_path_planner: bool,
     /// Path planner iterations per call.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, default_value_t = 2000)]
     pub rrt_iterations: usize,
-    /// Path planner wall-time cap per call, seconds.
-    #[arg(long, default_value_t = 0.25)]
+    /// Path planner wall-time safety cap per call, seconds (the iteration budget keeps runs
+    /// reproducible; this only guards against pathological models).
+    #[arg(long, default_value_t = 5.0)]
     pub rrt_time: f64,
     /// No progress bar, no warnings.
     #[arg(long, short)]

@@ -41,6 +41,7 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
         contact_distance: to_m("contact-distance", args.contact_distance)?,
         normal_clusters: args.normals,
         sphere_directions: args.sphere_directions,
+        ignore_overlapping: args.ignore_overlapping,
         ..WorldConfig::default()
     };
     let world = World::new(assembly, &config)?;

@@ -94,10 +94,14 @@ impl Geom {
             .unwrap_or_else(|_| (*self.mesh).clone())
     }
 
-    /// Whether this part shrunk by `amount` still touches `other` (surfaces crossing).
+    /// Whether this part shrunk by `amount` still overlaps `other`: surfaces crossing, or one
+    /// wholly inside the other.
     fn eroded_hits(&self, amount: f32, other: &Geom) -> bool {
         let id = Pose::IDENTITY;
-        query::intersection_test(&id, &self.erode(amount), &id, &*other.mesh).map_or(true, |r| r.intersecting)
+        let shrunk = self.erode(amount);
+        query::intersection_test(&id, &shrunk, &id, &*other.mesh).map_or(true, |r| r.intersecting)
+            || (other.closed && nests(&self.aabb, &other.aabb) && contains_point(&other.mesh, shrunk.vertices()[0]))
+            || (self.closed && nests(&other.aabb, &self.aabb) && contains_point(&shrunk, other.mesh.vertices()[0]))
     }
 }
 
@@ -197,14 +201,12 @@ impl World {
             .map(|&(i, j)| {
                 let (a, b) = (&*self.geoms[i].mesh, &*self.geoms[j].mesh);
                 let id = Pose::IDENTITY;
-                let touching = !matches!(
-                    query::closest_points(&id, a, &id, b, self.contact_distance),
-                    Ok(ClosestPoints::Disjoint)
-                );
-                if !touching {
-                    return (i, j, false, Some(0.0), Some(0.0));
-                }
-                (i, j, true, self.extra_erosion(i, j, limit_of(i)), self.extra_erosion(j, i, limit_of(j)))
+                // parry's mesh-mesh closest points can miss an overlap: measure every candidate
+                let (e_ij, e_ji) = (self.extra_erosion(i, j, limit_of(i)), self.extra_erosion(j, i, limit_of(j)));
+                let overlapping = e_ij != Some(0.0) || e_ji != Some(0.0);
+                let touching = overlapping
+                    || !matches!(query::closest_points(&id, a, &id, b, self.contact_distance), Ok(ClosestPoints::Disjoint));
+                (i, j, touching, e_ij, e_ji)
             })
             .collect();
         self.contacts = vec![PartSet::empty(count); count];
@@ -225,7 +227,11 @@ impl World {
                 (None, None) => None,
             };
             match eroder {
-                Some((_, extra)) if extra == 0.0 => {}
+                _ if e_ij == Some(0.0) && e_ji == Some(0.0) => {}
+                Some((k, extra)) if extra == 0.0 => {
+                    // only the other part, shrunk by the tolerance, still crosses: shrink this one
+                    self.overlaps.insert((i, j), (k, 0.0));
+                }
                 Some((k, extra)) => {
                     self.warnings.push(format!(
                         "parts '{a}' and '{b}' overlap by about {} in the input (tolerance {}); their mutual tests shrink '{}' by that much",
@@ -443,44 +449,51 @@ impl World {
     }
 
     /// How far `p` must travel along `dir` for its bounds to clear the bounds of the other
-    /// present real parts (plus the contact distance); at least that margin.
+    /// present real parts, plus the contact distance. With no other part left, it clears its own
+    /// starting bounds (so the last part is lifted by its size, not by nothing).
     pub fn clearance(&self, p: usize, state: &PartSet, dir: Vec3) -> f32 {
+        let a = &self.geoms[p].aabb;
         let others = aabb_of(
             state
                 .iter()
                 .filter(|&q| q != p && q < self.num_parts())
                 .flat_map(|q| [self.geoms[q].aabb.mins, self.geoms[q].aabb.maxs]),
-        );
-        let a = &self.geoms[p].aabb;
-        let t = match others {
-            None => 0.0,
-            Some(u) => (0..3)
-                .filter(|&i| dir[i].abs() > 1e-6)
-                .map(|i| {
-                    if dir[i] > 0.0 {
-                        (u.maxs[i] - a.mins[i]) / dir[i]
-                    } else {
-                        (a.maxs[i] - u.mins[i]) / -dir[i]
-                    }
-                })
-                .fold(f32::INFINITY, f32::min)
-                .max(0.0),
-        };
+        )
+        .unwrap_or(*a);
+        let t = (0..3)
+            .filter(|&i| dir[i].abs() > 1e-6)
+            .map(|i| {
+                if dir[i] > 0.0 {
+                    (others.maxs[i] - a.mins[i]) / dir[i]
+                } else {
+                    (a.maxs[i] - others.mins[i]) / -dir[i]
+                }
+            })
+            .fold(f32::INFINITY, f32::min)
+            .max(0.0);
         t + self.contact_distance
     }
 
     /// The straight-line removal test of `p` in `state`: the free direction with the shortest
-    /// travel, or the union of all blockers when every direction is blocked.
+    /// travel (ties go to the direction closest to up), or the union of all blockers when every
+    /// direction is blocked.
     pub fn linear_removal(&self, p: usize, state: &PartSet) -> std::result::Result<Motion, PartSet> {
         let present = self.with_fixed(state);
         let row = self.blocking_row(p);
+        let up = self.assembly.up.vector();
         let mut best: Option<(f32, Vec3)> = None;
         let mut blockers = PartSet::empty(self.geoms.len());
         for (k, dir) in self.directions.iter().enumerate() {
             let b = row[k].intersection(&present);
             if b.is_empty() {
                 let d = self.clearance(p, state, *dir);
-                if best.is_none_or(|(bd, _)| d < bd) {
+                let better = match best {
+                    None => true,
+                    Some((bd, bdir)) => {
+                        d < bd - 1e-6 * bd.max(1e-9) || (d <= bd + 1e-6 * bd && dir.dot(up) > bdir.dot(up) + 1e-6)
+                    }
+                };
+                if better {
                     best = Some((d, *dir));
                 }
             } else {
@@ -567,14 +580,32 @@ impl World {
             if !(0..3).all(|k| bb.mins[k] < qb.maxs[k] && qb.mins[k] < bb.maxs[k]) {
                 return false;
             }
-            let (moving, fixed) = self.pair_shapes(p, q);
-            let fixed = &*fixed;
-            query::intersection_test(pose, &*moving, &id, fixed).map_or(true, |r| r.intersecting)
-                || contains_point(fixed, pose.transform_point(moving.vertices()[0]))
-                || contains_point(&moving, pose.inverse_transform_point(fixed.vertices()[0]))
+            let (k, amount) = self.pair_erosion(p, q);
+            let shrunk = self.eroded(k, amount);
+            // parry's mesh-mesh intersection test depends on argument order: always ask with the
+            // shrunk part first
+            let (shrunk_pose, raw, raw_pose, raw_closed) = if k == p {
+                (*pose, &self.geoms[q].mesh, id, self.geoms[q].closed)
+            } else {
+                (id, &self.geoms[p].mesh, *pose, self.geoms[p].closed)
+            };
+            let (bs, br) = (shrunk.aabb(&shrunk_pose), raw.aabb(&raw_pose));
+            // one wholly inside the other: only for closed surfaces whose boxes nest
+            query::intersection_test(&shrunk_pose, &*shrunk, &raw_pose, &**raw).map_or(true, |r| r.intersecting)
+                || (raw_closed
+                    && nests(&bs, &br)
+                    && contains_point(raw, raw_pose.inverse_transform_point(shrunk_pose.transform_point(shrunk.vertices()[0]))))
+                || (self.geoms[k].closed
+                    && nests(&br, &bs)
+                    && contains_point(&shrunk, shrunk_pose.inverse_transform_point(raw_pose.transform_point(raw.vertices()[0]))))
         });
         hit
     }
+}
+
+/// Whether box `a` lies within box `b`.
+fn nests(a: &Aabb, b: &Aabb) -> bool {
+    (0..3).all(|i| a.mins[i] >= b.mins[i] && a.maxs[i] <= b.maxs[i])
 }
 
 /// Whether `point` is inside the closed mesh.
