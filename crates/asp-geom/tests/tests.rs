@@ -1,3 +1,4 @@
 //! Integration tests of asp-geom.
 
+mod physics;
 mod removal;
