@@ -2,9 +2,11 @@
 //! under gravity with rapier3d for a short while, stay where they are.
 //!
 //! The fixed parts (and the world's virtual ground) are static; every other present part is a
-//! dynamic rigid body of density 1 whose collider is a convex decomposition of its collision
-//! mesh. After the simulated time, a part whose centre of mass moved — or which turned by an
-//! angle that moves its farthest point — more than a threshold is reported as floating.
+//! dynamic rigid body of density 1. A moving part's collider is its convex hull when it is
+//! convex, else a convex decomposition (V-HACD) of its collision mesh; a fixed part keeps its
+//! exact triangle mesh (static colliders need not be solid, and a mesh has no filled holes); the
+//! ground is a box. After the simulated time, a part whose centre of mass moved — or which turned
+//! by an angle that moves its farthest point — more than a threshold is reported as floating.
 //!
 //! Two facts of real CAD data shape the simulation:
 //! - **Parts rest exactly on each other** (face on face, distance 0). Rapier's speculative
@@ -19,10 +21,19 @@
 //!     them apart violently or let a pressed pin slide out of its hole.
 //!   - *Approximation overlaps* — convex pieces are a little larger than the mesh they
 //!     approximate, so neighbours that only touch may start interpenetrating. Before the first
-//!     step asp runs collision detection once, records the initial depth of every such pair, and
-//!     shifts that pair's contacts by it for the whole simulation (a contact-modification hook):
-//!     the assembled pose is the pair's rest configuration, exactly as the removal test shrinks a
-//!     pair by its input overlap. Nothing is pushed apart, and support is kept.
+//!     step asp runs collision detection once (a step of zero length), records the initial depth
+//!     of every such pair of convex pieces, and shifts that pair's contacts by it for the whole
+//!     simulation (a contact-modification hook): the assembled pose is the pair's rest
+//!     configuration, as the removal test shrinks a pair by its input overlap. Nothing is pushed
+//!     apart, and support is kept. This works for shallow overlaps, where the contact normal is
+//!     still the true one; a piece that swallows a neighbour deeply (the hull of a U around the
+//!     part in its notch) gives a meaningless normal — hence the decomposition.
+//!
+//! One fact of parry shapes it too: a convex part touching a triangle's edge face-on-face may get
+//! a false contact metres deep; such contacts with fixed meshes are dropped (see `ContactHook`).
+//!
+//! Fasteners are not modelled: a shelf held only by side contacts with the panels (its dowels or
+//! pins missing from the model) falls, where the contact graph calls it supported.
 //!
 //! The rapier world is built per call (so [`PhysicsStability`] is `Send + Sync` and can be used
 //! from rayon); only the collider shapes are cached. Rapier is deterministic single-threaded, and
@@ -33,7 +44,7 @@ use crate::feasibility::Stability;
 use crate::math::{Pose, Vec3};
 use crate::partset::PartSet;
 use crate::world::World;
-use parry3d::shape::TriMesh;
+use parry3d::shape::{TriMesh, TriMeshFlags};
 use parry3d::transformation::vhacd::{VHACDParameters, VHACD};
 use rapier3d::prelude::{
     ActiveHooks, ColliderBuilder, ContactModificationContext, PhysicsHooks, PhysicsWorld,
@@ -59,13 +70,15 @@ pub struct PhysicsConfig {
     /// time and a part tipping over an edge turns by radians, far beyond any threshold, while
     /// 120 steps stay cheap.
     pub simulated_time: f32,
-    /// The integration step, in seconds. Default 1/120 s: half rapier's default, so that contacts
-    /// between small parts settle without jitter.
+    /// The integration step, in seconds. Default 1/120 s, half rapier's 1/60 s: a part travels
+    /// half as far into its contacts per step, which matters for parts a few millimetres thick.
     pub time_step: f32,
     /// A part is unstable when it moved more than this fraction of the model's diagonal (its
-    /// centre of mass, or its farthest point through rotation). Default 0.01: a resting part
-    /// sinks into soft contacts by orders of magnitude less, a falling or tipping part moves
-    /// that far within a few hundredths of a second.
+    /// centre of mass, or its farthest point through rotation). Default 0.01. Resting parts
+    /// settle by 1e-5 to 1e-4 of the diagonal on the fixtures; an IKEA chair whose rear legs
+    /// end 4 mm above its front legs rocks back onto them and moves 0.007 of its diagonal, still
+    /// stable. A part falling onto something less than 1% of the diagonal below goes unnoticed;
+    /// a free fall covers 1% of a 1 m model in 0.045 s, and a tipping part soon after.
     pub displacement_fraction: f32,
     /// Coulomb friction coefficient of every contact. Default 0.5, rapier's default and a
     /// middle value for dry contacts of wood, plastic and steel.
@@ -76,9 +89,11 @@ pub struct PhysicsConfig {
     /// Whether non-convex parts are decomposed into convex pieces (V-HACD); otherwise each part
     /// is simulated as its convex hull (faster, but a hull fills holes and notches). Default true.
     pub convex_decomposition: bool,
-    /// Voxel resolution of the convex decomposition. Default 32: coarse enough to decompose a
-    /// part in milliseconds, fine enough for notches and holes of a few percent of its size
-    /// (the pieces are hulls of the mesh's own triangles, not of voxels).
+    /// Voxel resolution of the convex decomposition. Default 32: a part decomposes in tens of
+    /// milliseconds (64 costs about 4 times as much and was not more faithful on the fixtures).
+    /// The pieces are hulls of the mesh's own triangles. V-HACD may still bridge a hole or notch
+    /// with one piece; neighbours that start inside such a piece are handled as approximation
+    /// overlaps (see the module documentation).
     pub decomposition_resolution: u32,
 }
 
@@ -213,7 +228,7 @@ impl PhysicsStability {
         let floating = self
             .displacements(world, state)
             .into_iter()
-            .filter(|&(_, d)| !(d <= self.threshold))
+            .filter(|&(_, d)| d.is_nan() || d > self.threshold)
             .map(|(i, _)| i);
         let floating = PartSet::from_indices(self.shapes.len(), floating);
         if floating.is_empty() {
@@ -273,20 +288,25 @@ impl PhysicsStability {
         // depth; a step of zero length only detects the contacts (`detect_collisions` would
         // leave the new bodies out of the next steps' active set)
         sim.step();
-        let mut offsets = ContactOffsets::default();
+        let meshes = parts.iter().filter(|&&i| has_triangle_mesh(world, i)).map(|&i| i as u128);
+        let mut hook = ContactHook {
+            meshes: meshes.collect(),
+            max_depth: 2.0 * self.threshold,
+            ..ContactHook::default()
+        };
         for pair in sim.narrow_phase.contact_pairs() {
             let part = |h| sim.colliders.get(h).map_or(0, |c| c.user_data);
             let (a, b) = (part(pair.collider1), part(pair.collider2));
             for m in pair.manifolds() {
                 let deepest = m.points.iter().map(|p| p.dist).fold(0.0, f32::min);
                 if deepest < 0.0 {
-                    offsets.insert((a, m.subshape1), (b, m.subshape2), -deepest);
+                    hook.insert((a, m.subshape1), (b, m.subshape2), -deepest);
                 }
             }
         }
         for &h in &colliders {
             if let Some(c) = sim.colliders.get_mut(h) {
-                if offsets.parts.contains(&c.user_data) {
+                if hook.meshes.contains(&c.user_data) || hook.shifted.contains(&c.user_data) {
                     c.set_active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS);
                 }
             }
@@ -295,8 +315,7 @@ impl PhysicsStability {
         sim.integration_parameters.dt = self.config.time_step;
         let steps = (self.config.simulated_time / self.config.time_step).ceil() as usize;
         for _ in 0..steps {
-            sim.step_with_events(&offsets, &());
-
+            sim.step_with_events(&hook, &());
             if bodies.values().all(|&h| sim.bodies.get(h).is_none_or(|b| b.is_sleeping())) {
                 break;
             }
@@ -334,44 +353,68 @@ fn bonded_groups(world: &World, parts: &[usize]) -> BTreeMap<usize, usize> {
     parts.iter().map(|&i| (i, find(&root, i))).collect()
 }
 
-/// Initial interpenetration depths of sub-shape pairs — (part, sub-shape) on each side, the
-/// smaller first — by which their contacts are shifted for the whole simulation. Per sub-shape
-/// pair, not per part pair: a convex piece swelling into a neighbour must not let the pair's
-/// other contacts (say, the face the neighbour rests on) sink by as much.
+/// The contact-modification hook.
+///
+/// `depth`: initial interpenetration depths of sub-shape pairs — (part, sub-shape) on each side,
+/// the smaller first — by which their contacts are shifted for the whole simulation. Per
+/// sub-shape pair, not per part pair: a convex piece swelling into a neighbour must not let the
+/// pair's other contacts (say, the face the neighbour rests on) sink by as much.
+///
+/// Contacts with a triangle mesh (a fixed part) still deeper than `max_depth` (twice the
+/// displacement threshold) after the shift are dropped. parry's triangle-versus-polyhedron
+/// manifolds report metres of false penetration where a part touches a triangle's edge
+/// face-on-face (a shaft in its hole, a cap under a tube; measured on the tube fixture: 2.4 m),
+/// and obeying one flings the part. A true contact that deep means one of the two parts already
+/// moved more than the threshold, so dropping it cannot turn an unstable state stable.
 #[derive(Default)]
-struct ContactOffsets {
-    depth: BTreeMap<((u128, u32), (u128, u32)), f32>,
-    parts: BTreeSet<u128>,
+struct ContactHook {
+    depth: BTreeMap<(SubShape, SubShape), f32>,
+    /// Parts with shifted sub-shape pairs.
+    shifted: BTreeSet<u128>,
+    /// Parts whose collider is a triangle mesh.
+    meshes: BTreeSet<u128>,
+    max_depth: f32,
 }
 
-impl ContactOffsets {
-    fn key(a: (u128, u32), b: (u128, u32)) -> ((u128, u32), (u128, u32)) {
+/// A convex piece of a collider: (part index as the collider's user data, sub-shape index).
+type SubShape = (u128, u32);
+
+impl ContactHook {
+    fn key(a: SubShape, b: SubShape) -> (SubShape, SubShape) {
         (a.min(b), a.max(b))
     }
 
-    fn insert(&mut self, a: (u128, u32), b: (u128, u32), depth: f32) {
+    fn insert(&mut self, a: SubShape, b: SubShape, depth: f32) {
         let d = self.depth.entry(Self::key(a, b)).or_insert(0.0);
         *d = d.max(depth);
-        self.parts.extend([a.0, b.0]);
+        self.shifted.extend([a.0, b.0]);
     }
 }
 
-impl PhysicsHooks for ContactOffsets {
+impl PhysicsHooks for ContactHook {
     fn modify_solver_contacts(&self, context: &mut ContactModificationContext) {
         let part = |h| context.colliders.get(h).map_or(0, |c| c.user_data);
         let (a, b) = (part(context.collider1), part(context.collider2));
         if let Some(rigid) = context.rigid_mut() {
             let (s1, s2) = (rigid.manifold.subshape1, rigid.manifold.subshape2);
-            let Some(&depth) = self.depth.get(&Self::key((a, s1), (b, s2))) else { return };
+            let depth = self.depth.get(&Self::key((a, s1), (b, s2))).copied().unwrap_or(0.0);
             for contact in rigid.solver_contacts.iter_mut() {
                 contact.dist += depth;
+            }
+            if self.meshes.contains(&a) || self.meshes.contains(&b) {
+                rigid.solver_contacts.retain(|c| c.dist >= -self.max_depth);
             }
         }
     }
 }
 
-/// The collider of part `i` (ground included): a box for the ground, the exact triangle mesh
-/// for fixed parts (static), a convex decomposition for the others.
+/// Whether part `i`'s collider is a triangle mesh: a fixed part other than the ground.
+fn has_triangle_mesh(world: &World, i: usize) -> bool {
+    world.fixed().contains(i) && world.ground() != Some(i)
+}
+
+/// The collider of part `i` (ground included): a box for the ground, the exact triangle mesh for
+/// fixed parts (static, so it need not be solid: no filled holes), convex pieces for the others.
 fn part_shape(world: &World, i: usize, config: &PhysicsConfig) -> Option<PartShape> {
     let aabb = world.aabb(i);
     let centre = (aabb.mins + aabb.maxs) * 0.5;
@@ -385,12 +428,10 @@ fn part_shape(world: &World, i: usize, config: &PhysicsConfig) -> Option<PartSha
         });
     }
     let mesh = world.mesh(i);
-    let shape = if world.fixed().contains(i) {
-        // as the world builds it: oriented, without rapier's internal-edge fixing (which made
-        // parts resting across the coplanar triangles of voxel-like meshes slide)
-        SharedShape::new(mesh.clone())
+    let shape = if has_triangle_mesh(world, i) {
+        static_mesh(mesh)
     } else {
-        dynamic_shape(mesh, world.is_closed(i), config)
+        convex_shape(mesh, world.is_closed(i), config)
             .unwrap_or_else(|| thin_box(aabb, world.assembly().diagonal()))
     };
     let com = shape.mass_properties(1.0).local_com;
@@ -399,10 +440,18 @@ fn part_shape(world: &World, i: usize, config: &PhysicsConfig) -> Option<PartSha
     Some(PartShape { shape, pose: Pose::IDENTITY, com, radius })
 }
 
-/// A moving part's collider: its convex hull when the part is (nearly) convex or decomposition
-/// is off, else a V-HACD decomposition (pieces are hulls of the mesh's own triangles), falling
-/// back to the hull when the decomposition yields nothing. `None` for a flat part.
-fn dynamic_shape(mesh: &TriMesh, closed: bool, config: &PhysicsConfig) -> Option<SharedShape> {
+/// A fixed part's triangle mesh, plain: rapier's internal-edge fixing made parts resting across
+/// the coplanar triangles of voxel-like meshes slide.
+fn static_mesh(mesh: &TriMesh) -> SharedShape {
+    let flags = TriMeshFlags::ORIENTED;
+    SharedShape::trimesh_with_flags(mesh.vertices().to_vec(), mesh.indices().to_vec(), flags)
+        .unwrap_or_else(|_| SharedShape::new(mesh.clone()))
+}
+
+/// A part's collider: its convex hull when the part is (nearly) convex or decomposition is off,
+/// else a V-HACD decomposition (pieces are hulls of the mesh's own triangles), falling back to
+/// the hull when the decomposition yields nothing. `None` for a flat part.
+fn convex_shape(mesh: &TriMesh, closed: bool, config: &PhysicsConfig) -> Option<SharedShape> {
     let hull = SharedShape::convex_hull(mesh.vertices());
     let hull_volume = hull.as_ref().map_or(0.0, |h| h.mass_properties(1.0).mass());
     let convex = closed && mesh_volume(mesh) >= CONVEX_VOLUME_RATIO * hull_volume;
