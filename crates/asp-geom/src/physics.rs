@@ -44,7 +44,7 @@ use crate::feasibility::Stability;
 use crate::math::{Pose, Vec3};
 use crate::partset::PartSet;
 use crate::world::World;
-use parry3d::shape::{TriMesh, TriMeshFlags};
+use parry3d::shape::TriMesh;
 use parry3d::transformation::vhacd::{VHACDParameters, VHACD};
 use rapier3d::prelude::{
     ActiveHooks, ColliderBuilder, ContactModificationContext, PhysicsHooks, PhysicsWorld,
@@ -86,11 +86,12 @@ pub struct PhysicsConfig {
     /// Constraint-solver iterations per step. Default 8, what rapier recommends for stacks of
     /// objects (its own default is 4).
     pub solver_iterations: usize,
-    /// Whether non-convex parts are decomposed into convex pieces (V-HACD); otherwise each part
+    /// Whether non-convex moving parts are decomposed into convex pieces (V-HACD); otherwise each
     /// is simulated as its convex hull (faster, but a hull fills holes and notches). Default true.
     pub convex_decomposition: bool,
     /// Voxel resolution of the convex decomposition. Default 32: a part decomposes in tens of
-    /// milliseconds (64 costs about 4 times as much and was not more faithful on the fixtures).
+    /// milliseconds (64 took 4 to 10 times as long on the fixtures' voxel parts and still let a
+    /// piece bridge the tube's bore).
     /// The pieces are hulls of the mesh's own triangles. V-HACD may still bridge a hole or notch
     /// with one piece; neighbours that start inside such a piece are handled as approximation
     /// overlaps (see the module documentation).
@@ -440,12 +441,11 @@ fn part_shape(world: &World, i: usize, config: &PhysicsConfig) -> Option<PartSha
     Some(PartShape { shape, pose: Pose::IDENTITY, com, radius })
 }
 
-/// A fixed part's triangle mesh, plain: rapier's internal-edge fixing made parts resting across
-/// the coplanar triangles of voxel-like meshes slide.
+/// A fixed part's triangle mesh as the world built it (oriented), without rapier's
+/// internal-edge fixing: that made parts resting across the coplanar triangles of voxel-like
+/// meshes slide.
 fn static_mesh(mesh: &TriMesh) -> SharedShape {
-    let flags = TriMeshFlags::ORIENTED;
-    SharedShape::trimesh_with_flags(mesh.vertices().to_vec(), mesh.indices().to_vec(), flags)
-        .unwrap_or_else(|_| SharedShape::new(mesh.clone()))
+    SharedShape::new(mesh.clone())
 }
 
 /// A part's collider: its convex hull when the part is (nearly) convex or decomposition is off,
