@@ -35,6 +35,9 @@ pub enum OrderArg {
 pub enum StabilityArg {
     /// Every part linked through contacts to a fixed part.
     Contact,
+    /// Simulate what remains under gravity (rapier3d); unstable when a part moves more than
+    /// `--physics-threshold`.
+    Physics,
 }
 
 /// Flags of `asp plan`.
@@ -85,6 +88,10 @@ pub struct PlanArgs {
     /// Stability criterion.
     #[arg(long, value_enum, default_value_t = StabilityArg::Contact)]
     pub stability: StabilityArg,
+    /// Physics stability: how far (fraction of the model's diagonal) a part may move in the
+    /// simulation before the state counts as unstable.
+    #[arg(long, default_value_t = 0.01)]
+    pub physics_threshold: f64,
     /// Seed of every random choice (random order, path planner).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
