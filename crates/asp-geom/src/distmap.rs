@@ -789,13 +789,15 @@ impl DistanceMaps {
                             }
                             _ => {
                                 let world = world.as_ref().expect("built when a part is a mesh");
-                                let erosion = world.erosion(i, j);
-                                let moving = world.eroded(i, erosion);
+                                let (_, erosion) = world.pair_erosion(i, j);
+                                let (moving, fixed) = world.pair_shapes(i, j);
+                                let ignored = world.ignores(i, j);
                                 for (d, m) in dirs.iter().enumerate() {
-                                    row[d] = if first_overlap(&aabbs[i], *m, &aabbs[j], 0.0)
-                                        .is_some_and(|t| t < d_max)
+                                    row[d] = if !ignored
+                                        && first_overlap(&aabbs[i], *m, &aabbs[j], 0.0)
+                                            .is_some_and(|t| t < d_max)
                                     {
-                                        cast_distance(&moving, world.mesh(j), *m, d_max, erosion)
+                                        cast_distance(&moving, &fixed, *m, d_max, erosion)
                                     } else {
                                         d_max
                                     };

@@ -17,9 +17,10 @@ use std::time::{Duration, Instant};
 /// Budget and resolution of the path planner.
 #[derive(Clone, Debug)]
 pub struct RrtConfig {
-    /// Iterations (sample + extend + connect) before giving up. Default 3000.
+    /// Iterations (sample + extend + connect) before giving up. Default 2000.
     pub max_iterations: usize,
-    /// Wall-time cap per call. Default 2 s.
+    /// Wall-time safety cap per call (the iteration budget is the one that keeps results
+    /// reproducible). Default 5 s.
     pub max_time: Duration,
     /// Longest tree edge as a fraction of the model's diagonal. Default 0.05.
     pub step_fraction: f32,
@@ -30,8 +31,8 @@ pub struct RrtConfig {
 impl Default for RrtConfig {
     fn default() -> Self {
         RrtConfig {
-            max_iterations: 3000,
-            max_time: Duration::from_secs(2),
+            max_iterations: 2000,
+            max_time: Duration::from_secs(5),
             step_fraction: 0.05,
             rotate: true,
         }

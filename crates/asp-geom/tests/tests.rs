@@ -2,4 +2,5 @@
 
 mod distmap;
 mod loaders;
+mod physics;
 mod removal;

@@ -7,4 +7,5 @@ mod hypervolume;
 mod mcts;
 mod objectives;
 mod pareto;
+mod real;
 mod verify;
