@@ -1532,7 +1532,15 @@ impl<'m> MapState<'m> {
         self.refresh_free();
         let candidates = self.free.and_not(&self.fixed);
         match self.maps.support {
-            Support::Below => out.extend(candidates.and_not(&self.holding).iter()),
+            Support::Below => {
+                for (k, &w) in candidates.and_not(&self.holding).0.iter().enumerate() {
+                    let mut w = w;
+                    while w != 0 {
+                        out.push(k * 64 + w.trailing_zeros() as usize);
+                        w &= w - 1;
+                    }
+                }
+            }
             Support::ContactGraph => {
                 out.extend(candidates.iter().filter(|&a| self.removal_keeps_stable(a)))
             }
