@@ -17,21 +17,35 @@ pub enum Motion {
         /// Travel in metres.
         distance: f32,
     },
-    /// A path of poses (translation + rotation), the first the identity.
+    /// A path of poses (translation + rotation), the first the identity. Each pose is the rigid
+    /// transform applied to the part's assembled geometry. Between two waypoints the `pivot`
+    /// (the centre of the part's bounds, world frame) moves on a straight line while the rotation
+    /// turns by slerp about it (see [`interpolate_about`]).
     Path {
-        /// Waypoints; consecutive poses are joined by interpolation.
+        /// Waypoints.
         poses: Vec<Pose>,
+        /// The point of the part that moves straight between waypoints.
+        pivot: Vec3,
     },
 }
 
+/// The pose a fraction `s` of the way from `a` to `b`: the `pivot`'s image moves linearly, the
+/// rotation turns by slerp about it.
+pub fn interpolate_about(pivot: Vec3, a: &Pose, b: &Pose, s: f32) -> Pose {
+    let centre = a.transform_point(pivot).lerp(b.transform_point(pivot), s);
+    let r = a.rotation.slerp(b.rotation, s);
+    Pose::from_parts(centre - r * pivot, r)
+}
+
 impl Motion {
-    /// The length of the translation part of the motion, in metres.
+    /// The distance the part's pivot (or any point, for a straight line) travels, in metres.
     pub fn length(&self) -> f32 {
         match self {
             Motion::Linear { distance, .. } => *distance,
-            Motion::Path { poses } => {
-                poses.windows(2).map(|w| (w[1].translation - w[0].translation).length()).sum()
-            }
+            Motion::Path { poses, pivot } => poses
+                .windows(2)
+                .map(|w| (w[1].transform_point(*pivot) - w[0].transform_point(*pivot)).length())
+                .sum(),
         }
     }
 }

@@ -1,15 +1,22 @@
 #![doc = include_str!("../README.md")]
 
 pub mod assembly;
+pub mod checker;
+pub mod erode;
 pub mod error;
 pub mod feasibility;
+pub mod fixtures;
 // pub mod io; (enabled when the loaders land)
 pub mod math;
 pub mod mesh;
 pub mod partset;
+pub mod rrt;
+pub mod world;
 
 pub use assembly::{Assembly, Part, Units};
+pub use checker::{Checker, CheckerConfig, StabilityMode};
 pub use error::{GeomError, Result};
-pub use feasibility::{FeasibilityChecker, Motion, MotionKind, Outcome, Stability};
+pub use feasibility::{CounterSnapshot, FeasibilityChecker, Motion, MotionKind, Outcome, Stability};
 pub use mesh::Mesh;
 pub use partset::PartSet;
+pub use world::{World, WorldConfig};

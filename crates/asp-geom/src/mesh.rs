@@ -85,7 +85,7 @@ impl Mesh {
                     }
                     // the four corners of the face, counter-clockwise seen from outside
                     let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-                    let mut corner = |du: i32, dv: i32| {
+                    let corner = |du: i32, dv: i32| {
                         let mut p = c;
                         p[axis] += positive as i32;
                         p[u] += du;

@@ -1,0 +1,108 @@
+//! Hand-built assemblies with known answers, for tests, benchmarks and examples.
+//! All are in metres, +Z up.
+
+use crate::assembly::{Assembly, Part, Units};
+use crate::math::{Axis, Vec3};
+use crate::mesh::Mesh;
+
+fn part(name: &str, mesh: Mesh, fixed: bool) -> Part {
+    Part { name: name.into(), mesh, fixed, extras: serde_json::Value::Null }
+}
+
+fn assembly(name: &str, parts: Vec<Part>) -> Assembly {
+    Assembly {
+        parts,
+        units: Units::metres(),
+        up: Axis::Z,
+        source: format!("fixture:{name}").into(),
+        warnings: Vec::new(),
+    }
+}
+
+fn cuboid(mins: [f32; 3], maxs: [f32; 3]) -> Mesh {
+    Mesh::cuboid(Vec3::from_array(mins), Vec3::from_array(maxs))
+}
+
+fn voxels(cells: &[[i32; 3]]) -> Mesh {
+    Mesh::from_voxels(cells, Vec3::ONE, Vec3::ZERO)
+}
+
+/// A fixed base slab with two unit boxes stacked on it, same footprint. The top box leaves up or
+/// sideways (sliding along the box below), never down; the lower box can slide out sideways but
+/// that leaves the top box floating.
+pub fn stacked_boxes() -> Assembly {
+    assembly(
+        "stacked_boxes",
+        vec![
+            part("base", cuboid([-1.0, -1.0, -0.5], [2.0, 2.0, 0.0]), true),
+            part("lower", cuboid([0.0, 0.0, 0.0], [1.0, 1.0, 1.0]), false),
+            part("top", cuboid([0.0, 0.0, 1.0], [1.0, 1.0, 2.0]), false),
+        ],
+    )
+}
+
+/// A fixed plate (3 × 3 × 2) with a 1 × 1 blind hole of depth 1 and a peg of 1 × 1 × 2 in it
+/// with zero clearance: the peg leaves only along +Z, the hole's axis.
+pub fn peg_in_hole() -> Assembly {
+    let plate: Vec<[i32; 3]> = (0..3)
+        .flat_map(|x| (0..3).flat_map(move |y| (0..2).map(move |z| [x, y, z])))
+        .filter(|c| *c != [1, 1, 1])
+        .collect();
+    assembly(
+        "peg_in_hole",
+        vec![part("plate", voxels(&plate), true), part("peg", voxels(&[[1, 1, 1], [1, 1, 2]]), false)],
+    )
+}
+
+/// The four-part tube of the seed's figure 2.1, from boxes: a fixed receptacle (a square tube
+/// along Z), a stick through it with zero clearance, a handle resting on the stick's top and a
+/// cap closing the receptacle's bottom. The handle (up or sideways) and the cap (down or
+/// sideways) leave first, in either order; the stick only after both, along ±Z.
+pub fn tube() -> Assembly {
+    let ring: Vec<[i32; 3]> = (0..3)
+        .flat_map(|x| (0..3).flat_map(move |y| (0..4).map(move |z| [x, y, z])))
+        .filter(|c| !(c[0] == 1 && c[1] == 1))
+        .collect();
+    assembly(
+        "tube",
+        vec![
+            part("receptacle", voxels(&ring), true),
+            part("stick", cuboid([1.0, 1.0, 0.0], [2.0, 2.0, 5.0]), false),
+            part("handle", cuboid([0.0, 0.0, 5.0], [3.0, 3.0, 5.5]), false),
+            part("cap", cuboid([0.0, 0.0, -0.5], [3.0, 3.0, 0.0]), false),
+        ],
+    )
+}
+
+/// A fixed housing (5 × 3 × 5 cells) with an L-shaped channel: a 0.6 cube sits at the channel's
+/// closed end and must move 2 along +X, then 3.5 up +Z to get out — no straight line works, a
+/// path planner must find the L.
+pub fn l_path() -> Assembly {
+    let channel = [[1, 1, 1], [2, 1, 1], [3, 1, 1], [3, 1, 2], [3, 1, 3], [3, 1, 4]];
+    let housing: Vec<[i32; 3]> = (0..5)
+        .flat_map(|x| (0..3).flat_map(move |y| (0..5).map(move |z| [x, y, z])))
+        .filter(|c| !channel.contains(c))
+        .collect();
+    assembly(
+        "l_path",
+        vec![
+            part("housing", voxels(&housing), true),
+            part("block", cuboid([1.2, 1.2, 1.2], [1.8, 1.8, 1.8]), false),
+        ],
+    )
+}
+
+/// A fixed base, two pillars and a keystone lying across both. Either pillar may slide out
+/// first (the keystone still rests on the other), but the keystone must leave before the last
+/// pillar: in assembly order, the keystone cannot be placed before its support.
+pub fn arch() -> Assembly {
+    assembly(
+        "arch",
+        vec![
+            part("base", cuboid([-3.0, -1.0, -0.5], [3.0, 1.0, 0.0]), true),
+            part("pillar_a", cuboid([-2.0, -0.5, 0.0], [-1.0, 0.5, 2.0]), false),
+            part("pillar_b", cuboid([1.0, -0.5, 0.0], [2.0, 0.5, 2.0]), false),
+            part("keystone", cuboid([-2.0, -0.5, 2.0], [2.0, 0.5, 2.5]), false),
+        ],
+    )
+}

@@ -1,0 +1,110 @@
+//! Straight-line removal, path planning and stability on fixtures with known answers.
+
+use asp_geom::math::Vec3;
+use asp_geom::rrt::{plan_removal_path, RrtConfig};
+use asp_geom::feasibility::interpolate_about;
+use asp_geom::{fixtures, Motion, PartSet, Stability, World, WorldConfig};
+
+fn world(a: asp_geom::Assembly) -> World {
+    World::new(a, &WorldConfig::default()).expect("fixture builds")
+}
+
+/// The axis directions along which `part` is free in `state`.
+fn free_axes(w: &World, part: usize, state: &PartSet) -> Vec<&'static str> {
+    let names = ["+x", "-x", "+y", "-y", "+z", "-z"];
+    let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+    let row = w.blocking_row(part);
+    let present = w.with_fixed(state);
+    axes.iter()
+        .zip(names)
+        .filter(|(a, _)| {
+            let k = w.directions().iter().position(|d| d.dot(**a) > 0.9999).unwrap();
+            !row[k].intersects(&present)
+        })
+        .map(|(_, n)| n)
+        .collect()
+}
+
+#[test]
+fn stacked_top_box_leaves_up_or_sideways_never_down() {
+    let w = world(fixtures::stacked_boxes());
+    let all = PartSet::full(3);
+    assert_eq!(free_axes(&w, 2, &all), vec!["+x", "-x", "+y", "-y", "+z"]);
+    // the lower box slides out sideways under the top one, but not up or down
+    assert_eq!(free_axes(&w, 1, &all), vec!["+x", "-x", "+y", "-y"]);
+    // once the top box is gone the lower one may also leave upward
+    assert_eq!(free_axes(&w, 1, &all.without(2)), vec!["+x", "-x", "+y", "-y", "+z"]);
+    // and its removal motion clears the remaining bounds
+    match w.linear_removal(2, &all).unwrap() {
+        Motion::Linear { direction, distance } => {
+            // straight up is the shortest way out of the remaining bounds
+            assert_eq!(direction, Vec3::Z);
+            assert!(distance > 0.0 && distance < 1.0, "{distance}");
+        }
+        m => panic!("{m:?}"),
+    }
+}
+
+#[test]
+fn zero_clearance_peg_leaves_only_along_the_hole_axis() {
+    let w = world(fixtures::peg_in_hole());
+    let all = PartSet::full(2);
+    assert_eq!(free_axes(&w, 1, &all), vec!["+z"]);
+    // every other candidate direction (clustered normals) is blocked too
+    let row = w.blocking_row(1);
+    let free: Vec<Vec3> = w.directions().iter().zip(row).filter(|(_, b)| b.is_empty()).map(|(d, _)| *d).collect();
+    assert_eq!(free, vec![Vec3::Z]);
+}
+
+#[test]
+fn moving_into_a_contact_is_blocked_and_reports_the_blocker() {
+    let w = world(fixtures::stacked_boxes());
+    // the lower box is blocked along ±z: by the top box and the base
+    let k_up = w.directions().iter().position(|d| *d == Vec3::Z).unwrap();
+    let k_down = w.directions().iter().position(|d| *d == -Vec3::Z).unwrap();
+    assert_eq!(w.blocking_row(1)[k_up].iter().collect::<Vec<_>>(), vec![2]);
+    assert_eq!(w.blocking_row(1)[k_down].iter().collect::<Vec<_>>(), vec![0]);
+}
+
+#[test]
+fn tube_stick_is_locked_by_handle_and_cap() {
+    let w = world(fixtures::tube());
+    let all = PartSet::full(4);
+    let blockers = w.linear_removal(1, &all).unwrap_err();
+    assert_eq!(blockers.iter().collect::<Vec<_>>(), vec![0, 2, 3]);
+    assert!(w.linear_removal(2, &all).is_ok());
+    assert!(w.linear_removal(3, &all).is_ok());
+    assert_eq!(free_axes(&w, 1, &PartSet::from_indices(4, [0, 1])), vec!["+z", "-z"]);
+}
+
+#[test]
+fn l_shaped_channel_needs_a_path() {
+    let w = world(fixtures::l_path());
+    let all = PartSet::full(2);
+    assert!(w.linear_removal(1, &all).is_err(), "no straight line leaves the channel");
+    let motion = plan_removal_path(&w, 1, &all, &RrtConfig::default(), 7).expect("RRT finds the L");
+    let Motion::Path { poses, pivot } = &motion else { panic!("{motion:?}") };
+    assert!(poses.len() >= 3, "an L needs a corner: {poses:?}");
+    // every pose along the path, finely interpolated, is collision-free, and the last is outside
+    for w2 in poses.windows(2) {
+        for k in 0..=50 {
+            let p = interpolate_about(*pivot, &w2[0], &w2[1], k as f32 / 50.0);
+            assert!(w.collision_at(1, &p, &all).is_none(), "collision at {p:?}");
+        }
+    }
+    let last = poses.last().unwrap();
+    let out = w.aabb(1).transform_by(last);
+    assert!(out.mins.z >= 5.0 - 1e-3 || out.maxs.x <= 0.0 || out.mins.x >= 5.0, "{out:?}");
+}
+
+#[test]
+fn arch_keystone_floats_without_pillars() {
+    let w = world(fixtures::arch());
+    // keystone on one pillar: linked, stable
+    assert_eq!(w.contact_stability(&PartSet::from_indices(4, [2, 3])), Stability::Stable);
+    // keystone alone: floating
+    assert_eq!(
+        w.contact_stability(&PartSet::from_indices(4, [3])),
+        Stability::Unstable { floating: PartSet::from_indices(4, [3]) }
+    );
+}
