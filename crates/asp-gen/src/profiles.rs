@@ -280,7 +280,7 @@ impl ProfileAssembly {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let mut last = String::new();
         for _ in 0..RESTARTS {
-            let mut b = Builder { p: params, profiles: Vec::new(), connectors: Vec::new() };
+            let mut b = Builder { p: params, profiles: Vec::new(), connectors: Vec::new(), end_slabs: Vec::new() };
             match b.build(&mut rng) {
                 Ok(()) => {
                     return Ok(ProfileAssembly {
@@ -467,6 +467,8 @@ struct Builder<'p> {
     p: &'p ProfileParams,
     profiles: Vec<Profile>,
     connectors: Vec<Connector>,
+    /// The last wall thickness of every profile end that meets another profile.
+    end_slabs: Vec<Cuboid>,
 }
 
 impl Builder<'_> {
@@ -696,9 +698,24 @@ impl Builder<'_> {
         let (lo, hi) = (seg.lo + inset(seg.lo_end), seg.hi - inset(seg.hi_end));
         let profile = Profile { axis, cuboid: self.profile_box(axis, at, lo, hi), role, layer, fixed };
         let index = self.profiles.len();
+        // every end meets exactly one profile (else its connector would hold on to two), and
+        // the new profile touches no end of another
+        if self.end_slabs.iter().any(|slab| slab.touches(&profile.cuboid, TOLERANCE)) {
+            return Err(format!("a {role:?} profile touches the end of another"));
+        }
         let mut connectors = Vec::new();
+        let mut slabs = Vec::new();
         for (end, other) in [(seg.lo, seg.lo_end), (seg.hi, seg.hi_end)] {
             if let Some(attached_to) = other {
+                let mut slab = profile.cuboid;
+                let t = self.p.connector_thickness;
+                (slab.mins[axis], slab.maxs[axis]) = if end == seg.lo { (end, end + t) } else { (end - t, end) };
+                let touches_another =
+                    self.profiles.iter().enumerate().any(|(j, q)| j != attached_to && q.cuboid.touches(&slab, TOLERANCE));
+                if touches_another {
+                    return Err(format!("a {role:?} profile ends against two profiles"));
+                }
+                slabs.push(slab);
                 let (mesh, cells) = self.connector_cells(&profile, end, end == seg.lo);
                 let shape = if axis == 2 { ConnectorShape::O } else { ConnectorShape::U };
                 connectors.push(Connector { shape, holds: index, attached_to, cells, mesh, fixed });
@@ -714,6 +731,7 @@ impl Builder<'_> {
         }
         self.profiles.push(profile);
         self.connectors.extend(connectors);
+        self.end_slabs.extend(slabs);
         Ok(index)
     }
 
