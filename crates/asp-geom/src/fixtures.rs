@@ -56,8 +56,9 @@ pub fn peg_in_hole() -> Assembly {
 
 /// The four-part tube of the seed's figure 2.1, from boxes: a fixed receptacle (a square tube
 /// along Z), a stick through it with zero clearance, a handle resting on the stick's top and a
-/// cap closing the receptacle's bottom. The handle (up or sideways) and the cap (down or
-/// sideways) leave first, in either order; the stick only after both, along ±Z.
+/// cap closing the receptacle's bottom. The stick can never leave first: it leaves up after the
+/// handle is gone, or down after the cap is gone (along ±Z only); handle and cap also slide off
+/// sideways.
 pub fn tube() -> Assembly {
     let ring: Vec<[i32; 3]> = (0..3)
         .flat_map(|x| (0..3).flat_map(move |y| (0..4).map(move |z| [x, y, z])))

@@ -159,9 +159,37 @@ impl Query<'_> {
     }
 }
 
-/// Plans a removal path for `part` out of `state` with RRT-Connect. Returns the path (poses of
-/// the part, the first the identity) or the parts that were hit while searching.
+/// Plans a removal path for `part` out of `state` with RRT-Connect. Translation-only paths are
+/// tried first with half the budget (most real removal paths need no rotation, and the 3-D
+/// search is far easier), then full SE(3) when `config.rotate`. Returns the path (poses of the
+/// part, the first the identity) or the parts that were hit while searching.
 pub fn plan_removal_path(
+    world: &World,
+    part: usize,
+    state: &PartSet,
+    config: &RrtConfig,
+    seed: u64,
+) -> std::result::Result<Motion, PartSet> {
+    let half = RrtConfig {
+        max_iterations: config.max_iterations.div_ceil(2),
+        max_time: config.max_time / 2,
+        rotate: false,
+        ..config.clone()
+    };
+    match rrt_connect(world, part, state, &half, seed) {
+        Ok(m) => Ok(m),
+        Err(blockers) if !config.rotate => Err(blockers),
+        Err(mut blockers) => {
+            let full = RrtConfig { max_iterations: config.max_iterations - half.max_iterations, max_time: config.max_time - half.max_time, ..config.clone() };
+            rrt_connect(world, part, state, &full, seed.wrapping_add(1)).map_err(|b| {
+                blockers.union_with(&b);
+                blockers
+            })
+        }
+    }
+}
+
+fn rrt_connect(
     world: &World,
     part: usize,
     state: &PartSet,

@@ -457,8 +457,20 @@ impl World {
                 return false;
             }
             let moving = self.eroded(p, self.erosion(p, q));
-            query::cast_shapes_nonlinear(&motion, &*moving, &still, &self.geoms[q].mesh, 0.0, 1.0, true)
-                .map_or(true, |h| h.is_some())
+            let fixed = &self.geoms[q].mesh;
+            let hit = if rel.angle_between(crate::math::Rot::IDENTITY) < 1e-6 {
+                // pure translation: the (faster) linear cast is exact
+                let options = ShapeCastOptions {
+                    max_time_of_impact: 1.0,
+                    target_distance: 0.0,
+                    stop_at_penetration: true,
+                    compute_impact_geometry_on_penetration: false,
+                };
+                query::cast_shapes(a, cb - ca, &*moving, &Pose::IDENTITY, Vec3::ZERO, fixed, options)
+            } else {
+                query::cast_shapes_nonlinear(&motion, &*moving, &still, fixed, 0.0, 1.0, true)
+            };
+            hit.map_or(true, |h| h.is_some())
         });
         hit
     }

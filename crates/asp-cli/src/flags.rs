@@ -1,0 +1,110 @@
+//! Command-line flags.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+
+/// Plan in which order, and along which motions, a product can be put together.
+#[derive(Parser, Debug)]
+#[command(name = "asp", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Plan a feasible assembly sequence by taking the model apart (Assembly-by-Disassembly).
+    Plan(PlanArgs),
+}
+
+/// Part orderings of the depth-first search.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum OrderArg {
+    /// The model's part order (vanilla AbD).
+    Given,
+    /// A random order in every state (`--seed`).
+    Random,
+    /// Given order with bookkeeping: a blocked part is retested only after a blocker is gone.
+    Bookkeeping,
+}
+
+/// Stability criteria.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum StabilityArg {
+    /// Every part linked through contacts to a fixed part.
+    Contact,
+}
+
+/// Flags of `asp plan`.
+#[derive(Args, Debug)]
+pub struct PlanArgs {
+    /// The model: a .glb/.gltf file, or a folder of .obj/.stl files (one part per file).
+    pub model: PathBuf,
+    /// Also write the plan as JSON to this file (format: docs/plan-format.md).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Print the plan JSON on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// The unit of the model's coordinates: m, cm, mm, in, ft or metres per unit
+    /// [default: m, or what the file says].
+    #[arg(long)]
+    pub unit: Option<String>,
+    /// The up axis: x, y, z, -x, -y, -z [default: +y for glTF, +z for OBJ/STL, or what the file says].
+    #[arg(long)]
+    pub up: Option<String>,
+    /// Base parts that stay in place (names). Without any, a ground plane under the lowest point
+    /// is the base.
+    #[arg(long, num_args = 1.., value_name = "NAME")]
+    pub fixed: Vec<String>,
+    /// Contact tolerance in model units: motions may push a part this deep into another
+    /// [default: 1e-4 × the model's diagonal].
+    #[arg(long)]
+    pub tolerance: Option<f64>,
+    /// Parts closer than this (model units) are in contact for stability [default: 1e-3 × diagonal].
+    #[arg(long)]
+    pub contact_distance: Option<f64>,
+    /// Clustered surface-normal directions tried besides the six axes (each with its opposite).
+    #[arg(long, default_value_t = 10)]
+    pub normals: usize,
+    /// Extra removal directions sampled evenly on the sphere.
+    #[arg(long, default_value_t = 0)]
+    pub sphere_directions: usize,
+    /// Part ordering.
+    #[arg(long, value_enum, default_value_t = OrderArg::Given)]
+    pub order: OrderArg,
+    /// Bookkeeping on top of any ordering (implied by `--order bookkeeping`).
+    #[arg(long)]
+    pub bookkeeping: bool,
+    /// Stability criterion.
+    #[arg(long, value_enum, default_value_t = StabilityArg::Contact)]
+    pub stability: StabilityArg,
+    /// Seed of every random choice (random order, path planner).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Stop after this many removal tests.
+    #[arg(long)]
+    pub max_tests: Option<u64>,
+    /// Stop after this many seconds.
+    #[arg(long)]
+    pub timeout: Option<f64>,
+    /// Never call the path planner (straight lines only).
+    #[arg(long)]
+    pub no_path_planner: bool,
+    /// Path planner iterations per call.
+    #[arg(long, default_value_t = 3000)]
+    pub rrt_iterations: usize,
+    /// Path planner wall-time cap per call, seconds.
+    #[arg(long, default_value_t = 2.0)]
+    pub rrt_time: f64,
+    /// No progress bar, no warnings.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Parses the process arguments (exits with usage on error).
+pub fn parse() -> Cli {
+    Cli::parse()
+}

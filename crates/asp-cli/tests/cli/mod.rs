@@ -1,0 +1,156 @@
+//! `asp plan` end to end: exit codes, output files, determinism and bad input.
+
+use asp_geom::io::write_glb;
+use asp_geom::{fixtures, Assembly};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn asp(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_asp")).args(args).output().expect("asp runs")
+}
+
+fn data(rel: &str) -> String {
+    format!("{}/../../tests/data/{rel}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn fixture_file(dir: &Path, a: &Assembly, name: &str) -> PathBuf {
+    let path = dir.join(name);
+    write_glb(a, &path).expect("write fixture");
+    path
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn plans_a_fixture_prints_a_table_and_writes_the_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = fixture_file(dir.path(), &fixtures::tube(), "tube.glb");
+    let out = dir.path().join("plan.json");
+    let o = asp(&["plan", model.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let table = String::from_utf8(o.stdout).unwrap();
+    assert!(table.contains("found"), "{table}");
+    assert!(table.contains("stick") && table.contains("handle") && table.contains("cap"), "{table}");
+    let plan = json(&out);
+    assert_eq!(plan["format_version"], "1.0");
+    assert_eq!(plan["status"], "found");
+    assert_eq!(plan["up"], "+z");
+    assert_eq!(plan["parts"].as_array().unwrap().len(), 4);
+    assert_eq!(plan["assembly_sequence"].as_array().unwrap().len(), 3);
+    assert_eq!(plan["assembly_sequence"][0]["motion"]["kind"], "linear");
+    assert!(plan["stats"]["removal_tests"].as_u64().unwrap() >= 3);
+}
+
+#[test]
+fn same_input_and_seed_give_identical_json_apart_from_seconds() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = fixture_file(dir.path(), &fixtures::arch(), "arch.glb");
+    let run = |k: usize| {
+        let out = dir.path().join(format!("p{k}.json"));
+        let o = asp(&["plan", model.to_str().unwrap(), "--order", "random", "--seed", "4", "--out", out.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let mut v = json(&out);
+        v["stats"]["seconds"] = serde_json::Value::Null;
+        serde_json::to_string(&v).unwrap()
+    };
+    assert_eq!(run(1), run(2));
+}
+
+#[test]
+fn no_plan_exits_1_and_explains() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = fixture_file(dir.path(), &fixtures::l_path(), "l.glb");
+    let out = dir.path().join("plan.json");
+    let o = asp(&["plan", model.to_str().unwrap(), "--no-path-planner", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let table = String::from_utf8(o.stdout).unwrap();
+    assert!(table.contains("block") && table.contains("blocked by housing"), "{table}");
+    let plan = json(&out);
+    assert_eq!(plan["status"], "no_plan");
+    assert_eq!(plan["explanation"][0]["name"], "block");
+    assert_eq!(plan["explanation"][0]["parts"][0]["name"], "housing");
+    // with the path planner it is found, along a path
+    let o = asp(&["plan", model.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(plan["assembly_sequence"][0]["motion"]["kind"], "path");
+    assert_eq!(plan["stats"]["path_planner_calls"], 1);
+}
+
+/// Asserts a one-line error naming `needle`, exit code 2, no panic.
+fn assert_error(o: &Output, needle: &str) {
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.starts_with("error: ") && err.trim_end().lines().count() == 1, "{err}");
+    assert!(err.contains(needle), "{needle:?} not in {err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn bad_input_is_one_line_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.glb");
+    assert_error(&asp(&["plan", missing.to_str().unwrap()]), "missing.glb");
+    let truncated = dir.path().join("truncated.glb");
+    let good = std::fs::read(data("beam/beam.glb")).unwrap();
+    std::fs::write(&truncated, &good[..good.len() / 3]).unwrap();
+    assert_error(&asp(&["plan", truncated.to_str().unwrap()]), "truncated.glb");
+    let garbage = dir.path().join("garbage.glb");
+    std::fs::write(&garbage, b"glTF\x02\x00\x00\x00this is not a model").unwrap();
+    assert_error(&asp(&["plan", garbage.to_str().unwrap()]), "garbage.glb");
+    let beam = data("beam/beam.glb");
+    assert_error(&asp(&["plan", &beam, "--up", "w"]), "--up");
+    assert_error(&asp(&["plan", &beam, "--unit", "furlongs"]), "--unit");
+    assert_error(&asp(&["plan", &beam, "--fixed", "no_such_part"]), "no_such_part");
+    assert_error(&asp(&["plan", &beam, "--tolerance", "-1"]), "--tolerance");
+}
+
+#[test]
+fn parts_overlapping_far_beyond_the_tolerance_are_an_error_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut a = fixtures::stacked_boxes();
+    // push the top box half-way into the lower one
+    for v in &mut a.parts[2].mesh.vertices {
+        v.z -= 0.5;
+    }
+    let model = fixture_file(dir.path(), &a, "overlap.glb");
+    let o = asp(&["plan", model.to_str().unwrap()]);
+    assert_error(&o, "overlap");
+    assert!(stderr(&o).contains("'lower'") && stderr(&o).contains("'top'"), "{}", stderr(&o));
+}
+
+#[test]
+fn small_overlaps_and_open_meshes_are_warnings_naming_the_parts() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut a = fixtures::stacked_boxes();
+    for v in &mut a.parts[2].mesh.vertices {
+        v.z -= 0.01; // a press fit: 10 × the default tolerance, far below the error limit
+    }
+    a.parts[1].mesh.triangles.pop(); // a hole in the lower box
+    let model = fixture_file(dir.path(), &a, "warn.glb");
+    let o = asp(&["plan", model.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert!(err.contains("warning") && err.contains("'lower' and 'top' overlap"), "{err}");
+    assert!(err.contains("part 'lower': mesh is not closed"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn a_single_part_plans_trivially() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut a = fixtures::stacked_boxes();
+    a.parts.truncate(2);
+    a.parts[0].fixed = false;
+    a.parts.remove(0);
+    let model = fixture_file(dir.path(), &a, "single.glb");
+    let o = asp(&["plan", model.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(plan["assembly_sequence"].as_array().unwrap().len(), 1);
+}

@@ -1,0 +1,3 @@
+//! Integration tests of the `asp` binary (the real executable).
+
+mod cli;

@@ -1,0 +1,62 @@
+//! Criterion benches of the removal test (one part, all straight directions) and the stability
+//! check, on the shipped real assemblies and a fixture.
+//!
+//! `cold`: the first test of a part, which computes and caches its blocking row (every
+//! direction × every neighbour: the real geometric work). `warm`: a later test of the same part
+//! in another state (bitset work on the cached row).
+
+use asp_geom::io::{load, LoadOptions};
+use asp_geom::math::Axis;
+use asp_geom::{fixtures, Assembly, PartSet, Units, World, WorldConfig};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use std::hint::black_box;
+use std::path::Path;
+
+fn models() -> Vec<(String, Assembly)> {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data");
+    let z = LoadOptions { up: Some(Axis::Z), ..LoadOptions::default() };
+    let mut out = vec![("tube".to_string(), fixtures::tube())];
+    out.push(("beam".into(), load(&data.join("beam/beam.glb"), &z).expect("beam")));
+    for name in ["bookcase_billy_0191", "chair_bertil_0148", "table_lack_0825", "desk_hannes_0529"] {
+        out.push((name.into(), load(&data.join(format!("ikea/{name}.glb")), &z).expect(name)));
+    }
+    let mm = LoadOptions { unit: Units::parse("mm"), up: Some(Axis::Z), ..LoadOptions::default() };
+    out.push(("pump".into(), load(&data.join("pump"), &mm).expect("pump")));
+    out
+}
+
+fn bench(c: &mut Criterion) {
+    for (name, assembly) in models() {
+        let world = World::new(assembly.clone(), &WorldConfig::default()).expect("world");
+        let n = world.num_parts();
+        let full = PartSet::full(n);
+        let mut group = c.benchmark_group(format!("removal_test/{name}"));
+        group.sample_size(10);
+        let mut k = 0;
+        group.bench_function("cold", |b| {
+            b.iter_batched(
+                || {
+                    k += 1;
+                    (World::new(assembly.clone(), &WorldConfig::default()).expect("world"), k % n)
+                },
+                |(w, p)| black_box(w.linear_removal(p, &full).is_ok()),
+                BatchSize::PerIteration,
+            )
+        });
+        for p in 0..n {
+            world.blocking_row(p);
+        }
+        let mut k = 0;
+        group.bench_function("warm", |b| {
+            b.iter(|| {
+                k += 1;
+                black_box(world.linear_removal(k % n, &full).is_ok())
+            })
+        });
+        group.finish();
+        c.bench_function(&format!("stability/{name}"), |b| b.iter(|| black_box(world.contact_stability(&full))));
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

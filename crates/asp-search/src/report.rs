@@ -1,0 +1,227 @@
+//! The plan JSON: a versioned contract other tools read (documented in `docs/plan-format.md`).
+//!
+//! Lengths and positions are in the model's units; directions are unit vectors in the model
+//! frame; `assembly_sequence` runs in assembly order (the removal order reversed, each motion
+//! reversed into an insertion).
+
+use crate::problem::{PlanOutcome, Status, StuckReason};
+use asp_geom::math::Pose;
+use asp_geom::{Assembly, Motion, PartSet};
+use serde::{Deserialize, Serialize};
+
+/// The version of the plan format this build writes. Minor bumps add keys; major bumps change
+/// or remove them.
+pub const FORMAT_VERSION: &str = "1.0";
+
+/// A whole plan file.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct PlanReport {
+    /// [`FORMAT_VERSION`].
+    pub format_version: String,
+    /// The model file or folder, as given.
+    pub model: String,
+    /// The model's unit (`m`, `mm`, ...); every length below is in it.
+    pub units: String,
+    /// The up axis (`+z`, `+y`, ...); gravity points the other way.
+    pub up: String,
+    /// The contact tolerance used, in model units.
+    pub tolerance: f64,
+    /// `found`, `no_plan` or `budget_exhausted`.
+    pub status: String,
+    /// Every part of the model.
+    pub parts: Vec<PartEntry>,
+    /// One entry per non-fixed part, in assembly order (empty unless `found`).
+    pub assembly_sequence: Vec<AssemblyStep>,
+    /// Part indices in removal order (the branch reached, when not `found`).
+    pub disassembly_sequence: Vec<usize>,
+    /// The effort spent.
+    pub stats: StatsEntry,
+    /// For `no_plan`: the parts of the deepest dead-end state and what holds each.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub explanation: Vec<Explanation>,
+    /// Non-fatal problems found in the model, one line each.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+    /// Pareto runs: every non-dominated sequence with its objective vector.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pareto_front: Option<Vec<ParetoEntry>>,
+}
+
+/// A part of the model.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct PartEntry {
+    /// Index (position in the model).
+    pub index: usize,
+    /// Name.
+    pub name: String,
+    /// Base part, never moved.
+    pub fixed: bool,
+}
+
+/// One assembly step.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct AssemblyStep {
+    /// Part index.
+    pub part: usize,
+    /// Part name.
+    pub name: String,
+    /// How it goes in.
+    pub motion: MotionEntry,
+}
+
+/// An insertion motion, ending in the part's assembled pose.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum MotionEntry {
+    /// Move along `direction` (unit) by `distance` into place.
+    Linear {
+        /// Unit insertion direction.
+        direction: [f64; 3],
+        /// Travel in model units.
+        distance: f64,
+    },
+    /// Follow `poses` (each `[x, y, z, qx, qy, qz, qw]`: the rigid transform applied to the
+    /// part's assembled geometry; the last is the identity). Between waypoints `pivot` moves on
+    /// a straight line and the rotation turns by slerp about it.
+    Path {
+        /// Waypoints.
+        poses: Vec<[f64; 7]>,
+        /// The point that moves straight between waypoints, model frame.
+        pivot: [f64; 3],
+    },
+}
+
+/// Effort counters.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Default)]
+pub struct StatsEntry {
+    /// Removal tests run.
+    pub removal_tests: u64,
+    /// Tests failed by collision.
+    pub failed_collision: u64,
+    /// Tests failed by stability.
+    pub failed_gravity: u64,
+    /// Path planner calls.
+    pub path_planner_calls: u64,
+    /// Wall time in seconds (the only field that differs between identical runs).
+    pub seconds: f64,
+}
+
+/// Why one part could not leave the deepest dead-end state.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Explanation {
+    /// Part index.
+    pub part: usize,
+    /// Part name.
+    pub name: String,
+    /// `blocked` (every motion collides), `unsupported` (its removal leaves parts without
+    /// support) or `dead_end` (it can leave, but nothing after that works).
+    pub reason: String,
+    /// The parts involved: blockers, or parts left unsupported.
+    pub parts: Vec<NamedPart>,
+}
+
+/// A part reference with its name (`ground` for the virtual ground plane).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct NamedPart {
+    /// Part index (the ground has index = number of parts).
+    pub part: usize,
+    /// Name.
+    pub name: String,
+}
+
+/// A point of a Pareto front.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ParetoEntry {
+    /// Objective values, in the order of the run's objectives.
+    pub objectives: Vec<f64>,
+    /// The disassembly sequence (part indices in removal order).
+    pub disassembly_sequence: Vec<usize>,
+}
+
+impl PlanReport {
+    /// The report of `outcome` on `assembly`; `tolerance` in metres.
+    pub fn new(assembly: &Assembly, outcome: &PlanOutcome, tolerance: f32, warnings: &[String]) -> Self {
+        let u = |m: f32| assembly.units.from_metres(m as f64);
+        let name = |i: usize| assembly.parts.get(i).map(|p| p.name.clone()).unwrap_or_else(|| "ground".into());
+        let named = |s: &PartSet| s.iter().map(|part| NamedPart { part, name: name(part) }).collect();
+        let status = match &outcome.status {
+            Status::Found => "found",
+            Status::NoPlan { .. } => "no_plan",
+            Status::BudgetExhausted => "budget_exhausted",
+        };
+        let assembly_sequence = if outcome.status == Status::Found {
+            outcome
+                .removals
+                .iter()
+                .rev()
+                .map(|s| AssemblyStep { part: s.part, name: name(s.part), motion: insertion(&s.motion, &u) })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let explanation = match &outcome.status {
+            Status::NoPlan { stuck, .. } => stuck
+                .iter()
+                .map(|s| {
+                    let (reason, parts) = match &s.reason {
+                        StuckReason::Blocked(b) => ("blocked", named(b)),
+                        StuckReason::WouldLeaveUnsupported(f) => ("unsupported", named(f)),
+                        StuckReason::DeadEnd => ("dead_end", Vec::new()),
+                    };
+                    Explanation { part: s.part, name: name(s.part), reason: reason.into(), parts }
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
+        let c = &outcome.stats.counters;
+        PlanReport {
+            format_version: FORMAT_VERSION.into(),
+            model: assembly.source.display().to_string(),
+            units: assembly.units.name.clone(),
+            up: assembly.up.to_string(),
+            tolerance: u(tolerance),
+            status: status.into(),
+            parts: assembly
+                .parts
+                .iter()
+                .enumerate()
+                .map(|(index, p)| PartEntry { index, name: p.name.clone(), fixed: p.fixed })
+                .collect(),
+            assembly_sequence,
+            disassembly_sequence: outcome.removals.iter().map(|s| s.part).collect(),
+            stats: StatsEntry {
+                removal_tests: c.removal_tests,
+                failed_collision: c.failed_collision,
+                failed_gravity: c.failed_gravity,
+                path_planner_calls: c.path_planner_calls,
+                seconds: outcome.stats.seconds,
+            },
+            explanation,
+            warnings: warnings.to_vec(),
+            pareto_front: None,
+        }
+    }
+}
+
+/// The insertion that undoes a removal motion, in model units.
+fn insertion(motion: &Motion, u: &dyn Fn(f32) -> f64) -> MotionEntry {
+    let v3 = |v: asp_geom::math::Vec3, f: &dyn Fn(f32) -> f64| [f(v.x), f(v.y), f(v.z)];
+    let unit = |x: f32| x as f64;
+    match motion {
+        Motion::Linear { direction, distance } => {
+            MotionEntry::Linear { direction: v3(-*direction, &unit), distance: u(*distance) }
+        }
+        Motion::Path { poses, pivot } => MotionEntry::Path {
+            poses: poses
+                .iter()
+                .rev()
+                .map(|p: &Pose| {
+                    let t = v3(p.translation, u);
+                    let q = p.rotation;
+                    [t[0], t[1], t[2], q.x as f64, q.y as f64, q.z as f64, q.w as f64]
+                })
+                .collect(),
+            pivot: v3(*pivot, u),
+        },
+    }
+}

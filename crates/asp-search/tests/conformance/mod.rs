@@ -1,0 +1,108 @@
+//! Every planner configuration on every fixture with a known answer; every found plan is
+//! re-checked by the independent sweep.
+
+use crate::verify::verify_plan;
+use asp_geom::{fixtures, Assembly, Checker, CheckerConfig, FeasibilityChecker, World, WorldConfig};
+use asp_search::{Budget, Dfs, Ordering, PlanOutcome, Planner, Problem, Status};
+
+fn planners() -> Vec<(&'static str, Dfs)> {
+    vec![
+        ("given", Dfs::builder().build()),
+        ("random", Dfs::builder().ordering(Ordering::Random).seed(3).build()),
+        ("bookkeeping", Dfs::builder().bookkeeping(true).build()),
+        ("random+bookkeeping", Dfs::builder().ordering(Ordering::Random).bookkeeping(true).seed(5).build()),
+    ]
+}
+
+fn plan(assembly: Assembly, planner: &Dfs) -> (Checker, PlanOutcome) {
+    let checker = Checker::new(World::new(assembly, &WorldConfig::default()).unwrap(), CheckerConfig::default());
+    let outcome = planner.solve(&Problem::full(&checker), &Budget::default());
+    (checker, outcome)
+}
+
+fn names(checker: &Checker, outcome: &PlanOutcome) -> Vec<String> {
+    outcome.removals.iter().map(|s| checker.world().name(s.part).to_string()).collect()
+}
+
+#[test]
+fn every_planner_solves_every_fixture_and_every_step_rechecks() {
+    for (label, planner) in planners() {
+        for assembly in [fixtures::stacked_boxes(), fixtures::peg_in_hole(), fixtures::tube(), fixtures::arch(), fixtures::l_path()] {
+            let source = assembly.source.clone();
+            let (checker, outcome) = plan(assembly, &planner);
+            assert_eq!(outcome.status, Status::Found, "{label} on {source:?}");
+            verify_plan(checker.world(), &outcome);
+            assert_eq!(outcome.stats.counters, checker.counters(), "{label}: counters");
+        }
+    }
+}
+
+#[test]
+fn tube_stick_follows_the_side_cleared_and_arch_keystone_precedes_its_last_pillar() {
+    for (label, planner) in planners() {
+        let (c, o) = plan(fixtures::tube(), &planner);
+        let order = names(&c, &o);
+        let stick = order.iter().position(|n| n == "stick").unwrap();
+        assert!(stick > 0, "{label}: the stick cannot leave first: {order:?}");
+        let asp_geom::Motion::Linear { direction, .. } = o.removals[stick].motion else { panic!() };
+        let gone: Vec<&str> = order[..stick].iter().map(|s| s.as_str()).collect();
+        if direction == asp_geom::math::Vec3::Z {
+            assert!(gone.contains(&"handle"), "{label}: {order:?}");
+        } else {
+            assert_eq!(direction, -asp_geom::math::Vec3::Z, "{label}");
+            assert!(gone.contains(&"cap"), "{label}: {order:?}");
+        }
+        let (c, o) = plan(fixtures::arch(), &planner);
+        let order = names(&c, &o);
+        let key = order.iter().position(|n| n == "keystone").unwrap();
+        assert!(key < 2, "{label}: keystone removed after both pillars: {order:?}");
+    }
+}
+
+#[test]
+fn arch_in_given_order_hits_the_gravity_check() {
+    let (c, o) = plan(fixtures::arch(), &Dfs::builder().build());
+    assert_eq!(names(&c, &o), vec!["pillar_a", "keystone", "pillar_b"]);
+    assert_eq!(o.stats.counters.failed_gravity, 1, "pillar_b before the keystone is unstable");
+}
+
+#[test]
+fn l_path_needs_the_path_planner() {
+    let (_, o) = plan(fixtures::l_path(), &Dfs::builder().build());
+    assert_eq!(o.stats.counters.path_planner_calls, 1);
+    assert!(matches!(o.removals[0].motion, asp_geom::Motion::Path { .. }));
+    let (_, o) = plan(fixtures::l_path(), &Dfs::builder().path_planner(false).build());
+    match o.status {
+        Status::NoPlan { stuck, .. } => {
+            assert_eq!(stuck.len(), 1);
+            assert_eq!(stuck[0].reason, asp_search::StuckReason::Blocked(asp_geom::PartSet::from_indices(2, [0])));
+        }
+        s => panic!("{s:?}"),
+    }
+}
+
+#[test]
+fn bookkeeping_never_runs_more_tests_than_vanilla() {
+    for assembly in [fixtures::stacked_boxes(), fixtures::tube(), fixtures::arch()] {
+        let (_, vanilla) = plan(assembly.clone(), &Dfs::builder().build());
+        let (_, bk) = plan(assembly, &Dfs::builder().bookkeeping(true).build());
+        assert!(bk.stats.counters.removal_tests <= vanilla.stats.counters.removal_tests);
+    }
+}
+
+#[test]
+fn budget_of_one_test_is_exhausted() {
+    let checker = Checker::new(World::new(fixtures::tube(), &WorldConfig::default()).unwrap(), CheckerConfig::default());
+    let o = Dfs::builder().build().solve(&Problem::full(&checker), &Budget { max_tests: Some(1), timeout: None });
+    assert_eq!(o.status, Status::BudgetExhausted);
+    assert_eq!(o.stats.counters.removal_tests, 1);
+}
+
+#[test]
+fn same_seed_same_plan() {
+    let p = Dfs::builder().ordering(Ordering::Random).seed(11).build();
+    let (_, a) = plan(fixtures::tube(), &p);
+    let (_, b) = plan(fixtures::tube(), &p);
+    assert_eq!(a.removals, b.removals);
+    assert_eq!(a.stats.counters, b.stats.counters);
+}

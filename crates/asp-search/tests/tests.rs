@@ -1,0 +1,4 @@
+//! Integration tests of asp-search.
+
+mod conformance;
+mod verify;
