@@ -6,7 +6,7 @@ pub mod erode;
 pub mod error;
 pub mod feasibility;
 pub mod fixtures;
-// pub mod io; (enabled when the loaders land)
+pub mod io;
 pub mod math;
 pub mod mesh;
 pub mod partset;

@@ -1,3 +1,4 @@
-//! Integration tests of asp-geom.
+//! The one integration test binary of asp-geom.
 
+mod loaders;
 mod removal;

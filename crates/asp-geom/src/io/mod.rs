@@ -1,8 +1,8 @@
 //! Loading assemblies from files (glTF 2.0, folders of OBJ/STL) and writing GLB.
 
 mod folder;
-mod gltf_read;
 mod glb_write;
+mod gltf_read;
 
 pub use glb_write::write_glb;
 
@@ -25,8 +25,7 @@ pub struct LoadOptions {
 /// Loads `path`: a `.glb`/`.gltf` file or a folder of `.obj`/`.stl` files (one part per file).
 /// Meshes come back in metres, world frame, part names unique; the assembly is validated.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Assembly> {
-    let meta = std::fs::metadata(path)
-        .map_err(|source| GeomError::Io { path: path.to_path_buf(), source })?;
+    let meta = std::fs::metadata(path).map_err(|source| io_error(path, source))?;
     let mut assembly = if meta.is_dir() {
         folder::load_folder(path, options)?
     } else {
@@ -45,4 +44,40 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Assembly> {
     assembly.set_fixed(&options.fixed)?;
     assembly.validate()?;
     Ok(assembly)
+}
+
+/// A [`GeomError::Io`] for `path` whose message is lowercase like every other asp message
+/// ("no such file or directory" rather than the operating system's capitalised text).
+/// The error kind is kept, so callers can still match on it.
+pub(crate) fn io_error(path: &Path, source: std::io::Error) -> GeomError {
+    let source = std::io::Error::new(source.kind(), lowercase_first(&source.to_string()));
+    GeomError::Io { path: path.to_path_buf(), source }
+}
+
+/// Another library's message made to read like asp's: first letter in lowercase (unless the
+/// first word is an acronym such as "EOF") and no final period.
+pub(crate) fn lowercase_first(text: &str) -> String {
+    let text = text.trim().trim_end_matches('.');
+    let mut chars = text.chars();
+    match (chars.next(), chars.next()) {
+        (Some(first), second) if !second.is_some_and(char::is_uppercase) => {
+            first.to_lowercase().chain(text.chars().skip(1)).collect()
+        }
+        _ => text.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_of_other_libraries_are_lowercased() {
+        assert_eq!(
+            lowercase_first("No such file or directory (os error 2)"),
+            "no such file or directory (os error 2)"
+        );
+        assert_eq!(lowercase_first("EOF while expecting facet."), "EOF while expecting facet");
+        assert_eq!(lowercase_first(""), "");
+    }
 }

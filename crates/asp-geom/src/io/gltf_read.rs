@@ -1,0 +1,678 @@
+//! glTF 2.0 reader (`.glb`, `.gltf` with external or embedded buffers).
+//!
+//! Every mesh instance of the default scene (else the first scene) becomes one part, its mesh
+//! baked in world coordinates and converted to metres. The `gltf` crate parses and validates the
+//! JSON; buffer data is read here with explicit bounds checks, because the crate's accessor
+//! iterators panic on some malformed files.
+
+use super::{io_error, lowercase_first, LoadOptions};
+use crate::assembly::{Assembly, Part, Units};
+use crate::error::{GeomError, Result};
+use crate::math::{Axis, Vec3};
+use crate::mesh::Mesh;
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::{Mode, Semantic};
+use gltf::scene::Transform;
+use gltf::{Accessor, Document, Node, Primitive, Scene};
+use parry3d::glamx::{DMat4, DQuat, DVec3};
+use serde_json::Value;
+use std::borrow::Cow;
+use std::path::{Path, PathBuf};
+
+/// Inside this module a failure is just its reason; [`load_gltf`] adds the file name.
+type Res<T> = std::result::Result<T, String>;
+
+/// Loads a `.glb` or `.gltf` file: one part per mesh instance of the default scene.
+pub(crate) fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Assembly> {
+    let bytes = std::fs::read(path).map_err(|source| io_error(path, source))?;
+    read_gltf(path, &bytes, options).map_err(|reason| GeomError::format(path, reason))
+}
+
+fn read_gltf(path: &Path, bytes: &[u8], options: &LoadOptions) -> Res<Assembly> {
+    let (json, blob) = if bytes.starts_with(b"glTF") {
+        split_glb(bytes)?
+    } else if has_glb_extension(path) {
+        return Err("not a glb file (the 'gltf' magic bytes are missing)".into());
+    } else {
+        (bytes, None)
+    };
+    let document = parse_document(json)?;
+    let buffers = load_buffers(&document, path, blob)?;
+    let scene = document.default_scene().or_else(|| document.scenes().next());
+    let settings = scene.as_ref().map(scene_settings).transpose()?.unwrap_or_default();
+    let units = options.unit.clone().or(settings.unit).unwrap_or_else(Units::metres);
+    let up = options.up.or(settings.up).unwrap_or(Axis::Y);
+    let mut builder = PartBuilder::new(&document, buffers, units.metres);
+    if let Some(scene) = &scene {
+        builder.add_scene(scene)?;
+    }
+    Ok(Assembly { parts: builder.parts, units, up, source: path.to_path_buf(), warnings: builder.warnings })
+}
+
+fn has_glb_extension(path: &Path) -> bool {
+    path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Container and document
+
+/// Splits a GLB file into its JSON chunk and its optional BIN chunk.
+fn split_glb(bytes: &[u8]) -> Res<(&[u8], Option<&[u8]>)> {
+    let (version, length) = match (read_u32(bytes, 4), read_u32(bytes, 8)) {
+        (Some(version), Some(length)) => (version, length as usize),
+        _ => return Err("truncated glb: the 12-byte header is incomplete".into()),
+    };
+    if version != 2 {
+        return Err(format!("unsupported glb version {version} (expected 2)"));
+    }
+    if length > bytes.len() {
+        return Err(format!(
+            "truncated glb: the header announces {length} bytes but the file has {}",
+            bytes.len()
+        ));
+    }
+    let body = &bytes[..length];
+    let mut chunks = Vec::new();
+    let mut at = 12;
+    while at < body.len() {
+        let (Some(len), Some(kind)) = (read_u32(body, at), body.get(at + 4..at + 8)) else {
+            return Err(format!("truncated glb: incomplete chunk header at byte {at}"));
+        };
+        let start = at + 8;
+        let Some(data) = start.checked_add(len as usize).and_then(|end| body.get(start..end)) else {
+            return Err(format!(
+                "truncated glb: a chunk announces {len} bytes but only {} remain",
+                body.len() - start
+            ));
+        };
+        chunks.push((kind, data));
+        at = start + data.len();
+    }
+    match chunks.as_slice() {
+        [(b"JSON", json), rest @ ..] => {
+            let bin = rest.iter().find(|(kind, _)| *kind == b"BIN\0").map(|(_, data)| *data);
+            Ok((json, bin))
+        }
+        _ => Err("corrupted glb: the first chunk is not json".into()),
+    }
+}
+
+fn read_u32(bytes: &[u8], at: usize) -> Option<u32> {
+    let b = bytes.get(at..at.checked_add(4)?)?;
+    Some(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+}
+
+/// Parses and validates the glTF JSON.
+fn parse_document(json: &[u8]) -> Res<Document> {
+    let root = gltf::json::Root::from_slice(json).map_err(|e| format!("invalid gltf json: {e}"))?;
+    // gltf-json's validation indexes the POSITION accessor without a bounds check: check first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(bad) = primitive.attributes.values().find(|a| a.value() >= root.accessors.len()) {
+                return Err(format!(
+                    "invalid gltf: meshes[{m}].primitives[{p}] uses accessor {} which does not exist",
+                    bad.value()
+                ));
+            }
+        }
+    }
+    Document::from_json(root).map_err(|e| match e {
+        gltf::Error::Validation(errors) => describe_validation(&errors),
+        other => format!("invalid gltf: {}", lowercase_first(&other.to_string())),
+    })
+}
+
+fn describe_validation(errors: &[(gltf::json::Path, gltf::json::validation::Error)]) -> String {
+    let shown: Vec<String> = errors.iter().take(3).map(|(path, error)| format!("{path}: {error}")).collect();
+    let more = match errors.len().saturating_sub(shown.len()) {
+        0 => String::new(),
+        n => format!(" (and {n} more)"),
+    };
+    format!("invalid gltf: {}{more}", shown.join("; "))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Buffers
+
+/// The bytes of every buffer, in document order.
+fn load_buffers<'a>(document: &Document, path: &Path, blob: Option<&'a [u8]>) -> Res<Vec<Cow<'a, [u8]>>> {
+    document
+        .buffers()
+        .map(|buffer| {
+            let data = buffer_data(&buffer, path, blob)?;
+            if data.len() < buffer.length() {
+                return Err(format!(
+                    "truncated buffer {}: {} bytes, expected {}",
+                    buffer.index(),
+                    data.len(),
+                    buffer.length()
+                ));
+            }
+            Ok(data)
+        })
+        .collect()
+}
+
+fn buffer_data<'a>(buffer: &gltf::Buffer, path: &Path, blob: Option<&'a [u8]>) -> Res<Cow<'a, [u8]>> {
+    let index = buffer.index();
+    match buffer.source() {
+        gltf::buffer::Source::Bin => blob
+            .map(Cow::Borrowed)
+            .ok_or_else(|| format!("buffer {index} has no uri and the file has no binary chunk")),
+        gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+            gltf::buffer::Data::from_source(buffer.source(), None)
+                .map(|data| Cow::Owned(data.0))
+                .map_err(|e| format!("buffer {index}: invalid data uri ({e})"))
+        }
+        gltf::buffer::Source::Uri(uri) => {
+            let file =
+                external_file(path, uri).ok_or_else(|| format!("buffer {index}: unsupported uri '{uri}'"))?;
+            std::fs::read(&file).map(Cow::Owned).map_err(|e| match e.kind() {
+                std::io::ErrorKind::NotFound => {
+                    format!("buffer file '{}' is missing", file.display())
+                }
+                _ => format!(
+                    "cannot read buffer file '{}': {}",
+                    file.display(),
+                    lowercase_first(&e.to_string())
+                ),
+            })
+        }
+    }
+}
+
+/// Where a buffer URI points: relative to the glTF file, or a `file:` URI. None for other schemes.
+fn external_file(gltf_path: &Path, uri: &str) -> Option<PathBuf> {
+    let decoded = percent_decode(uri)?;
+    if let Some(rest) = decoded.strip_prefix("file://").or_else(|| decoded.strip_prefix("file:")) {
+        return Some(PathBuf::from(rest));
+    }
+    if decoded.contains("://") {
+        return None;
+    }
+    Some(gltf_path.parent().unwrap_or(Path::new("")).join(decoded))
+}
+
+/// Decodes `%xx` escapes of a URI; None when the result is not UTF-8.
+fn percent_decode(uri: &str) -> Option<String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = bytes.get(i + 1..i + 3).and_then(|h| std::str::from_utf8(h).ok());
+        match (bytes[i], hex.and_then(|h| u8::from_str_radix(h, 16).ok())) {
+            (b'%', Some(byte)) => {
+                out.push(byte);
+                i += 3;
+            }
+            (byte, _) => {
+                out.push(byte);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene settings and node metadata
+
+/// What the scene's `extras.asp` says about the file.
+#[derive(Default)]
+struct SceneSettings {
+    unit: Option<Units>,
+    up: Option<Axis>,
+}
+
+fn scene_settings(scene: &Scene) -> Res<SceneSettings> {
+    let asp = parse_extras(scene.extras(), "scene")?.and_then(|mut e| e.get_mut("asp").map(Value::take));
+    let Some(asp) = asp else { return Ok(SceneSettings::default()) };
+    let text = |key: &str| match asp.get(key) {
+        None | Some(Value::Null) => Ok(None),
+        Some(Value::String(s)) => Ok(Some(s.clone())),
+        Some(Value::Number(n)) => Ok(Some(n.to_string())),
+        Some(other) => Err(format!("scene extras.asp.{key} must be a string, not {other}")),
+    };
+    let unit = match text("unit")? {
+        Some(s) => {
+            Some(Units::parse(&s).ok_or_else(|| format!("scene extras.asp.unit '{s}' is not a known unit"))?)
+        }
+        None => None,
+    };
+    let up = match text("up")? {
+        Some(s) => Some(
+            Axis::parse(&s).ok_or_else(|| format!("scene extras.asp.up '{s}' is not an axis such as +z"))?,
+        ),
+        None => None,
+    };
+    Ok(SceneSettings { unit, up })
+}
+
+/// A node's `extras.asp` object without its `fixed` key (kept in [`Part::fixed`] instead), and
+/// the fixed flag. An absent or empty object gives `Value::Null`.
+fn node_metadata(node: &Node, label: &str) -> Res<(Value, bool)> {
+    let mut asp = parse_extras(node.extras(), label)?
+        .and_then(|mut e| e.get_mut("asp").map(Value::take))
+        .unwrap_or(Value::Null);
+    let fixed = match asp.as_object_mut().and_then(|m| m.remove("fixed")) {
+        None => false,
+        Some(Value::Bool(fixed)) => fixed,
+        Some(other) => return Err(format!("{label}: extras.asp.fixed must be true or false, not {other}")),
+    };
+    if asp.as_object().is_some_and(|m| m.is_empty()) {
+        asp = Value::Null;
+    }
+    Ok((asp, fixed))
+}
+
+fn parse_extras(extras: &gltf::json::Extras, label: &str) -> Res<Option<Value>> {
+    extras
+        .as_ref()
+        .map(|raw| serde_json::from_str(raw.get()))
+        .transpose()
+        .map_err(|e| format!("{label}: invalid extras ({e})"))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Parts
+
+/// A mesh's triangle primitives merged, in the mesh's own frame, before any node transform.
+#[derive(Clone)]
+struct LocalMesh {
+    vertices: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+    /// Descriptions of skipped (point or line) primitives.
+    skipped: Vec<String>,
+}
+
+/// Walks the scene and collects one part per mesh instance.
+struct PartBuilder<'a> {
+    buffers: Vec<Cow<'a, [u8]>>,
+    /// Metres per model unit.
+    scale: f64,
+    /// Meshes already read, by mesh index (instanced meshes are read once).
+    meshes: Vec<Option<LocalMesh>>,
+    node_count: usize,
+    parts: Vec<Part>,
+    warnings: Vec<String>,
+}
+
+impl<'a> PartBuilder<'a> {
+    fn new(document: &Document, buffers: Vec<Cow<'a, [u8]>>, scale: f64) -> Self {
+        PartBuilder {
+            buffers,
+            scale,
+            meshes: vec![None; document.meshes().len()],
+            node_count: document.nodes().len(),
+            parts: Vec::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    /// Visits the scene's node trees depth first (an explicit stack: no recursion limit), in
+    /// file order, composing transforms from the roots down.
+    fn add_scene(&mut self, scene: &Scene) -> Res<()> {
+        let mut seen = vec![false; self.node_count];
+        let mut stack: Vec<(Node, DMat4)> = scene.nodes().map(|node| (node, DMat4::IDENTITY)).collect();
+        stack.reverse();
+        while let Some((node, parent)) = stack.pop() {
+            if std::mem::replace(&mut seen[node.index()], true) {
+                return Err(format!(
+                    "invalid node hierarchy: node {} is reached twice (a cycle or several parents)",
+                    node.index()
+                ));
+            }
+            let world = parent * local_matrix(&node)?;
+            if let Some(mesh) = node.mesh() {
+                self.add_instance(&node, &mesh, &world)?;
+            }
+            let first_child = stack.len();
+            stack.extend(node.children().map(|child| (child, world)));
+            stack[first_child..].reverse();
+        }
+        Ok(())
+    }
+
+    fn add_instance(&mut self, node: &Node, mesh: &gltf::Mesh, world: &DMat4) -> Res<()> {
+        let name = node
+            .name()
+            .or(mesh.name())
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("part_{}", self.parts.len()));
+        let label = format!("node '{name}'");
+        let local = self.local_mesh(mesh)?;
+        if local.triangles.is_empty() && !local.skipped.is_empty() {
+            self.warnings.push(format!("{label}: its mesh has only point or line primitives; not a part"));
+            return Ok(());
+        }
+        for skipped in &local.skipped {
+            self.warnings.push(format!("part '{name}': skipped {skipped}; only triangles are used"));
+        }
+        let (extras, fixed) = node_metadata(node, &label)?;
+        let mesh = bake(&local, world, self.scale);
+        self.parts.push(Part { name, mesh, fixed, extras });
+        Ok(())
+    }
+
+    /// The mesh's triangle primitives merged in its own frame (read once per mesh).
+    fn local_mesh(&mut self, mesh: &gltf::Mesh) -> Res<LocalMesh> {
+        if let Some(Some(done)) = self.meshes.get(mesh.index()) {
+            return Ok(done.clone());
+        }
+        let label = match mesh.name() {
+            Some(name) => format!("mesh '{name}'"),
+            None => format!("mesh {}", mesh.index()),
+        };
+        let mut local = LocalMesh { vertices: Vec::new(), triangles: Vec::new(), skipped: Vec::new() };
+        for primitive in mesh.primitives() {
+            let context = format!("{label}, primitive {}", primitive.index());
+            if !is_triangles(primitive.mode()) {
+                let mode = format!("{:?}", primitive.mode()).to_lowercase();
+                local.skipped.push(format!("{context} ({mode})"));
+                continue;
+            }
+            let (vertices, triangles) =
+                self.read_primitive(&primitive).map_err(|reason| format!("{context}: {reason}"))?;
+            // the running total is checked below, so the previous one fits in u32
+            let base = local.vertices.len() as u32;
+            local.vertices.extend(vertices);
+            if u32::try_from(local.vertices.len()).is_err() {
+                return Err(format!("{label}: more than 2^32 vertices"));
+            }
+            local.triangles.extend(triangles.iter().map(|t| t.map(|i| i + base)));
+        }
+        if let Some(slot) = self.meshes.get_mut(mesh.index()) {
+            *slot = Some(local.clone());
+        }
+        Ok(local)
+    }
+
+    fn read_primitive(&self, primitive: &Primitive) -> Res<(Vec<DVec3>, Vec<[u32; 3]>)> {
+        let positions = primitive.get(&Semantic::Positions).ok_or("no position attribute")?;
+        let vertices = read_positions(&positions, &self.buffers)?;
+        let indices = match primitive.indices() {
+            Some(accessor) => read_indices(&accessor, &self.buffers, vertices.len())?,
+            None => (0..vertices.len()).map(|i| i as u32).collect(),
+        };
+        Ok((vertices, triangulate(primitive.mode(), &indices)?))
+    }
+}
+
+fn is_triangles(mode: Mode) -> bool {
+    matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan)
+}
+
+/// The node's local transform as a matrix (glTF: `matrix`, or translation × rotation × scale).
+fn local_matrix(node: &Node) -> Res<DMat4> {
+    match node.transform() {
+        Transform::Matrix { matrix } => Ok(DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)))),
+        Transform::Decomposed { translation, rotation, scale } => {
+            let rotation = DQuat::from_array(rotation.map(f64::from));
+            let length = rotation.length();
+            if !length.is_finite() || length <= 1e-9 {
+                return Err(format!("node {}: rotation is not a unit quaternion", node.index()));
+            }
+            Ok(DMat4::from_scale_rotation_translation(
+                DVec3::from_array(scale.map(f64::from)),
+                rotation.normalize(),
+                DVec3::from_array(translation.map(f64::from)),
+            ))
+        }
+    }
+}
+
+/// The mesh moved by `world` and scaled to metres. A mirroring transform reverses the winding
+/// (glTF spec), so triangles are flipped back to keep their outward side.
+fn bake(local: &LocalMesh, world: &DMat4, scale: f64) -> Mesh {
+    let vertices = local
+        .vertices
+        .iter()
+        .map(|v| {
+            let p = world.transform_point3(*v) * scale;
+            Vec3::new(p.x as f32, p.y as f32, p.z as f32)
+        })
+        .collect();
+    let mirrored = world.determinant() < 0.0;
+    let triangles =
+        local.triangles.iter().map(|&[a, b, c]| if mirrored { [a, c, b] } else { [a, b, c] }).collect();
+    Mesh::new(vertices, triangles)
+}
+
+/// Triangles from a triangle list, strip or fan (strips and fans drop their degenerate
+/// stitching triangles).
+fn triangulate(mode: Mode, indices: &[u32]) -> Res<Vec<[u32; 3]>> {
+    let n = indices.len();
+    let triangles: Vec<[u32; 3]> = match mode {
+        Mode::Triangles if n % 3 != 0 => {
+            return Err(format!("{n} triangle indices is not a multiple of 3"));
+        }
+        Mode::Triangles => {
+            return Ok(indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect());
+        }
+        // spec: triangle i of a strip is (p_i, p_{i+1+i%2}, p_{i+2-i%2})
+        Mode::TriangleStrip => (0..n.saturating_sub(2))
+            .map(|i| [indices[i], indices[i + 1 + i % 2], indices[i + 2 - i % 2]])
+            .collect(),
+        // spec: triangle i of a fan is (p_{i+1}, p_{i+2}, p_0)
+        Mode::TriangleFan => {
+            (0..n.saturating_sub(2)).map(|i| [indices[i + 1], indices[i + 2], indices[0]]).collect()
+        }
+        other => return Err(format!("{other:?} is not a triangle mode").to_lowercase()),
+    };
+    Ok(triangles.into_iter().filter(|[a, b, c]| a != b && b != c && a != c).collect())
+}
+
+// ---------------------------------------------------------------------------------------------
+// Accessors
+
+/// Largest element count accepted for an accessor that has no buffer view (sparse over zeros):
+/// such counts are not backed by file bytes, so a corrupted count must not exhaust memory.
+const MAX_ZERO_FILLED: usize = 1 << 22;
+
+fn read_positions(accessor: &Accessor, buffers: &[Cow<[u8]>]) -> Res<Vec<DVec3>> {
+    if accessor.dimensions() != Dimensions::Vec3 {
+        return Err(format!(
+            "position accessor {} has unsupported type {:?} (expected vec3)",
+            accessor.index(),
+            accessor.dimensions()
+        )
+        .to_lowercase());
+    }
+    let flat = read_accessor(accessor, buffers)?;
+    Ok(flat.chunks_exact(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect())
+}
+
+fn read_indices(accessor: &Accessor, buffers: &[Cow<[u8]>], vertex_count: usize) -> Res<Vec<u32>> {
+    let unsigned = matches!(accessor.data_type(), DataType::U8 | DataType::U16 | DataType::U32);
+    if accessor.dimensions() != Dimensions::Scalar || !unsigned || accessor.normalized() {
+        return Err(format!(
+            "index accessor {} has unsupported type {:?} {:?} (expected scalar unsigned integers)",
+            accessor.index(),
+            accessor.dimensions(),
+            accessor.data_type()
+        )
+        .to_lowercase());
+    }
+    read_accessor(accessor, buffers)?
+        .into_iter()
+        .map(|i| match i as usize {
+            i if i < vertex_count => Ok(i as u32),
+            i => Err(format!(
+                "index accessor {}: index {i} is out of range ({vertex_count} vertices)",
+                accessor.index()
+            )),
+        })
+        .collect()
+}
+
+/// Every component of every element, as f64 (exact for all glTF component types), sparse
+/// substitutions applied.
+fn read_accessor(accessor: &Accessor, buffers: &[Cow<[u8]>]) -> Res<Vec<f64>> {
+    let layout = Layout {
+        data_type: accessor.data_type(),
+        components: accessor.dimensions().multiplicity(),
+        normalized: accessor.normalized(),
+    };
+    let count = accessor.count();
+    let context = |reason: String| format!("accessor {}: {reason}", accessor.index());
+    let mut values = match accessor.view() {
+        Some(view) => {
+            let bytes = view_bytes(&view, buffers).map_err(context)?;
+            layout.read(bytes, accessor.offset(), view.stride(), count).map_err(context)?
+        }
+        None if count <= MAX_ZERO_FILLED => vec![0.0; count * layout.components],
+        None => return Err(context(format!("count {count} without a buffer view is too large"))),
+    };
+    if let Some(sparse) = accessor.sparse() {
+        apply_sparse(&mut values, &sparse, layout, buffers).map_err(context)?;
+    }
+    Ok(values)
+}
+
+/// Replaces the elements a sparse accessor lists.
+fn apply_sparse(
+    values: &mut [f64],
+    sparse: &gltf::accessor::sparse::Sparse,
+    layout: Layout,
+    buffers: &[Cow<[u8]>],
+) -> Res<()> {
+    use gltf::accessor::sparse::IndexType;
+    let count = sparse.count();
+    let (indices, substitutes) = (sparse.indices(), sparse.values());
+    let index_layout = Layout {
+        data_type: match indices.index_type() {
+            IndexType::U8 => DataType::U8,
+            IndexType::U16 => DataType::U16,
+            IndexType::U32 => DataType::U32,
+        },
+        components: 1,
+        normalized: false,
+    };
+    let targets = index_layout.read(view_bytes(&indices.view(), buffers)?, indices.offset(), None, count)?;
+    let substitutes =
+        layout.read(view_bytes(&substitutes.view(), buffers)?, substitutes.offset(), None, count)?;
+    let n = layout.components;
+    for (target, substitute) in targets.iter().zip(substitutes.chunks_exact(n)) {
+        let start = *target as usize * n;
+        let slot = values
+            .get_mut(start..start + n)
+            .ok_or_else(|| format!("sparse index {target} is out of range"))?;
+        slot.copy_from_slice(substitute);
+    }
+    Ok(())
+}
+
+/// The bytes of a buffer view, checked against its buffer.
+fn view_bytes<'b>(view: &gltf::buffer::View, buffers: &'b [Cow<[u8]>]) -> Res<&'b [u8]> {
+    let buffer = buffers
+        .get(view.buffer().index())
+        .ok_or_else(|| format!("buffer view {} has no buffer", view.index()))?;
+    view.offset().checked_add(view.length()).and_then(|end| buffer.get(view.offset()..end)).ok_or_else(|| {
+        format!(
+            "buffer view {} (bytes {}..+{}) lies outside buffer {} ({} bytes)",
+            view.index(),
+            view.offset(),
+            view.length(),
+            view.buffer().index(),
+            buffer.len()
+        )
+    })
+}
+
+/// How the elements of an accessor are stored.
+#[derive(Clone, Copy)]
+struct Layout {
+    data_type: DataType,
+    components: usize,
+    normalized: bool,
+}
+
+impl Layout {
+    /// Reads `count` elements starting at `offset`, `stride` bytes apart (tightly packed when
+    /// None), after checking that they all lie inside `bytes`.
+    fn read(self, bytes: &[u8], offset: usize, stride: Option<usize>, count: usize) -> Res<Vec<f64>> {
+        let size = self.data_type.size();
+        let element = size * self.components;
+        let stride = stride.unwrap_or(element);
+        if stride < element {
+            return Err(format!("byte stride {stride} is smaller than an element ({element} bytes)"));
+        }
+        if count == 0 {
+            return Ok(Vec::new());
+        }
+        let end = (count - 1)
+            .checked_mul(stride)
+            .and_then(|n| n.checked_add(element))
+            .and_then(|n| n.checked_add(offset));
+        if end.is_none_or(|end| end > bytes.len()) {
+            return Err(format!(
+                "{count} elements at offset {offset} read past the end of the buffer view ({} bytes)",
+                bytes.len()
+            ));
+        }
+        let mut values = Vec::with_capacity(count * self.components);
+        for i in 0..count {
+            let start = offset + i * stride;
+            let element = &bytes[start..start + element];
+            values.extend(element.chunks_exact(size).map(|c| self.component(c)));
+        }
+        Ok(values)
+    }
+
+    /// One component; normalized integers map to [0, 1] or [-1, 1] (glTF spec, section 3.11).
+    fn component(self, b: &[u8]) -> f64 {
+        let (value, max) = match self.data_type {
+            DataType::I8 => (f64::from(b[0] as i8), 127.0),
+            DataType::U8 => (f64::from(b[0]), 255.0),
+            DataType::I16 => (f64::from(i16::from_le_bytes([b[0], b[1]])), 32767.0),
+            DataType::U16 => (f64::from(u16::from_le_bytes([b[0], b[1]])), 65535.0),
+            DataType::U32 => (f64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])), 1.0),
+            DataType::F32 => (f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])), 1.0),
+        };
+        if self.normalized && max > 1.0 {
+            (value / max).max(-1.0)
+        } else {
+            value
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_and_fans_follow_the_spec_winding() {
+        let strip = triangulate(Mode::TriangleStrip, &[0, 1, 2, 3, 4]).unwrap();
+        assert_eq!(strip, vec![[0, 1, 2], [1, 3, 2], [2, 3, 4]]);
+        let fan = triangulate(Mode::TriangleFan, &[0, 1, 2, 3]).unwrap();
+        assert_eq!(fan, vec![[1, 2, 0], [2, 3, 0]]);
+        // degenerate stitching triangles are dropped
+        assert!(triangulate(Mode::TriangleStrip, &[0, 1, 1, 2]).unwrap().is_empty());
+        assert!(triangulate(Mode::Triangles, &[0, 1, 2, 3]).is_err());
+    }
+
+    #[test]
+    fn percent_decoding() {
+        assert_eq!(percent_decode("my%20parts.bin").as_deref(), Some("my parts.bin"));
+        assert_eq!(percent_decode("100%").as_deref(), Some("100%"));
+        assert_eq!(percent_decode("%ff"), None);
+    }
+
+    #[test]
+    fn glb_headers_that_lie_are_errors() {
+        assert!(split_glb(b"glTF").unwrap_err().contains("truncated"));
+        let mut short = b"glTF".to_vec();
+        short.extend(2u32.to_le_bytes());
+        short.extend(4u32.to_le_bytes()); // length smaller than the header itself
+        assert!(split_glb(&short).unwrap_err().contains("not json"));
+    }
+
+    #[test]
+    fn normalized_components() {
+        let layout = Layout { data_type: DataType::I8, components: 1, normalized: true };
+        assert_eq!(layout.read(&[127, 0x80, 0], 0, None, 3).unwrap(), vec![1.0, -1.0, 0.0]);
+        let layout = Layout { data_type: DataType::U16, components: 1, normalized: false };
+        assert!(layout.read(&[1, 0, 2], 0, None, 2).is_err());
+    }
+}
