@@ -3,7 +3,7 @@
 
 use crate::check::DisassemblyCheck;
 use crate::error::{GenError, Result};
-use crate::manifest::{Checks, ManifestEntry, PartCounts};
+use crate::manifest::{Checks, Manifest, ManifestEntry, PartCounts, FORMAT_VERSION};
 use crate::profiles::{ConnectorShape, ProfileAssembly, ProfileParams};
 use crate::soma::{validate_cell, SomaCube, SomaParams};
 use asp_geom::Assembly;
@@ -11,6 +11,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
 /// What to generate, with all parameters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -159,4 +160,44 @@ pub fn generate_batch(
             Ok(entry)
         })
         .collect()
+}
+
+/// A batch to generate: the generator, where its parameters came from, how many, which seed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Batch {
+    /// What to generate.
+    pub generator: Generator,
+    /// The preset the parameters started from, recorded in the manifest.
+    pub preset: Option<String>,
+    /// Number of assemblies (≥ 1).
+    pub count: usize,
+    /// The batch seed.
+    pub seed: u64,
+}
+
+/// Generates `batch` into folder `out` (created when missing): one GLB per assembly, loadable
+/// with no extra options (fixed parts and the +Z up axis are in the file), and
+/// `manifest.json`. Calls `done` after each assembly. Files of the same names are overwritten.
+pub fn write_batch(batch: &Batch, out: &Path, done: &(dyn Fn() + Sync)) -> Result<Manifest> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| GenError::Io { path, source }
+    };
+    batch.generator.validate()?;
+    std::fs::create_dir_all(out).map_err(io(out))?;
+    let write = |g: &Generated, e: &ManifestEntry| Ok(asp_geom::io::write_glb(&g.assembly, &out.join(&e.file))?);
+    let assemblies = generate_batch(&batch.generator, batch.count, batch.seed, &write, done)?;
+    let manifest = Manifest {
+        format_version: FORMAT_VERSION,
+        generator: batch.generator.clone(),
+        preset: batch.preset.clone(),
+        seed: batch.seed,
+        count: batch.count,
+        failed_checks: assemblies.iter().filter(|e| !e.checks.passed()).count(),
+        assemblies,
+    };
+    let path = out.join("manifest.json");
+    let json = serde_json::to_string_pretty(&manifest).map_err(|e| GenError::Io { path: path.clone(), source: e.into() })?;
+    std::fs::write(&path, format!("{json}\n")).map_err(io(&path))?;
+    Ok(manifest)
 }

@@ -8,7 +8,7 @@ pub mod manifest;
 pub mod profiles;
 pub mod soma;
 
-pub use batch::{assembly_seed, generate_batch, Generated, Generator};
+pub use batch::{assembly_seed, generate_batch, write_batch, Batch, Generated, Generator};
 pub use check::DisassemblyCheck;
 pub use error::{GenError, Result};
 pub use manifest::{Manifest, ManifestEntry};

@@ -351,8 +351,8 @@ impl ProfileAssembly {
                     approach[side] = -sign;
                     let mut close = [0.0; 3];
                     close[closing] = 1.0;
-                    let orientation = quaternion(cross(close, approach), close, approach);
-                    out.push(GraspPoint { position, orientation, width: p.profile_size });
+                    let orientation = quaternion(cross(close, approach), close, approach).map(|q| tidy(q, 1e12));
+                    out.push(GraspPoint { position: position.map(|x| tidy(x, 1e9)), orientation, width: p.profile_size });
                 }
             }
         }
@@ -360,7 +360,8 @@ impl ProfileAssembly {
     }
 
     /// The assembly (metres, +Z up): profiles named `profile_NN`, then connectors named
-    /// `u_connector_NN` / `o_connector_NN`, with their metadata under `extras.asp`.
+    /// `u_connector_NN` / `o_connector_NN`, with their metadata in their extras (written to
+    /// the file's `extras.asp`): kind, role, exact boxes, grasp points.
     pub fn to_assembly(&self, source: &str) -> Assembly {
         let axis_name = |a: usize| ["x", "y", "z"][a];
         let mut parts: Vec<Part> = self
@@ -371,15 +372,16 @@ impl ProfileAssembly {
                 name: profile_name(i),
                 mesh: p.cuboid.mesh(),
                 fixed: p.fixed,
-                extras: json!({"asp": {
+                extras: json!({
                     "kind": "profile",
                     "role": p.role,
                     "layer": p.layer,
                     "axis": axis_name(p.axis),
-                    "length": p.length(),
+                    "length": tidy(p.length(), 1e9),
                     "size": self.params.profile_size,
+                    "boxes": [box_array(&p.cuboid)],
                     "grasp_points": self.grasp_points(i),
-                }}),
+                }),
             })
             .collect();
         for (k, c) in self.connectors.iter().enumerate() {
@@ -391,12 +393,13 @@ impl ProfileAssembly {
                 name: format!("{}_connector_{k:02}", shape.to_lowercase()),
                 mesh: c.mesh.clone(),
                 fixed: c.fixed,
-                extras: json!({"asp": {
+                extras: json!({
                     "kind": "connector",
                     "shape": shape,
                     "holds": profile_name(c.holds),
                     "attached_to": profile_name(c.attached_to),
-                }}),
+                    "boxes": c.cells.iter().map(box_array).collect::<Vec<_>>(),
+                }),
             });
         }
         Assembly { parts, units: Units::metres(), up: Axis::Z, source: source.into(), warnings: Vec::new() }
@@ -406,6 +409,17 @@ impl ProfileAssembly {
     pub fn check_disassembly(&self) -> DisassemblyCheck {
         check_disassembly(&BoxModel::new(self.part_boxes(), self.fixed(), TOLERANCE))
     }
+}
+
+/// A box as `[min x, min y, min z, max x, max y, max z]`, to the nanometre.
+fn box_array(b: &Cuboid) -> [f64; 6] {
+    [b.mins[0], b.mins[1], b.mins[2], b.maxs[0], b.maxs[1], b.maxs[2]].map(|v| tidy(v, 1e9))
+}
+
+/// `v` rounded to `1 / per_unit` (e.g. `1e9` per metre: nanometres), without negative zero:
+/// short decimals in the file that every JSON reader parses back to the same number.
+fn tidy(v: f64, per_unit: f64) -> f64 {
+    (v * per_unit).round() / per_unit + 0.0
 }
 
 fn profile_name(i: usize) -> String {

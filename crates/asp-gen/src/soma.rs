@@ -213,13 +213,13 @@ impl SomaCube {
                 name: name.clone(),
                 mesh: Mesh::from_voxels(cells, Vec3::splat(c), Vec3::ZERO),
                 fixed: false,
-                extras: json!({"asp": {
+                extras: json!({
                     "kind": "soma_piece",
                     "cube_size": self.size,
                     "cell_size": cell,
                     "origin": [0.0, 0.0, 0.0],
                     "cells": cells,
-                }}),
+                }),
             })
             .collect();
         let edge = self.size as f32 * c;
@@ -227,7 +227,7 @@ impl SomaCube {
             name: "floor".into(),
             mesh: Mesh::cuboid(Vec3::new(-c, -c, -0.5 * c), Vec3::new(edge + c, edge + c, 0.0)),
             fixed: true,
-            extras: json!({"asp": {"kind": "floor"}}),
+            extras: json!({"kind": "floor"}),
         });
         Assembly {
             parts,

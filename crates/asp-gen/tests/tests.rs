@@ -7,7 +7,7 @@ use asp_gen::manifest::PartCounts;
 use asp_gen::profiles::{ConnectorShape, Role, TOLERANCE};
 use asp_gen::*;
 use asp_geom::math::Axis;
-use asp_geom::{Assembly, Checker, CheckerConfig, FeasibilityChecker, MotionKind, Outcome, PartSet, World, WorldConfig};
+use asp_geom::{Checker, CheckerConfig, World, WorldConfig};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::collections::HashSet;
@@ -73,14 +73,14 @@ fn soma_extras_carry_the_voxels() {
     let c = cube(4, 2);
     let a = c.to_assembly(0.03, "x");
     for (part, cells) in a.parts.iter().zip(c.pieces()) {
-        let asp = &part.extras["asp"];
+        let asp = &part.extras;
         assert_eq!(asp["kind"], "soma_piece");
         assert_eq!(asp["cube_size"], 4);
         assert_eq!(asp["cell_size"], 0.03);
         let stored: Vec<[i32; 3]> = serde_json::from_value(asp["cells"].clone()).unwrap();
         assert_eq!(&stored, cells);
     }
-    assert_eq!(a.parts.last().unwrap().extras["asp"]["kind"], "floor");
+    assert_eq!(a.parts.last().unwrap().extras["kind"], "floor");
 }
 
 #[test]
@@ -303,15 +303,17 @@ fn grasp_points_every_2_cm_with_3_cm_margins_on_four_sides() {
         let mut along: Vec<f64> = g.iter().map(|x| x.position[p.axis]).collect();
         along.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
         assert_eq!(along.len(), expected);
-        assert!((along[0] - (lo + 0.03)).abs() < 1e-9);
+        assert!((along[0] - (lo + 0.03)).abs() <= 1e-9);
         assert!(*along.last().unwrap() <= hi - 0.03 + 1e-9);
-        assert!(along.windows(2).all(|w| (w[1] - w[0] - 0.02).abs() < 1e-9));
+        assert!(along.windows(2).all(|w| (w[1] - w[0] - 0.02).abs() < 2e-9));
         let mut approaches = HashSet::new();
         for x in &g {
             assert_eq!(x.width, 0.02);
+            let json = serde_json::to_string(x).unwrap();
+            assert!(!json.contains("-0.0") && json.len() < 120, "short numbers: {json}");
             // on the centre line
             let c = p.centre();
-            assert!((0..3).filter(|&k| k != p.axis).all(|k| (x.position[k] - c[k]).abs() < 1e-12));
+            assert!((0..3).filter(|&k| k != p.axis).all(|k| (x.position[k] - c[k]).abs() <= 1e-9));
             // unit quaternion whose z axis (approach) is perpendicular to the profile
             let [qx, qy, qz, qw] = x.orientation;
             assert!(((qx * qx + qy * qy + qz * qz + qw * qw) - 1.0).abs() < 1e-9);
@@ -323,7 +325,7 @@ fn grasp_points_every_2_cm_with_3_cm_margins_on_four_sides() {
     }
     // stored in the file's extras
     let asm = a.to_assembly("x");
-    let stored = &asm.parts[0].extras["asp"]["grasp_points"];
+    let stored = &asm.parts[0].extras["grasp_points"];
     assert_eq!(stored.as_array().unwrap().len(), a.grasp_points(0).len());
     assert_eq!(stored[0]["width"], 0.02);
 }
@@ -432,40 +434,101 @@ fn custom_profile_parameters_work() {
     assert!(a.check_disassembly().straight_line);
 }
 
-// ---------------------------------------------------------------- asp-geom's removal checker
+// ---------------------------------------------------------------- files and `asp plan`
 
-/// Removes parts top-down with asp-geom's straight-line removal test and contact-graph
-/// stability; returns the parts left when nothing more comes out.
-fn remove_with_asp_geom(assembly: Assembly) -> Vec<String> {
-    let lowest: Vec<f32> = assembly.parts.iter().map(|p| p.mesh.aabb().unwrap().mins.z).collect();
-    let checker = Checker::new(World::new(assembly, &WorldConfig::default()).unwrap(), CheckerConfig::default());
-    let mut state = PartSet::full(checker.num_parts());
-    let mut order: Vec<usize> = (0..checker.num_parts()).filter(|&i| !checker.is_fixed(i)).collect();
-    order.sort_by(|&a, &b| lowest[b].total_cmp(&lowest[a]).then(a.cmp(&b)));
-    loop {
-        let next = order.iter().copied().filter(|&i| state.contains(i)).find(|&i| {
-            matches!(checker.test_removal(i, &state, MotionKind::Linear), Outcome::Removed(_))
-        });
-        match next {
-            Some(i) => state.remove(i),
-            None => break,
+fn write(generator: Generator, count: usize, seed: u64, out: &std::path::Path) -> Manifest {
+    write_batch(&Batch { generator, preset: None, count, seed }, out, &|| {}).unwrap()
+}
+
+#[test]
+fn written_files_load_with_no_options_and_keep_their_metadata() {
+    let dir = tempfile::tempdir().unwrap();
+    let generator = Generator::Profiles(ProfileParams::single_layer());
+    let manifest = write(generator.clone(), 2, 3, dir.path());
+    let from_disk: Manifest =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(from_disk, manifest);
+    assert_eq!(manifest.generator, generator);
+    for entry in &manifest.assemblies {
+        let loaded = asp_geom::io::load(&dir.path().join(&entry.file), &Default::default()).unwrap();
+        let generated = ProfileAssembly::generate(&ProfileParams::single_layer(), entry.seed).unwrap().to_assembly("x");
+        assert_eq!(loaded.up, Axis::Z);
+        assert_eq!(loaded.units.metres, 1.0);
+        assert_eq!(loaded.len(), entry.parts);
+        assert_eq!(loaded.parts.iter().filter(|p| p.fixed).count(), entry.fixed_parts);
+        for (l, g) in loaded.parts.iter().zip(&generated.parts) {
+            assert_eq!((&l.name, l.fixed), (&g.name, g.fixed));
+            if l.extras != g.extras {
+                let (a, b) = (l.extras.to_string(), g.extras.to_string());
+                let at = a.bytes().zip(b.bytes()).position(|(x, y)| x != y).unwrap_or(0);
+                panic!("{}: extras differ at {}: {} vs {}", l.name, at, &a[at.saturating_sub(60)..(at + 40).min(a.len())], &b[at.saturating_sub(60)..(at + 40).min(b.len())]);
+            }
+            assert_eq!(l.mesh.triangles.len(), g.mesh.triangles.len());
         }
     }
-    order.iter().filter(|&&i| state.contains(i)).map(|&i| checker.world().name(i).to_string()).collect()
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = write(Generator::Soma(SomaParams { size: 3, cell: 0.05 }), 1, 0, dir.path());
+    let loaded = asp_geom::io::load(&dir.path().join(&manifest.assemblies[0].file), &Default::default()).unwrap();
+    assert_eq!(loaded.up, Axis::Z);
+    assert_eq!(loaded.parts.iter().filter(|p| p.fixed).map(|p| p.name.as_str()).collect::<Vec<_>>(), ["floor"]);
+    assert!(loaded.parts[0].extras["cells"].is_array());
 }
 
 #[test]
-#[ignore = "asp-geom's erosion keeps saddle vertices (faces with normals +z and -z) in place, so its removal test falsely blocks voxel pieces and U connectors; see docs/generators.md"]
-fn asp_geom_checker_takes_a_soma_cube_apart() {
-    assert_eq!(remove_with_asp_geom(cube(4, 0).to_assembly(0.05, "soma4")), Vec::<String>::new());
-    assert_eq!(remove_with_asp_geom(SomaCube::classic().to_assembly(0.05, "classic")), Vec::<String>::new());
+fn the_same_seed_writes_the_same_bytes() {
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    for generator in [Generator::Soma(SomaParams { size: 4, cell: 0.05 }), Generator::Profiles(ProfileParams::double_layer())] {
+        let manifest = write(generator.clone(), 3, 9, a.path());
+        write(generator.clone(), 3, 9, b.path());
+        for name in manifest.assemblies.iter().map(|e| e.file.as_str()).chain(["manifest.json"]) {
+            let (x, y) = (std::fs::read(a.path().join(name)).unwrap(), std::fs::read(b.path().join(name)).unwrap());
+            assert!(x == y, "{name} differs");
+        }
+        let other = tempfile::tempdir().unwrap();
+        let m = write(generator, 1, 10, other.path());
+        let x = std::fs::read(a.path().join(&m.assemblies[0].file)).unwrap();
+        let y = std::fs::read(other.path().join(&m.assemblies[0].file)).unwrap();
+        assert!(x != y, "another seed, another assembly");
+    }
+}
+
+/// Plans a written file the way `asp plan FILE` does with no flags (within a time budget).
+fn plans_to_completion(path: &std::path::Path) -> std::result::Result<(), String> {
+    use asp_search::{Budget, Dfs, Planner, Problem, Status};
+    let assembly = asp_geom::io::load(path, &Default::default()).map_err(|e| e.to_string())?;
+    let checker = Checker::new(World::new(assembly, &WorldConfig::default()).unwrap(), CheckerConfig::default());
+    let budget = Budget { timeout: Some(std::time::Duration::from_secs(60)), ..Budget::default() };
+    let outcome = Dfs::builder().build().solve(&Problem::full(&checker), &budget);
+    match outcome.status {
+        Status::Found => Ok(()),
+        Status::NoPlan { stuck, .. } => {
+            Err(format!("{}: no plan, stuck: {:?}", path.display(), stuck.iter().map(|s| checker.world().name(s.part)).collect::<Vec<_>>()))
+        }
+        Status::BudgetExhausted => Err(format!("{}: budget exhausted", path.display())),
+    }
+}
+
+const EROSION: &str = "asp-geom's erosion keeps saddle vertices of voxel pieces and U connectors (faces with normals +z and -z) in place, so its removal test blocks them falsely; see docs/generators.md";
+
+#[test]
+#[ignore = "asp-geom's erosion keeps saddle vertices in place (see EROSION): the classic cube has no plan"]
+fn generated_soma_cubes_plan_to_completion() {
+    let dir = tempfile::tempdir().unwrap();
+    let classic = write(Generator::ClassicSoma { cell: 0.05 }, 1, 0, dir.path());
+    let random = write(Generator::Soma(SomaParams { size: 4, cell: 0.05 }), 4, 0, dir.path());
+    for entry in classic.assemblies.iter().chain(&random.assemblies) {
+        plans_to_completion(&dir.path().join(&entry.file)).expect(EROSION);
+    }
 }
 
 #[test]
-#[ignore = "asp-geom's erosion keeps saddle vertices (faces with normals +z and -z) in place, so its removal test falsely blocks voxel pieces and U connectors; see docs/generators.md"]
-fn asp_geom_checker_takes_a_profile_assembly_apart() {
-    let a = profiles(&ProfileParams::single_layer(), 0).to_assembly("profiles");
-    assert_eq!(remove_with_asp_geom(a), Vec::<String>::new());
+#[ignore = "asp-geom's erosion keeps saddle vertices in place (see EROSION): profile assemblies exhaust the budget"]
+fn generated_profile_assemblies_plan_to_completion() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = write(Generator::Profiles(ProfileParams::single_layer()), 2, 0, dir.path());
+    for entry in &manifest.assemblies {
+        plans_to_completion(&dir.path().join(&entry.file)).expect(EROSION);
+    }
 }
 
 // ---------------------------------------------------------------- batches
