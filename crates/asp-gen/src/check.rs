@@ -1,16 +1,17 @@
 //! The generators' own straight-line disassembly check: which parts can leave along a ±axis,
-//! in which order, and whether that order keeps every intermediate state linked to the fixed
-//! parts through contacts.
+//! in which order, and whether an order exists that keeps every intermediate state linked to
+//! the fixed parts through contacts.
 //!
 //! Whether a part can leave along an axis only gets easier as other parts leave, so removing any
-//! removable part never hurts: the greedy loop below decides straight-line disassemblability
-//! exactly. Stability is not monotone; the greedy order that prefers stable states is a witness
-//! when it succeeds, not a proof of impossibility when it fails.
+//! removable part never hurts: a greedy loop decides straight-line disassemblability exactly.
+//! Stability is not monotone, so a stable order is searched depth-first (top-down, dead states
+//! remembered) within a budget of expanded states.
 
 use crate::cuboid::Cuboid;
 use asp_geom::math::Axis;
 use asp_geom::PartSet;
 use serde::{Deserialize, Serialize};
+use std::collections::HashSet;
 
 /// The six removal directions, upward first (the natural way to lift a part off).
 pub const DIRECTIONS: [Axis; 6] = [
@@ -22,6 +23,9 @@ pub const DIRECTIONS: [Axis; 6] = [
     Axis { index: 2, negative: true },
 ];
 
+/// States the stable-order search may expand before it gives up.
+pub const SEARCH_BUDGET: usize = 20_000;
+
 /// What the straight-line disassembly check found for one assembly.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DisassemblyCheck {
@@ -31,9 +35,11 @@ pub struct DisassemblyCheck {
     pub straight_line: bool,
     /// Non-fixed parts left when no remaining part could leave (empty when `straight_line`).
     pub stuck: Vec<usize>,
-    /// The greedy order found keeps each state contact-linked to the fixed parts.
+    /// A removal order was found in which every state stays contact-linked to the fixed parts
+    /// (false: none exists, or none was found within [`SEARCH_BUDGET`] states).
     pub stable_order: bool,
-    /// The removal order found: part index and the axis it leaves along.
+    /// The removal order found: part index and the axis it leaves along (the stable order when
+    /// one was found, else the greedy straight-line order).
     pub order: Vec<(usize, Axis)>,
 }
 
@@ -43,11 +49,13 @@ pub trait RemovalModel {
     fn num_parts(&self) -> usize;
     /// Whether part `i` stays in place.
     fn is_fixed(&self, i: usize) -> bool;
-    /// Whether part `i` can leave `state` along `axis` without pushing into any present part.
-    fn can_leave(&self, i: usize, axis: Axis, state: &PartSet) -> bool;
+    /// Every part that part `i` would push into if it moved along `axis` to infinity.
+    fn blockers(&self, i: usize, axis: Axis) -> Vec<usize>;
     /// The parts that touch part `i` (shared face area), in any order.
     fn contacts(&self, i: usize) -> &[usize];
-    /// The height of part `i`'s lowest point; parts lying higher are tried first (top-down).
+    /// The height of part `i`'s lowest point; parts lying higher are tried first (top-down),
+    /// and among parts at one height the later ones (generators add a part after the parts it
+    /// rests on: reverse build order).
     fn bottom(&self, i: usize) -> f64;
 }
 
@@ -69,36 +77,69 @@ pub fn is_contact_linked(model: &impl RemovalModel, state: &PartSet) -> bool {
     reached.len() == state.len()
 }
 
-/// Removes parts greedily along ±axes, top-down, preferring stable remaining states.
+/// Runs the check: exact straight-line disassemblability, then a search for a stable order.
 pub fn check_disassembly(model: &impl RemovalModel) -> DisassemblyCheck {
     let n = model.num_parts();
-    let mut order_by_height: Vec<usize> = (0..n).filter(|&i| !model.is_fixed(i)).collect();
-    order_by_height.sort_by(|&a, &b| model.bottom(b).total_cmp(&model.bottom(a)).then(a.cmp(&b)));
+    let mut ranked: Vec<usize> = (0..n).filter(|&i| !model.is_fixed(i)).collect();
+    ranked.sort_by(|&a, &b| model.bottom(b).total_cmp(&model.bottom(a)).then(b.cmp(&a)));
+    let blockers: Vec<Vec<PartSet>> = (0..n)
+        .map(|i| DIRECTIONS.iter().map(|&a| PartSet::from_indices(n, model.blockers(i, a))).collect())
+        .collect();
+    let free_axis = |i: usize, state: &PartSet| {
+        DIRECTIONS.iter().zip(&blockers[i]).find(|(_, b)| !b.intersects(state)).map(|(&a, _)| a)
+    };
+    // straight lines only: take out whatever can leave, until nothing can
     let mut state = PartSet::full(n);
     let mut order = Vec::new();
-    let mut stable_order = true;
-    loop {
-        let mut fallback = None;
-        let mut pick = None;
-        for &i in order_by_height.iter().filter(|&&i| state.contains(i)) {
-            let Some(&axis) = DIRECTIONS.iter().find(|&&a| model.can_leave(i, a, &state)) else {
-                continue;
-            };
-            if is_contact_linked(model, &state.without(i)) {
-                pick = Some((i, axis));
-                break;
-            }
-            fallback.get_or_insert((i, axis));
-        }
-        let Some((i, axis)) = pick.or(fallback) else { break };
-        stable_order &= pick.is_some();
+    while let Some((i, axis)) = ranked.iter().filter(|&&i| state.contains(i)).find_map(|&i| Some((i, free_axis(i, &state)?))) {
         state.remove(i);
         order.push((i, axis));
     }
     let stuck: Vec<usize> = state.iter().filter(|&i| !model.is_fixed(i)).collect();
-    DisassemblyCheck {
-        linked: is_contact_linked(model, &PartSet::full(n)),
-        straight_line: stuck.is_empty(), stable_order: stable_order && stuck.is_empty(), stuck, order }
+    let mut search = StableSearch { model, ranked: &ranked, free_axis: &free_axis, dead: HashSet::new(), budget: SEARCH_BUDGET, order: Vec::new() };
+    let stable_order = stuck.is_empty() && search.run(&PartSet::full(n)) == Some(true);
+    if stable_order {
+        order = search.order;
+    }
+    DisassemblyCheck { linked: is_contact_linked(model, &PartSet::full(n)), straight_line: stuck.is_empty(), stuck, stable_order, order }
+}
+
+/// Depth-first search for a removal order whose states all stay contact-linked.
+struct StableSearch<'a, M, F> {
+    model: &'a M,
+    ranked: &'a [usize],
+    free_axis: &'a F,
+    /// States from which no stable order exists.
+    dead: HashSet<PartSet>,
+    budget: usize,
+    order: Vec<(usize, Axis)>,
+}
+
+impl<M: RemovalModel, F: Fn(usize, &PartSet) -> Option<Axis>> StableSearch<'_, M, F> {
+    /// Some(true) when `state` can be emptied, Some(false) when it cannot, None out of budget.
+    fn run(&mut self, state: &PartSet) -> Option<bool> {
+        if self.ranked.iter().all(|&i| !state.contains(i)) {
+            return Some(true);
+        }
+        if self.dead.contains(state) {
+            return Some(false);
+        }
+        self.budget = self.budget.checked_sub(1)?;
+        for &i in self.ranked.iter().filter(|&&i| state.contains(i)) {
+            let Some(axis) = (self.free_axis)(i, state) else { continue };
+            let next = state.without(i);
+            if !is_contact_linked(self.model, &next) {
+                continue;
+            }
+            self.order.push((i, axis));
+            if self.run(&next)? {
+                return Some(true);
+            }
+            self.order.pop();
+        }
+        self.dead.insert(state.clone());
+        Some(false)
+    }
 }
 
 /// Parts made of axis-aligned boxes: a part leaves along an axis when sweeping its boxes to
@@ -136,12 +177,12 @@ impl RemovalModel for BoxModel {
         self.fixed[i]
     }
 
-    fn can_leave(&self, i: usize, axis: Axis, state: &PartSet) -> bool {
-        !state.iter().filter(|&j| j != i).any(|j| {
-            self.parts[i].iter().any(|a| {
-                self.parts[j].iter().any(|b| a.sweep_hits(b, axis.index as usize, axis.negative, self.tol))
-            })
-        })
+    fn blockers(&self, i: usize, axis: Axis) -> Vec<usize> {
+        let (a, negative) = (axis.index as usize, axis.negative);
+        (0..self.parts.len())
+            .filter(|&j| j != i)
+            .filter(|&j| self.parts[i].iter().any(|x| self.parts[j].iter().any(|y| x.sweep_hits(y, a, negative, self.tol))))
+            .collect()
     }
 
     fn contacts(&self, i: usize) -> &[usize] {
@@ -175,6 +216,40 @@ mod tests {
         let parts = vec![vec![unit(0.0, 0.0, 0.0)], vec![unit(0.0, 0.0, 3.0)]];
         let check = check_disassembly(&BoxModel::new(parts, vec![true, false], 1e-9));
         assert!(!check.linked && check.straight_line);
+    }
+
+    /// Explicit blockers and contacts: 0 fixed; 1 free; 2 free; 3 blocked by 2 everywhere.
+    /// 3 rests on 1 and 2, so 1 must stay until 2 and 3 are gone.
+    struct DeadEnd {
+        contacts: Vec<Vec<usize>>,
+    }
+
+    impl RemovalModel for DeadEnd {
+        fn num_parts(&self) -> usize {
+            4
+        }
+        fn is_fixed(&self, i: usize) -> bool {
+            i == 0
+        }
+        fn blockers(&self, i: usize, _: Axis) -> Vec<usize> {
+            if i == 3 { vec![2] } else { vec![] }
+        }
+        fn contacts(&self, i: usize) -> &[usize] {
+            &self.contacts[i]
+        }
+        fn bottom(&self, i: usize) -> f64 {
+            [0.0, 3.0, 2.0, 1.0][i]
+        }
+    }
+
+    #[test]
+    fn the_stable_search_backtracks_out_of_a_dead_end() {
+        // top-down, part 1 goes first and strands 3 on 2; the search must back out of that
+        let model = DeadEnd { contacts: vec![vec![1, 2], vec![0, 3], vec![0, 3], vec![1, 2]] };
+        let check = check_disassembly(&model);
+        assert!(check.linked && check.straight_line && check.stable_order);
+        let parts: Vec<usize> = check.order.iter().map(|&(i, _)| i).collect();
+        assert_eq!(parts, vec![2, 3, 1]);
     }
 
     #[test]

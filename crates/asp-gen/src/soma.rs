@@ -7,7 +7,7 @@
 use crate::check::{check_disassembly, DisassemblyCheck, RemovalModel};
 use crate::error::{GenError, Result};
 use asp_geom::math::{Axis, Vec3};
-use asp_geom::{Assembly, Mesh, Part, PartSet, Units};
+use asp_geom::{Assembly, Mesh, Part, Units};
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -288,24 +288,28 @@ impl RemovalModel for VoxelModel<'_> {
         i == self.floor()
     }
 
-    /// A piece leaves along an axis iff no cell of another present piece lies on the ray of
-    /// any of its cells; the floor spans the cube's footprint, so it blocks every −z ray.
-    fn can_leave(&self, i: usize, axis: Axis, state: &PartSet) -> bool {
-        if i == self.floor() || (axis == Axis { index: 2, negative: true } && state.contains(self.floor())) {
-            return false;
+    /// The pieces with a cell on the ray of any cell of piece `i`; the floor spans the cube's
+    /// footprint, so it lies on every −z ray.
+    fn blockers(&self, i: usize, axis: Axis) -> Vec<usize> {
+        let mut out = Vec::new();
+        if i == self.floor() {
+            return out;
+        }
+        if axis.index == 2 && axis.negative {
+            out.push(self.floor());
         }
         let step = if axis.negative { -1 } else { 1 };
-        self.cube.pieces[i].iter().all(|&start| {
+        for &start in &self.cube.pieces[i] {
             let mut c = start;
-            loop {
-                c[axis.index as usize] += step;
-                match self.cube.piece_at(c) {
-                    None => return true,
-                    Some(q) if q != i && state.contains(q) => return false,
-                    Some(_) => {}
+            c[axis.index as usize] += step;
+            while let Some(q) = self.cube.piece_at(c) {
+                if q != i && !out.contains(&q) {
+                    out.push(q);
                 }
+                c[axis.index as usize] += step;
             }
-        })
+        }
+        out
     }
 
     fn contacts(&self, i: usize) -> &[usize] {
@@ -397,13 +401,12 @@ mod tests {
     fn the_floor_blocks_downward_removal() {
         let cube = SomaCube::from_labels(2, vec![0, 0, 0, 0, 1, 1, 1, 1]).unwrap();
         let model = VoxelModel::new(&cube);
-        let all = PartSet::full(3);
         let down = Axis { index: 2, negative: true };
-        assert!(!model.can_leave(0, down, &all));
-        assert!(!model.can_leave(0, Axis::Z, &all), "piece 1 lies on top of piece 0");
-        assert!(model.can_leave(1, Axis::Z, &all));
-        assert!(model.can_leave(0, Axis { index: 0, negative: false }, &all), "sliding out sideways");
-        assert!(model.can_leave(0, down, &all.without(2)), "without the floor");
+        assert_eq!(model.blockers(0, down), vec![2], "the floor");
+        assert_eq!(model.blockers(0, Axis::Z), vec![1], "piece 1 lies on top of piece 0");
+        assert_eq!(model.blockers(1, Axis::Z), Vec::<usize>::new());
+        assert_eq!(model.blockers(1, down), vec![2, 0]);
+        assert!(model.blockers(0, Axis { index: 0, negative: false }).is_empty(), "sliding out sideways");
         assert_eq!(model.contacts(2), &[0]);
     }
 }
