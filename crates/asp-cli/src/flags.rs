@@ -35,6 +35,9 @@ pub enum OrderArg {
 pub enum StabilityArg {
     /// Every part linked through contacts to a fixed part.
     Contact,
+    /// Simulate what remains under gravity (rapier3d); unstable when a part moves more than
+    /// `--physics-threshold`.
+    Physics,
 }
 
 /// Flags of `asp plan`.
@@ -66,6 +69,10 @@ pub struct PlanArgs {
     /// Parts closer than this (model units) are in contact for stability [default: 1e-3 × diagonal].
     #[arg(long)]
     pub contact_distance: Option<f64>,
+    /// Ignore collisions between parts that overlap in the input far beyond the tolerance
+    /// (warned) instead of stopping with an error.
+    #[arg(long)]
+    pub ignore_overlapping: bool,
     /// Clustered surface-normal directions tried besides the six axes (each with its opposite).
     #[arg(long, default_value_t = 10)]
     pub normals: usize,
@@ -81,6 +88,10 @@ pub struct PlanArgs {
     /// Stability criterion.
     #[arg(long, value_enum, default_value_t = StabilityArg::Contact)]
     pub stability: StabilityArg,
+    /// Physics stability: how far (fraction of the model's diagonal) a part may move in the
+    /// simulation before the state counts as unstable.
+    #[arg(long, default_value_t = 0.01)]
+    pub physics_threshold: f64,
     /// Seed of every random choice (random order, path planner).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -94,10 +105,11 @@ pub struct PlanArgs {
     #[arg(long)]
     pub no_path_planner: bool,
     /// Path planner iterations per call.
-    #[arg(long, default_value_t = 3000)]
+    #[arg(long, default_value_t = 2000)]
     pub rrt_iterations: usize,
-    /// Path planner wall-time cap per call, seconds.
-    #[arg(long, default_value_t = 2.0)]
+    /// Path planner wall-time safety cap per call, seconds (the iteration budget keeps runs
+    /// reproducible; this only guards against pathological models).
+    #[arg(long, default_value_t = 5.0)]
     pub rrt_time: f64,
     /// No progress bar, no warnings.
     #[arg(long, short)]

@@ -4,6 +4,7 @@ use crate::flags::{OrderArg, PlanArgs, StabilityArg};
 use anyhow::{bail, Context};
 use asp_geom::io::{load, LoadOptions};
 use asp_geom::math::Axis;
+use asp_geom::physics::PhysicsConfig;
 use asp_geom::rrt::RrtConfig;
 use asp_geom::{Checker, CheckerConfig, StabilityMode, Units, World, WorldConfig};
 use asp_search::report::{MotionEntry, PlanReport};
@@ -41,6 +42,7 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
         contact_distance: to_m("contact-distance", args.contact_distance)?,
         normal_clusters: args.normals,
         sphere_directions: args.sphere_directions,
+        ignore_overlapping: args.ignore_overlapping,
         ..WorldConfig::default()
     };
     let world = World::new(assembly, &config)?;
@@ -51,6 +53,14 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
     }
     let stability = match args.stability {
         StabilityArg::Contact => StabilityMode::ContactGraph,
+        StabilityArg::Physics => {
+            let physics = PhysicsConfig {
+                displacement_fraction: positive("physics-threshold", args.physics_threshold)? as f32,
+                ..PhysicsConfig::default()
+            };
+            physics.validate()?;
+            StabilityMode::Physics(physics)
+        }
     };
     let rrt = RrtConfig {
         max_iterations: args.rrt_iterations,

@@ -5,6 +5,7 @@ use crate::feasibility::{
     CounterSnapshot, Counters, FeasibilityChecker, MotionKind, Outcome, Stability,
 };
 use crate::partset::PartSet;
+use crate::physics::{PhysicsConfig, PhysicsStability};
 use crate::rrt::{plan_removal_path, RrtConfig};
 use crate::world::World;
 
@@ -14,6 +15,9 @@ pub enum StabilityMode {
     /// Every present part is linked through the contact graph to a fixed part (seed 3.3).
     #[default]
     ContactGraph,
+    /// The present parts are simulated under gravity with rapier3d (fixed parts static); the
+    /// state is unstable when any part moves more than a threshold (see [`crate::physics`]).
+    Physics(PhysicsConfig),
 }
 
 /// Settings of the [`Checker`].
@@ -30,17 +34,30 @@ pub struct Checker {
     world: World,
     config: CheckerConfig,
     counters: Counters,
+    /// The physics check, when the stability mode asks for it (its shapes are cached lazily).
+    physics: Option<PhysicsStability>,
 }
 
 impl Checker {
-    /// A checker over `world`.
+    /// A checker over `world`. A physics stability mode with out-of-range settings falls back to
+    /// the default physics settings; validate them first with [`PhysicsConfig::validate`].
     pub fn new(world: World, config: CheckerConfig) -> Self {
-        Checker { world, config, counters: Counters::default() }
+        let physics = match &config.stability {
+            StabilityMode::ContactGraph => None,
+            StabilityMode::Physics(physics) => Some(PhysicsStability::new(&world, physics)),
+        };
+        Checker { world, config, counters: Counters::default(), physics }
     }
 
     /// The collision world.
     pub fn world(&self) -> &World {
         &self.world
+    }
+
+    /// The physics stability check, when the stability mode is [`StabilityMode::Physics`] (e.g. to
+    /// [`PhysicsStability::prepare`] its shapes up front).
+    pub fn physics(&self) -> Option<&PhysicsStability> {
+        self.physics.as_ref()
     }
 }
 
@@ -72,8 +89,9 @@ impl FeasibilityChecker for Checker {
     }
 
     fn stability(&self, state: &PartSet) -> Stability {
-        match &self.config.stability {
-            StabilityMode::ContactGraph => self.world.contact_stability(state),
+        match &self.physics {
+            None => self.world.contact_stability(state),
+            Some(physics) => physics.stability(&self.world, state),
         }
     }
 

@@ -10,6 +10,7 @@ pub mod io;
 pub mod math;
 pub mod mesh;
 pub mod partset;
+pub mod physics;
 pub mod rrt;
 pub mod world;
 
@@ -19,4 +20,5 @@ pub use error::{GeomError, Result};
 pub use feasibility::{CounterSnapshot, FeasibilityChecker, Motion, MotionKind, Outcome, Stability};
 pub use mesh::Mesh;
 pub use partset::PartSet;
+pub use physics::{PhysicsConfig, PhysicsStability};
 pub use world::{World, WorldConfig};

@@ -172,14 +172,16 @@ impl Mesh {
         }
     }
 
-    /// Merges vertices closer than `eps` (by rounding to a grid) and drops triangles that became
-    /// degenerate. Real files often duplicate vertices per face for flat shading.
-    pub fn weld(&mut self, eps: f32) {
-        let mut map: HashMap<[i64; 3], u32> = HashMap::new();
+    /// Merges vertices with bit-identical coordinates (real files often duplicate vertices per
+    /// face for flat shading) and drops triangles that became degenerate. Exact on purpose: a
+    /// grid snap, however fine, can fuse distinct vertices of small features and open holes.
+    pub fn weld(&mut self) {
+        let mut map: HashMap<[u32; 3], u32> = HashMap::new();
         let mut remap = Vec::with_capacity(self.vertices.len());
         let mut vertices = Vec::new();
         for v in &self.vertices {
-            let key = [v.x, v.y, v.z].map(|c| (c as f64 / eps as f64).round() as i64);
+            // +0.0 and -0.0 are the same point
+            let key = [v.x + 0.0, v.y + 0.0, v.z + 0.0].map(f32::to_bits);
             let id = *map.entry(key).or_insert_with(|| {
                 vertices.push(*v);
                 (vertices.len() - 1) as u32
@@ -188,12 +190,11 @@ impl Mesh {
         }
         self.vertices = vertices;
         let tris = std::mem::take(&mut self.triangles);
-        self.triangles = tris
+        let mut tris: Vec<[u32; 3]> = tris
             .into_iter()
             .map(|t| t.map(|i| remap[i as usize]))
             .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
             .collect();
-        let mut tris = std::mem::take(&mut self.triangles);
         tris.retain(|t| self.triangle_normal(t).length_squared() > 0.0);
         self.triangles = tris;
     }
@@ -254,7 +255,7 @@ mod tests {
             m.triangles.push([base, base + 2, base + 1]); // inverted
         }
         assert_eq!(m.topology().boundary_edges, 36);
-        m.weld(1e-6);
+        m.weld();
         assert_eq!(m.vertices.len(), 8);
         assert!(m.orient_outward());
         assert!(m.topology().is_closed_manifold());

@@ -17,9 +17,10 @@ use std::time::{Duration, Instant};
 /// Budget and resolution of the path planner.
 #[derive(Clone, Debug)]
 pub struct RrtConfig {
-    /// Iterations (sample + extend + connect) before giving up. Default 3000.
+    /// Iterations (sample + extend + connect) before giving up. Default 2000.
     pub max_iterations: usize,
-    /// Wall-time cap per call. Default 2 s.
+    /// Wall-time safety cap per call (the iteration budget is the one that keeps results
+    /// reproducible). Default 5 s.
     pub max_time: Duration,
     /// Longest tree edge as a fraction of the model's diagonal. Default 0.05.
     pub step_fraction: f32,
@@ -30,8 +31,8 @@ pub struct RrtConfig {
 impl Default for RrtConfig {
     fn default() -> Self {
         RrtConfig {
-            max_iterations: 3000,
-            max_time: Duration::from_secs(2),
+            max_iterations: 2000,
+            max_time: Duration::from_secs(5),
             step_fraction: 0.05,
             rotate: true,
         }
@@ -170,25 +171,29 @@ pub fn plan_removal_path(
     config: &RrtConfig,
     seed: u64,
 ) -> std::result::Result<Motion, PartSet> {
+    if !config.rotate {
+        return rrt_connect(world, part, state, config, seed);
+    }
     let half = RrtConfig {
         max_iterations: config.max_iterations.div_ceil(2),
         max_time: config.max_time / 2,
         rotate: false,
         ..config.clone()
     };
-    match rrt_connect(world, part, state, &half, seed) {
-        Ok(m) => Ok(m),
-        Err(blockers) if !config.rotate => Err(blockers),
-        Err(mut blockers) => {
-            let full = RrtConfig { max_iterations: config.max_iterations - half.max_iterations, max_time: config.max_time - half.max_time, ..config.clone() };
-            rrt_connect(world, part, state, &full, seed.wrapping_add(1)).map_err(|b| {
-                blockers.union_with(&b);
-                blockers
-            })
-        }
-    }
+    rrt_connect(world, part, state, &half, seed).or_else(|mut blockers| {
+        let full = RrtConfig {
+            max_iterations: config.max_iterations - half.max_iterations,
+            max_time: config.max_time - half.max_time,
+            ..config.clone()
+        };
+        rrt_connect(world, part, state, &full, seed.wrapping_add(1)).map_err(|b| {
+            blockers.union_with(&b);
+            blockers
+        })
+    })
 }
 
+/// One RRT-Connect search within `config`'s budget.
 fn rrt_connect(
     world: &World,
     part: usize,

@@ -13,12 +13,12 @@ use crate::erode::eroded_vertices;
 use crate::error::{GeomError, Result};
 use crate::feasibility::{Motion, Stability};
 use crate::math::{aabb_of, sweep_overlap, Aabb, Pose, Vec3};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, Topology};
 use crate::partset::PartSet;
 use parry3d::query::{self, ClosestPoints, NonlinearRigidMotion, PointQuery, ShapeCastOptions};
 use parry3d::shape::{TriMesh, TriMeshFlags};
 use rayon::prelude::*;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Settings of the collision world. Lengths in metres; `None` means "relative to the model".
@@ -36,10 +36,14 @@ pub struct WorldConfig {
     pub cluster_angle_deg: f32,
     /// Extra directions sampled evenly on the sphere (Fibonacci lattice). Default 0.
     pub sphere_directions: usize,
-    /// Two parts overlapping in the input by more than this fraction of the smaller part's
-    /// thinnest extent cannot be planned (error); smaller overlaps are warned about and absorbed
-    /// by shrinking that pair's test by the overlap depth. Default 0.25.
+    /// Parts that overlap in the input are warned about and each is shrunk, in tests against the
+    /// other, until it no longer crosses the other's surface — up to this fraction of its
+    /// thinnest extent (default 0.4: shrinking by half the thickness would make it vanish).
+    /// A pair that does not separate within that is an error, or ignored (next field).
     pub max_overlap_fraction: f32,
+    /// Ignore collisions between parts that overlap beyond `max_overlap_fraction` (warned)
+    /// instead of failing. Default false.
+    pub ignore_overlapping: bool,
 }
 
 impl Default for WorldConfig {
@@ -50,14 +54,15 @@ impl Default for WorldConfig {
             normal_clusters: 10,
             cluster_angle_deg: 10.0,
             sphere_directions: 0,
-            max_overlap_fraction: 0.25,
+            max_overlap_fraction: 0.4,
+            ignore_overlapping: false,
         }
     }
 }
 
 /// One part's collision geometry.
 struct Geom {
-    mesh: TriMesh,
+    mesh: Arc<TriMesh>,
     aabb: Aabb,
     /// Eroded copies keyed by the erosion amount's bits.
     eroded: Mutex<BTreeMap<u32, Arc<TriMesh>>>,
@@ -65,29 +70,38 @@ struct Geom {
 }
 
 impl Geom {
-    fn new(mesh: &Mesh, weld_eps: f32) -> Result<(Geom, bool)> {
+    /// The collision geometry of `mesh`, and the topology of its welded surface.
+    fn new(mesh: &Mesh) -> Result<(Geom, Topology)> {
         let mut m = mesh.clone();
-        m.weld(weld_eps);
+        m.weld();
         m.orient_outward();
-        let closed = m.topology().is_closed_manifold();
+        let topology = m.topology();
+        let closed = topology.is_closed_manifold();
         let aabb = m.aabb().ok_or_else(|| GeomError::config("empty mesh"))?;
         let mesh = TriMesh::with_flags(m.vertices, m.triangles, TriMeshFlags::ORIENTED)
             .map_err(|e| GeomError::config(format!("cannot build a collision mesh: {e}")))?;
-        Ok((Geom { mesh, aabb, eroded: Mutex::new(BTreeMap::new()), closed }, closed))
+        Ok((Geom { mesh: Arc::new(mesh), aabb, eroded: Mutex::new(BTreeMap::new()), closed }, topology))
     }
 
     fn eroded(&self, amount: f32) -> Arc<TriMesh> {
         let mut cache = self.eroded.lock().unwrap_or_else(|e| e.into_inner());
-        cache
-            .entry(amount.to_bits())
-            .or_insert_with(|| {
-                let v = eroded_vertices(self.mesh.vertices(), self.mesh.indices(), amount);
-                Arc::new(
-                    TriMesh::with_flags(v, self.mesh.indices().to_vec(), TriMeshFlags::ORIENTED)
-                        .unwrap_or_else(|_| self.mesh.clone()),
-                )
-            })
-            .clone()
+        cache.entry(amount.to_bits()).or_insert_with(|| Arc::new(self.erode(amount))).clone()
+    }
+
+    fn erode(&self, amount: f32) -> TriMesh {
+        let v = eroded_vertices(self.mesh.vertices(), self.mesh.indices(), amount);
+        TriMesh::with_flags(v, self.mesh.indices().to_vec(), TriMeshFlags::ORIENTED)
+            .unwrap_or_else(|_| (*self.mesh).clone())
+    }
+
+    /// Whether this part shrunk by `amount` still overlaps `other`: surfaces crossing, or one
+    /// wholly inside the other.
+    fn eroded_hits(&self, amount: f32, other: &Geom) -> bool {
+        let id = Pose::IDENTITY;
+        let shrunk = self.erode(amount);
+        query::intersection_test(&id, &shrunk, &id, &*other.mesh).map_or(true, |r| r.intersecting)
+            || (other.closed && nests(&self.aabb, &other.aabb) && contains_point(&other.mesh, shrunk.vertices()[0]))
+            || (self.closed && nests(&other.aabb, &self.aabb) && contains_point(&shrunk, other.mesh.vertices()[0]))
     }
 }
 
@@ -100,7 +114,9 @@ pub struct World {
     contact_distance: f32,
     directions: Vec<Vec3>,
     contacts: Vec<PartSet>,
-    overlaps: BTreeMap<(usize, usize), f32>,
+    /// Unordered pair (low, high) → (the part shrunk in their tests, its extra erosion).
+    overlaps: BTreeMap<(usize, usize), (usize, f32)>,
+    ignored: BTreeSet<(usize, usize)>,
     fixed: PartSet,
     rows: Vec<OnceLock<Vec<PartSet>>>,
     warnings: Vec<String>,
@@ -115,19 +131,18 @@ impl World {
         let diag = assembly.diagonal().max(f32::MIN_POSITIVE);
         let tolerance = config.tolerance.unwrap_or(1e-4 * diag);
         let contact_distance = config.contact_distance.unwrap_or(1e-3 * diag);
-        if !(tolerance > 0.0 && tolerance.is_finite()) || !(contact_distance > 0.0) {
+        let positive = |v: f32| v.is_finite() && v > 0.0;
+        if !positive(tolerance) || !positive(contact_distance) {
             return Err(GeomError::config("tolerance and contact distance must be positive"));
         }
         let mut warnings = assembly.warnings.clone();
-        let weld_eps = 1e-7 * diag;
         let mut geoms = Vec::with_capacity(assembly.len() + 1);
         for p in &assembly.parts {
-            let (g, closed) = Geom::new(&p.mesh, weld_eps).map_err(|e| GeomError::Assembly {
+            let (g, t) = Geom::new(&p.mesh).map_err(|e| GeomError::Assembly {
                 path: assembly.source.clone(),
                 reason: format!("part '{}': {e}", p.name),
             })?;
-            if !closed {
-                let t = p.mesh.topology();
+            if !t.is_closed_manifold() {
                 warnings.push(format!(
                     "part '{}': mesh is not closed and manifold ({} open, {} non-manifold, {} misoriented edges); its removal tests may be conservative",
                     p.name, t.boundary_edges, t.non_manifold_edges, t.misoriented_edges
@@ -139,7 +154,7 @@ impl World {
         let mut fixed = PartSet::from_indices(n + 1, assembly.parts.iter().enumerate().filter(|(_, p)| p.fixed).map(|(i, _)| i));
         let ground = if fixed.is_empty() {
             let bb = assembly.aabb().expect("validated assembly has vertices");
-            let (g, _) = Geom::new(&ground_box(&bb, assembly.up.vector(), diag), weld_eps)?;
+            let (g, _) = Geom::new(&ground_box(&bb, assembly.up.vector(), diag))?;
             geoms.push(g);
             fixed.insert(n);
             Some(n)
@@ -157,16 +172,17 @@ impl World {
             directions,
             contacts: Vec::new(),
             overlaps: BTreeMap::new(),
+            ignored: BTreeSet::new(),
             fixed,
             rows,
             warnings,
         };
-        world.measure_contacts(config.max_overlap_fraction)?;
+        world.measure_contacts(config.max_overlap_fraction, config.ignore_overlapping)?;
         Ok(world)
     }
 
     /// Finds contacts (parts within the contact distance) and input overlaps between parts.
-    fn measure_contacts(&mut self, max_overlap_fraction: f32) -> Result<()> {
+    fn measure_contacts(&mut self, max_overlap_fraction: f32, ignore_overlapping: bool) -> Result<()> {
         let count = self.geoms.len();
         let pairs: Vec<(usize, usize)> = (0..count)
             .flat_map(|i| ((i + 1)..count).map(move |j| (i, j)))
@@ -177,57 +193,103 @@ impl World {
                 (0..3).all(|k| a.mins[k] <= b.maxs[k] + m && b.mins[k] <= a.maxs[k] + m)
             })
             .collect();
-        let found: Vec<(usize, usize, bool, f32)> = pairs
+        let limit_of = |k: usize| {
+            max_overlap_fraction * (self.geoms[k].aabb.maxs - self.geoms[k].aabb.mins).min_element()
+        };
+        type Found = (usize, usize, bool, Option<f32>, Option<f32>);
+        let found: Vec<Found> = pairs
             .par_iter()
             .map(|&(i, j)| {
-                let (a, b) = (&self.geoms[i].mesh, &self.geoms[j].mesh);
+                let (a, b) = (&*self.geoms[i].mesh, &*self.geoms[j].mesh);
                 let id = Pose::IDENTITY;
-                let touching = !matches!(
-                    query::closest_points(&id, a, &id, b, self.contact_distance),
-                    Ok(ClosestPoints::Disjoint)
-                );
-                let depth = if touching {
-                    penetration_depth(&self.geoms[i], &self.geoms[j])
-                        .max(penetration_depth(&self.geoms[j], &self.geoms[i]))
-                } else {
-                    0.0
-                };
-                (i, j, touching, depth)
+                // parry's mesh-mesh closest points can miss an overlap: measure every candidate
+                let (e_ij, e_ji) = (self.extra_erosion(i, j, limit_of(i)), self.extra_erosion(j, i, limit_of(j)));
+                let overlapping = e_ij != Some(0.0) || e_ji != Some(0.0);
+                let touching = overlapping
+                    || !matches!(query::closest_points(&id, a, &id, b, self.contact_distance), Ok(ClosestPoints::Disjoint));
+                (i, j, touching, e_ij, e_ji)
             })
             .collect();
         self.contacts = vec![PartSet::empty(count); count];
-        for (i, j, touching, depth) in found {
+        let units = self.assembly.units.clone();
+        let len = |m: f32| format!("{:.4} {}", units.from_metres(m as f64), units.name);
+        for (i, j, touching, e_ij, e_ji) in found {
             if touching {
                 self.contacts[i].insert(j);
                 self.contacts[j].insert(i);
             }
-            if depth > self.tolerance {
-                let thinnest = |k: usize| {
-                    let e = self.geoms[k].aabb.maxs - self.geoms[k].aabb.mins;
-                    e.min_element()
-                };
-                let limit = max_overlap_fraction * thinnest(i).min(thinnest(j));
-                let units = &self.assembly.units;
-                let msg = format!(
-                    "parts '{}' and '{}' overlap by {:.4} {} in the input (tolerance {:.4} {})",
-                    self.name(i),
-                    self.name(j),
-                    units.from_metres(depth as f64),
-                    units.name,
-                    units.from_metres(self.tolerance as f64),
-                    units.name
-                );
-                if depth > limit {
-                    return Err(GeomError::Assembly {
-                        path: self.assembly.source.clone(),
-                        reason: format!("{msg}, more than {:.0}% of the thinner part: fix the model or raise --tolerance", max_overlap_fraction * 100.0),
-                    });
+            let (a, b) = (self.name(i).to_string(), self.name(j).to_string());
+            // the pair's tests shrink whichever part separates with the least shrinking: a screw
+            // through a thin plate's tapped hole is shrunk, not the plate
+            let eroder = match (e_ij, e_ji) {
+                (Some(x), Some(y)) if x <= y => Some((i, x)),
+                (_, Some(y)) => Some((j, y)),
+                (Some(x), None) => Some((i, x)),
+                (None, None) => None,
+            };
+            match eroder {
+                _ if e_ij == Some(0.0) && e_ji == Some(0.0) => {}
+                Some((k, 0.0)) => {
+                    // only the other part, shrunk by the tolerance, still crosses: shrink this one
+                    self.overlaps.insert((i, j), (k, 0.0));
                 }
-                self.warnings.push(format!("{msg}; their mutual tests allow that overlap"));
-                self.overlaps.insert((i, j), depth);
+                Some((k, extra)) => {
+                    self.warnings.push(format!(
+                        "parts '{a}' and '{b}' overlap by about {} in the input (tolerance {}); their mutual tests shrink '{}' by that much",
+                        len(extra),
+                        len(self.tolerance),
+                        self.name(k)
+                    ));
+                    self.overlaps.insert((i, j), (k, extra));
+                }
+                None => {
+                    let msg = format!(
+                        "parts '{a}' and '{b}' overlap far beyond the tolerance ({}): shrinking either by {:.0}% of its thickness does not separate them",
+                        len(self.tolerance),
+                        max_overlap_fraction * 100.0
+                    );
+                    if !ignore_overlapping {
+                        return Err(GeomError::Assembly {
+                            path: self.assembly.source.clone(),
+                            reason: format!("{msg}; fix the model, raise --tolerance, or pass --ignore-overlapping"),
+                        });
+                    }
+                    self.warnings.push(format!("{msg}; their collisions with each other are ignored (--ignore-overlapping)"));
+                    self.ignored.insert((i, j));
+                    self.ignored.insert((j, i));
+                }
             }
         }
         Ok(())
+    }
+
+    /// The least extra erosion of part `p` (beyond the tolerance, to within a sixteenth) after
+    /// which it no longer crosses `q`'s surface: 0 when they merely touch, `None` when even
+    /// `limit` does not separate them.
+    fn extra_erosion(&self, p: usize, q: usize, limit: f32) -> Option<f32> {
+        let (a, b) = (&self.geoms[p], &self.geoms[q]);
+        let tol = self.tolerance;
+        let clear = |extra: f32| !a.eroded_hits(tol + extra, b);
+        if clear(0.0) {
+            return Some(0.0);
+        }
+        let mut hi = tol;
+        while !clear(hi) {
+            if hi >= limit {
+                return None;
+            }
+            hi = (hi * 2.0).min(limit);
+        }
+        let mut lo = hi / 2.0;
+        for _ in 0..4 {
+            let mid = 0.5 * (lo + hi);
+            if clear(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Some(hi)
     }
 
     /// The assembly this world was built from.
@@ -275,9 +337,16 @@ impl World {
         &self.contacts[i]
     }
 
-    /// Pairs that overlap in the input beyond the tolerance, with their depth in metres.
-    pub fn overlaps(&self) -> &BTreeMap<(usize, usize), f32> {
+    /// Pairs (low index, high index) that overlap in the input, with the part their tests shrink
+    /// and its extra erosion in metres.
+    pub fn overlaps(&self) -> &BTreeMap<(usize, usize), (usize, f32)> {
         &self.overlaps
+    }
+
+    /// Whether collisions between `p` and `q` are ignored (gross input overlap with
+    /// `ignore_overlapping`).
+    pub fn ignores(&self, p: usize, q: usize) -> bool {
+        self.ignored.contains(&(p, q))
     }
 
     /// Warnings found while preparing (open meshes, overlaps), one line each.
@@ -300,14 +369,30 @@ impl World {
         &self.geoms[i].mesh
     }
 
-    /// How much part `p`'s test against `q` shrinks `p`: the tolerance plus their input overlap.
-    pub fn erosion(&self, p: usize, q: usize) -> f32 {
-        self.tolerance + self.overlaps.get(&(p.min(q), p.max(q))).copied().unwrap_or(0.0)
+    /// Which part the tests of the pair (`p`, `q`) shrink, and by how much (metres): normally the
+    /// moving part `p` by the tolerance; for parts overlapping in the input, the one that
+    /// separates with the least shrinking, by the tolerance plus that.
+    pub fn pair_erosion(&self, p: usize, q: usize) -> (usize, f32) {
+        match self.overlaps.get(&(p.min(q), p.max(q))) {
+            Some(&(k, extra)) => (k, self.tolerance + extra),
+            None => (p, self.tolerance),
+        }
     }
 
     /// Part `p` shrunk by `amount` (cached).
     pub fn eroded(&self, p: usize, amount: f32) -> Arc<TriMesh> {
         self.geoms[p].eroded(amount)
+    }
+
+    /// The shapes of `p` and `q` for their mutual tests: one of them shrunk (see
+    /// [`World::pair_erosion`]), both in their assembled pose.
+    pub fn pair_shapes(&self, p: usize, q: usize) -> (Arc<TriMesh>, Arc<TriMesh>) {
+        let (k, amount) = self.pair_erosion(p, q);
+        if k == p {
+            (self.eroded(p, amount), self.geoms[q].mesh.clone())
+        } else {
+            (self.geoms[p].mesh.clone(), self.eroded(q, amount))
+        }
     }
 
     /// The state plus the fixed parts that are always present (ground included).
@@ -319,10 +404,13 @@ impl World {
 
     /// Whether `q` blocks `p` moving along `dir` (unit) from the assembled pose, to infinity.
     pub fn pair_blocks(&self, p: usize, q: usize, dir: Vec3) -> bool {
+        if self.ignores(p, q) {
+            return false;
+        }
         let Some((_, t1)) = sweep_overlap(&self.geoms[p].aabb, dir, &self.geoms[q].aabb) else {
             return false;
         };
-        let moving = self.eroded(p, self.erosion(p, q));
+        let (moving, fixed) = self.pair_shapes(p, q);
         let options = ShapeCastOptions {
             max_time_of_impact: t1,
             target_distance: 0.0,
@@ -331,7 +419,7 @@ impl World {
         };
         let id = Pose::IDENTITY;
         // an unsupported pair would be a parry gap: block, the conservative answer
-        query::cast_shapes(&id, dir, &*moving, &id, Vec3::ZERO, &self.geoms[q].mesh, options)
+        query::cast_shapes(&id, dir, &*moving, &id, Vec3::ZERO, &*fixed, options)
             .map(|hit| hit.is_some())
             .unwrap_or(true)
     }
@@ -362,44 +450,51 @@ impl World {
     }
 
     /// How far `p` must travel along `dir` for its bounds to clear the bounds of the other
-    /// present real parts (plus the contact distance); at least that margin.
+    /// present real parts, plus the contact distance. With no other part left, it clears its own
+    /// starting bounds (so the last part is lifted by its size, not by nothing).
     pub fn clearance(&self, p: usize, state: &PartSet, dir: Vec3) -> f32 {
+        let a = &self.geoms[p].aabb;
         let others = aabb_of(
             state
                 .iter()
                 .filter(|&q| q != p && q < self.num_parts())
                 .flat_map(|q| [self.geoms[q].aabb.mins, self.geoms[q].aabb.maxs]),
-        );
-        let a = &self.geoms[p].aabb;
-        let t = match others {
-            None => 0.0,
-            Some(u) => (0..3)
-                .filter(|&i| dir[i].abs() > 1e-6)
-                .map(|i| {
-                    if dir[i] > 0.0 {
-                        (u.maxs[i] - a.mins[i]) / dir[i]
-                    } else {
-                        (a.maxs[i] - u.mins[i]) / -dir[i]
-                    }
-                })
-                .fold(f32::INFINITY, f32::min)
-                .max(0.0),
-        };
+        )
+        .unwrap_or(*a);
+        let t = (0..3)
+            .filter(|&i| dir[i].abs() > 1e-6)
+            .map(|i| {
+                if dir[i] > 0.0 {
+                    (others.maxs[i] - a.mins[i]) / dir[i]
+                } else {
+                    (a.maxs[i] - others.mins[i]) / -dir[i]
+                }
+            })
+            .fold(f32::INFINITY, f32::min)
+            .max(0.0);
         t + self.contact_distance
     }
 
     /// The straight-line removal test of `p` in `state`: the free direction with the shortest
-    /// travel, or the union of all blockers when every direction is blocked.
+    /// travel (ties go to the direction closest to up), or the union of all blockers when every
+    /// direction is blocked.
     pub fn linear_removal(&self, p: usize, state: &PartSet) -> std::result::Result<Motion, PartSet> {
         let present = self.with_fixed(state);
         let row = self.blocking_row(p);
+        let up = self.assembly.up.vector();
         let mut best: Option<(f32, Vec3)> = None;
         let mut blockers = PartSet::empty(self.geoms.len());
         for (k, dir) in self.directions.iter().enumerate() {
             let b = row[k].intersection(&present);
             if b.is_empty() {
                 let d = self.clearance(p, state, *dir);
-                if best.is_none_or(|(bd, _)| d < bd) {
+                let better = match best {
+                    None => true,
+                    Some((bd, bdir)) => {
+                        d < bd - 1e-6 * bd.max(1e-9) || (d <= bd + 1e-6 * bd && dir.dot(up) > bdir.dot(up) + 1e-6)
+                    }
+                };
+                if better {
                     best = Some((d, *dir));
                 }
             } else {
@@ -451,13 +546,13 @@ impl World {
         let rel = b.rotation * a.rotation.inverse();
         let motion = NonlinearRigidMotion::new(*a, pivot, cb - ca, rel.to_scaled_axis());
         let still = NonlinearRigidMotion::constant_position(Pose::IDENTITY);
-        let hit = present.iter().filter(|&q| q != p).find(|&q| {
+        let hit = present.iter().filter(|&q| q != p && !self.ignores(p, q)).find(|&q| {
             let qb = &self.geoms[q].aabb;
             if !(0..3).all(|k| sweep.mins[k] < qb.maxs[k] && qb.mins[k] < sweep.maxs[k]) {
                 return false;
             }
-            let moving = self.eroded(p, self.erosion(p, q));
-            let fixed = &self.geoms[q].mesh;
+            let (moving, fixed) = self.pair_shapes(p, q);
+            let fixed = &*fixed;
             let hit = if rel.angle_between(crate::math::Rot::IDENTITY) < 1e-6 {
                 // pure translation: the (faster) linear cast is exact
                 let options = ShapeCastOptions {
@@ -481,44 +576,42 @@ impl World {
         let present = self.with_fixed(state);
         let bb = self.geoms[p].aabb.transform_by(pose);
         let id = Pose::IDENTITY;
-        let hit = present.iter().filter(|&q| q != p).find(|&q| {
+        let hit = present.iter().filter(|&q| q != p && !self.ignores(p, q)).find(|&q| {
             let qb = &self.geoms[q].aabb;
             if !(0..3).all(|k| bb.mins[k] < qb.maxs[k] && qb.mins[k] < bb.maxs[k]) {
                 return false;
             }
-            let moving = self.eroded(p, self.erosion(p, q));
-            let fixed = &self.geoms[q].mesh;
-            query::intersection_test(pose, &*moving, &id, fixed).map_or(true, |r| r.intersecting)
-                || contains_point(fixed, pose.transform_point(moving.vertices()[0]))
-                || contains_point(&moving, pose.inverse_transform_point(fixed.vertices()[0]))
+            let (k, amount) = self.pair_erosion(p, q);
+            let shrunk = self.eroded(k, amount);
+            // parry's mesh-mesh intersection test depends on argument order: always ask with the
+            // shrunk part first
+            let (shrunk_pose, raw, raw_pose, raw_closed) = if k == p {
+                (*pose, &self.geoms[q].mesh, id, self.geoms[q].closed)
+            } else {
+                (id, &self.geoms[p].mesh, *pose, self.geoms[p].closed)
+            };
+            let (bs, br) = (shrunk.aabb(&shrunk_pose), raw.aabb(&raw_pose));
+            // one wholly inside the other: only for closed surfaces whose boxes nest
+            query::intersection_test(&shrunk_pose, &*shrunk, &raw_pose, &**raw).map_or(true, |r| r.intersecting)
+                || (raw_closed
+                    && nests(&bs, &br)
+                    && contains_point(raw, raw_pose.inverse_transform_point(shrunk_pose.transform_point(shrunk.vertices()[0]))))
+                || (self.geoms[k].closed
+                    && nests(&br, &bs)
+                    && contains_point(&shrunk, shrunk_pose.inverse_transform_point(raw_pose.transform_point(raw.vertices()[0]))))
         });
         hit
     }
 }
 
+/// Whether box `a` lies within box `b`.
+fn nests(a: &Aabb, b: &Aabb) -> bool {
+    (0..3).all(|i| a.mins[i] >= b.mins[i] && a.maxs[i] <= b.maxs[i])
+}
+
 /// Whether `point` is inside the closed mesh.
 fn contains_point(mesh: &TriMesh, point: Vec3) -> bool {
     mesh.local_aabb().contains_local_point(point) && mesh.project_local_point(point, false).is_inside
-}
-
-/// How deep the vertices of `a` reach inside `b` (0 when none is inside).
-fn penetration_depth(a: &Geom, b: &Geom) -> f32 {
-    if !b.closed {
-        return 0.0;
-    }
-    a.mesh
-        .vertices()
-        .iter()
-        .filter(|v| b.aabb.contains_local_point(**v))
-        .map(|v| {
-            let proj = b.mesh.project_local_point(*v, false);
-            if proj.is_inside {
-                (proj.point - *v).length()
-            } else {
-                0.0
-            }
-        })
-        .fold(0.0, f32::max)
 }
 
 /// A slab under the model whose top face lies at the model's lowest point along `up`.

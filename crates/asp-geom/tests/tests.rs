@@ -1,4 +1,5 @@
 //! The one integration test binary of asp-geom.
 
 mod loaders;
+mod physics;
 mod removal;

@@ -93,6 +93,9 @@ struct Search<'p, 'a> {
     /// Bookkeeping: the blockers of each part's last collision failure.
     blocked_by: Vec<Option<PartSet>>,
     dead: HashSet<PartSet>,
+    /// Locked cores: sets of parts each blocked only by parts of the set (and fixed parts), so
+    /// no state containing one can ever be taken apart (see [`locked_core`]).
+    cores: Vec<PartSet>,
     path: Vec<Step>,
     expanded: u64,
     exhausted: bool,
@@ -126,7 +129,7 @@ impl Search<'_, '_> {
         if self.problem.is_goal(state) {
             return true;
         }
-        if self.dead.contains(state) || self.out_of_budget() {
+        if self.dead.contains(state) || self.cores.iter().any(|c| c.is_subset(state)) || self.out_of_budget() {
             return false;
         }
         self.expanded += 1;
@@ -171,6 +174,9 @@ impl Search<'_, '_> {
             }
         }
         if !self.exhausted {
+            if let Some(core) = locked_core(&reasons, |p| self.problem.checker.is_fixed(p)) {
+                self.cores.push(core);
+            }
             self.dead.insert(state.clone());
             if self.deepest.as_ref().is_none_or(|(s, _)| state.len() < s.len()) {
                 reasons.sort_by_key(|s| s.part);
@@ -205,6 +211,31 @@ impl Search<'_, '_> {
     }
 }
 
+/// The largest set `C` of parts of a dead state such that each part of `C` was blocked (in
+/// every direction tried) only by parts of `C` and fixed parts. Straight-line blocking is a
+/// property of part pairs, so removing parts outside `C` never frees a part of `C`: every state
+/// containing `C` is a dead end too. (With the path planner in play this is a heuristic: a path
+/// that failed among these parts is taken to fail among more.)
+fn locked_core(reasons: &[Stuck], is_fixed: impl Fn(usize) -> bool) -> Option<PartSet> {
+    let mut core: Vec<(usize, &PartSet)> = reasons
+        .iter()
+        .filter_map(|s| match &s.reason {
+            StuckReason::Blocked(b) => Some((s.part, b)),
+            _ => None,
+        })
+        .collect();
+    loop {
+        let members: Vec<usize> = core.iter().map(|(p, _)| *p).collect();
+        let before = core.len();
+        core.retain(|(_, b)| b.iter().all(|q| is_fixed(q) || members.contains(&q)));
+        if core.len() == before {
+            break;
+        }
+    }
+    let n = reasons.iter().map(|s| s.part + 1).max().unwrap_or(0);
+    (!core.is_empty()).then(|| PartSet::from_indices(n, core.iter().map(|(p, _)| *p)))
+}
+
 impl Planner for Dfs {
     fn name(&self) -> &'static str {
         "dfs"
@@ -221,6 +252,7 @@ impl Planner for Dfs {
             rng: ChaCha8Rng::seed_from_u64(self.seed),
             blocked_by: vec![None; problem.checker.num_parts()],
             dead: HashSet::new(),
+            cores: Vec::new(),
             path: Vec::new(),
             expanded: 0,
             exhausted: false,

@@ -1,4 +1,5 @@
 //! Integration tests of asp-search.
 
 mod conformance;
+mod real;
 mod verify;

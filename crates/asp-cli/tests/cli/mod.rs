@@ -108,7 +108,7 @@ fn bad_input_is_one_line_naming_the_file() {
     assert_error(&asp(&["plan", &beam, "--up", "w"]), "--up");
     assert_error(&asp(&["plan", &beam, "--unit", "furlongs"]), "--unit");
     assert_error(&asp(&["plan", &beam, "--fixed", "no_such_part"]), "no_such_part");
-    assert_error(&asp(&["plan", &beam, "--tolerance", "-1"]), "--tolerance");
+    assert_error(&asp(&["plan", &beam, "--tolerance=-1"]), "--tolerance");
 }
 
 #[test]
@@ -153,4 +153,22 @@ fn a_single_part_plans_trivially() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(plan["assembly_sequence"].as_array().unwrap().len(), 1);
+}
+
+#[test]
+fn physics_stability_takes_the_keystone_before_a_pillar() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = fixture_file(dir.path(), &fixtures::arch(), "arch.glb");
+    let order = |extra: &[&str]| {
+        let mut args = vec!["plan", model.to_str().unwrap(), "--json"];
+        args.extend_from_slice(extra);
+        let o = asp(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        plan["disassembly_sequence"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect::<Vec<_>>()
+    };
+    // contact graph: a pillar may go first (the keystone still touches the other one)
+    assert_eq!(order(&[]), vec![1, 3, 2]);
+    // physics: a keystone on one pillar tips over, so it must leave first
+    assert_eq!(order(&["--stability", "physics"]), vec![3, 1, 2]);
 }

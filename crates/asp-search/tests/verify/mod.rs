@@ -9,6 +9,7 @@ use asp_geom::{Motion, PartSet, Stability, World};
 use asp_search::{PlanOutcome, Status};
 use parry3d::query::{intersection_test, PointQuery};
 use parry3d::shape::{TriMesh, TriMeshFlags};
+use std::collections::HashMap;
 
 fn shrunk(world: &World, p: usize, amount: f32) -> TriMesh {
     let m = world.mesh(p);
@@ -17,15 +18,25 @@ fn shrunk(world: &World, p: usize, amount: f32) -> TriMesh {
 }
 
 /// Whether part `p` at `pose` penetrates a present part (other than itself) deeper than the
-/// tolerance: surfaces crossing, or one inside the other.
-fn penetrates(world: &World, p: usize, pose: &Pose, present: &PartSet) -> Option<usize> {
-    present.iter().filter(|&q| q != p).find(|&q| {
-        let moving = shrunk(world, p, world.erosion(p, q));
-        let other = world.mesh(q);
+/// tolerance: surfaces crossing, or one inside the other. Each pair shrinks the part the world
+/// chose for it (the moving part, or for input overlaps the one that separates more easily).
+fn penetrates(world: &World, p: usize, pose: &Pose, present: &PartSet, shrunk_cache: &mut HashMap<(usize, u32), TriMesh>) -> Option<usize> {
+    present.iter().filter(|&q| q != p && !world.ignores(p, q)).find(|&q| {
+        let (k, amount) = world.pair_erosion(p, q);
+        let shrunk_k = shrunk_cache.entry((k, amount.to_bits())).or_insert_with(|| shrunk(world, k, amount)).clone();
+        // parry's mesh-mesh intersection test depends on argument order (see
+        // shared research notes): always ask with the shrunk part first, in its own frame
         let id = Pose::IDENTITY;
-        intersection_test(pose, &moving, &id, other).unwrap().intersecting
-            || other.contains_local_point(pose.transform_point(moving.vertices()[0]))
-            || moving.contains_local_point(pose.inverse_transform_point(other.vertices()[0]))
+        let (shrunk_pose, raw, raw_pose) = if k == p { (*pose, world.mesh(q).clone(), id) } else { (id, world.mesh(p).clone(), *pose) };
+        let closed_raw = world.is_closed(if k == p { q } else { p });
+        let (bs, br) = (shrunk_k.aabb(&shrunk_pose), raw.aabb(&raw_pose));
+        let nests = |a: &parry3d::bounding_volume::Aabb, b: &parry3d::bounding_volume::Aabb| {
+            (0..3).all(|i| a.mins[i] >= b.mins[i] && a.maxs[i] <= b.maxs[i])
+        };
+        // one wholly inside the other: only for closed surfaces whose boxes nest
+        intersection_test(&shrunk_pose, &shrunk_k, &raw_pose, &raw).unwrap().intersecting
+            || (closed_raw && nests(&bs, &br) && raw.contains_point(&raw_pose, shrunk_pose.transform_point(shrunk_k.vertices()[0])))
+            || (world.is_closed(k) && nests(&br, &bs) && shrunk_k.contains_point(&shrunk_pose, raw_pose.transform_point(raw.vertices()[0])))
     })
 }
 
@@ -35,6 +46,7 @@ pub fn verify_plan(world: &World, outcome: &PlanOutcome) {
     assert_eq!(outcome.status, Status::Found, "only found plans are verified");
     let n = world.num_parts();
     let mut state = PartSet::full(n);
+    let mut cache = HashMap::new();
     for (k, step) in outcome.removals.iter().enumerate() {
         let p = step.part;
         assert!(state.contains(p) && !world.fixed().contains(p), "step {k}: part {p} not removable");
@@ -54,7 +66,7 @@ pub fn verify_plan(world: &World, outcome: &PlanOutcome) {
                 .collect(),
         };
         for pose in &poses {
-            if let Some(q) = penetrates(world, p, pose, &present) {
+            if let Some(q) = penetrates(world, p, pose, &present, &mut cache) {
                 panic!("step {k}: part '{}' hits '{}' at {pose:?}", world.name(p), world.name(q));
             }
         }
