@@ -1,1 +1,16 @@
-//! asp-gen
+#![doc = include_str!("../README.md")]
+
+pub mod batch;
+pub mod check;
+pub mod cuboid;
+pub mod error;
+pub mod manifest;
+pub mod profiles;
+pub mod soma;
+
+pub use batch::{assembly_seed, generate_batch, write_batch, Batch, Generated, Generator};
+pub use check::DisassemblyCheck;
+pub use error::{GenError, Result};
+pub use manifest::{Manifest, ManifestEntry};
+pub use profiles::{ProfileAssembly, ProfileParams};
+pub use soma::{SomaCube, SomaParams};

@@ -7,6 +7,7 @@
 
 use asp_geom::io::{load, LoadOptions};
 use asp_geom::math::Axis;
+use asp_geom::physics::{PhysicsConfig, PhysicsStability};
 use asp_geom::{fixtures, Assembly, PartSet, Units, World, WorldConfig};
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use std::hint::black_box;
@@ -55,6 +56,14 @@ fn bench(c: &mut Criterion) {
         });
         group.finish();
         c.bench_function(&format!("stability/{name}"), |b| b.iter(|| black_box(world.contact_stability(&full))));
+        if name == "tube" || name == "table_lack_0825" {
+            // the physics check of the state with part 1 removed (rapier, 1 s simulated)
+            let physics = PhysicsStability::new(&world, &PhysicsConfig::default());
+            let state = full.without(1);
+            c.bench_function(&format!("stability_physics/{name}"), |b| {
+                b.iter(|| black_box(physics.stability(&world, &state)))
+            });
+        }
     }
 }
 

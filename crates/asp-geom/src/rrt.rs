@@ -171,25 +171,29 @@ pub fn plan_removal_path(
     config: &RrtConfig,
     seed: u64,
 ) -> std::result::Result<Motion, PartSet> {
+    if !config.rotate {
+        return rrt_connect(world, part, state, config, seed);
+    }
     let half = RrtConfig {
         max_iterations: config.max_iterations.div_ceil(2),
         max_time: config.max_time / 2,
         rotate: false,
         ..config.clone()
     };
-    match rrt_connect(world, part, state, &half, seed) {
-        Ok(m) => Ok(m),
-        Err(blockers) if !config.rotate => Err(blockers),
-        Err(mut blockers) => {
-            let full = RrtConfig { max_iterations: config.max_iterations - half.max_iterations, max_time: config.max_time - half.max_time, ..config.clone() };
-            rrt_connect(world, part, state, &full, seed.wrapping_add(1)).map_err(|b| {
-                blockers.union_with(&b);
-                blockers
-            })
-        }
-    }
+    rrt_connect(world, part, state, &half, seed).or_else(|mut blockers| {
+        let full = RrtConfig {
+            max_iterations: config.max_iterations - half.max_iterations,
+            max_time: config.max_time - half.max_time,
+            ..config.clone()
+        };
+        rrt_connect(world, part, state, &full, seed.wrapping_add(1)).map_err(|b| {
+            blockers.union_with(&b);
+            blockers
+        })
+    })
 }
 
+/// One RRT-Connect search within `config`'s budget.
 fn rrt_connect(
     world: &World,
     part: usize,

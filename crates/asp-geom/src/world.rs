@@ -131,7 +131,8 @@ impl World {
         let diag = assembly.diagonal().max(f32::MIN_POSITIVE);
         let tolerance = config.tolerance.unwrap_or(1e-4 * diag);
         let contact_distance = config.contact_distance.unwrap_or(1e-3 * diag);
-        if !(tolerance > 0.0 && tolerance.is_finite()) || !(contact_distance > 0.0) {
+        let positive = |v: f32| v.is_finite() && v > 0.0;
+        if !positive(tolerance) || !positive(contact_distance) {
             return Err(GeomError::config("tolerance and contact distance must be positive"));
         }
         let mut warnings = assembly.warnings.clone();
@@ -228,7 +229,7 @@ impl World {
             };
             match eroder {
                 _ if e_ij == Some(0.0) && e_ji == Some(0.0) => {}
-                Some((k, extra)) if extra == 0.0 => {
+                Some((k, 0.0)) => {
                     // only the other part, shrunk by the tolerance, still crosses: shrink this one
                     self.overlaps.insert((i, j), (k, 0.0));
                 }
