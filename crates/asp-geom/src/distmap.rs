@@ -249,7 +249,7 @@ pub struct Hemisphere {
 impl Hemisphere {
     /// Samples `resolution × resolution` directions (odd, 3..=15) around `up`.
     pub fn new(resolution: usize, up: Axis) -> Result<Self> {
-        if resolution < 3 || resolution > MAX_RESOLUTION || resolution % 2 == 0 {
+        if !(3..=MAX_RESOLUTION).contains(&resolution) || resolution % 2 == 0 {
             return Err(GeomError::config(format!(
                 "distance map resolution must be odd and within 3..={MAX_RESOLUTION}, got {resolution}"
             )));
@@ -430,7 +430,7 @@ impl MapConfigBuilder {
     pub fn build(self) -> Result<MapConfig> {
         let c = self.config;
         let r = c.resolution;
-        if r < 3 || r > MAX_RESOLUTION || r % 2 == 0 {
+        if !(3..=MAX_RESOLUTION).contains(&r) || r % 2 == 0 {
             return Err(GeomError::config(format!(
                 "distance map resolution must be odd and within 3..={MAX_RESOLUTION}, got {r}"
             )));
@@ -514,6 +514,9 @@ enum Shape {
     Mesh,
 }
 
+/// A part's voxels with the origin and cell size fitted to its mesh.
+type VoxelFit = (Vec<[i32; 3]>, Vec3, Vec3);
+
 /// The frame box sweeps run in: world = origin + grid * cell.
 #[derive(Clone, Copy, Debug)]
 struct SweepFrame {
@@ -522,7 +525,7 @@ struct SweepFrame {
 }
 
 impl SweepFrame {
-    fn to_frame(&self, b: &Aabb) -> Aabb {
+    fn frame_box(&self, b: &Aabb) -> Aabb {
         Aabb::new((b.mins - self.origin) / self.cell, (b.maxs - self.origin) / self.cell)
     }
 }
@@ -602,7 +605,7 @@ fn fit_voxels(cells: &[[i32; 3]], mesh: &Mesh) -> Option<(Vec3, Vec3)> {
     }
     let span = Vec3::new((hi[0] - lo[0]) as f32, (hi[1] - lo[1]) as f32, (hi[2] - lo[2]) as f32);
     let cell = (aabb.maxs - aabb.mins) / span;
-    if !(cell.min_element() > 0.0) {
+    if cell.min_element().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     let origin = aabb.mins - Vec3::new(lo[0] as f32, lo[1] as f32, lo[2] as f32) * cell;
@@ -656,7 +659,7 @@ impl DistanceMaps {
             .collect();
 
         // Geometry: voxels, single boxes, or meshes.
-        let mut voxel_fits: Vec<Option<(Vec<[i32; 3]>, Vec3, Vec3)>> = Vec::with_capacity(n);
+        let mut voxel_fits: Vec<Option<VoxelFit>> = Vec::with_capacity(n);
         for p in &assembly.parts {
             let fit = if config.use_voxels {
                 voxels_of(&p.extras).and_then(|cells| match fit_voxels(&cells, &p.mesh) {
@@ -711,7 +714,7 @@ impl DistanceMaps {
                 shapes.push(Shape::Boxes { boxes, integer: shared_grid });
             } else if let Some(b) = single_box(&p.mesh) {
                 geometry.push(PartGeometry::Box);
-                shapes.push(Shape::Boxes { boxes: vec![frame.to_frame(&b)], integer: false });
+                shapes.push(Shape::Boxes { boxes: vec![frame.frame_box(&b)], integer: false });
             } else {
                 geometry.push(PartGeometry::Mesh);
                 shapes.push(Shape::Mesh);
@@ -773,8 +776,8 @@ impl DistanceMaps {
                                 Shape::Boxes { boxes: bj, integer: ij },
                             ) => {
                                 let tol = if *ii && *ij { 0.0 } else { frame_tol };
-                                let ai = frame.to_frame(&aabbs[i]);
-                                let aj = frame.to_frame(&aabbs[j]);
+                                let ai = frame.frame_box(&aabbs[i]);
+                                let aj = frame.frame_box(&aabbs[j]);
                                 for (d, m) in frame_dirs.iter().enumerate() {
                                     let mut best = d_max;
                                     if first_overlap(&ai, *m, &aj, tol).is_some_and(|t| t < d_max) {
@@ -1420,14 +1423,12 @@ impl<'m> MapState<'m> {
         let mut cover = Bits::EMPTY;
         for (&j, &b) in maps.blockers[i].iter().zip(&maps.blocker_masks[i]) {
             let j = j as usize;
-            if self.present.contains(j) {
-                if !b.and_not(blocked).is_empty() {
-                    blocked = blocked.or(b);
-                    cover.insert(j);
-                    if blocked == self.all {
-                        self.covers[i] = cover;
-                        return false;
-                    }
+            if self.present.contains(j) && !b.and_not(blocked).is_empty() {
+                blocked = blocked.or(b);
+                cover.insert(j);
+                if blocked == self.all {
+                    self.covers[i] = cover;
+                    return false;
                 }
             }
         }

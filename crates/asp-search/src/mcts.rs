@@ -2,7 +2,8 @@
 //! rather than the mean (eq. 5.9), normalised to `[0, 1]` with the minimum and maximum of the
 //! siblings' maxima as local bounds, or the global bounds of all returns seen while a node has
 //! fewer than two valued children (Vodopivec et al.). Expansion, random rollouts, a search
-//! budget per step and episodes are shared with [`crate::ParetoMcts`] (see [`crate::search`]).
+//! budget per step, episodes and transpositions are shared with [`crate::ParetoMcts`] (see
+//! [`crate::search`]).
 //!
 //! ```
 //! # use asp_search::Mcts;

@@ -1,10 +1,13 @@
 //! Pareto-MCTS (thesis 6.4.2, after Perez et al.): every node keeps a local Pareto front of the
-//! return vectors of the complete sequences through it; selection uses MOUCB,
-//! `HV(P(n'))/N(n') + c·sqrt(2 ln N(n) / N(n'))`, with the hypervolume of the child's front in
-//! objectives normalised to `[0, 1]` by the global bounds of all returns seen (reference point
-//! −0.1 in every normalised objective, so the extreme points of a front count); backpropagation
-//! adds the vector to each front on the way up and stops at the first node whose front dominates
-//! or equals it. The root's front, with the sequences that reached it, is the answer.
+//! return vectors of the complete sequences through it (suffixes from its state, see
+//! [`crate::search`]); selection uses MOUCB, `HV(P(n'))/N(n') + c·sqrt(2 ln N(n) / N(n'))`,
+//! with the hypervolume of the child's front as whole returns, in objectives normalised to
+//! `[0, 1]` by the global bounds of all returns seen (reference −0.1 in every normalised
+//! objective, so the extreme points of a front count); backpropagation adds the vector to each
+//! front on the way up — in the plain tree it stops at the first node whose front dominates or
+//! equals it, as in the thesis; on the graph of states it continues, since a state's better
+//! suffix may have come along another path. The root's front, with the sequences that reached
+//! it, is the answer.
 //!
 //! ```
 //! # use asp_search::ParetoMcts;

@@ -1,22 +1,31 @@
 //! The machinery shared by [`crate::Mcts`] and [`crate::ParetoMcts`]: settings and their
-//! validating builder, the search tree, episodes with a search budget per step (thesis 5.4.2),
+//! validating builder, the search graph, episodes with a search budget per step (thesis 5.4.2),
 //! root-parallel threads, and the outcome with its trace.
 //!
 //! # Episodes and steps
 //! An *episode* walks from the root to a complete disassembly. At each *search step* it runs
 //! `budget` *iterations* from the current node — selection by the tree policy, expansion of one
 //! untried removal (chosen at random), a rollout with the default policy until no part can be
-//! removed, and backpropagation to the root — and then moves to the child the tree policy
-//! picks. The next episode starts again at the root.
+//! removed, and backpropagation along the path to the root — and then moves to the child the
+//! tree policy picks. The next episode starts again at the root.
 //!
-//! # Solved and dead subtrees
+//! # Transpositions
+//! Removing A then B leaves the same state as B then A. By default every state (present parts
+//! and the objectives' memories, e.g. the direction-change objective's `H`) has one node, so the
+//! search runs on a graph: node values hold *suffix* returns (from the state to the end, which do
+//! not depend on the path), selection adds the edge's reward and the path's returns so far, and
+//! at the end the answer is read off the graph's complete paths by dynamic programming and merged
+//! with the best complete sequences sampled. `transpositions(false)` grows the thesis' plain tree
+//! instead (there a node's suffix values equal its whole returns less a constant).
+//!
+//! # Solved and dead nodes
 //! A node whose removals have all been expanded and whose children are all finished is
-//! *solved* (its subtree has been enumerated) or *dead* (no complete sequence under it).
-//! Selection skips finished children; when the root is finished the search stops early: its
-//! answer is then exact.
+//! *solved* (everything below it has been explored) or *dead* (no complete sequence below it).
+//! Selection skips finished children; when the root is finished the search stops early and its
+//! answer is exact.
 //!
 //! # Threads
-//! Root parallelism: each thread grows its own tree with its own random stream
+//! Root parallelism: each thread grows its own graph with its own random stream
 //! (`seed`, thread index) and its share of the episodes; the answers are merged in thread order.
 //! The output depends only on the seed, the settings and the thread count (not on timing)
 //! unless a time limit stops the search. `threads = 1` runs on the calling thread.

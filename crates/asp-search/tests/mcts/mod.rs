@@ -88,3 +88,21 @@ fn node_cap_still_finds_sequences() {
     let best = out.best().unwrap();
     p.evaluate(&best.sequence).unwrap();
 }
+
+#[test]
+fn the_thesis_tree_without_transpositions_also_finds_optima() {
+    for (name, assembly) in exact_instances().into_iter().take(2) {
+        let maps = maps(&assembly, 5);
+        let p = problem(&maps, "access");
+        let exact = exact_front(&p, 100_000).unwrap();
+        let search = Mcts::builder().transpositions(false).seed(2).build().unwrap();
+        assert!(!search.settings().transpositions());
+        let out = search.solve(&p).unwrap();
+        let best = out.best().unwrap();
+        assert!(close(best.values[0], exact.solutions[0].values[0]), "{name}");
+        p.evaluate(&best.sequence).unwrap();
+        // a tree holds one node per removal order tried, a graph one per state
+        let graph = Mcts::builder().seed(2).build().unwrap().solve(&p).unwrap();
+        assert!(graph.stats.tree_nodes <= out.stats.tree_nodes, "{name}");
+    }
+}

@@ -95,3 +95,21 @@ fn threads_are_reproducible_and_merge_fronts() {
     assert!(csv.starts_with("episode,iterations,seconds,value,front_size\n"));
     assert_eq!(csv.lines().count(), t.len() + 1);
 }
+
+#[test]
+fn the_graph_read_out_is_exact_once_the_root_is_solved() {
+    // 3×3×3 cubes: the graph is explored completely within the default budget, and the front
+    // read off it equals the exact one point for point
+    for seed in 0..3 {
+        let cube = soma(3, seed);
+        let maps = maps(&cube, 5);
+        let p = problem(&maps, "access,dirchange");
+        let exact = exact_front(&p, 1_000_000).unwrap();
+        let out = ParetoMcts::builder().seed(seed).build().unwrap().solve(&p).unwrap();
+        assert!(out.stats.exhausted, "seed {seed}");
+        assert_eq!(out.solutions.len(), exact.solutions.len(), "seed {seed}");
+        for (s, e) in out.solutions.iter().zip(&exact.solutions) {
+            assert!(s.values.iter().zip(&e.values).all(|(a, b)| close(*a, *b)), "{:?} vs {:?}", s.values, e.values);
+        }
+    }
+}
