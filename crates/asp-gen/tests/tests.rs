@@ -419,13 +419,14 @@ fn profile_assemblies_are_linked_and_come_apart_along_straight_lines() {
 
 #[test]
 fn stable_orders_are_found_where_plain_top_down_strands_a_connector() {
-    // assemblies of `asp gen` batches (seed 1, 500 each) whose stable order was missed: plain
-    // top-down removal took a profile away before the profile resting on it through a U
+    // assemblies of `asp gen` batches (seeds 0 and 1, 500 each) whose stable order was missed:
+    // plain top-down removal took a profile away before the profile resting on it through a U
     // connector, which then hung on that profile alone
     for (params, seed) in [
         (ProfileParams::double_layer(), 2270958130545493676),
         (ProfileParams::double_layer(), 7589064093957187971),
         (ProfileParams::single_layer(), 9851787880037274203),
+        (ProfileParams::double_layer(), 14632709568069078079),
     ] {
         let check = profiles(&params, seed).check_disassembly();
         assert!(check.linked && check.straight_line && check.stable_order, "seed {seed}: {check:?}");
@@ -523,26 +524,25 @@ fn plans_to_completion(path: &std::path::Path) -> std::result::Result<(), String
     }
 }
 
-const EROSION: &str = "asp-geom's erosion keeps saddle vertices of voxel pieces and U connectors (faces with normals +z and -z) in place, so its removal test blocks them falsely; see docs/generators.md";
+const RING: &str = "asp-geom reports an O connector sliding up along the support it surrounds as blocked (at profile scale only); see docs/generators.md";
 
 #[test]
-#[ignore = "asp-geom's erosion keeps saddle vertices in place (see EROSION): the classic cube has no plan"]
 fn generated_soma_cubes_plan_to_completion() {
     let dir = tempfile::tempdir().unwrap();
     let classic = write(Generator::ClassicSoma { cell: 0.05 }, 1, 0, dir.path());
     let random = write(Generator::Soma(SomaParams { size: 4, cell: 0.05 }), 4, 0, dir.path());
     for entry in classic.assemblies.iter().chain(&random.assemblies) {
-        plans_to_completion(&dir.path().join(&entry.file)).expect(EROSION);
+        plans_to_completion(&dir.path().join(&entry.file)).unwrap();
     }
 }
 
 #[test]
-#[ignore = "asp-geom's erosion keeps saddle vertices in place (see EROSION): profile assemblies exhaust the budget"]
+#[ignore = "asp-geom blocks O connectors sliding along their supports (see RING): most profile assemblies exhaust the budget"]
 fn generated_profile_assemblies_plan_to_completion() {
     let dir = tempfile::tempdir().unwrap();
     let manifest = write(Generator::Profiles(ProfileParams::single_layer()), 2, 0, dir.path());
     for entry in &manifest.assemblies {
-        plans_to_completion(&dir.path().join(&entry.file)).expect(EROSION);
+        plans_to_completion(&dir.path().join(&entry.file)).expect(RING);
     }
 }
 
