@@ -92,7 +92,7 @@ pub struct PlanArgs {
     /// simulation before the state counts as unstable.
     #[arg(long, default_value_t = 0.01)]
     pub physics_threshold: f64,
-    /// Seed of every random choice (random order, path planner).
+    /// Seed of every random choice (random order, path planner, optimisation).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Stop after this many removal tests.
@@ -114,6 +114,9 @@ pub struct PlanArgs {
     /// No progress bar, no warnings.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Optimisation (`--objective`): MCTS / Pareto-MCTS on distance maps.
+    #[command(flatten)]
+    pub optimise: crate::optimise::OptimiseArgs,
 }
 
 /// Parses the process arguments (exits with usage on error).

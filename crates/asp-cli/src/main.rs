@@ -3,6 +3,7 @@
 //! The binary is thin: it parses flags, calls the library crates, and formats output.
 
 mod flags;
+mod optimise;
 mod output;
 
 use flags::{Cli, Command};

@@ -13,7 +13,7 @@ use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 use std::time::Duration;
 
-fn positive(name: &str, v: f64) -> anyhow::Result<f64> {
+pub(crate) fn positive(name: &str, v: f64) -> anyhow::Result<f64> {
     if v > 0.0 && v.is_finite() {
         Ok(v)
     } else {
@@ -33,6 +33,9 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
     };
     let options = LoadOptions { unit, up, fixed: args.fixed.clone() };
     let assembly = load(&args.model, &options)?;
+    if args.optimise.is_active() {
+        return crate::optimise::plan(args, assembly);
+    }
     let metres = assembly.units.metres;
     let to_m = |name: &str, v: Option<f64>| -> anyhow::Result<Option<f32>> {
         v.map(|v| positive(name, v).map(|v| (v * metres) as f32)).transpose()
@@ -124,7 +127,7 @@ fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
 }
 
 /// The human-readable plan: a header, the assembly sequence, and the explanation when stuck.
-fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
+pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
     let s = &r.stats;
     writeln!(
         out,

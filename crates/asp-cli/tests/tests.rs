@@ -1,3 +1,4 @@
 //! Integration tests of the `asp` binary (the real executable).
 
 mod cli;
+mod optimise;

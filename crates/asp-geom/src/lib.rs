@@ -2,6 +2,7 @@
 
 pub mod assembly;
 pub mod checker;
+pub mod distmap;
 pub mod erode;
 pub mod error;
 pub mod feasibility;

@@ -1,15 +1,48 @@
-//! Errors of asp-search: bad configuration only (a plan that is not found is a status).
+//! Errors of asp-search: bad input and bad configuration only (a search that finds nothing is an
+//! outcome, not an error).
 
-/// What can be wrong with a planner's configuration.
+use asp_geom::GeomError;
+
+/// Everything that can go wrong before or around a search.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SearchError {
-    /// A setting is out of range.
+    /// A configuration value is out of range or inconsistent.
     #[error("invalid configuration: {reason}")]
     Config {
-        /// What is wrong.
+        /// What is wrong, in lowercase words.
         reason: String,
     },
+    /// An objective name that asp does not know.
+    #[error("unknown objective '{name}' (known: {known})")]
+    UnknownObjective {
+        /// The name given.
+        name: String,
+        /// The known names, comma separated.
+        known: String,
+    },
+    /// An exact reference was asked for an instance that is too large.
+    #[error("too large for exact search: {reason}")]
+    TooLarge {
+        /// Which limit was hit.
+        reason: String,
+    },
+    /// A sequence given for evaluation is not feasible.
+    #[error("infeasible sequence: {reason}")]
+    Infeasible {
+        /// The first step that fails and why.
+        reason: String,
+    },
+    /// An error of the geometry layer (loading, distance maps).
+    #[error(transparent)]
+    Geom(#[from] GeomError),
+}
+
+impl SearchError {
+    /// Shorthand for a [`SearchError::Config`].
+    pub fn config(reason: impl Into<String>) -> Self {
+        SearchError::Config { reason: reason.into() }
+    }
 }
 
 /// Result with [`SearchError`].

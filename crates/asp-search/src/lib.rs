@@ -2,12 +2,26 @@
 
 pub mod dfs;
 pub mod error;
+pub mod exact;
+pub mod hypervolume;
+pub mod mcts;
+pub mod mdp;
+pub mod objective;
+pub mod pareto;
+pub mod policy;
 pub mod problem;
 pub mod report;
+pub mod search;
 
 pub use dfs::{Dfs, Ordering};
 pub use error::{Result, SearchError};
+pub use mcts::Mcts;
+pub use mdp::Mdp;
+pub use objective::{Accessibility, DirectionChanges, Memory, Objective, PathLength};
+pub use pareto::ParetoMcts;
+pub use policy::{EpsilonGreedy, Policy, QFunction, RandomPolicy};
 pub use problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, Stuck, StuckReason};
+pub use search::{SearchOutcome, SearchStatus, Solution};
 
 /// A planner: takes a problem apart within a budget. Every planner runs the same conformance
 /// tests (`tests/conformance`).

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.0";
+pub const FORMAT_VERSION: &str = "1.1";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -45,6 +45,9 @@ pub struct PlanReport {
     /// Pareto runs: every non-dominated sequence with its objective vector.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pareto_front: Option<Vec<ParetoEntry>>,
+    /// Optimising runs (`--objective`): the objectives, the result and the search's settings.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub optimisation: Option<OptimisationEntry>,
 }
 
 /// A part of the model.
@@ -138,6 +141,45 @@ pub struct ParetoEntry {
     pub disassembly_sequence: Vec<usize>,
 }
 
+/// What an optimising run (`--objective`) searched for and found.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct OptimisationEntry {
+    /// `mcts` (one objective) or `pareto_mcts`.
+    pub method: String,
+    /// The objectives' names, in the order of every objective vector.
+    pub objectives: Vec<String>,
+    /// The objective vector of `assembly_sequence` (the best sequence, or the front's first).
+    pub values: Vec<f64>,
+    /// Pareto runs: the hypervolume of the front relative to `reference`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hypervolume: Option<f64>,
+    /// The hypervolume reference point (each objective's worst possible total).
+    pub reference: Vec<f64>,
+    /// Whether the whole search space was explored (the answer is then exact).
+    pub exhaustive: bool,
+    /// Episodes run.
+    pub episodes: u64,
+    /// MCTS iterations run.
+    pub iterations: u64,
+    /// Tree nodes built (all threads).
+    pub tree_nodes: u64,
+    /// Iterations per search step.
+    pub budget: usize,
+    /// Threads.
+    pub threads: usize,
+    /// Seed.
+    pub seed: u64,
+    /// Distance map resolution `N_M`.
+    pub resolution: usize,
+    /// The distance maps' cap `d_max` in metres (objective values are in metres too:
+    /// `access` and `pathlen` are sums of lengths, `dirchange` a count).
+    pub d_max: f64,
+    /// Seconds to build the distance maps.
+    pub map_seconds: f64,
+    /// Seconds of search.
+    pub search_seconds: f64,
+}
+
 impl PlanReport {
     /// The report of `outcome` on `assembly`; `tolerance` in metres.
     pub fn new(assembly: &Assembly, outcome: &PlanOutcome, tolerance: f32, warnings: &[String]) -> Self {
@@ -199,6 +241,7 @@ impl PlanReport {
             explanation,
             warnings: warnings.to_vec(),
             pareto_front: None,
+            optimisation: None,
         }
     }
 }

@@ -1,5 +1,11 @@
-//! Integration tests of asp-search.
+//! Integration tests of asp-search (one binary; modules in subfolders).
 
 mod conformance;
+mod exact;
+mod fixtures;
+mod hypervolume;
+mod mcts;
+mod objectives;
+mod pareto;
 mod real;
 mod verify;

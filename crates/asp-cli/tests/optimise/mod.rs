@@ -1,0 +1,130 @@
+//! `asp plan --objective`: single-objective MCTS and Pareto-MCTS end to end, their JSON and
+//! trace, reproducibility, and flag errors.
+
+use asp_geom::io::write_glb;
+use asp_geom::math::{Axis, Vec3};
+use asp_geom::{Assembly, Mesh, Part, Units};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn asp(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_asp")).args(args).output().expect("asp runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// A 3×3×3 cube of 5 cm voxels in three layers of three bars, crossing like a Jenga tower;
+/// each bar carries its cells in `extras.asp.cells` as the Soma generator writes them.
+fn jenga(dir: &Path) -> PathBuf {
+    let mut parts = Vec::new();
+    for z in 0..3 {
+        for k in 0..3 {
+            let cells: Vec<[i32; 3]> =
+                (0..3).map(|t| if z % 2 == 0 { [t, k, z] } else { [k, t, z] }).collect();
+            parts.push(Part {
+                name: format!("bar_{z}{k}"),
+                mesh: Mesh::from_voxels(&cells, Vec3::splat(0.05), Vec3::ZERO),
+                fixed: false,
+                extras: serde_json::json!({ "asp": { "cells": cells } }),
+            });
+        }
+    }
+    let a = Assembly { parts, units: Units::metres(), up: Axis::Z, source: "jenga".into(), warnings: Vec::new() };
+    let path = dir.join("jenga.glb");
+    write_glb(&a, &path).unwrap();
+    path
+}
+
+#[test]
+fn single_objective_writes_the_best_sequence() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = jenga(dir.path());
+    let out = dir.path().join("plan.json");
+    let o = asp(&[
+        "plan", model.to_str().unwrap(), "--objective", "access", "--episodes", "50", "--threads", "1",
+        "--seed", "1", "--out", out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let table = String::from_utf8(o.stdout).unwrap();
+    assert!(table.contains("best access"), "{table}");
+    let plan = json(&out);
+    assert_eq!(plan["status"], "found");
+    assert_eq!(plan["assembly_sequence"].as_array().unwrap().len(), 9);
+    assert_eq!(plan["disassembly_sequence"].as_array().unwrap().len(), 9);
+    let opt = &plan["optimisation"];
+    assert_eq!(opt["method"], "mcts");
+    assert_eq!(opt["objectives"], serde_json::json!(["access"]));
+    assert!(opt["values"][0].as_f64().unwrap() > 0.0);
+    assert!(plan.get("pareto_front").is_none());
+    // the top layer goes first in disassembly: the assembly sequence ends with a top bar
+    let last = plan["assembly_sequence"][8]["name"].as_str().unwrap();
+    assert!(last.starts_with("bar_2"), "{last}");
+    assert_eq!(plan["assembly_sequence"][0]["motion"]["kind"], "linear");
+}
+
+#[test]
+fn pareto_front_trace_and_reproducibility() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = jenga(dir.path());
+    let run = |k: usize, threads: &str| {
+        let out = dir.path().join(format!("front{k}.json"));
+        let trace = dir.path().join(format!("hv{k}.csv"));
+        let o = asp(&[
+            "plan", model.to_str().unwrap(), "--objective", "access,dirchange", "--pareto", "--episodes", "60",
+            "--budget", "5", "--threads", threads, "--seed", "1", "--out", out.to_str().unwrap(), "--trace",
+            trace.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let mut v = json(&out);
+        for key in ["map_seconds", "search_seconds"] {
+            v["optimisation"][key] = serde_json::Value::Null;
+        }
+        v["stats"]["seconds"] = serde_json::Value::Null;
+        (v, std::fs::read_to_string(trace).unwrap())
+    };
+    let (a, trace) = run(0, "2");
+    let front = a["pareto_front"].as_array().unwrap();
+    assert!(!front.is_empty());
+    for e in front {
+        assert_eq!(e["objectives"].as_array().unwrap().len(), 2);
+        let mut seq: Vec<u64> =
+            e["disassembly_sequence"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+        seq.sort();
+        assert_eq!(seq, (0..9).collect::<Vec<u64>>());
+    }
+    let opt = &a["optimisation"];
+    assert_eq!(opt["method"], "pareto_mcts");
+    assert_eq!(opt["threads"], 2);
+    assert!(opt["hypervolume"].as_f64().unwrap() > 0.0);
+    assert_eq!(opt["episodes"], 60);
+    let mut lines = trace.lines();
+    assert_eq!(lines.next(), Some("episode,iterations,seconds,value,front_size"));
+    assert!(lines.count() >= 1);
+    // same seed and thread count: the same plan
+    let (b, _) = run(1, "2");
+    assert_eq!(a, b);
+}
+
+#[test]
+fn bad_objective_flags_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = jenga(dir.path());
+    let m = model.to_str().unwrap();
+    let o = asp(&["plan", m, "--objective", "speed"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("unknown objective 'speed'"), "{}", stderr(&o));
+    let o = asp(&["plan", m, "--objective", "access,dirchange"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--pareto"), "{}", stderr(&o));
+    let o = asp(&["plan", m, "--objective", "access", "--budget", "0"]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = asp(&["plan", m, "--objective", "access", "--resolution", "4"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("resolution"), "{}", stderr(&o));
+}

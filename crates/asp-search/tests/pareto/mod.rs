@@ -1,0 +1,98 @@
+//! Pareto-MCTS: ≥ 99 % of the exact hypervolume within the default budget on instances with
+//! exact fronts, feasible and mutually non-dominated answers, reproducible threads.
+
+use crate::fixtures::{close, figure_6_2, maps, problem, random_cube};
+use asp_search::exact::exact_front;
+use asp_search::hypervolume::dominates;
+use asp_search::search::SearchStatus;
+use asp_search::ParetoMcts;
+
+#[test]
+fn figure_6_2_front() {
+    let maps = maps(&figure_6_2(), 3);
+    let p = problem(&maps, "access,dirchange");
+    let out = ParetoMcts::builder().seed(1).build().unwrap().solve(&p).unwrap();
+    assert_eq!(out.status, SearchStatus::Found);
+    assert_eq!(out.solutions.len(), 1);
+    assert_eq!(out.solutions[0].sequence, vec![2, 1, 0]);
+    assert_eq!(out.solutions[0].values[1], 3.0);
+}
+
+#[test]
+fn reaches_99_percent_of_the_exact_hypervolume_on_3x3x3_cubes() {
+    let mut checked = 0;
+    for seed in 0..10 {
+        let cube = random_cube(3, 100 + seed);
+        let maps = maps(&cube, 5);
+        for objectives in ["access,dirchange", "access,pathlen", "access,dirchange,pathlen"] {
+            let p = problem(&maps, objectives);
+            let exact = exact_front(&p, 2_000_000).unwrap();
+            if exact.solutions.is_empty() {
+                continue;
+            }
+            // a tight reference: just below the worst total of every objective
+            let reference: Vec<f64> =
+                exact.worst.iter().map(|w| w - 1e-3 * w.abs().max(1.0)).collect();
+            let out = ParetoMcts::builder()
+                .seed(seed)
+                .reference(reference.clone())
+                .build()
+                .unwrap()
+                .solve(&p)
+                .unwrap();
+            let hv_exact = exact.hypervolume(&reference);
+            assert!(
+                out.value >= 0.99 * hv_exact,
+                "cube {seed} ({} parts) {objectives}: {} of exact {hv_exact} ({} of {} points, {} episodes)",
+                maps.num_parts(),
+                out.value,
+                out.solutions.len(),
+                exact.solutions.len(),
+                out.stats.episodes
+            );
+            for (i, s) in out.solutions.iter().enumerate() {
+                let (v, _) = p.evaluate(&s.sequence).unwrap();
+                assert!(v.iter().zip(&s.values).all(|(a, b)| close(*a, *b)));
+                for t in &out.solutions[i + 1..] {
+                    assert!(!dominates(&s.values, &t.values) && !dominates(&t.values, &s.values));
+                }
+                // no answer lies beyond the exact front
+                assert!(exact.solutions.iter().any(|e| e
+                    .values
+                    .iter()
+                    .zip(&s.values)
+                    .all(|(a, b)| *a >= *b - 1e-9 * b.abs().max(1.0))));
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked >= 20);
+}
+
+#[test]
+fn threads_are_reproducible_and_merge_fronts() {
+    let cube = random_cube(4, 21);
+    let maps = maps(&cube, 5);
+    let p = problem(&maps, "access,dirchange");
+    let run = |threads| {
+        ParetoMcts::builder().episodes(20).threads(threads).seed(9).build().unwrap().solve(&p).unwrap()
+    };
+    let (a, b) = (run(1), run(1));
+    assert_eq!(a.solutions, b.solutions);
+    let (c, d) = (run(2), run(2));
+    assert_eq!(c.solutions, d.solutions);
+    assert_eq!(c.stats.threads, 2);
+    assert_eq!(c.stats.episodes, 20);
+    for s in &c.solutions {
+        p.evaluate(&s.sequence).unwrap();
+    }
+    // the trace is monotone in the hypervolume and ends with the answer's value
+    let t = &c.trace;
+    assert!(t.windows(2).all(|w| w[1].value >= w[0].value - 1e-9));
+    assert!(close(t.last().unwrap().value, c.value));
+    let mut csv = Vec::new();
+    c.write_trace_csv(&mut csv).unwrap();
+    let csv = String::from_utf8(csv).unwrap();
+    assert!(csv.starts_with("episode,iterations,seconds,value,front_size\n"));
+    assert_eq!(csv.lines().count(), t.len() + 1);
+}
