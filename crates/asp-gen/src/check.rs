@@ -93,9 +93,8 @@ pub fn check_disassembly(model: &impl RemovalModel) -> DisassemblyCheck {
     // is added after what it rests on), plain reverse build order, top-down in build order; on
     // 300 double-layer assemblies each alone missed 1 to 14 stable orders, together none
     let rankings = [top_down(true), movable.iter().rev().copied().collect(), top_down(false)];
-    let blockers: Vec<Vec<PartSet>> = (0..n)
-        .map(|i| DIRECTIONS.iter().map(|&a| PartSet::from_indices(n, model.blockers(i, a))).collect())
-        .collect();
+    let blockers: Vec<Vec<PartSet>> =
+        (0..n).map(|i| DIRECTIONS.iter().map(|&a| PartSet::from_indices(n, model.blockers(i, a))).collect()).collect();
     let free_axis = |i: usize, state: &PartSet| {
         DIRECTIONS.iter().zip(&blockers[i]).find(|(_, b)| !b.intersects(state)).map(|(&a, _)| a)
     };
@@ -112,7 +111,8 @@ pub fn check_disassembly(model: &impl RemovalModel) -> DisassemblyCheck {
     let stable = stuck.is_empty().then(|| {
         rankings.iter().find_map(|ranked| {
             let dead = HashSet::new();
-            let mut search = StableSearch { model, ranked, free_axis: &free_axis, dead, budget: SEARCH_BUDGET, order: Vec::new() };
+            let mut search =
+                StableSearch { model, ranked, free_axis: &free_axis, dead, budget: SEARCH_BUDGET, order: Vec::new() };
             (search.run(&PartSet::full(n)) == Some(true)).then_some(search.order)
         })
     });
@@ -120,7 +120,13 @@ pub fn check_disassembly(model: &impl RemovalModel) -> DisassemblyCheck {
     if let Some(Some(stable)) = stable {
         order = stable;
     }
-    DisassemblyCheck { linked: is_contact_linked(model, &PartSet::full(n)), straight_line: stuck.is_empty(), stuck, stable_order, order }
+    DisassemblyCheck {
+        linked: is_contact_linked(model, &PartSet::full(n)),
+        straight_line: stuck.is_empty(),
+        stuck,
+        stable_order,
+        order,
+    }
 }
 
 /// Depth-first search for a removal order whose states all stay contact-linked.
@@ -200,7 +206,9 @@ impl RemovalModel for BoxModel {
         let (a, negative) = (axis.index as usize, axis.negative);
         (0..self.parts.len())
             .filter(|&j| j != i)
-            .filter(|&j| self.parts[i].iter().any(|x| self.parts[j].iter().any(|y| x.sweep_hits(y, a, negative, self.tol))))
+            .filter(|&j| {
+                self.parts[i].iter().any(|x| self.parts[j].iter().any(|y| x.sweep_hits(y, a, negative, self.tol)))
+            })
             .collect()
     }
 
@@ -224,7 +232,11 @@ mod tests {
     #[test]
     fn a_stack_comes_apart_top_down() {
         // floor (fixed), a block on it, a block on that
-        let parts = vec![vec![Cuboid::new([-1.0, -1.0, -1.0], [2.0, 2.0, 0.0])], vec![unit(0.0, 0.0, 0.0)], vec![unit(0.0, 0.0, 1.0)]];
+        let parts = vec![
+            vec![Cuboid::new([-1.0, -1.0, -1.0], [2.0, 2.0, 0.0])],
+            vec![unit(0.0, 0.0, 0.0)],
+            vec![unit(0.0, 0.0, 1.0)],
+        ];
         let check = check_disassembly(&BoxModel::new(parts, vec![true, false, false], 1e-9));
         assert!(check.linked && check.straight_line && check.stable_order);
         assert_eq!(check.order, vec![(2, Axis::Z), (1, Axis::Z)]);
@@ -251,7 +263,11 @@ mod tests {
             i == 0
         }
         fn blockers(&self, i: usize, _: Axis) -> Vec<usize> {
-            if i == 3 { vec![2] } else { vec![] }
+            if i == 3 {
+                vec![2]
+            } else {
+                vec![]
+            }
         }
         fn contacts(&self, i: usize) -> &[usize] {
             &self.contacts[i]
