@@ -556,12 +556,14 @@ fn first_overlap(moving: &Aabb, dir: Vec3, fixed: &Aabb, tol: f32) -> Option<f32
     (t0 < t1).then_some(entry.min(t0))
 }
 
-/// The voxels of a part: `extras.asp.cells` (as the Soma generator writes them) or
-/// `extras.asp.voxels`, as `[[i, j, k], ...]` or `{"cells": [...]}`. Their size and position
-/// are fitted to the part's mesh, so any cell size and unit work.
+/// The voxels of a part from its metadata ([`crate::Part::extras`], the node's `extras.asp`):
+/// `cells` (as the Soma generator writes them) or `voxels`, as `[[i, j, k], ...]` or
+/// `{"cells": [...]}`; also accepted one level down under `asp`. Their size and position are
+/// fitted to the part's mesh, so any cell size and unit work.
 pub fn voxels_of(extras: &serde_json::Value) -> Option<Vec<[i32; 3]>> {
-    let asp = extras.get("asp")?;
-    let v = asp.get("cells").or_else(|| asp.get("voxels"))?;
+    let find = |o: &serde_json::Value| o.get("cells").or_else(|| o.get("voxels")).cloned();
+    let v = find(extras).or_else(|| extras.get("asp").and_then(find))?;
+    let v = &v;
     let cells = match v {
         serde_json::Value::Array(a) => a,
         serde_json::Value::Object(o) => o.get("cells")?.as_array()?,

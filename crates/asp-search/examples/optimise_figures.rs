@@ -9,63 +9,19 @@
 //! ```
 
 use asp_geom::distmap::{DistanceMaps, MapConfig};
-use asp_geom::math::{Axis, Vec3};
-use asp_geom::{Assembly, Mesh, Part, Units};
+use asp_geom::Assembly;
 use asp_search::exact::exact_front;
 use asp_search::objective::parse_objectives;
 use asp_search::{Mdp, ParetoMcts};
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// A random `size³` Soma cube of 5 cm cells (thesis Algorithm 1).
-fn soma_cube(size: i32, seed: u64) -> Assembly {
+/// A random `size³` Soma cube of 5 cm cells from the generator (thesis Algorithm 1), on its
+/// fixed floor slab.
+pub fn soma_cube(size: usize, seed: u64) -> Assembly {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    let idx = |c: [i32; 3]| ((c[2] * size + c[1]) * size + c[0]) as usize;
-    let mut owner = vec![usize::MAX; (size * size * size) as usize];
-    let mut pieces: Vec<Vec<[i32; 3]>> = Vec::new();
-    loop {
-        let empty: Vec<[i32; 3]> = (0..size * size * size)
-            .map(|k| [k % size, (k / size) % size, k / (size * size)])
-            .filter(|&c| owner[idx(c)] == usize::MAX)
-            .collect();
-        if empty.is_empty() {
-            break;
-        }
-        let id = pieces.len();
-        let mut cells = vec![empty[rng.random_range(0..empty.len())]];
-        owner[idx(cells[0])] = id;
-        for _ in 0..3 {
-            let mut frontier = Vec::new();
-            for c in &cells {
-                for (axis, step) in [(0, 1), (0, -1), (1, 1), (1, -1), (2, 1), (2, -1)] {
-                    let mut n = *c;
-                    n[axis] += step;
-                    if n.iter().all(|&v| (0..size).contains(&v)) && owner[idx(n)] == usize::MAX {
-                        frontier.push(n);
-                    }
-                }
-            }
-            if frontier.is_empty() {
-                break;
-            }
-            let n = frontier[rng.random_range(0..frontier.len())];
-            owner[idx(n)] = id;
-            cells.push(n);
-        }
-        pieces.push(cells);
-    }
-    let parts = pieces
-        .iter()
-        .enumerate()
-        .map(|(i, c)| Part {
-            name: format!("piece_{i:02}"),
-            mesh: Mesh::from_voxels(c, Vec3::splat(0.05), Vec3::ZERO),
-            fixed: false,
-            extras: serde_json::json!({ "asp": { "cells": c } }),
-        })
-        .collect();
-    Assembly { parts, units: Units::metres(), up: Axis::Z, source: "soma".into(), warnings: Vec::new() }
+    asp_gen::SomaCube::random(size, &mut rng).expect("soma cube").to_assembly(0.05, "soma")
 }
 
 fn mdp(cube: &Assembly) -> (Mdp, f64) {
@@ -80,7 +36,7 @@ fn main() {
     let arg = |k: usize, default: &str| args.get(k).cloned().unwrap_or_else(|| default.to_string());
     match arg(0, "speed").as_str() {
         "speed" => {
-            let size: i32 = arg(1, "5").parse().expect("size");
+            let size: usize = arg(1, "5").parse().expect("size");
             let episodes: usize = arg(2, "400").parse().expect("episodes");
             let cube = soma_cube(size, 1);
             let (mdp, map_seconds) = mdp(&cube);
@@ -102,7 +58,7 @@ fn main() {
             }
         }
         "hv" => {
-            let size: i32 = arg(1, "5").parse().expect("size");
+            let size: usize = arg(1, "5").parse().expect("size");
             let times: Vec<f64> = arg(2, "1,10,60").split(',').map(|t| t.parse().expect("seconds")).collect();
             let threads: usize = arg(3, "2").parse().expect("threads");
             let cube = soma_cube(size, 1);
@@ -128,7 +84,7 @@ fn main() {
             }
         }
         "exact" => {
-            let size: i32 = arg(1, "3").parse().expect("size");
+            let size: usize = arg(1, "3").parse().expect("size");
             let count: u64 = arg(2, "20").parse().expect("count");
             let (mut sum, mut min, mut runs) = (0.0, f64::INFINITY, 0);
             for seed in 0..count {

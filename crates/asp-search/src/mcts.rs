@@ -56,7 +56,7 @@ impl Mcts {
     }
 }
 
-/// The largest return seen through a node (`-inf` before any).
+/// The largest suffix return seen from a node (`-inf` before any).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct MaxValue(pub f64);
 
@@ -72,46 +72,40 @@ impl Variant for MaxBackup {
     type Value = MaxValue;
 
     #[inline]
-    fn record(value: &mut MaxValue, ret: &[f64]) -> bool {
-        if ret[0] > value.0 {
-            value.0 = ret[0];
+    fn record(value: &mut MaxValue, suffix: &[f64]) -> bool {
+        if suffix[0] > value.0 {
+            value.0 = suffix[0];
         }
         true
     }
 
-    fn select(
-        tree: &mut Tree<MaxValue>,
-        parent: u32,
-        candidates: &[u32],
-        ctx: &SelectContext<'_>,
-    ) -> usize {
-        // Local bounds: the siblings' maxima.
+    fn select(tree: &Tree<MaxValue>, node: u32, candidates: &[u32], ctx: &SelectContext<'_>) -> usize {
+        // Q of an edge: its reward plus the child's best suffix. Local bounds: the siblings'.
+        let q = |e: u32| tree.reward(e)[0] + tree.values[tree.edges[e as usize].child as usize].0;
         let (mut lo, mut hi, mut valued) = (f64::INFINITY, f64::NEG_INFINITY, 0);
-        for c in tree.children(parent) {
-            let q = tree.values[c as usize].0;
-            if q.is_finite() {
-                lo = lo.min(q);
-                hi = hi.max(q);
+        for e in tree.edges_of(node) {
+            let v = q(e);
+            if v.is_finite() {
+                lo = lo.min(v);
+                hi = hi.max(v);
                 valued += 1;
             }
         }
-        if valued < 2 || hi <= lo {
-            lo = ctx.bounds.lo[0];
-            hi = ctx.bounds.hi[0];
-        }
-        let parent_visits = tree.nodes[parent as usize].visits;
+        let local = valued >= 2 && hi > lo;
+        let parent_visits = tree.nodes[node as usize].visits;
         let mut best = (f64::NEG_INFINITY, 0);
-        for (k, &c) in candidates.iter().enumerate() {
-            let q = tree.values[c as usize].0;
-            let q_hat = if !q.is_finite() {
+        for (k, &e) in candidates.iter().enumerate() {
+            let v = q(e);
+            let q_hat = if !v.is_finite() {
                 0.0
-            } else if hi > lo {
-                ((q - lo) / (hi - lo)).clamp(0.0, 1.0)
+            } else if local {
+                (v - lo) / (hi - lo)
             } else {
-                1.0
+                // global bounds of the whole returns
+                ctx.bounds.normalise(0, ctx.prefix[0] + v).clamp(0.0, 1.0)
             };
-            let score = q_hat
-                + exploration_term(ctx.exploration, parent_visits, tree.nodes[c as usize].visits);
+            let score =
+                q_hat + exploration_term(ctx.exploration, parent_visits, tree.edges[e as usize].visits);
             if score > best.0 {
                 best = (score, k);
             }

@@ -14,7 +14,7 @@
 //! ```
 
 use crate::error::Result;
-use crate::hypervolume::ParetoFront;
+use crate::hypervolume::{hypervolume_2d, ParetoFront};
 use crate::mdp::{Mdp, MAX_OBJECTIVES};
 use crate::search::{
     exploration_term, run, SearchBuilder, SearchOutcome, SearchSettings, SelectContext, Tree,
@@ -56,18 +56,10 @@ impl ParetoMcts {
     }
 }
 
-/// A node's local front and the cached normalised hypervolume.
-#[derive(Clone, Debug)]
+/// A node's local front of suffix return vectors.
+#[derive(Clone, Debug, Default)]
 pub(crate) struct FrontValue {
     front: Option<ParetoFront<()>>,
-    hv: f64,
-    hv_version: u64,
-}
-
-impl Default for FrontValue {
-    fn default() -> Self {
-        FrontValue { front: None, hv: 0.0, hv_version: u64::MAX }
-    }
 }
 
 pub(crate) struct FrontBackup;
@@ -76,32 +68,19 @@ impl Variant for FrontBackup {
     type Value = FrontValue;
 
     #[inline]
-    fn record(value: &mut FrontValue, ret: &[f64]) -> bool {
-        let front = value.front.get_or_insert_with(|| ParetoFront::new(ret.len()));
-        let added = front.insert(ret, || ());
-        if added {
-            value.hv_version = u64::MAX;
-        }
-        added
+    fn record(value: &mut FrontValue, suffix: &[f64]) -> bool {
+        let front = value.front.get_or_insert_with(|| ParetoFront::new(suffix.len()));
+        front.insert(suffix, || ())
     }
 
-    fn select(
-        tree: &mut Tree<FrontValue>,
-        parent: u32,
-        candidates: &[u32],
-        ctx: &SelectContext<'_>,
-    ) -> usize {
-        let parent_visits = tree.nodes[parent as usize].visits;
+    fn select(tree: &Tree<FrontValue>, node: u32, candidates: &[u32], ctx: &SelectContext<'_>) -> usize {
+        let parent_visits = tree.nodes[node as usize].visits;
         let mut best = (f64::NEG_INFINITY, 0);
-        for (k, &c) in candidates.iter().enumerate() {
-            let visits = tree.nodes[c as usize].visits;
-            let v = &mut tree.values[c as usize];
-            if v.hv_version != ctx.bounds.version {
-                v.hv = normalised_hypervolume(v.front.as_ref(), ctx);
-                v.hv_version = ctx.bounds.version;
-            }
-            let score = v.hv / visits.max(1) as f64
-                + exploration_term(ctx.exploration, parent_visits, visits);
+        for (k, &e) in candidates.iter().enumerate() {
+            let visits = tree.edges[e as usize].visits;
+            let child = tree.edges[e as usize].child as usize;
+            let hv = normalised_hypervolume(tree.values[child].front.as_ref(), tree.reward(e), ctx);
+            let score = hv / visits.max(1) as f64 + exploration_term(ctx.exploration, parent_visits, visits);
             if score > best.0 {
                 best = (score, k);
             }
@@ -110,14 +89,31 @@ impl Variant for FrontBackup {
     }
 }
 
-fn normalised_hypervolume(front: Option<&ParetoFront<()>>, ctx: &SelectContext<'_>) -> f64 {
+/// The hypervolume of the whole returns `prefix + reward + suffix` over a child's suffix front,
+/// in objectives normalised by the global bounds (reference −0.1 in each).
+fn normalised_hypervolume(front: Option<&ParetoFront<()>>, reward: &[f64], ctx: &SelectContext<'_>) -> f64 {
     let Some(front) = front else { return 0.0 };
-    let m = ctx.m;
+    let m = reward.len();
+    if m == 2 {
+        // the 2-D sweep on a stack buffer
+        let mut pts = [[0.0f64; 2]; 64];
+        let mut count = 0;
+        for (p, _) in front.iter() {
+            if count == pts.len() {
+                break;
+            }
+            for k in 0..2 {
+                pts[count][k] = ctx.bounds.normalise(k, ctx.prefix[k] + reward[k] + p[k]);
+            }
+            count += 1;
+        }
+        return hypervolume_2d(&pts[..count], [NORMALISED_REFERENCE; 2]);
+    }
     let mut norm: ParetoFront<()> = ParetoFront::new(m);
     let mut buf = [0.0f64; MAX_OBJECTIVES];
     for (p, _) in front.iter() {
         for k in 0..m {
-            buf[k] = ctx.bounds.normalise(k, p[k]);
+            buf[k] = ctx.bounds.normalise(k, ctx.prefix[k] + reward[k] + p[k]);
         }
         norm.insert(&buf[..m], || ());
     }

@@ -29,6 +29,8 @@ use crate::mdp::{Mdp, MAX_OBJECTIVES};
 use asp_geom::distmap::MapState;
 use asp_geom::{Motion, PartSet};
 use rand::RngExt;
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
 use std::marker::PhantomData;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -56,6 +58,7 @@ pub struct SearchSettings {
     pub(crate) time_limit: Option<Duration>,
     pub(crate) policy: Arc<dyn Policy>,
     pub(crate) reference: Option<Vec<f64>>,
+    pub(crate) transpositions: bool,
 }
 
 impl Default for SearchSettings {
@@ -70,6 +73,7 @@ impl Default for SearchSettings {
             time_limit: None,
             policy: Arc::new(RandomPolicy),
             reference: None,
+            transpositions: true,
         }
     }
 }
@@ -102,6 +106,10 @@ impl SearchSettings {
     /// Wall-clock limit, if any.
     pub fn time_limit(&self) -> Option<Duration> {
         self.time_limit
+    }
+    /// Whether states reached along different paths share one node.
+    pub fn transpositions(&self) -> bool {
+        self.transpositions
     }
 }
 
@@ -170,6 +178,15 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
     /// The hypervolume reference point (default: every objective's worst possible total).
     pub fn reference(mut self, reference: Vec<f64>) -> Self {
         self.settings.reference = Some(reference);
+        self
+    }
+
+    /// Whether states reached by different removal orders share one node (default true): the
+    /// search runs on a graph of states, node values are about the removals still to come, and
+    /// the answer is read off the graph's complete paths at the end. `false` grows the thesis'
+    /// plain tree.
+    pub fn transpositions(mut self, yes: bool) -> Self {
+        self.settings.transpositions = yes;
         self
     }
 
@@ -302,7 +319,7 @@ impl SearchOutcome {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The tree
+// The search graph
 
 pub(crate) const NONE: u32 = u32::MAX;
 
@@ -313,58 +330,86 @@ pub(crate) enum Status {
     Dead,
 }
 
+/// A disassembly state: the parts present and the objectives' memories (kept in
+/// [`Tree::memory`]). With transpositions every state has one node however it was reached.
 #[derive(Clone, Debug)]
 pub(crate) struct Node {
-    pub parent: u32,
-    pub first_child: u32,
-    pub next_sibling: u32,
+    pub first_edge: u32,
     pub visits: u32,
-    pub action: u16,
     pub status: Status,
+    /// The next node with the same key hash (transposition index chain).
+    next_same: u32,
     pub present: PartSet,
     /// Parts known to be collision-free here (they stay so in every descendant).
     pub free: PartSet,
     pub untried: PartSet,
 }
 
-/// The search tree: nodes, their values, the returns accumulated on the way to them and the
-/// objectives' memories there.
+/// A removal from a node: the child it leads to, its rewards (in [`Tree::rewards`]) and visits.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Edge {
+    pub child: u32,
+    pub next: u32,
+    pub visits: u32,
+    pub action: u16,
+}
+
+/// The search graph (a tree without transpositions). Node values are about *suffixes*: the
+/// returns from the node's state to the end, which do not depend on how the state was reached.
 pub(crate) struct Tree<V> {
     pub nodes: Vec<Node>,
     pub values: Vec<V>,
-    prefix: Vec<f64>,
+    pub edges: Vec<Edge>,
+    rewards: Vec<f64>,
     memory: Vec<Memory>,
-    m: usize,
+    index: HashMap<u64, u32>,
+    pub m: usize,
 }
 
-impl<V: Default> Tree<V> {
-    fn prefix(&self, n: u32) -> &[f64] {
-        &self.prefix[n as usize * self.m..(n as usize + 1) * self.m]
-    }
-
+impl<V> Tree<V> {
     fn memory(&self, n: u32) -> &[Memory] {
         &self.memory[n as usize * self.m..(n as usize + 1) * self.m]
     }
 
-    pub fn children(&self, n: u32) -> ChildIter<'_, V> {
-        ChildIter { tree: self, next: self.nodes[n as usize].first_child }
+    /// The rewards of edge `e`.
+    pub fn reward(&self, e: u32) -> &[f64] {
+        &self.rewards[e as usize * self.m..(e as usize + 1) * self.m]
+    }
+
+    /// The edges out of node `n`.
+    pub fn edges_of(&self, n: u32) -> EdgeIter<'_, V> {
+        EdgeIter { tree: self, next: self.nodes[n as usize].first_edge }
+    }
+
+    /// Whether node `n` holds `present` and `memory`.
+    fn is(&self, n: u32, present: &PartSet, memory: &[Memory]) -> bool {
+        self.nodes[n as usize].present == *present && self.memory(n) == memory
     }
 }
 
-pub(crate) struct ChildIter<'a, V> {
+/// Iterates the edges out of a node.
+pub(crate) struct EdgeIter<'a, V> {
     tree: &'a Tree<V>,
     next: u32,
 }
 
-impl<V> Iterator for ChildIter<'_, V> {
+impl<V> Iterator for EdgeIter<'_, V> {
     type Item = u32;
     fn next(&mut self) -> Option<u32> {
         (self.next != NONE).then(|| {
-            let c = self.next;
-            self.next = self.tree.nodes[c as usize].next_sibling;
-            c
+            let e = self.next;
+            self.next = self.tree.edges[e as usize].next;
+            e
         })
     }
+}
+
+/// A hash of a state (present parts and memories), for the transposition index.
+fn state_hash(present: &PartSet, memory: &[Memory]) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    present.hash(&mut h);
+    memory.hash(&mut h);
+    h.finish()
 }
 
 /// Global bounds of the returns seen so far (per objective).
@@ -372,28 +417,17 @@ impl<V> Iterator for ChildIter<'_, V> {
 pub(crate) struct Bounds {
     pub lo: [f64; MAX_OBJECTIVES],
     pub hi: [f64; MAX_OBJECTIVES],
-    pub version: u64,
 }
 
 impl Bounds {
     fn new() -> Self {
-        Bounds { lo: [f64::INFINITY; MAX_OBJECTIVES], hi: [f64::NEG_INFINITY; MAX_OBJECTIVES], version: 0 }
+        Bounds { lo: [f64::INFINITY; MAX_OBJECTIVES], hi: [f64::NEG_INFINITY; MAX_OBJECTIVES] }
     }
 
     fn update(&mut self, ret: &[f64]) {
-        let mut changed = false;
         for (k, &v) in ret.iter().enumerate() {
-            if v < self.lo[k] {
-                self.lo[k] = v;
-                changed = true;
-            }
-            if v > self.hi[k] {
-                self.hi[k] = v;
-                changed = true;
-            }
-        }
-        if changed {
-            self.version += 1;
+            self.lo[k] = self.lo[k].min(v);
+            self.hi[k] = self.hi[k].max(v);
         }
     }
 
@@ -409,23 +443,24 @@ impl Bounds {
     }
 }
 
-/// What the tree policy needs besides the tree.
+/// What the tree policy needs besides the graph.
 pub(crate) struct SelectContext<'a> {
     pub exploration: f64,
     pub bounds: &'a Bounds,
-    pub m: usize,
+    /// The returns collected on the way to the node selection starts from.
+    pub prefix: &'a [f64],
 }
 
 /// The variant-specific parts: the node value, its backup and the tree policy.
 pub(crate) trait Variant: Send + Sync {
-    /// What a node keeps of the returns through it.
+    /// What a node keeps of the suffix returns through it.
     type Value: Default + Send;
-    /// Records the return `ret` of a complete sequence through the node; false when
-    /// backpropagation of values should stop here (the rest of the path only counts a visit).
-    fn record(value: &mut Self::Value, ret: &[f64]) -> bool;
-    /// The position in `candidates` (children of `parent`, not empty) the tree policy picks.
-    fn select(tree: &mut Tree<Self::Value>, parent: u32, candidates: &[u32], ctx: &SelectContext<'_>)
-        -> usize;
+    /// Records the suffix return of a complete sequence through the node; false when it
+    /// added nothing (without transpositions, backpropagation of values then stops: the node's
+    /// ancestors hold something at least as good).
+    fn record(value: &mut Self::Value, suffix: &[f64]) -> bool;
+    /// The position in `candidates` (edges out of `node`, not empty) the tree policy picks.
+    fn select(tree: &Tree<Self::Value>, node: u32, candidates: &[u32], ctx: &SelectContext<'_>) -> usize;
 }
 
 /// `c · sqrt(2 ln N(parent) / N(child))`.
@@ -453,6 +488,11 @@ struct Worker<'p, V: Variant> {
     sim: MapState<'p>,
     actions: Vec<usize>,
     candidates: Vec<u32>,
+    /// The nodes of the current path from the root, the edges between them, and the returns
+    /// collected up to each node (`m` per node).
+    path: Vec<u32>,
+    path_edges: Vec<u32>,
+    path_prefix: Vec<f64>,
     sequence: Vec<u16>,
     bounds: Bounds,
     archive: ParetoFront<Vec<u16>>,
@@ -473,11 +513,8 @@ impl<'p, V: Variant> Worker<'p, V> {
         let full = PartSet::full(n);
         let complete = sim.is_complete();
         let root = Node {
-            parent: NONE,
-            first_child: NONE,
-            next_sibling: NONE,
+            first_edge: NONE,
             visits: 0,
-            action: u16::MAX,
             status: if complete {
                 Status::Solved
             } else if actions.is_empty() {
@@ -485,17 +522,23 @@ impl<'p, V: Variant> Worker<'p, V> {
             } else {
                 Status::Open
             },
+            next_same: NONE,
             present: full,
             free: sim.collision_free(),
             untried: PartSet::from_indices(n, actions.iter().copied()),
         };
-        let tree = Tree {
+        let mut tree = Tree {
             nodes: vec![root],
             values: vec![V::Value::default()],
-            prefix: vec![0.0; m],
+            edges: Vec::new(),
+            rewards: Vec::new(),
             memory: vec![Memory::default(); m],
+            index: HashMap::new(),
             m,
         };
+        if settings.transpositions {
+            tree.index.insert(state_hash(&tree.nodes[0].present, tree.memory(0)), 0);
+        }
         Worker {
             problem,
             settings,
@@ -506,6 +549,9 @@ impl<'p, V: Variant> Worker<'p, V> {
             sim,
             actions,
             candidates: Vec::with_capacity(n),
+            path: Vec::with_capacity(n + 1),
+            path_edges: Vec::with_capacity(n),
+            path_prefix: Vec::with_capacity((n + 1) * m),
             sequence: Vec::with_capacity(n),
             bounds: Bounds::new(),
             archive: ParetoFront::new(m),
@@ -520,21 +566,44 @@ impl<'p, V: Variant> Worker<'p, V> {
         self.tree.nodes[0].status != Status::Open
     }
 
+    /// Moves the path along edge `e` to its child.
+    fn push(&mut self, e: u32) {
+        let m = self.m;
+        let child = self.tree.edges[e as usize].child;
+        let base = self.path_prefix.len() - m;
+        for k in 0..m {
+            let v = self.path_prefix[base + k] + self.tree.rewards[e as usize * m + k];
+            self.path_prefix.push(v);
+        }
+        self.path.push(child);
+        self.path_edges.push(e);
+    }
+
+    /// Cuts the path back to its first `len` nodes.
+    fn truncate(&mut self, len: usize) {
+        self.path.truncate(len);
+        self.path_edges.truncate(len - 1);
+        self.path_prefix.truncate(len * self.m);
+    }
+
     /// One episode: search steps from the root down to a complete sequence.
     fn episode(&mut self) {
-        let mut current = 0u32;
+        self.path.clear();
+        self.path_edges.clear();
+        self.path_prefix.clear();
+        self.path.push(0);
+        self.path_prefix.extend(std::iter::repeat_n(0.0, self.m));
         loop {
+            let current = *self.path.last().expect("the path starts at the root");
             let node = &self.tree.nodes[current as usize];
-            if node.status == Status::Dead
-                || (node.status == Status::Solved && node.first_child == NONE)
-            {
+            if node.status == Status::Dead || (node.status == Status::Solved && node.first_edge == NONE) {
                 break;
             }
             for _ in 0..self.settings.budget {
                 if self.tree.nodes[current as usize].status != Status::Open {
                     break;
                 }
-                self.iterate(current);
+                self.iterate();
                 self.stats.iterations += 1;
                 if self.deadline.is_some_and(|d| Instant::now() >= d) {
                     self.stopped = true;
@@ -542,69 +611,74 @@ impl<'p, V: Variant> Worker<'p, V> {
                 }
             }
             match self.commit(current) {
-                Some(c) => current = c,
+                Some(e) => self.push(e),
                 None => break,
             }
         }
     }
 
-    /// The child the tree policy moves to at the end of a search step (any unfinished or
-    /// solved child).
+    /// The edge the tree policy takes at the end of a search step (to any child that is not
+    /// dead).
     fn commit(&mut self, node: u32) -> Option<u32> {
         self.candidates.clear();
-        let mut c = self.tree.nodes[node as usize].first_child;
-        while c != NONE {
-            if self.tree.nodes[c as usize].status != Status::Dead {
-                self.candidates.push(c);
+        for e in self.tree.edges_of(node) {
+            let child = self.tree.edges[e as usize].child;
+            if self.tree.nodes[child as usize].status != Status::Dead {
+                self.candidates.push(e);
             }
-            c = self.tree.nodes[c as usize].next_sibling;
         }
         if self.candidates.is_empty() {
             return None;
         }
-        let ctx = SelectContext { exploration: self.settings.exploration, bounds: &self.bounds, m: self.m };
-        let k = V::select(&mut self.tree, node, &self.candidates, &ctx);
+        let m = self.m;
+        let prefix = &self.path_prefix[self.path_prefix.len() - m..];
+        let ctx = SelectContext { exploration: self.settings.exploration, bounds: &self.bounds, prefix };
+        let k = V::select(&self.tree, node, &self.candidates, &ctx);
         Some(self.candidates[k])
     }
 
-    /// Selection, expansion, rollout and backpropagation from `start`.
-    fn iterate(&mut self, start: u32) {
+    /// Selection, expansion, rollout and backpropagation from the end of the path.
+    fn iterate(&mut self) {
         let m = self.m;
+        let base = self.path.len();
         // Selection: descend through fully expanded nodes.
-        let mut node = start;
         loop {
+            let node = *self.path.last().expect("path");
             let nd = &self.tree.nodes[node as usize];
             if nd.status != Status::Open {
+                self.truncate(base);
                 return;
             }
             if !nd.untried.is_empty() {
                 break;
             }
             self.candidates.clear();
-            let mut c = nd.first_child;
-            while c != NONE {
-                if self.tree.nodes[c as usize].status == Status::Open {
-                    self.candidates.push(c);
+            for e in self.tree.edges_of(node) {
+                let child = self.tree.edges[e as usize].child;
+                if self.tree.nodes[child as usize].status == Status::Open {
+                    self.candidates.push(e);
                 }
-                c = self.tree.nodes[c as usize].next_sibling;
             }
             if self.candidates.is_empty() {
-                self.refresh_status(node);
+                self.refresh_path_status();
+                self.truncate(base);
                 return;
             }
-            let ctx = SelectContext { exploration: self.settings.exploration, bounds: &self.bounds, m };
-            let k = V::select(&mut self.tree, node, &self.candidates, &ctx);
-            node = self.candidates[k];
+            let prefix = &self.path_prefix[self.path_prefix.len() - m..];
+            let ctx = SelectContext { exploration: self.settings.exploration, bounds: &self.bounds, prefix };
+            let k = V::select(&self.tree, node, &self.candidates, &ctx);
+            let e = self.candidates[k];
+            self.push(e);
         }
 
         // Expansion: a random untried removal.
-        let parent = node;
+        let parent = *self.path.last().expect("path");
         let pn = &self.tree.nodes[parent as usize];
         self.sim.reset_with_free(&pn.present, &pn.free);
         let mut memories = [Memory::default(); MAX_OBJECTIVES];
         memories[..m].copy_from_slice(self.tree.memory(parent));
         let mut ret = [0.0f64; MAX_OBJECTIVES];
-        ret[..m].copy_from_slice(self.tree.prefix(parent));
+        ret[..m].copy_from_slice(&self.path_prefix[self.path_prefix.len() - m..]);
         let untried = &self.tree.nodes[parent as usize].untried;
         let pick = self.rng.random_range(0..untried.len());
         let action = untried.iter().nth(pick).expect("pick < len");
@@ -613,52 +687,71 @@ impl<'p, V: Variant> Worker<'p, V> {
         for k in 0..m {
             ret[k] += rewards[k];
         }
-        let expanded = self.tree.nodes.len() < self.settings.max_nodes;
-        let leaf = if expanded {
-            self.tree.nodes[parent as usize].untried.remove(action);
-            self.sim.feasible_actions(&mut self.actions);
-            let status = if self.sim.is_complete() {
-                Status::Solved
-            } else if self.actions.is_empty() {
-                Status::Dead
-            } else {
-                Status::Open
-            };
-            let id = self.tree.nodes.len() as u32;
-            let first = self.tree.nodes[parent as usize].first_child;
-            self.tree.nodes.push(Node {
-                parent,
-                first_child: NONE,
-                next_sibling: first,
-                visits: 0,
-                action: action as u16,
-                status,
-                present: self.sim.present(),
-                free: self.sim.collision_free(),
-                untried: PartSet::from_indices(self.n, self.actions.iter().copied()),
-            });
-            self.tree.nodes[parent as usize].first_child = id;
-            self.tree.values.push(V::Value::default());
-            self.tree.prefix.extend_from_slice(&ret[..m]);
-            self.tree.memory.extend_from_slice(&memories[..m]);
-            id
-        } else {
-            parent
-        };
-
-        // The sequence so far: the tree path to the leaf (and the unexpanded action).
-        self.sequence.clear();
-        let mut a = leaf;
-        while a != 0 {
-            self.sequence.push(self.tree.nodes[a as usize].action);
-            a = self.tree.nodes[a as usize].parent;
+        let present = self.sim.present();
+        // The child: an existing node with the same state, or a new one.
+        let hash = if self.settings.transpositions { state_hash(&present, &memories[..m]) } else { 0 };
+        let mut existing = NONE;
+        if self.settings.transpositions {
+            let mut c = self.tree.index.get(&hash).copied().unwrap_or(NONE);
+            while c != NONE {
+                if self.tree.is(c, &present, &memories[..m]) {
+                    existing = c;
+                    break;
+                }
+                c = self.tree.nodes[c as usize].next_same;
+            }
         }
-        self.sequence.reverse();
+        let expanded = existing != NONE || self.tree.nodes.len() < self.settings.max_nodes;
+        let mut new_child = false;
+        if expanded {
+            self.tree.nodes[parent as usize].untried.remove(action);
+            let child = if existing != NONE {
+                existing
+            } else {
+                new_child = true;
+                self.sim.feasible_actions(&mut self.actions);
+                let status = if self.sim.is_complete() {
+                    Status::Solved
+                } else if self.actions.is_empty() {
+                    Status::Dead
+                } else {
+                    Status::Open
+                };
+                let id = self.tree.nodes.len() as u32;
+                let next_same = if self.settings.transpositions {
+                    self.tree.index.insert(hash, id).unwrap_or(NONE)
+                } else {
+                    NONE
+                };
+                self.tree.nodes.push(Node {
+                    first_edge: NONE,
+                    visits: 0,
+                    status,
+                    next_same,
+                    present,
+                    free: self.sim.collision_free(),
+                    untried: PartSet::from_indices(self.n, self.actions.iter().copied()),
+                });
+                self.tree.values.push(V::Value::default());
+                self.tree.memory.extend_from_slice(&memories[..m]);
+                id
+            };
+            let e = self.tree.edges.len() as u32;
+            let first = self.tree.nodes[parent as usize].first_edge;
+            self.tree.edges.push(Edge { child, next: first, visits: 0, action: action as u16 });
+            self.tree.rewards.extend_from_slice(&rewards[..m]);
+            self.tree.nodes[parent as usize].first_edge = e;
+            self.push(e);
+        }
+
+        // The sequence so far: the path's removals (and the unexpanded action).
+        self.sequence.clear();
+        self.sequence.extend(self.path_edges.iter().map(|&e| self.tree.edges[e as usize].action));
         if !expanded {
             self.sequence.push(action as u16);
         }
 
-        // Rollout with the default policy.
+        // Rollout with the default policy (from a transposed child too: more evidence).
         let policy = &*self.settings.policy;
         loop {
             self.sim.feasible_actions(&mut self.actions);
@@ -684,45 +777,58 @@ impl<'p, V: Variant> Worker<'p, V> {
         let complete = self.sim.is_complete();
         if complete {
             self.bounds.update(&ret[..m]);
-        } else {
-            self.stats.dead_rollouts += 1;
-        }
-
-        // Backpropagation: visits along the whole path, values until a node rejects them.
-        let mut propagate = complete;
-        let mut b = leaf;
-        loop {
-            let i = b as usize;
-            self.tree.nodes[i].visits += 1;
-            if propagate {
-                propagate = V::record(&mut self.tree.values[i], &ret[..m]);
-            }
-            if b == 0 {
-                break;
-            }
-            b = self.tree.nodes[i].parent;
-        }
-        if propagate {
             let seq = &self.sequence;
             if self.archive.insert(&ret[..m], || seq.clone()) {
                 self.archive_changed = true;
             }
+        } else {
+            self.stats.dead_rollouts += 1;
         }
-        if expanded && self.tree.nodes[leaf as usize].status != Status::Open {
-            self.refresh_status(parent);
+
+        // Backpropagation along the path: visits everywhere, suffix values until a node adds
+        // nothing (without transpositions) or everywhere (with them).
+        let mut propagate = complete;
+        let mut suffix = [0.0f64; MAX_OBJECTIVES];
+        for i in (0..self.path.len()).rev() {
+            let node = self.path[i] as usize;
+            self.tree.nodes[node].visits += 1;
+            if i > 0 {
+                self.tree.edges[self.path_edges[i - 1] as usize].visits += 1;
+            }
+            if propagate {
+                for k in 0..m {
+                    suffix[k] = ret[k] - self.path_prefix[i * m + k];
+                }
+                let added = V::record(&mut self.tree.values[node], &suffix[..m]);
+                if !added && !self.settings.transpositions {
+                    propagate = false;
+                }
+            }
         }
+        let leaf = *self.path.last().expect("path");
+        if new_child && self.tree.nodes[leaf as usize].status != Status::Open
+            || self.tree.nodes[parent as usize].untried.is_empty()
+        {
+            self.refresh_path_status();
+        }
+        self.truncate(base);
     }
 
-    /// Recomputes the status of `node` from its children, and of its ancestors while it changes.
-    fn refresh_status(&mut self, mut node: u32) {
-        loop {
+    /// Recomputes the status of the path's nodes from their children, from the end up, while
+    /// they change.
+    fn refresh_path_status(&mut self) {
+        for i in (0..self.path.len()).rev() {
+            let node = self.path[i];
             let nd = &self.tree.nodes[node as usize];
+            if nd.first_edge == NONE {
+                continue; // a leaf: its status is its own
+            }
             if !nd.untried.is_empty() {
-                return;
+                return; // open, and so are its ancestors
             }
             let (mut open, mut solved) = (false, false);
-            for c in self.tree.children(node) {
-                match self.tree.nodes[c as usize].status {
+            for e in self.tree.edges_of(node) {
+                match self.tree.nodes[self.tree.edges[e as usize].child as usize].status {
                     Status::Open => open = true,
                     Status::Solved => solved = true,
                     Status::Dead => {}
@@ -739,10 +845,6 @@ impl<'p, V: Variant> Worker<'p, V> {
                 return;
             }
             self.tree.nodes[node as usize].status = status;
-            if node == 0 {
-                return;
-            }
-            node = self.tree.nodes[node as usize].parent;
         }
     }
 
@@ -786,6 +888,72 @@ impl<'p, V: Variant> Worker<'p, V> {
         }
         self.stats.tree_nodes = self.tree.nodes.len() as u64;
         self.stats.exhausted = self.root_finished();
+        if self.settings.transpositions {
+            self.read_graph();
+        }
+    }
+
+    /// Adds to the archive the non-dominated complete sequences that lie wholly in the graph:
+    /// with transpositions the best suffix of a state may have been found after reaching it on
+    /// another path, so the archive alone can miss combinations. Dynamic programming over the
+    /// graph's complete paths (exact when the root is finished).
+    fn read_graph(&mut self) {
+        let m = self.m;
+        let count = self.tree.nodes.len();
+        // fronts[node]: suffix vectors of complete paths in the graph, with (edge, child point)
+        let mut fronts: Vec<Option<ParetoFront<(u32, u32)>>> = vec![None; count];
+        // post-order without recursion
+        let mut stack: Vec<(u32, bool)> = vec![(0, false)];
+        let mut point = vec![0.0f64; m];
+        while let Some((node, expanded)) = stack.pop() {
+            if fronts[node as usize].is_some() {
+                continue;
+            }
+            if !expanded {
+                stack.push((node, true));
+                for e in self.tree.edges_of(node) {
+                    let child = self.tree.edges[e as usize].child;
+                    if fronts[child as usize].is_none() {
+                        stack.push((child, false));
+                    }
+                }
+                continue;
+            }
+            let mut front = ParetoFront::new(m);
+            let nd = &self.tree.nodes[node as usize];
+            if nd.first_edge == NONE && nd.status == Status::Solved {
+                front.insert(&vec![0.0; m], || (NONE, NONE));
+            }
+            for e in self.tree.edges_of(node) {
+                let child = self.tree.edges[e as usize].child as usize;
+                let Some(cf) = &fronts[child] else { continue };
+                for (k, (p, _)) in cf.iter().enumerate() {
+                    for j in 0..m {
+                        point[j] = self.tree.rewards[e as usize * m + j] + p[j];
+                    }
+                    front.insert(&point, || (e, k as u32));
+                }
+            }
+            fronts[node as usize] = Some(front);
+        }
+        let Some(root) = &fronts[0] else { return };
+        for (k, (p, _)) in root.iter().enumerate() {
+            if self.archive.covers(p) {
+                continue;
+            }
+            let mut seq = Vec::with_capacity(self.n);
+            let (mut node, mut at) = (0usize, k);
+            loop {
+                let &(e, next) = fronts[node].as_ref().expect("computed").payload(at);
+                if e == NONE {
+                    break;
+                }
+                seq.push(self.tree.edges[e as usize].action);
+                node = self.tree.edges[e as usize].child as usize;
+                at = next as usize;
+            }
+            self.archive.insert(p, || seq);
+        }
     }
 }
 

@@ -2,15 +2,14 @@
 //! non-dominated set of all enumerated sequences, its optimum their maximum, its worst point their
 //! minimum.
 
-use crate::fixtures::{close, maps, problem, random_cube};
+use crate::fixtures::{close, exact_instances, maps, problem, soma};
 use asp_search::exact::{enumerate_sequences, exact_front};
 use asp_search::hypervolume::{weakly_dominates, ParetoFront};
 
 #[test]
-fn dynamic_programme_equals_enumeration_on_3x3x3_cubes() {
+fn dynamic_programme_equals_enumeration() {
     let mut checked = 0;
-    for seed in 0..12 {
-        let cube = random_cube(3, seed);
+    for (seed, (_, cube)) in exact_instances().into_iter().enumerate() {
         let maps = maps(&cube, 5);
         for objectives in ["access,dirchange", "access,dirchange,pathlen", "access", "dirchange", "pathlen"] {
             let p = problem(&maps, objectives);
@@ -54,7 +53,7 @@ fn dynamic_programme_equals_enumeration_on_3x3x3_cubes() {
 
 #[test]
 fn limits_are_errors() {
-    let cube = random_cube(3, 1);
+    let cube = soma(3, 1);
     let maps = maps(&cube, 3);
     let p = problem(&maps, "access");
     assert!(enumerate_sequences(&p, 1).is_err());

@@ -1,7 +1,7 @@
 //! Single-objective MCTS: finds the exact optimum on small instances within its default budget,
 //! returns feasible sequences, is reproducible with one thread and a seed, validates settings.
 
-use crate::fixtures::{close, figure_6_2, maps, problem, random_cube};
+use crate::fixtures::{close, exact_instances, figure_6_2, maps, problem, soma};
 use asp_search::exact::exact_front;
 use asp_search::search::SearchStatus;
 use asp_search::{Mcts, SearchError};
@@ -18,23 +18,22 @@ fn finds_the_optimum_of_figure_6_2() {
 }
 
 #[test]
-fn finds_the_exact_optimum_on_3x3x3_cubes() {
-    for seed in 0..8 {
-        let cube = random_cube(3, seed);
-        let maps = maps(&cube, 5);
-        for objective in ["access", "dirchange", "pathlen"] {
+fn finds_the_exact_optimum_on_instances_with_exact_references() {
+    for (name, assembly) in exact_instances() {
+        let maps = maps(&assembly, 5);
+        for (k, objective) in ["access", "dirchange", "pathlen"].into_iter().enumerate() {
             let p = problem(&maps, objective);
             let exact = exact_front(&p, 2_000_000).unwrap();
-            let out = Mcts::builder().seed(seed).build().unwrap().solve(&p).unwrap();
+            let out = Mcts::builder().seed(k as u64).build().unwrap().solve(&p).unwrap();
             if exact.solutions.is_empty() {
-                assert_ne!(out.status, SearchStatus::Found);
+                assert_ne!(out.status, SearchStatus::Found, "{name}");
                 continue;
             }
             let best = out.best().expect("a sequence exists");
             let optimum = exact.solutions[0].values[0];
             assert!(
                 close(best.values[0], optimum),
-                "cube {seed} ({} parts) {objective}: {} vs optimum {optimum}",
+                "{name} ({} parts) {objective}: {} vs optimum {optimum}",
                 maps.num_parts(),
                 best.values[0]
             );
@@ -48,7 +47,7 @@ fn finds_the_exact_optimum_on_3x3x3_cubes() {
 
 #[test]
 fn one_thread_and_a_seed_reproduce_the_search() {
-    let cube = random_cube(4, 11);
+    let cube = soma(4, 11);
     let maps = maps(&cube, 5);
     let p = problem(&maps, "access");
     let run = |seed| Mcts::builder().episodes(40).seed(seed).build().unwrap().solve(&p).unwrap();
@@ -81,7 +80,7 @@ fn settings_are_validated() {
 
 #[test]
 fn node_cap_still_finds_sequences() {
-    let cube = random_cube(4, 3);
+    let cube = soma(4, 3);
     let maps = maps(&cube, 5);
     let p = problem(&maps, "dirchange");
     let out = Mcts::builder().episodes(5).max_nodes(10).seed(1).build().unwrap().solve(&p).unwrap();
