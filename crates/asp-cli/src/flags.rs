@@ -17,6 +17,8 @@ pub struct Cli {
 pub enum Command {
     /// Plan a feasible assembly sequence by taking the model apart (Assembly-by-Disassembly).
     Plan(PlanArgs),
+    /// Generate training assemblies (Soma cubes, aluminium profile assemblies).
+    Gen(crate::gen::GenArgs),
 }
 
 /// Part orderings of the depth-first search.

@@ -161,7 +161,11 @@ pub fn run(args: &GenArgs) -> anyhow::Result<ExitCode> {
         let noun = if manifest.count == 1 { "assembly" } else { "assemblies" };
         eprintln!("wrote {} {noun} and manifest.json to {}", manifest.count, batch_args.out.display());
         if !failed.is_empty() {
-            eprintln!("warning: {} failed the generator's checks (see manifest.json): {}", failed.len(), failed.join(", "));
+            eprintln!(
+                "warning: {} failed the generator's checks (see manifest.json): {}",
+                failed.len(),
+                failed.join(", ")
+            );
         }
     }
     Ok(if failed.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
@@ -191,8 +195,23 @@ mod tests {
         let a = parse(&["profiles", "--preset", "double-layer", "--count", "7", "--out", "d"]).unwrap();
         assert!(matches!(a.kind, GenKind::Profiles(ProfilesArgs { preset: Some(Preset::DoubleLayer), .. })));
         let custom = [
-            "profiles", "--width", "0.4", "--length", "0.4", "--height", "0.6", "--layers", "3", "--supports", "3",
-            "--front", "3", "--back", "4", "--out", "d",
+            "profiles",
+            "--width",
+            "0.4",
+            "--length",
+            "0.4",
+            "--height",
+            "0.6",
+            "--layers",
+            "3",
+            "--supports",
+            "3",
+            "--front",
+            "3",
+            "--back",
+            "4",
+            "--out",
+            "d",
         ];
         assert!(parse(&custom).is_ok());
         assert!(parse(&["soma"]).is_err(), "--out is required");
@@ -208,7 +227,8 @@ mod tests {
         let read = |f: &str| std::fs::read(out.join(f)).unwrap();
         let first: Vec<Vec<u8>> = ["soma3_000.glb", "soma3_001.glb", "soma3_002.glb", "manifest.json"].map(read).into();
         assert_eq!(run(&args).unwrap(), ExitCode::SUCCESS);
-        let second: Vec<Vec<u8>> = ["soma3_000.glb", "soma3_001.glb", "soma3_002.glb", "manifest.json"].map(read).into();
+        let second: Vec<Vec<u8>> =
+            ["soma3_000.glb", "soma3_001.glb", "soma3_002.glb", "manifest.json"].map(read).into();
         assert!(first == second, "same seed, same bytes");
         assert_ne!(first[0], first[1]);
     }

@@ -3,6 +3,7 @@
 //! The binary is thin: it parses flags, calls the library crates, and formats output.
 
 mod flags;
+mod gen;
 mod optimise;
 mod output;
 
@@ -23,5 +24,6 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Plan(args) => output::plan(&args),
+        Command::Gen(args) => gen::run(&args),
     }
 }

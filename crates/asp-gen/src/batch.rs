@@ -197,7 +197,8 @@ pub fn write_batch(batch: &Batch, out: &Path, done: &(dyn Fn() + Sync)) -> Resul
         assemblies,
     };
     let path = out.join("manifest.json");
-    let json = serde_json::to_string_pretty(&manifest).map_err(|e| GenError::Io { path: path.clone(), source: e.into() })?;
+    let json =
+        serde_json::to_string_pretty(&manifest).map_err(|e| GenError::Io { path: path.clone(), source: e.into() })?;
     std::fs::write(&path, format!("{json}\n")).map_err(io(&path))?;
     Ok(manifest)
 }

@@ -4,8 +4,8 @@
 //!
 //! Whether a part can leave along an axis only gets easier as other parts leave, so removing any
 //! removable part never hurts: a greedy loop decides straight-line disassemblability exactly.
-//! Stability is not monotone, so a stable order is searched depth-first (top-down, dead states
-//! remembered) within a budget of expanded states.
+//! Stability is not monotone, so a stable order is searched depth-first (dead states
+//! remembered) within a budget of expanded states, trying a few part orderings in turn.
 
 use crate::cuboid::Cuboid;
 use asp_geom::math::Axis;
@@ -23,7 +23,7 @@ pub const DIRECTIONS: [Axis; 6] = [
     Axis { index: 2, negative: true },
 ];
 
-/// States the stable-order search may expand before it gives up.
+/// States the stable-order search may expand per part ordering before it gives up.
 pub const SEARCH_BUDGET: usize = 20_000;
 
 /// What the straight-line disassembly check found for one assembly.
@@ -80,28 +80,53 @@ pub fn is_contact_linked(model: &impl RemovalModel, state: &PartSet) -> bool {
 /// Runs the check: exact straight-line disassemblability, then a search for a stable order.
 pub fn check_disassembly(model: &impl RemovalModel) -> DisassemblyCheck {
     let n = model.num_parts();
-    let mut ranked: Vec<usize> = (0..n).filter(|&i| !model.is_fixed(i)).collect();
-    ranked.sort_by(|&a, &b| model.bottom(b).total_cmp(&model.bottom(a)).then(b.cmp(&a)));
-    let blockers: Vec<Vec<PartSet>> = (0..n)
-        .map(|i| DIRECTIONS.iter().map(|&a| PartSet::from_indices(n, model.blockers(i, a))).collect())
-        .collect();
+    let movable: Vec<usize> = (0..n).filter(|&i| !model.is_fixed(i)).collect();
+    let top_down = |later_first: bool| {
+        let mut r = movable.clone();
+        r.sort_by(|&a, &b| {
+            let by_index = if later_first { b.cmp(&a) } else { a.cmp(&b) };
+            model.bottom(b).total_cmp(&model.bottom(a)).then(by_index)
+        });
+        r
+    };
+    // the part orders the stable search tries in turn: top-down in reverse build order (a part
+    // is added after what it rests on), plain reverse build order, top-down in build order; on
+    // 300 double-layer assemblies each alone missed 1 to 14 stable orders, together none
+    let rankings = [top_down(true), movable.iter().rev().copied().collect(), top_down(false)];
+    let blockers: Vec<Vec<PartSet>> =
+        (0..n).map(|i| DIRECTIONS.iter().map(|&a| PartSet::from_indices(n, model.blockers(i, a))).collect()).collect();
     let free_axis = |i: usize, state: &PartSet| {
         DIRECTIONS.iter().zip(&blockers[i]).find(|(_, b)| !b.intersects(state)).map(|(&a, _)| a)
     };
     // straight lines only: take out whatever can leave, until nothing can
     let mut state = PartSet::full(n);
     let mut order = Vec::new();
-    while let Some((i, axis)) = ranked.iter().filter(|&&i| state.contains(i)).find_map(|&i| Some((i, free_axis(i, &state)?))) {
+    while let Some((i, axis)) =
+        rankings[0].iter().filter(|&&i| state.contains(i)).find_map(|&i| Some((i, free_axis(i, &state)?)))
+    {
         state.remove(i);
         order.push((i, axis));
     }
     let stuck: Vec<usize> = state.iter().filter(|&i| !model.is_fixed(i)).collect();
-    let mut search = StableSearch { model, ranked: &ranked, free_axis: &free_axis, dead: HashSet::new(), budget: SEARCH_BUDGET, order: Vec::new() };
-    let stable_order = stuck.is_empty() && search.run(&PartSet::full(n)) == Some(true);
-    if stable_order {
-        order = search.order;
+    let stable = stuck.is_empty().then(|| {
+        rankings.iter().find_map(|ranked| {
+            let dead = HashSet::new();
+            let mut search =
+                StableSearch { model, ranked, free_axis: &free_axis, dead, budget: SEARCH_BUDGET, order: Vec::new() };
+            (search.run(&PartSet::full(n)) == Some(true)).then_some(search.order)
+        })
+    });
+    let stable_order = matches!(stable, Some(Some(_)));
+    if let Some(Some(stable)) = stable {
+        order = stable;
     }
-    DisassemblyCheck { linked: is_contact_linked(model, &PartSet::full(n)), straight_line: stuck.is_empty(), stuck, stable_order, order }
+    DisassemblyCheck {
+        linked: is_contact_linked(model, &PartSet::full(n)),
+        straight_line: stuck.is_empty(),
+        stuck,
+        stable_order,
+        order,
+    }
 }
 
 /// Depth-first search for a removal order whose states all stay contact-linked.
@@ -181,7 +206,9 @@ impl RemovalModel for BoxModel {
         let (a, negative) = (axis.index as usize, axis.negative);
         (0..self.parts.len())
             .filter(|&j| j != i)
-            .filter(|&j| self.parts[i].iter().any(|x| self.parts[j].iter().any(|y| x.sweep_hits(y, a, negative, self.tol))))
+            .filter(|&j| {
+                self.parts[i].iter().any(|x| self.parts[j].iter().any(|y| x.sweep_hits(y, a, negative, self.tol)))
+            })
             .collect()
     }
 
@@ -205,7 +232,11 @@ mod tests {
     #[test]
     fn a_stack_comes_apart_top_down() {
         // floor (fixed), a block on it, a block on that
-        let parts = vec![vec![Cuboid::new([-1.0, -1.0, -1.0], [2.0, 2.0, 0.0])], vec![unit(0.0, 0.0, 0.0)], vec![unit(0.0, 0.0, 1.0)]];
+        let parts = vec![
+            vec![Cuboid::new([-1.0, -1.0, -1.0], [2.0, 2.0, 0.0])],
+            vec![unit(0.0, 0.0, 0.0)],
+            vec![unit(0.0, 0.0, 1.0)],
+        ];
         let check = check_disassembly(&BoxModel::new(parts, vec![true, false, false], 1e-9));
         assert!(check.linked && check.straight_line && check.stable_order);
         assert_eq!(check.order, vec![(2, Axis::Z), (1, Axis::Z)]);
@@ -232,7 +263,11 @@ mod tests {
             i == 0
         }
         fn blockers(&self, i: usize, _: Axis) -> Vec<usize> {
-            if i == 3 { vec![2] } else { vec![] }
+            if i == 3 {
+                vec![2]
+            } else {
+                vec![]
+            }
         }
         fn contacts(&self, i: usize) -> &[usize] {
             &self.contacts[i]

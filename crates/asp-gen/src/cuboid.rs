@@ -51,11 +51,8 @@ impl Cuboid {
     /// Whether moving this box along `axis` (towards `negative` or positive infinity) would
     /// push it into `other` deeper than `tol`.
     pub fn sweep_hits(&self, other: &Cuboid, axis: usize, negative: bool, tol: f64) -> bool {
-        let ahead = if negative {
-            other.mins[axis] < self.maxs[axis] - tol
-        } else {
-            other.maxs[axis] > self.mins[axis] + tol
-        };
+        let ahead =
+            if negative { other.mins[axis] < self.maxs[axis] - tol } else { other.maxs[axis] > self.mins[axis] + tol };
         ahead && (0..3).filter(|&b| b != axis).all(|b| self.overlap_along(other, b) > tol)
     }
 

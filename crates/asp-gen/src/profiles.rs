@@ -352,7 +352,11 @@ impl ProfileAssembly {
                     let mut close = [0.0; 3];
                     close[closing] = 1.0;
                     let orientation = quaternion(cross(close, approach), close, approach).map(|q| tidy(q, 1e12));
-                    out.push(GraspPoint { position: position.map(|x| tidy(x, 1e9)), orientation, width: p.profile_size });
+                    out.push(GraspPoint {
+                        position: position.map(|x| tidy(x, 1e9)),
+                        orientation,
+                        width: p.profile_size,
+                    });
                 }
             }
         }
@@ -533,7 +537,8 @@ impl Builder<'_> {
     /// Four profiles along the outline at height `z`, between the corner posts.
     fn frame(&mut self, z: f64, role: Role, layer: Option<usize>, fixed: bool) -> std::result::Result<(), String> {
         let (d, l, w) = (self.p.profile_size, self.p.length, self.p.width);
-        let lines = [(0, [0.0, d / 2.0, z]), (0, [0.0, w - d / 2.0, z]), (1, [d / 2.0, 0.0, z]), (1, [l - d / 2.0, 0.0, z])];
+        let lines =
+            [(0, [0.0, d / 2.0, z]), (0, [0.0, w - d / 2.0, z]), (1, [d / 2.0, 0.0, z]), (1, [l - d / 2.0, 0.0, z])];
         for (axis, at) in lines {
             let seg = self.segments(axis, at).into_iter().find(|s| s.lo_end.is_some() && s.hi_end.is_some());
             let seg = seg.ok_or("the outline is blocked")?;
@@ -569,9 +574,10 @@ impl Builder<'_> {
                             return None;
                         }
                         let foot = [x, y][axis];
-                        let seg = self.segments(axis, at).into_iter().find(|s| {
-                            s.lo <= foot - d / 2.0 + TOLERANCE && s.hi >= foot + d / 2.0 - TOLERANCE
-                        })?;
+                        let seg = self
+                            .segments(axis, at)
+                            .into_iter()
+                            .find(|s| s.lo <= foot - d / 2.0 + TOLERANCE && s.hi >= foot + d / 2.0 - TOLERANCE)?;
                         if self.held_length(&seg) < eps_p || seg.lo_end.is_none() || seg.hi_end.is_none() {
                             return None;
                         }
@@ -595,9 +601,8 @@ impl Builder<'_> {
         let mut connected = vec![false; supports.len()];
         let sides = std::iter::repeat_n(Side::Back, self.p.back).chain(std::iter::repeat_n(Side::Front, self.p.front));
         for (n, side) in sides.enumerate() {
-            let placed = (0..TRIES_PER_PROFILE).find_map(|_| {
-                self.try_layer_profile(side, z, layer, (x_front, x_back), supports, &connected, rng)
-            });
+            let placed = (0..TRIES_PER_PROFILE)
+                .find_map(|_| self.try_layer_profile(side, z, layer, (x_front, x_back), supports, &connected, rng));
             let index = placed.ok_or_else(|| format!("no room for layer profile {} of layer {}", n + 1, layer + 1))?;
             let p = &self.profiles[index];
             for (k, &s) in supports.iter().enumerate() {
@@ -724,8 +729,11 @@ impl Builder<'_> {
                 let mut slab = profile.cuboid;
                 let t = self.p.connector_thickness;
                 (slab.mins[axis], slab.maxs[axis]) = if end == seg.lo { (end, end + t) } else { (end - t, end) };
-                let touches_another =
-                    self.profiles.iter().enumerate().any(|(j, q)| j != attached_to && q.cuboid.touches(&slab, TOLERANCE));
+                let touches_another = self
+                    .profiles
+                    .iter()
+                    .enumerate()
+                    .any(|(j, q)| j != attached_to && q.cuboid.touches(&slab, TOLERANCE));
                 if touches_another {
                     return Err(format!("a {role:?} profile ends against two profiles"));
                 }

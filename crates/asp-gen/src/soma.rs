@@ -16,8 +16,7 @@ use serde_json::json;
 pub const MAX_SIZE: usize = 64;
 
 /// The cells of the classic Soma cube in one solved arrangement: layer z, row y, column x.
-const CLASSIC: [[&str; 3]; 3] =
-    [["VPL", "PPL", "BBT"], ["VPL", "VBT", "ABT"], ["ZZL", "AZZ", "AAT"]];
+const CLASSIC: [[&str; 3]; 3] = [["VPL", "PPL", "BBT"], ["VPL", "VBT", "ABT"], ["ZZL", "AZZ", "AAT"]];
 /// The classic pieces in the order they appear as parts.
 const CLASSIC_LETTERS: [char; 7] = ['V', 'L', 'T', 'Z', 'A', 'B', 'P'];
 
@@ -229,13 +228,7 @@ impl SomaCube {
             fixed: true,
             extras: json!({"kind": "floor"}),
         });
-        Assembly {
-            parts,
-            units: Units::metres(),
-            up: Axis::Z,
-            source: source.into(),
-            warnings: Vec::new(),
-        }
+        Assembly { parts, units: Units::metres(), up: Axis::Z, source: source.into(), warnings: Vec::new() }
     }
 
     /// Straight-line disassembly of the pieces along ±axes on the voxel grid, with the floor

@@ -182,9 +182,7 @@ fn voxel_rays_agree_with_box_sweeps() {
         let mut parts: Vec<Vec<Cuboid>> = c
             .pieces()
             .iter()
-            .map(|cells| {
-                cells.iter().map(|v| Cuboid::new(v.map(f64::from), v.map(|k| f64::from(k) + 1.0))).collect()
-            })
+            .map(|cells| cells.iter().map(|v| Cuboid::new(v.map(f64::from), v.map(|k| f64::from(k) + 1.0))).collect())
             .collect();
         parts.push(vec![Cuboid::new([-1.0, -1.0, -1.0], [5.0, 5.0, 0.0])]);
         let mut fixed = vec![false; parts.len()];
@@ -202,7 +200,8 @@ fn profiles(params: &ProfileParams, seed: u64) -> ProfileAssembly {
 
 #[test]
 fn profile_presets_have_the_thesis_counts() {
-    for (params, removable, total) in [(ProfileParams::single_layer(), 21, 29), (ProfileParams::double_layer(), 30, 38)] {
+    for (params, removable, total) in [(ProfileParams::single_layer(), 21, 29), (ProfileParams::double_layer(), 30, 38)]
+    {
         for seed in 0..5 {
             let a = profiles(&params, seed);
             let free = a.profiles.iter().filter(|p| !p.fixed).count();
@@ -235,7 +234,9 @@ fn profile_parts_do_not_overlap_beyond_the_tolerance() {
             let boxes: Vec<_> = asm.parts[..a.profiles.len()].iter().map(|p| p.mesh.aabb().unwrap()).collect();
             for (i, x) in boxes.iter().enumerate() {
                 for y in &boxes[i + 1..] {
-                    let depth = (0..3).map(|k| x.maxs[k].min(y.maxs[k]) - x.mins[k].max(y.mins[k])).fold(f32::INFINITY, f32::min);
+                    let depth = (0..3)
+                        .map(|k| x.maxs[k].min(y.maxs[k]) - x.mins[k].max(y.mins[k]))
+                        .fold(f32::INFINITY, f32::min);
                     assert!(depth <= 1e-5, "profiles overlap by {depth}");
                 }
             }
@@ -341,8 +342,7 @@ fn end_touches(p: &asp_gen::profiles::Profile, lo: bool, q: &Cuboid, gap: f64) -
         cap.mins[a] = cap.maxs[a];
         cap.maxs[a] += gap;
     }
-    (0..3).filter(|&k| k != a).all(|k| cap.overlap_along(q, k) > 1e-9)
-        && cap.overlap_along(q, a) >= -1e-9
+    (0..3).filter(|&k| k != a).all(|k| cap.overlap_along(q, k) > 1e-9) && cap.overlap_along(q, a) >= -1e-9
 }
 
 #[test]
@@ -385,19 +385,32 @@ fn supports_and_layer_profiles_follow_the_front_back_rules() {
     let params = ProfileParams::double_layer();
     for seed in 0..8 {
         let a = profiles(&params, seed);
-        let supports: Vec<[f64; 3]> = a.profiles.iter().filter(|p| p.role == Role::Support).map(|p| p.centre()).collect();
+        let supports: Vec<[f64; 3]> =
+            a.profiles.iter().filter(|p| p.role == Role::Support).map(|p| p.centre()).collect();
         assert_eq!(supports.len(), 2);
         for (k, s) in supports.iter().enumerate() {
             assert!(s[0] >= params.min_length && s[0] <= params.length - params.min_length);
             let half = params.width / 2.0;
-            assert!(if k == 0 { s[1] >= params.min_length && s[1] <= half } else { s[1] >= half && s[1] <= params.width - params.min_length });
+            assert!(if k == 0 {
+                s[1] >= params.min_length && s[1] <= half
+            } else {
+                s[1] >= half && s[1] <= params.width - params.min_length
+            });
         }
         let x_front = supports.iter().map(|s| s[0]).fold(f64::INFINITY, f64::min);
         let x_back = supports.iter().map(|s| s[0]).fold(f64::NEG_INFINITY, f64::max);
         for p in &a.profiles {
             match p.role {
-                Role::Back => assert!(if p.axis == 1 { p.centre()[0] >= x_front - 1e-9 } else { p.cuboid.mins[0] >= x_front - 1e-9 }),
-                Role::Front => assert!(if p.axis == 1 { p.centre()[0] <= x_back + 1e-9 } else { p.cuboid.maxs[0] <= x_back + 1e-9 }),
+                Role::Back => assert!(if p.axis == 1 {
+                    p.centre()[0] >= x_front - 1e-9
+                } else {
+                    p.cuboid.mins[0] >= x_front - 1e-9
+                }),
+                Role::Front => assert!(if p.axis == 1 {
+                    p.centre()[0] <= x_back + 1e-9
+                } else {
+                    p.cuboid.maxs[0] <= x_back + 1e-9
+                }),
                 _ => {}
             }
             if let Some(l) = p.layer {
@@ -419,13 +432,14 @@ fn profile_assemblies_are_linked_and_come_apart_along_straight_lines() {
 
 #[test]
 fn stable_orders_are_found_where_plain_top_down_strands_a_connector() {
-    // assemblies of `asp gen` batches (seed 1, 500 each) whose stable order was missed: plain
-    // top-down removal took a profile away before the profile resting on it through a U
+    // assemblies of `asp gen` batches (seeds 0 and 1, 500 each) whose stable order was missed:
+    // plain top-down removal took a profile away before the profile resting on it through a U
     // connector, which then hung on that profile alone
     for (params, seed) in [
         (ProfileParams::double_layer(), 2270958130545493676),
         (ProfileParams::double_layer(), 7589064093957187971),
         (ProfileParams::single_layer(), 9851787880037274203),
+        (ProfileParams::double_layer(), 14632709568069078079),
     ] {
         let check = profiles(&params, seed).check_disassembly();
         assert!(check.linked && check.straight_line && check.stable_order, "seed {seed}: {check:?}");
@@ -476,7 +490,13 @@ fn written_files_load_with_no_options_and_keep_their_metadata() {
             if l.extras != g.extras {
                 let (a, b) = (l.extras.to_string(), g.extras.to_string());
                 let at = a.bytes().zip(b.bytes()).position(|(x, y)| x != y).unwrap_or(0);
-                panic!("{}: extras differ at {}: {} vs {}", l.name, at, &a[at.saturating_sub(60)..(at + 40).min(a.len())], &b[at.saturating_sub(60)..(at + 40).min(b.len())]);
+                panic!(
+                    "{}: extras differ at {}: {} vs {}",
+                    l.name,
+                    at,
+                    &a[at.saturating_sub(60)..(at + 40).min(a.len())],
+                    &b[at.saturating_sub(60)..(at + 40).min(b.len())]
+                );
             }
             assert_eq!(l.mesh.triangles.len(), g.mesh.triangles.len());
         }
@@ -492,7 +512,9 @@ fn written_files_load_with_no_options_and_keep_their_metadata() {
 #[test]
 fn the_same_seed_writes_the_same_bytes() {
     let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
-    for generator in [Generator::Soma(SomaParams { size: 4, cell: 0.05 }), Generator::Profiles(ProfileParams::double_layer())] {
+    for generator in
+        [Generator::Soma(SomaParams { size: 4, cell: 0.05 }), Generator::Profiles(ProfileParams::double_layer())]
+    {
         let manifest = write(generator.clone(), 3, 9, a.path());
         write(generator.clone(), 3, 9, b.path());
         for name in manifest.assemblies.iter().map(|e| e.file.as_str()).chain(["manifest.json"]) {
@@ -511,38 +533,53 @@ fn the_same_seed_writes_the_same_bytes() {
 fn plans_to_completion(path: &std::path::Path) -> std::result::Result<(), String> {
     use asp_search::{Budget, Dfs, Planner, Problem, Status};
     let assembly = asp_geom::io::load(path, &Default::default()).map_err(|e| e.to_string())?;
-    let checker = Checker::new(World::new(assembly, &WorldConfig::default()).unwrap(), CheckerConfig::default());
+    let world = World::new(assembly, &WorldConfig::default()).map_err(|e| e.to_string())?;
+    let checker = Checker::new(world, CheckerConfig::default());
     let budget = Budget { timeout: Some(std::time::Duration::from_secs(60)), ..Budget::default() };
     let outcome = Dfs::builder().build().solve(&Problem::full(&checker), &budget);
     match outcome.status {
         Status::Found => Ok(()),
-        Status::NoPlan { stuck, .. } => {
-            Err(format!("{}: no plan, stuck: {:?}", path.display(), stuck.iter().map(|s| checker.world().name(s.part)).collect::<Vec<_>>()))
-        }
+        Status::NoPlan { stuck, .. } => Err(format!(
+            "{}: no plan, stuck: {:?}",
+            path.display(),
+            stuck.iter().map(|s| checker.world().name(s.part)).collect::<Vec<_>>()
+        )),
         Status::BudgetExhausted => Err(format!("{}: budget exhausted", path.display())),
     }
 }
 
-const EROSION: &str = "asp-geom's erosion keeps saddle vertices of voxel pieces and U connectors (faces with normals +z and -z) in place, so its removal test blocks them falsely; see docs/generators.md";
+const RING: &str = "asp-geom reports an O connector sliding up along the support it surrounds as blocked (at profile scale only); see docs/generators.md";
 
 #[test]
-#[ignore = "asp-geom's erosion keeps saddle vertices in place (see EROSION): the classic cube has no plan"]
 fn generated_soma_cubes_plan_to_completion() {
     let dir = tempfile::tempdir().unwrap();
     let classic = write(Generator::ClassicSoma { cell: 0.05 }, 1, 0, dir.path());
     let random = write(Generator::Soma(SomaParams { size: 4, cell: 0.05 }), 4, 0, dir.path());
     for entry in classic.assemblies.iter().chain(&random.assemblies) {
-        plans_to_completion(&dir.path().join(&entry.file)).expect(EROSION);
+        plans_to_completion(&dir.path().join(&entry.file)).unwrap();
     }
 }
 
 #[test]
-#[ignore = "asp-geom's erosion keeps saddle vertices in place (see EROSION): profile assemblies exhaust the budget"]
+#[ignore = "asp-geom misjudges 2 of these 50 cubes (a false overlap between touching pieces; a false block): see docs/generators.md"]
+fn a_batch_of_fifty_5x5x5_cubes_plans_to_completion() {
+    // `asp gen soma --size 5 --count 50 --seed 0`: soma5_018 stops with "parts 'piece_02' and
+    // 'piece_19' overlap far beyond the tolerance", soma5_036 ends with no plan although its
+    // piece_30 lifts straight off the full cube (+z); the other 48 plan in milliseconds
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = write(Generator::Soma(SomaParams { size: 5, cell: 0.05 }), 50, 0, dir.path());
+    let failures: Vec<String> =
+        manifest.assemblies.iter().filter_map(|e| plans_to_completion(&dir.path().join(&e.file)).err()).collect();
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+#[ignore = "asp-geom blocks O connectors sliding along their supports (see RING): most profile assemblies exhaust the budget"]
 fn generated_profile_assemblies_plan_to_completion() {
     let dir = tempfile::tempdir().unwrap();
     let manifest = write(Generator::Profiles(ProfileParams::single_layer()), 2, 0, dir.path());
     for entry in &manifest.assemblies {
-        plans_to_completion(&dir.path().join(&entry.file)).expect(EROSION);
+        plans_to_completion(&dir.path().join(&entry.file)).expect(RING);
     }
 }
 
