@@ -104,17 +104,22 @@ impl PartSet {
 
     /// The parts in increasing index order.
     pub fn iter(&self) -> impl Iterator<Item = usize> + '_ {
-        self.words.iter().enumerate().flat_map(|(k, &w)| {
-            let mut w = w;
-            std::iter::from_fn(move || {
-                (w != 0).then(|| {
-                    let b = w.trailing_zeros() as usize;
-                    w &= w - 1;
-                    k * 64 + b
-                })
+        set_bits(self.words.iter().copied())
+    }
+}
+
+/// The indices of the set bits of a bitset given as 64-bit words (word `k` holds bits
+/// `64k..64k+63`), in increasing order. Shared by every bitset in asp.
+pub fn set_bits(words: impl IntoIterator<Item = u64>) -> impl Iterator<Item = usize> {
+    words.into_iter().enumerate().flat_map(|(k, mut w)| {
+        std::iter::from_fn(move || {
+            (w != 0).then(|| {
+                let b = w.trailing_zeros() as usize;
+                w &= w - 1;
+                k * 64 + b
             })
         })
-    }
+    })
 }
 
 impl std::fmt::Debug for PartSet {
