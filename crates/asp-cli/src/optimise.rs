@@ -81,6 +81,11 @@ pub struct Optimised {
     pub pareto_front: Option<Vec<ParetoEntry>>,
     /// The run's settings and results for the plan's `optimisation` key.
     pub summary: OptimisationEntry,
+    /// Problems met while building the distance maps (voxels that do not match meshes, open
+    /// meshes, overlapping parts).
+    pub warnings: Vec<String>,
+    /// The contact tolerance the maps used, metres.
+    pub tolerance: f32,
 }
 
 /// Builds the distance maps of `assembly`, runs the search the flags ask for, writes the trace,
@@ -149,7 +154,9 @@ pub fn optimise(
             .write_trace_csv(std::io::BufWriter::new(file))
             .with_context(|| format!("{}: cannot write the trace", path.display()))?;
     }
-    Ok(adapt(&maps, &outcome, args, seed, map_seconds))
+    let mut optimised = adapt(&maps, &outcome, args, seed, map_seconds);
+    optimised.warnings = maps.warnings().to_vec();
+    Ok(optimised)
 }
 
 /// The search outcome as plan data: motions get the contact margin of the plan format.
@@ -215,7 +222,7 @@ fn adapt(
         map_seconds,
         search_seconds: s.seconds,
     };
-    Optimised { outcome: plan, pareto_front, summary }
+    Optimised { outcome: plan, pareto_front, summary, warnings: Vec::new(), tolerance: maps.tolerance() }
 }
 
 /// Prints the Pareto front (or the best value) under the plan table.
@@ -268,15 +275,17 @@ pub fn plan(args: &crate::flags::PlanArgs, assembly: Assembly) -> anyhow::Result
     let contact = to_m("contact-distance", args.contact_distance)?;
     let o = optimise(&assembly, &args.optimise, args.seed, tolerance, contact)?;
     let mut warnings = assembly.warnings.clone();
+    for w in &o.warnings {
+        if !warnings.contains(w) {
+            warnings.push(w.clone());
+        }
+    }
     if !args.quiet {
         for w in &warnings {
             eprintln!("warning: {}: {w}", args.model.display());
         }
     }
-    warnings.sort();
-    warnings.dedup();
-    let tol = tolerance.unwrap_or(asp_geom::distmap::DEFAULT_RELATIVE_TOLERANCE * assembly.diagonal());
-    let mut report = asp_search::report::PlanReport::new(&assembly, &o.outcome, tol, &warnings);
+    let mut report = asp_search::report::PlanReport::new(&assembly, &o.outcome, o.tolerance, &warnings);
     report.pareto_front = o.pareto_front;
     report.optimisation = Some(o.summary);
     let json = serde_json::to_string_pretty(&report)?;
