@@ -151,6 +151,13 @@ impl DirMask {
         DirMask { words: w }
     }
 
+    /// The set when `bit` is 1, the empty set when it is 0 (without a branch).
+    #[inline]
+    fn keep_if(self, bit: u64) -> DirMask {
+        let keep = bit.wrapping_neg();
+        DirMask { words: self.words.map(|w| w & keep) }
+    }
+
     /// The directions in increasing index order.
     pub fn iter(&self) -> impl Iterator<Item = usize> + '_ {
         crate::partset::set_bits(self.words.iter().copied())
@@ -190,6 +197,12 @@ impl Bits {
     #[inline]
     fn contains(&self, i: usize) -> bool {
         self.0[i >> 6] & (1 << (i & 63)) != 0
+    }
+
+    /// 1 when `i` is in the set, else 0.
+    #[inline]
+    fn bit(&self, i: usize) -> u64 {
+        (self.0[i >> 6] >> (i & 63)) & 1
     }
 
     #[inline]
@@ -467,9 +480,11 @@ pub struct DistanceMaps {
     /// For part `i`: the parts `j` (never the floor) with a non-empty `blocked(i, j)`, the
     /// most-blocking first.
     blockers: Vec<Vec<u16>>,
-    /// For part `i`: the padded rows `M(p_i, p_j)` of its blockers, in `blockers[i]` order,
-    /// contiguous (the hot loop of [`MapState::min_map`] streams through them).
-    blocker_rows: Vec<Vec<f32>>,
+    /// For part `i`: its blockers as a bitset (intersected with the present parts by
+    /// [`MapState::min_map`]).
+    blocker_set: Vec<Bits>,
+    /// A padded row of `d_max` (the padding 0): where a minimum map starts.
+    init_row: Vec<f32>,
     /// For part `i`: `blocked(i, j)` of its blockers, in `blockers[i]` order.
     blocker_masks: Vec<Vec<DirMask>>,
     /// For part `k`: the parts `i` that `k` blocks somewhere (`k ∈ blockers[i]`).
@@ -865,7 +880,8 @@ impl DistanceMaps {
             aabbs,
             geometry,
             blockers: Vec::new(),
-            blocker_rows: Vec::new(),
+            blocker_set: Vec::new(),
+            init_row: Vec::new(),
             blocker_masks: Vec::new(),
             blocks: Vec::new(),
             supporters: Vec::new(),
@@ -895,9 +911,17 @@ impl DistanceMaps {
                 b
             })
             .collect();
-        self.blocker_rows = (0..n)
-            .map(|i| self.blockers[i].iter().flat_map(|&j| self.padded_row(i, j as usize).to_vec()).collect())
+        self.blocker_set = (0..n)
+            .map(|i| {
+                let mut b = Bits::EMPTY;
+                for &j in &self.blockers[i] {
+                    b.insert(j as usize);
+                }
+                b
+            })
             .collect();
+        self.init_row = vec![0.0; self.stride];
+        self.init_row[..self.hemisphere.len()].fill(self.d_max);
         self.blocker_masks =
             (0..n).map(|i| self.blockers[i].iter().map(|&j| self.blocked(i, j as usize)).collect()).collect();
         self.blocks = vec![Bits::EMPTY; n];
@@ -994,11 +1018,6 @@ impl DistanceMaps {
     /// The directions in which `j` blocks `i` (`M(p_i, p_j) < d_max`).
     pub fn blocked(&self, i: usize, j: usize) -> DirMask {
         self.blocked[i * (self.n + 1) + j]
-    }
-
-    fn padded_row(&self, i: usize, j: usize) -> &[f32] {
-        let off = (i * (self.n + 1) + j) * self.stride;
-        &self.values[off..off + self.stride]
     }
 
     /// The parts that block `i` in some direction.
@@ -1227,6 +1246,42 @@ fn cast_distance(moving: &TriMesh, fixed: &TriMesh, dir: Vec3, d_max: f32, erosi
     }
 }
 
+/// Values per block of [`min_rows`]: 32 floats are eight SSE (or four AVX) registers, so the
+/// running minimum of a block stays in registers while the rows stream past.
+const MIN_BLOCK: usize = 32;
+
+/// `out = min(init, rows...)` elementwise, where the rows are `values[o..o + out.len()]` for
+/// each offset `o`. `out.len()` (the stride) is a multiple of 8. Blocks of [`MIN_BLOCK`] values
+/// are finished one at a time: the minimum is exact, so the order does not matter.
+fn min_rows(values: &[f32], offsets: &[usize], init: &[f32], out: &mut [f32]) {
+    let stride = out.len();
+    let mut at = 0;
+    while at + MIN_BLOCK <= stride {
+        min_block::<MIN_BLOCK>(values, offsets, init, out, at);
+        at += MIN_BLOCK;
+    }
+    match stride - at {
+        0 => {}
+        8 => min_block::<8>(values, offsets, init, out, at),
+        16 => min_block::<16>(values, offsets, init, out, at),
+        24 => min_block::<24>(values, offsets, init, out, at),
+        r => unreachable!("the stride is a multiple of 8, {r} values left"),
+    }
+}
+
+#[inline(always)]
+fn min_block<const W: usize>(values: &[f32], offsets: &[usize], init: &[f32], out: &mut [f32], at: usize) {
+    let mut acc: [f32; W] = init[at..at + W].try_into().expect("W values");
+    for &o in offsets {
+        let row: &[f32; W] = values[o + at..o + at + W].try_into().expect("W values");
+        for (a, b) in acc.iter_mut().zip(row) {
+            // a select, which vectorises to a packed minimum
+            *a = if *b < *a { *b } else { *a };
+        }
+    }
+    out[at..at + W].copy_from_slice(&acc);
+}
+
 /// A disassembly state over the distance maps, updated incrementally as parts leave: which
 /// parts are present, which are collision-free (monotone: removals only free parts), the
 /// minimum maps `M̄(p_i, s)` (recomputed lazily for the parts a removal affected), and for the
@@ -1254,6 +1309,8 @@ pub struct MapState<'m> {
     holding: Bits,
     /// The fixed parts.
     fixed: Bits,
+    /// Scratch: where the rows of a part's present blockers start in the maps' values.
+    offsets: Vec<usize>,
 }
 
 const UNCOUNTED: u16 = u16::MAX;
@@ -1276,6 +1333,7 @@ impl<'m> MapState<'m> {
             critical: vec![0; n],
             holding: Bits::EMPTY,
             fixed: Bits::from_set(&PartSet::from_indices(n, (0..n).filter(|&i| maps.fixed[i]))),
+            offsets: Vec::with_capacity(n),
         };
         s.reset(&PartSet::full(n));
         s
@@ -1401,6 +1459,22 @@ impl<'m> MapState<'m> {
     /// that fill every direction (taken most-covering first) as its cover.
     fn check_free(&mut self, i: usize) -> bool {
         let maps = self.maps;
+        // Without branches on presence (they mispredict): absent blockers add an empty mask.
+        let mut blocked = DirMask::EMPTY;
+        for (&j, &b) in maps.blockers[i].iter().zip(&maps.blocker_masks[i]) {
+            blocked = blocked.or(b.keep_if(self.present.bit(j as usize)));
+            if blocked == self.all {
+                self.covers[i] = self.cover(i);
+                return false;
+            }
+        }
+        true
+    }
+
+    /// The present blockers of stuck part `i` that each add directions, in blocker order, until
+    /// every direction is blocked.
+    fn cover(&self, i: usize) -> Bits {
+        let maps = self.maps;
         let mut blocked = DirMask::EMPTY;
         let mut cover = Bits::EMPTY;
         for (&j, &b) in maps.blockers[i].iter().zip(&maps.blocker_masks[i]) {
@@ -1409,12 +1483,11 @@ impl<'m> MapState<'m> {
                 blocked = blocked.or(b);
                 cover.insert(j);
                 if blocked == self.all {
-                    self.covers[i] = cover;
-                    return false;
+                    break;
                 }
             }
         }
-        true
+        cover
     }
 
     fn blocked_now(&self, i: usize) -> DirMask {
@@ -1451,28 +1524,27 @@ impl<'m> MapState<'m> {
 
     /// `M̄(p_i, s)` (eq. 6.4) of present part `i`, `N_M²` values.
     pub fn min_map(&mut self, i: usize) -> &[f32] {
-        let stride = self.maps.stride;
-        let dcount = self.maps.hemisphere.len();
         if self.stale.contains(i) {
-            let maps = self.maps;
-            let row = &mut self.rows[i * stride..(i + 1) * stride];
-            row[..dcount].fill(maps.d_max);
-            row[dcount..].fill(0.0);
-            let mut blocked = DirMask::EMPTY;
-            let rows = maps.blocker_rows[i].chunks_exact(stride);
-            for ((&j, other), mask) in maps.blockers[i].iter().zip(rows).zip(&maps.blocker_masks[i]) {
-                if self.present.contains(j as usize) {
-                    for (a, b) in row.iter_mut().zip(other) {
-                        // a select, which vectorises to a packed minimum
-                        *a = if *b < *a { *b } else { *a };
-                    }
-                    blocked = blocked.or(*mask);
-                }
-            }
-            self.row_free[i] = self.all.and_not(blocked);
-            self.stale.remove(i);
+            self.refresh_row(i);
         }
-        &self.rows[i * stride..i * stride + dcount]
+        let stride = self.maps.stride;
+        &self.rows[i * stride..i * stride + self.maps.hemisphere.len()]
+    }
+
+    /// Recomputes the minimum map of part `i` and its free directions from its present blockers.
+    fn refresh_row(&mut self, i: usize) {
+        let maps = self.maps;
+        let stride = maps.stride;
+        let first = i * (maps.n + 1);
+        self.offsets.clear();
+        let mut blocked = DirMask::EMPTY;
+        for j in maps.blocker_set[i].and(&self.present).iter() {
+            self.offsets.push((first + j) * stride);
+            blocked = blocked.or(maps.blocked[first + j]);
+        }
+        min_rows(&maps.values, &self.offsets, &maps.init_row, &mut self.rows[i * stride..(i + 1) * stride]);
+        self.row_free[i] = self.all.and_not(blocked);
+        self.stale.remove(i);
     }
 
     /// `Σ_{k,l} M̄_{k,l}(p_i, s)` of present part `i` (the accessibility reward, eq. 6.15),
