@@ -171,17 +171,21 @@ struct Bits([u64; 4]);
 
 impl Bits {
     const EMPTY: Bits = Bits([0; 4]);
+    /// Every index: the key of a row not yet computed (a part never blocks itself, so no
+    /// part's present blockers are all indices).
+    const NO_KEY: Bits = Bits([u64::MAX; 4]);
 
+    /// The parts of `s` below 256.
     fn from_set(s: &PartSet) -> Bits {
         let mut b = Bits::EMPTY;
-        for i in s.iter().filter(|&i| i < 256) {
-            b.insert(i);
+        for (w, v) in b.0.iter_mut().zip(s.words()) {
+            *w = *v;
         }
         b
     }
 
     fn to_set(self, n: usize) -> PartSet {
-        PartSet::from_indices(n, self.iter())
+        PartSet::from_words(n, &self.0)
     }
 
     #[inline]
@@ -211,10 +215,8 @@ impl Bits {
     }
 
     #[inline]
-    fn or_with(&mut self, o: &Bits) {
-        for (a, b) in self.0.iter_mut().zip(o.0) {
-            *a |= b;
-        }
+    fn or(&self, o: &Bits) -> Bits {
+        Bits([self.0[0] | o.0[0], self.0[1] | o.0[1], self.0[2] | o.0[2], self.0[3] | o.0[3]])
     }
 
     #[inline]
@@ -485,6 +487,10 @@ pub struct DistanceMaps {
     blocker_set: Vec<Bits>,
     /// A padded row of `d_max` (the padding 0): where a minimum map starts.
     init_row: Vec<f32>,
+    /// `dominators[i * n + j]` for a blocker `j` of `i`: the other blockers `k` of `i` with
+    /// `M(p_i, p_k) <= M(p_i, p_j)` in every direction (equal maps: the lower index). While one
+    /// of them is present, `M(p_i, p_j)` cannot lower `M̄(p_i, s)`, so the minimum skips it.
+    dominators: Vec<Bits>,
     /// For part `i`: `blocked(i, j)` of its blockers, in `blockers[i]` order.
     blocker_masks: Vec<Vec<DirMask>>,
     /// For part `k`: the parts `i` that `k` blocks somewhere (`k ∈ blockers[i]`).
@@ -882,6 +888,7 @@ impl DistanceMaps {
             blockers: Vec::new(),
             blocker_set: Vec::new(),
             init_row: Vec::new(),
+            dominators: Vec::new(),
             blocker_masks: Vec::new(),
             blocks: Vec::new(),
             supporters: Vec::new(),
@@ -902,7 +909,7 @@ impl DistanceMaps {
         let up = self.hemisphere.up_index();
         let support_tol = 2.0 * self.tolerance;
         // Blockers that block the most directions first, so a part's blocked directions fill
-        // up after few of them (see `MapState::has_free_direction`).
+        // up after few of them (see `MapState::check_free`).
         self.blockers = (0..n)
             .map(|i| {
                 let mut b: Vec<u16> =
@@ -922,6 +929,30 @@ impl DistanceMaps {
             .collect();
         self.init_row = vec![0.0; self.stride];
         self.init_row[..self.hemisphere.len()].fill(self.d_max);
+        let this = &*self;
+        let dominators: Vec<Vec<Bits>> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let mut row = vec![Bits::EMPTY; n];
+                for &j in &this.blockers[i] {
+                    let j = j as usize;
+                    let (mj, bj) = (this.map(i, j), this.blocked(i, j));
+                    for &k in &this.blockers[i] {
+                        let k = k as usize;
+                        // a dominator blocks at least where j does
+                        if k == j || !bj.and_not(this.blocked(i, k)).is_empty() {
+                            continue;
+                        }
+                        let mk = this.map(i, k);
+                        if mk.iter().zip(mj).all(|(a, b)| a <= b) && (k < j || mk != mj) {
+                            row[j].insert(k);
+                        }
+                    }
+                }
+                row
+            })
+            .collect();
+        self.dominators = dominators.concat();
         self.blocker_masks =
             (0..n).map(|i| self.blockers[i].iter().map(|&j| self.blocked(i, j as usize)).collect()).collect();
         self.blocks = vec![Bits::EMPTY; n];
@@ -1284,8 +1315,12 @@ fn min_block<const W: usize>(values: &[f32], offsets: &[usize], init: &[f32], ou
 
 /// A disassembly state over the distance maps, updated incrementally as parts leave: which
 /// parts are present, which are collision-free (monotone: removals only free parts), the
-/// minimum maps `M̄(p_i, s)` (recomputed lazily for the parts a removal affected), and for the
-/// [`Support::Below`] rule how many present supports each part has left.
+/// minimum maps `M̄(p_i, s)`, and for the [`Support::Below`] rule how many present supports each
+/// part has left.
+///
+/// A minimum map depends only on which of the part's blockers are present, so each computed
+/// row is kept with that set as its key and reused — after later removals and across
+/// [`MapState::reset`]s — while the part's present blockers are the same.
 #[derive(Clone, Debug)]
 pub struct MapState<'m> {
     maps: &'m DistanceMaps,
@@ -1293,13 +1328,19 @@ pub struct MapState<'m> {
     present: Bits,
     free: Bits,
     unchecked: Bits,
-    stale: Bits,
+    /// Per part: its minimum map (padded to the maps' stride), computed for the present
+    /// blockers in `row_keys` (a key no state has before the first computation).
     rows: Vec<f32>,
+    row_keys: Vec<Bits>,
     /// The free directions of each part, computed with its row (valid when the row is).
     row_free: Vec<DirMask>,
+    /// The sum of each row (NaN until asked for).
+    row_sums: Vec<f64>,
     /// For each present part not known to be free: present blockers that together block every
     /// direction (a witness that it is stuck); it is re-checked only when one of them leaves.
     covers: Vec<Bits>,
+    /// For each part `j`: the parts whose cover holds `j` (re-checked when `j` leaves).
+    watchers: Vec<Bits>,
     /// Present supports of each present part ([`UNCOUNTED`] for fixed parts and parts on the
     /// floor, which always stand).
     supports: Vec<u16>,
@@ -1309,7 +1350,8 @@ pub struct MapState<'m> {
     holding: Bits,
     /// The fixed parts.
     fixed: Bits,
-    /// Scratch: where the rows of a part's present blockers start in the maps' values.
+    /// Scratch (one slot per part): where the rows of a part's present blockers start in the
+    /// maps' values.
     offsets: Vec<usize>,
 }
 
@@ -1325,15 +1367,17 @@ impl<'m> MapState<'m> {
             present: Bits::EMPTY,
             free: Bits::EMPTY,
             unchecked: Bits::EMPTY,
-            stale: Bits::EMPTY,
             rows: vec![0.0; n * maps.stride],
+            row_keys: vec![Bits::NO_KEY; n],
             row_free: vec![DirMask::EMPTY; n],
+            row_sums: vec![f64::NAN; n],
             covers: vec![Bits::EMPTY; n],
+            watchers: vec![Bits::EMPTY; n],
             supports: vec![0; n],
             critical: vec![0; n],
             holding: Bits::EMPTY,
             fixed: Bits::from_set(&PartSet::from_indices(n, (0..n).filter(|&i| maps.fixed[i]))),
-            offsets: Vec::with_capacity(n),
+            offsets: vec![0; n],
         };
         s.reset(&PartSet::full(n));
         s
@@ -1351,7 +1395,8 @@ impl<'m> MapState<'m> {
         self.present = p;
         self.free = Bits::from_set(free).and(&p);
         self.unchecked = p;
-        self.stale = p;
+        // every stuck part is re-checked, and records its cover again
+        self.watchers.fill(Bits::EMPTY);
         if self.maps.support == Support::Below {
             let maps = self.maps;
             self.critical.fill(0);
@@ -1405,14 +1450,8 @@ impl<'m> MapState<'m> {
         self.present.remove(k);
         self.free.remove(k);
         self.unchecked.remove(k);
-        self.stale.remove(k);
-        let blocks = &maps.blocks[k];
-        for i in blocks.and_not(&self.free).and(&self.present).iter() {
-            if self.covers[i].contains(k) {
-                self.unchecked.insert(i);
-            }
-        }
-        self.stale.or_with(blocks);
+        // re-check the stuck parts whose cover `k` was in
+        self.unchecked = self.unchecked.or(&self.watchers[k].and(&self.present).and_not(&self.free));
         if maps.support == Support::Below {
             if self.supports[k] == 1 {
                 if let Some(j) = self.single_support(k) {
@@ -1460,34 +1499,26 @@ impl<'m> MapState<'m> {
     fn check_free(&mut self, i: usize) -> bool {
         let maps = self.maps;
         // Without branches on presence (they mispredict): absent blockers add an empty mask.
-        let mut blocked = DirMask::EMPTY;
-        for (&j, &b) in maps.blockers[i].iter().zip(&maps.blocker_masks[i]) {
-            blocked = blocked.or(b.keep_if(self.present.bit(j as usize)));
-            if blocked == self.all {
-                self.covers[i] = self.cover(i);
-                return false;
-            }
-        }
-        true
-    }
-
-    /// The present blockers of stuck part `i` that each add directions, in blocker order, until
-    /// every direction is blocked.
-    fn cover(&self, i: usize) -> Bits {
-        let maps = self.maps;
+        // The cover is the present blockers that add directions, in blocker order.
         let mut blocked = DirMask::EMPTY;
         let mut cover = Bits::EMPTY;
         for (&j, &b) in maps.blockers[i].iter().zip(&maps.blocker_masks[i]) {
             let j = j as usize;
-            if self.present.contains(j) && !b.and_not(blocked).is_empty() {
-                blocked = blocked.or(b);
-                cover.insert(j);
-                if blocked == self.all {
-                    break;
+            let b = b.keep_if(self.present.bit(j));
+            cover.0[j >> 6] |= u64::from(!b.and_not(blocked).is_empty()) << (j & 63);
+            blocked = blocked.or(b);
+            if blocked == self.all {
+                for k in self.covers[i].iter() {
+                    self.watchers[k].remove(i);
                 }
+                for k in cover.iter() {
+                    self.watchers[k].insert(i);
+                }
+                self.covers[i] = cover;
+                return false;
             }
         }
-        cover
+        true
     }
 
     fn blocked_now(&self, i: usize) -> DirMask {
@@ -1503,11 +1534,17 @@ impl<'m> MapState<'m> {
 
     /// `B^M̄(p_i, s)`: the free directions of present part `i`.
     pub fn free_mask(&self, i: usize) -> DirMask {
-        if self.stale.contains(i) {
-            self.all.and_not(self.blocked_now(i))
-        } else {
+        if self.row_is_current(i) {
             self.row_free[i]
+        } else {
+            self.all.and_not(self.blocked_now(i))
         }
+    }
+
+    /// Whether the kept minimum map of part `i` was computed for its present blockers.
+    #[inline]
+    fn row_is_current(&self, i: usize) -> bool {
+        self.maps.blocker_set[i].and(&self.present) == self.row_keys[i]
     }
 
     /// Whether present part `i` can leave without collision (eq. 6.5).
@@ -1524,7 +1561,7 @@ impl<'m> MapState<'m> {
 
     /// `M̄(p_i, s)` (eq. 6.4) of present part `i`, `N_M²` values.
     pub fn min_map(&mut self, i: usize) -> &[f32] {
-        if self.stale.contains(i) {
+        if !self.row_is_current(i) {
             self.refresh_row(i);
         }
         let stride = self.maps.stride;
@@ -1536,30 +1573,40 @@ impl<'m> MapState<'m> {
         let maps = self.maps;
         let stride = maps.stride;
         let first = i * (maps.n + 1);
-        self.offsets.clear();
+        let key = maps.blocker_set[i].and(&self.present);
+        let dominators = &maps.dominators[i * maps.n..(i + 1) * maps.n];
+        let mut count = 0;
         let mut blocked = DirMask::EMPTY;
-        for j in maps.blocker_set[i].and(&self.present).iter() {
-            self.offsets.push((first + j) * stride);
+        for j in key.iter() {
+            // Skips (without a branch) blockers with a present dominator: its map is nowhere
+            // larger, so the minimum is the same. Their blocked directions are a subset too.
+            self.offsets[count] = (first + j) * stride;
+            count += usize::from(dominators[j].and(&self.present).is_empty());
             blocked = blocked.or(maps.blocked[first + j]);
         }
-        min_rows(&maps.values, &self.offsets, &maps.init_row, &mut self.rows[i * stride..(i + 1) * stride]);
+        let offsets = &self.offsets[..count];
+        min_rows(&maps.values, offsets, &maps.init_row, &mut self.rows[i * stride..(i + 1) * stride]);
         self.row_free[i] = self.all.and_not(blocked);
-        self.stale.remove(i);
+        self.row_keys[i] = key;
+        self.row_sums[i] = f64::NAN;
     }
 
     /// `Σ_{k,l} M̄_{k,l}(p_i, s)` of present part `i` (the accessibility reward, eq. 6.15),
     /// summed in eight interleaved lanes.
     pub fn min_map_sum(&mut self, i: usize) -> f64 {
         self.min_map(i);
-        let stride = self.maps.stride;
-        let row = &self.rows[i * stride..(i + 1) * stride];
-        let mut lanes = [0.0f64; 8];
-        for chunk in row.chunks_exact(8) {
-            for (l, v) in lanes.iter_mut().zip(chunk) {
-                *l += *v as f64;
+        if self.row_sums[i].is_nan() {
+            let stride = self.maps.stride;
+            let row = &self.rows[i * stride..(i + 1) * stride];
+            let mut lanes = [0.0f64; 8];
+            for chunk in row.chunks_exact(8) {
+                for (l, v) in lanes.iter_mut().zip(chunk) {
+                    *l += *v as f64;
+                }
             }
+            self.row_sums[i] = lanes.iter().sum();
         }
-        lanes.iter().sum()
+        self.row_sums[i]
     }
 
     /// Whether removing `a` leaves a standing state (the gravity check). With

@@ -32,6 +32,21 @@ impl PartSet {
         s
     }
 
+    /// The set with room for `n` parts whose bit `i` is bit `i % 64` of `words[i / 64]` (bits at
+    /// or beyond `n` must be 0; missing words are 0).
+    pub fn from_words(n: usize, words: &[u64]) -> Self {
+        let mut s = Self::empty(n);
+        let len = s.words.len().min(words.len());
+        s.words[..len].copy_from_slice(&words[..len]);
+        debug_assert!(words[len..].iter().all(|&w| w == 0), "bits beyond the set's room");
+        s
+    }
+
+    /// The bits as 64-bit words (bit `i` is bit `i % 64` of word `i / 64`).
+    pub fn words(&self) -> &[u64] {
+        &self.words
+    }
+
     fn grow(&mut self, i: usize) {
         if i / 64 >= self.words.len() {
             self.words.resize(i / 64 + 1, 0);
@@ -144,6 +159,8 @@ mod tests {
         assert_eq!(t.intersection(&s).iter().collect::<Vec<_>>(), vec![69]);
         assert!(!t.is_subset(&s));
         assert!(PartSet::from_indices(70, [69]).is_subset(&s));
+        assert_eq!(PartSet::from_words(70, &[1 << 3, (1 << 1) | (1 << 5), 0]), t);
+        assert_eq!(t.words(), &[1 << 3, (1 << 1) | (1 << 5)]);
         let mut u = PartSet::empty(1);
         u.union_with(&t);
         assert_eq!(u, t);

@@ -222,6 +222,56 @@ fn incremental_state_matches_direct_definitions() {
 }
 
 #[test]
+fn incremental_state_matches_direct_definitions_on_voxel_cubes() {
+    // Random removals (feasible or not) and jumps between states: the kept minimum maps (reused
+    // across resets while a part's present blockers are the same, skipping blockers whose maps a
+    // present blocker undercuts) and the free parts always equal the definitions on the plain maps.
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    for seed in 0..2 {
+        let cube = voxel_cube(4, seed);
+        let n = cube.len();
+        let maps = DistanceMaps::build(&cube, &MapConfig::default()).unwrap();
+        let mut state = MapState::new(&maps);
+        let mut actions = Vec::new();
+        for (k, start) in random_states(n, 12, seed).into_iter().enumerate() {
+            // every other start knows its free parts (as tree nodes do)
+            if k % 2 == 0 {
+                state.reset(&start);
+            } else {
+                let free = PartSet::from_indices(n, start.iter().filter(|&p| maps.is_collision_free(p, &start)));
+                state.reset_with_free(&start, &free);
+            }
+            while !state.present().is_empty() {
+                let present = state.present();
+                state.feasible_actions(&mut actions);
+                // feasible: not fixed, collision-free, and no standing part loses its last support
+                let keeps_support = |p: usize| {
+                    let after = present.without(p);
+                    let standing = after.iter().all(|i| !maps.is_supported(i, &present) || maps.is_supported(i, &after));
+                    standing
+                };
+                let direct: Vec<usize> = present
+                    .iter()
+                    .filter(|&p| !maps.is_fixed(p) && maps.is_collision_free(p, &present) && keeps_support(p))
+                    .collect();
+                assert_eq!(actions, direct, "cube {seed} {present:?}");
+                assert_eq!(state.collision_free(), PartSet::from_indices(n, present.iter().filter(|&p| maps.is_collision_free(p, &present))));
+                for p in present.iter() {
+                    let m = maps.min_map(p, &present);
+                    assert_eq!(state.min_map(p), m.as_slice(), "cube {seed} part {p} {present:?}");
+                    let sum: f64 = m.iter().map(|&v| v as f64).sum();
+                    assert!((state.min_map_sum(p) - sum).abs() <= 1e-9 * sum.max(1.0));
+                    assert_eq!(state.free_mask(p), maps.free_mask(p, &present));
+                }
+                let present: Vec<usize> = present.iter().collect();
+                state.remove(present[rng.random_range(0..present.len())]);
+            }
+        }
+    }
+}
+
+#[test]
 fn y_up_assemblies_use_y_as_gravity() {
     // the same stack of two boxes, modelled with +y up
     let a = assembly(vec![boxed("bottom", [0.0; 3], [1.0; 3]), boxed("top", [0.0, 1.0, 0.0], [1.0, 2.0, 1.0])], Axis::Y);
