@@ -1282,32 +1282,48 @@ fn cast_distance(moving: &TriMesh, fixed: &TriMesh, dir: Vec3, d_max: f32, erosi
 const MIN_BLOCK: usize = 32;
 
 /// `out = min(init, rows...)` elementwise, where the rows are `values[o..o + out.len()]` for
-/// each offset `o`. `out.len()` (the stride) is a multiple of 8. Blocks of [`MIN_BLOCK`] values
-/// are finished one at a time: the minimum is exact, so the order does not matter.
-fn min_rows(values: &[f32], offsets: &[usize], init: &[f32], out: &mut [f32]) {
+/// each offset `o`, and the sum of `out` in f64 (over eight interleaved lanes: element `k` goes
+/// to lane `k % 8`, the lanes are added in order at the end). `out.len()` (the stride) is a
+/// multiple of 8. Blocks of [`MIN_BLOCK`] values are finished one at a time, in order: the
+/// minimum is exact, so the order of the rows does not matter.
+fn min_rows(values: &[f32], offsets: &[usize], init: &[f32], out: &mut [f32]) -> f64 {
     let stride = out.len();
+    let mut lanes = [0.0f64; 8];
     let mut at = 0;
     while at + MIN_BLOCK <= stride {
-        min_block::<MIN_BLOCK>(values, offsets, init, out, at);
+        min_block::<MIN_BLOCK>(values, offsets, init, out, at, &mut lanes);
         at += MIN_BLOCK;
     }
     match stride - at {
         0 => {}
-        8 => min_block::<8>(values, offsets, init, out, at),
-        16 => min_block::<16>(values, offsets, init, out, at),
-        24 => min_block::<24>(values, offsets, init, out, at),
+        8 => min_block::<8>(values, offsets, init, out, at, &mut lanes),
+        16 => min_block::<16>(values, offsets, init, out, at, &mut lanes),
+        24 => min_block::<24>(values, offsets, init, out, at, &mut lanes),
         r => unreachable!("the stride is a multiple of 8, {r} values left"),
     }
+    lanes.iter().sum()
 }
 
 #[inline(always)]
-fn min_block<const W: usize>(values: &[f32], offsets: &[usize], init: &[f32], out: &mut [f32], at: usize) {
+fn min_block<const W: usize>(
+    values: &[f32],
+    offsets: &[usize],
+    init: &[f32],
+    out: &mut [f32],
+    at: usize,
+    lanes: &mut [f64; 8],
+) {
     let mut acc: [f32; W] = init[at..at + W].try_into().expect("W values");
     for &o in offsets {
         let row: &[f32; W] = values[o + at..o + at + W].try_into().expect("W values");
         for (a, b) in acc.iter_mut().zip(row) {
             // a select, which vectorises to a packed minimum
             *a = if *b < *a { *b } else { *a };
+        }
+    }
+    for chunk in acc.chunks_exact(8) {
+        for (l, v) in lanes.iter_mut().zip(chunk) {
+            *l += *v as f64;
         }
     }
     out[at..at + W].copy_from_slice(&acc);
@@ -1334,7 +1350,7 @@ pub struct MapState<'m> {
     row_keys: Vec<Bits>,
     /// The free directions of each part, computed with its row (valid when the row is).
     row_free: Vec<DirMask>,
-    /// The sum of each row (NaN until asked for).
+    /// The sum of each row (valid with the row).
     row_sums: Vec<f64>,
     /// For each present part not known to be free: present blockers that together block every
     /// direction (a witness that it is stuck); it is re-checked only when one of them leaves.
@@ -1370,7 +1386,7 @@ impl<'m> MapState<'m> {
             rows: vec![0.0; n * maps.stride],
             row_keys: vec![Bits::NO_KEY; n],
             row_free: vec![DirMask::EMPTY; n],
-            row_sums: vec![f64::NAN; n],
+            row_sums: vec![0.0; n],
             covers: vec![Bits::EMPTY; n],
             watchers: vec![Bits::EMPTY; n],
             supports: vec![0; n],
@@ -1585,27 +1601,16 @@ impl<'m> MapState<'m> {
             blocked = blocked.or(maps.blocked[first + j]);
         }
         let offsets = &self.offsets[..count];
-        min_rows(&maps.values, offsets, &maps.init_row, &mut self.rows[i * stride..(i + 1) * stride]);
+        let row = &mut self.rows[i * stride..(i + 1) * stride];
+        self.row_sums[i] = min_rows(&maps.values, offsets, &maps.init_row, row);
         self.row_free[i] = self.all.and_not(blocked);
         self.row_keys[i] = key;
-        self.row_sums[i] = f64::NAN;
     }
 
     /// `Σ_{k,l} M̄_{k,l}(p_i, s)` of present part `i` (the accessibility reward, eq. 6.15),
     /// summed in eight interleaved lanes.
     pub fn min_map_sum(&mut self, i: usize) -> f64 {
         self.min_map(i);
-        if self.row_sums[i].is_nan() {
-            let stride = self.maps.stride;
-            let row = &self.rows[i * stride..(i + 1) * stride];
-            let mut lanes = [0.0f64; 8];
-            for chunk in row.chunks_exact(8) {
-                for (l, v) in lanes.iter_mut().zip(chunk) {
-                    *l += *v as f64;
-                }
-            }
-            self.row_sums[i] = lanes.iter().sum();
-        }
         self.row_sums[i]
     }
 

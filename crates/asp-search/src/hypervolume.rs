@@ -29,13 +29,19 @@ pub fn weakly_dominates(a: &[f64], b: &[f64]) -> bool {
 /// Exact hypervolume of 2-D points relative to `reference` (points that do not exceed the
 /// reference in both objectives add nothing).
 pub fn hypervolume_2d(points: &[[f64; 2]], reference: [f64; 2]) -> f64 {
-    let mut pts: Vec<[f64; 2]> =
-        points.iter().copied().filter(|p| p[0] > reference[0] && p[1] > reference[1]).collect();
-    // x descending; for equal x, y descending
-    pts.sort_by(|a, b| b[0].total_cmp(&a[0]).then(b[1].total_cmp(&a[1])));
+    hypervolume_2d_in_place(&mut points.to_vec(), reference)
+}
+
+/// [`hypervolume_2d`] on a buffer it may reorder (no allocation).
+pub fn hypervolume_2d_in_place(points: &mut [[f64; 2]], reference: [f64; 2]) -> f64 {
+    // x descending; for equal x, y descending (points that compare equal are identical)
+    points.sort_unstable_by(|a, b| b[0].total_cmp(&a[0]).then(b[1].total_cmp(&a[1])));
     let mut area = 0.0;
     let mut top = reference[1];
-    for p in pts {
+    for p in points.iter() {
+        if p[0] <= reference[0] {
+            break; // so is every later point
+        }
         if p[1] > top {
             area += (p[0] - reference[0]) * (p[1] - top);
             top = p[1];

@@ -17,7 +17,7 @@
 //! ```
 
 use crate::error::Result;
-use crate::hypervolume::{hypervolume_2d, ParetoFront};
+use crate::hypervolume::{hypervolume_2d_in_place, ParetoFront};
 use crate::mdp::{Mdp, MAX_OBJECTIVES};
 use crate::search::{
     exploration_term, run, SearchBuilder, SearchOutcome, SearchSettings, SelectContext, Tree,
@@ -110,7 +110,7 @@ fn normalised_hypervolume(front: Option<&ParetoFront<()>>, reward: &[f64], ctx: 
             }
             count += 1;
         }
-        return hypervolume_2d(&pts[..count], [NORMALISED_REFERENCE; 2]);
+        return hypervolume_2d_in_place(&mut pts[..count], [NORMALISED_REFERENCE; 2]);
     }
     let mut norm: ParetoFront<()> = ParetoFront::new(m);
     let mut buf = [0.0f64; MAX_OBJECTIVES];
