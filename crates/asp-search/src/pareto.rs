@@ -98,19 +98,21 @@ fn normalised_hypervolume(front: Option<&ParetoFront<()>>, reward: &[f64], ctx: 
     let Some(front) = front else { return 0.0 };
     let m = reward.len();
     if m == 2 {
-        // the 2-D sweep on a stack buffer
-        let mut pts = [[0.0f64; 2]; 64];
-        let mut count = 0;
-        for (p, _) in front.iter() {
-            if count == pts.len() {
-                break;
-            }
+        // the 2-D sweep on a stack buffer (on the heap for fronts of more than 64 points)
+        let mut stack = [[0.0f64; 2]; 64];
+        let mut heap;
+        let pts: &mut [[f64; 2]] = if front.len() <= stack.len() {
+            &mut stack[..front.len()]
+        } else {
+            heap = vec![[0.0f64; 2]; front.len()];
+            &mut heap
+        };
+        for (slot, (p, _)) in pts.iter_mut().zip(front.iter()) {
             for k in 0..2 {
-                pts[count][k] = ctx.bounds.normalise(k, ctx.prefix[k] + reward[k] + p[k]);
+                slot[k] = ctx.bounds.normalise(k, ctx.prefix[k] + reward[k] + p[k]);
             }
-            count += 1;
         }
-        return hypervolume_2d_in_place(&mut pts[..count], [NORMALISED_REFERENCE; 2]);
+        return hypervolume_2d_in_place(pts, [NORMALISED_REFERENCE; 2]);
     }
     let mut norm: ParetoFront<()> = ParetoFront::new(m);
     let mut buf = [0.0f64; MAX_OBJECTIVES];
@@ -122,4 +124,28 @@ fn normalised_hypervolume(front: Option<&ParetoFront<()>>, reward: &[f64], ctx: 
     }
     let reference = [NORMALISED_REFERENCE; MAX_OBJECTIVES];
     norm.hypervolume(&reference[..m])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hypervolume::hypervolume_2d;
+    use crate::search::Bounds;
+
+    #[test]
+    fn moucb_hypervolume_counts_every_point_of_a_large_front() {
+        // 100 points on the line x + y = 1 in objectives already in [0, 1]
+        let mut front = ParetoFront::new(2);
+        let pts: Vec<[f64; 2]> = (0..100).map(|k| [k as f64 / 99.0, 1.0 - k as f64 / 99.0]).collect();
+        for p in &pts {
+            assert!(front.insert(p, || ()));
+        }
+        let bounds = Bounds { lo: [0.0; MAX_OBJECTIVES], hi: [1.0; MAX_OBJECTIVES] };
+        let ctx = SelectContext { exploration: 1.0, bounds: &bounds, prefix: &[0.0, 0.0] };
+        let hv = normalised_hypervolume(Some(&front), &[0.0, 0.0], &ctx);
+        let all = hypervolume_2d(&pts, [NORMALISED_REFERENCE; 2]);
+        let first_64 = hypervolume_2d(&pts[..64], [NORMALISED_REFERENCE; 2]);
+        assert!(all > first_64);
+        assert_eq!(hv, all);
+    }
 }
