@@ -504,10 +504,10 @@ pub struct DistanceMaps {
     support: Support,
     /// For part `i` (and the floor at index `n`): the parts and the floor within the contact
     /// distance (filled for [`Support::ContactGraph`] only).
-    contacts: Vec<PartSet>,
+    contacts: Vec<Bits>,
     /// The parts the contact graph hangs from: the fixed parts, and the floor (index `n`) when
     /// no part is fixed.
-    bases: PartSet,
+    bases: Bits,
     warnings: Vec<String>,
 }
 
@@ -895,8 +895,8 @@ impl DistanceMaps {
             dependents: Vec::new(),
             on_floor: Vec::new(),
             support: config.support,
-            contacts,
-            bases,
+            contacts: contacts.iter().map(Bits::from_set).collect(),
+            bases: Bits::from_set(&bases),
             warnings,
         };
         maps.index();
@@ -1095,23 +1095,20 @@ impl DistanceMaps {
 
     /// The parts of `alive` linked through contacts among `alive` to a base (a fixed part, or
     /// the floor when no part is fixed); fixed parts are always alive.
-    fn linked(&self, alive: &PartSet) -> PartSet {
-        let n = self.n;
-        let mut alive = alive.clone();
-        for i in self.bases.iter() {
-            alive.insert(i);
-        }
-        let mut reached = self.bases.clone();
-        let mut frontier: Vec<usize> = reached.iter().collect();
-        while let Some(i) = frontier.pop() {
-            for j in self.contacts[i].iter() {
-                if alive.contains(j) && !reached.contains(j) {
-                    reached.insert(j);
-                    frontier.push(j);
-                }
+    fn linked(&self, alive: Bits) -> Bits {
+        let alive = alive.or(&self.bases);
+        let mut reached = self.bases;
+        let mut frontier = self.bases;
+        // breadth-first, a whole layer per step
+        while !frontier.is_empty() {
+            let mut next = Bits::EMPTY;
+            for i in frontier.iter() {
+                next = next.or(&self.contacts[i]);
             }
+            frontier = next.and(&alive).and_not(&reached);
+            reached = reached.or(&frontier);
         }
-        reached.remove(n);
+        reached.remove(self.n);
         reached
     }
 
@@ -1136,7 +1133,7 @@ impl DistanceMaps {
             }
             Support::ContactGraph => {
                 let alive = PartSet::from_indices(self.n, state.iter().filter(|&i| i < self.n));
-                let reached = self.linked(&alive);
+                let reached = self.linked(Bits::from_set(&alive));
                 for i in alive.iter() {
                     if !reached.contains(i) {
                         floating.insert(i);
@@ -1623,8 +1620,7 @@ impl<'m> MapState<'m> {
             Support::ContactGraph => {
                 let mut alive = self.present;
                 alive.remove(a);
-                let reached = self.maps.linked(&alive.to_set(self.maps.n));
-                alive.iter().all(|i| reached.contains(i))
+                alive.and_not(&self.maps.linked(alive)).is_empty()
             }
         }
     }

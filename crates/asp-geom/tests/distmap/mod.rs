@@ -228,10 +228,11 @@ fn incremental_state_matches_direct_definitions_on_voxel_cubes() {
     // present blocker undercuts) and the free parts always equal the definitions on the plain maps.
     use rand::{RngExt, SeedableRng};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
-    for seed in 0..2 {
+    use asp_geom::distmap::Support;
+    for (seed, support) in [(0, Support::Below), (1, Support::Below), (2, Support::ContactGraph)] {
         let cube = voxel_cube(4, seed);
         let n = cube.len();
-        let maps = DistanceMaps::build(&cube, &MapConfig::default()).unwrap();
+        let maps = DistanceMaps::build(&cube, &MapConfig::builder().support(support).build().unwrap()).unwrap();
         let mut state = MapState::new(&maps);
         let mut actions = Vec::new();
         for (k, start) in random_states(n, 12, seed).into_iter().enumerate() {
@@ -246,9 +247,15 @@ fn incremental_state_matches_direct_definitions_on_voxel_cubes() {
                 let present = state.present();
                 state.feasible_actions(&mut actions);
                 // feasible: not fixed, collision-free, and no standing part loses its last support
+                // (below), or every part left hangs from the floor through contacts (contact)
                 let keeps_support = |p: usize| {
                     let after = present.without(p);
-                    let standing = after.iter().all(|i| !maps.is_supported(i, &present) || maps.is_supported(i, &after));
+                    let standing = match support {
+                        Support::Below => {
+                            after.iter().all(|i| !maps.is_supported(i, &present) || maps.is_supported(i, &after))
+                        }
+                        Support::ContactGraph => maps.stability(&after) == Stability::Stable,
+                    };
                     standing
                 };
                 let direct: Vec<usize> = present
