@@ -53,6 +53,8 @@ use rayon::prelude::*;
 pub const MAX_RESOLUTION: usize = 15;
 /// Default map resolution `N_M` (the thesis does not state its value): 9 × 9 = 81 directions.
 pub const DEFAULT_RESOLUTION: usize = 9;
+/// How many directions [`MapState`] tries first when it checks whether a part is free.
+const PROBES: usize = 4;
 /// Largest number of parts distance maps are built for.
 pub const MAX_PARTS: usize = 255;
 /// Default contact tolerance, relative to the assembly's diagonal (as the collision world).
@@ -487,12 +489,19 @@ pub struct DistanceMaps {
     blocker_set: Vec<Bits>,
     /// A padded row of `d_max` (the padding 0): where a minimum map starts.
     init_row: Vec<f32>,
-    /// `dominators[i * n + j]` for a blocker `j` of `i`: the other blockers `k` of `i` with
-    /// `M(p_i, p_k) <= M(p_i, p_j)` in every direction (equal maps: the lower index). While one
-    /// of them is present, `M(p_i, p_j)` cannot lower `M̄(p_i, s)`, so the minimum skips it.
-    dominators: Vec<Bits>,
+    /// Words of a part bitset: `ceil(n / 64)`.
+    words: usize,
+    /// For a blocker `j` of `i`, at `(i * n + j) * words`: the other blockers `k` of `i` with
+    /// `M(p_i, p_k) <= M(p_i, p_j)` in every direction (equal maps: the lower index), `words`
+    /// words of a bitset. While one of them is present, `M(p_i, p_j)` cannot lower
+    /// `M̄(p_i, s)`, so the minimum skips it.
+    dominators: Vec<u64>,
     /// For part `i`: `blocked(i, j)` of its blockers, in `blockers[i]` order.
     blocker_masks: Vec<Vec<DirMask>>,
+    /// For part `i`: the parts blocking it along each of the [`PROBES`] directions the fewest
+    /// parts block (a part is often freed along one of them first: a quick test before the
+    /// full one).
+    probes: Vec<[Bits; PROBES]>,
     /// For part `k`: the parts `i` that `k` blocks somewhere (`k ∈ blockers[i]`).
     blocks: Vec<Bits>,
     /// For part `i`: the parts directly below it, touching (`M(p_j, p_i)(up) = 0`).
@@ -888,8 +897,10 @@ impl DistanceMaps {
             blockers: Vec::new(),
             blocker_set: Vec::new(),
             init_row: Vec::new(),
+            words: n.div_ceil(64),
             dominators: Vec::new(),
             blocker_masks: Vec::new(),
+            probes: Vec::new(),
             blocks: Vec::new(),
             supporters: Vec::new(),
             dependents: Vec::new(),
@@ -952,9 +963,24 @@ impl DistanceMaps {
                 row
             })
             .collect();
-        self.dominators = dominators.concat();
+        let words = self.words;
+        self.dominators = dominators.iter().flatten().flat_map(|b| b.0[..words].to_vec()).collect();
         self.blocker_masks =
             (0..n).map(|i| self.blockers[i].iter().map(|&j| self.blocked(i, j as usize)).collect()).collect();
+        let dcount = self.hemisphere.len();
+        self.probes = (0..n)
+            .map(|i| {
+                let mut along = vec![Bits::EMPTY; dcount];
+                for &j in &self.blockers[i] {
+                    for d in self.blocked(i, j as usize).iter() {
+                        along[d].insert(j as usize);
+                    }
+                }
+                let mut order: Vec<usize> = (0..dcount).collect();
+                order.sort_by_key(|&d| along[d].iter().count());
+                std::array::from_fn(|k| along[order[k]])
+            })
+            .collect();
         self.blocks = vec![Bits::EMPTY; n];
         for i in 0..n {
             for &j in &self.blockers[i] {
@@ -1278,24 +1304,24 @@ fn cast_distance(moving: &TriMesh, fixed: &TriMesh, dir: Vec3, d_max: f32, erosi
 /// running minimum of a block stays in registers while the rows stream past.
 const MIN_BLOCK: usize = 32;
 
-/// `out = min(init, rows...)` elementwise, where the rows are `values[o..o + out.len()]` for
-/// each offset `o`, and the sum of `out` in f64 (over eight interleaved lanes: element `k` goes
+/// `out = min(init, rows...)` elementwise, where the rows are `values[r * s..(r + 1) * s]`
+/// for each row index `r` and the stride `s = out.len()`, and the sum of `out` in f64 (over eight interleaved lanes: element `k` goes
 /// to lane `k % 8`, the lanes are added in order at the end). `out.len()` (the stride) is a
 /// multiple of 8. Blocks of [`MIN_BLOCK`] values are finished one at a time, in order: the
 /// minimum is exact, so the order of the rows does not matter.
-fn min_rows(values: &[f32], offsets: &[usize], init: &[f32], out: &mut [f32]) -> f64 {
+fn min_rows(values: &[f32], rows: &[usize], init: &[f32], out: &mut [f32]) -> f64 {
     let stride = out.len();
     let mut lanes = [0.0f64; 8];
     let mut at = 0;
     while at + MIN_BLOCK <= stride {
-        min_block::<MIN_BLOCK>(values, offsets, init, out, at, &mut lanes);
+        min_block::<MIN_BLOCK>(values, rows, init, out, at, &mut lanes);
         at += MIN_BLOCK;
     }
     match stride - at {
         0 => {}
-        8 => min_block::<8>(values, offsets, init, out, at, &mut lanes),
-        16 => min_block::<16>(values, offsets, init, out, at, &mut lanes),
-        24 => min_block::<24>(values, offsets, init, out, at, &mut lanes),
+        8 => min_block::<8>(values, rows, init, out, at, &mut lanes),
+        16 => min_block::<16>(values, rows, init, out, at, &mut lanes),
+        24 => min_block::<24>(values, rows, init, out, at, &mut lanes),
         r => unreachable!("the stride is a multiple of 8, {r} values left"),
     }
     lanes.iter().sum()
@@ -1304,15 +1330,17 @@ fn min_rows(values: &[f32], offsets: &[usize], init: &[f32], out: &mut [f32]) ->
 #[inline(always)]
 fn min_block<const W: usize>(
     values: &[f32],
-    offsets: &[usize],
+    rows: &[usize],
     init: &[f32],
     out: &mut [f32],
     at: usize,
     lanes: &mut [f64; 8],
 ) {
+    let stride = out.len();
     let mut acc: [f32; W] = init[at..at + W].try_into().expect("W values");
-    for &o in offsets {
-        let row: &[f32; W] = values[o + at..o + at + W].try_into().expect("W values");
+    for &r in rows {
+        let o = r * stride + at;
+        let row: &[f32; W] = values[o..o + W].try_into().expect("W values");
         for (a, b) in acc.iter_mut().zip(row) {
             // a select, which vectorises to a packed minimum
             *a = if *b < *a { *b } else { *a };
@@ -1363,9 +1391,9 @@ pub struct MapState<'m> {
     holding: Bits,
     /// The fixed parts.
     fixed: Bits,
-    /// Scratch (one slot per part): where the rows of a part's present blockers start in the
-    /// maps' values.
-    offsets: Vec<usize>,
+    /// Scratch (one slot per part): the rows (`i * (n + 1) + j`) of the blockers `j` that shape
+    /// part `i`'s minimum map.
+    kept: Vec<usize>,
 }
 
 const UNCOUNTED: u16 = u16::MAX;
@@ -1390,7 +1418,7 @@ impl<'m> MapState<'m> {
             critical: vec![0; n],
             holding: Bits::EMPTY,
             fixed: Bits::from_set(&PartSet::from_indices(n, (0..n).filter(|&i| maps.fixed[i]))),
-            offsets: vec![0; n],
+            kept: vec![0; n],
         };
         s.reset(&PartSet::full(n));
         s
@@ -1511,6 +1539,9 @@ impl<'m> MapState<'m> {
     /// that fill every direction (taken most-covering first) as its cover.
     fn check_free(&mut self, i: usize) -> bool {
         let maps = self.maps;
+        if maps.probes[i].iter().any(|p| p.and(&self.present).is_empty()) {
+            return true;
+        }
         // Without branches on presence (they mispredict): absent blockers add an empty mask.
         // The cover is the present blockers that add directions, in blocker order.
         let mut blocked = DirMask::EMPTY;
@@ -1583,23 +1614,46 @@ impl<'m> MapState<'m> {
 
     /// Recomputes the minimum map of part `i` and its free directions from its present blockers.
     fn refresh_row(&mut self, i: usize) {
+        // the bitsets in the loop have as many words as the part count needs
+        match self.maps.words {
+            1 => self.refresh_row_in::<1>(i),
+            2 => self.refresh_row_in::<2>(i),
+            3 => self.refresh_row_in::<3>(i),
+            _ => self.refresh_row_in::<4>(i),
+        }
+    }
+
+    fn refresh_row_in<const W: usize>(&mut self, i: usize) {
         let maps = self.maps;
         let stride = maps.stride;
         let first = i * (maps.n + 1);
         let key = maps.blocker_set[i].and(&self.present);
-        let dominators = &maps.dominators[i * maps.n..(i + 1) * maps.n];
+        let dominators = &maps.dominators[i * maps.n * W..(i + 1) * maps.n * W];
+        let present: [u64; W] = self.present.0[..W].try_into().expect("W words");
         let mut count = 0;
-        let mut blocked = DirMask::EMPTY;
-        for j in key.iter() {
-            // Skips (without a branch) blockers with a present dominator: its map is nowhere
-            // larger, so the minimum is the same. Their blocked directions are a subset too.
-            self.offsets[count] = (first + j) * stride;
-            count += usize::from(dominators[j].and(&self.present).is_empty());
-            blocked = blocked.or(maps.blocked[first + j]);
+        for (k, &word) in key.0[..W].iter().enumerate() {
+            let mut w = word;
+            while w != 0 {
+                let j = k * 64 + w.trailing_zeros() as usize;
+                w &= w - 1;
+                // Skips (without a branch) blockers with a present dominator: its map is nowhere
+                // larger, so the minimum is the same, and it blocks a subset of the directions.
+                let d: &[u64; W] = dominators[j * W..(j + 1) * W].try_into().expect("W words");
+                let mut shared = 0;
+                for (a, b) in d.iter().zip(&present) {
+                    shared |= a & b;
+                }
+                self.kept[count] = first + j;
+                count += usize::from(shared == 0);
+            }
         }
-        let offsets = &self.offsets[..count];
+        let kept = &self.kept[..count];
+        let mut blocked = DirMask::EMPTY;
+        for &r in kept {
+            blocked = blocked.or(maps.blocked[r]);
+        }
         let row = &mut self.rows[i * stride..(i + 1) * stride];
-        self.row_sums[i] = min_rows(&maps.values, offsets, &maps.init_row, row);
+        self.row_sums[i] = min_rows(&maps.values, kept, &maps.init_row, row);
         self.row_free[i] = self.all.and_not(blocked);
         self.row_keys[i] = key;
     }

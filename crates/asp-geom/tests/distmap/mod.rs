@@ -229,13 +229,17 @@ fn incremental_state_matches_direct_definitions_on_voxel_cubes() {
     use rand::{RngExt, SeedableRng};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
     use asp_geom::distmap::Support;
-    for (seed, support) in [(0, Support::Below), (1, Support::Below), (2, Support::ContactGraph)] {
-        let cube = voxel_cube(4, seed);
+    // (more than 64 parts: bitsets of two words)
+    for (size, seed, support) in
+        [(4, 0, Support::Below), (4, 1, Support::Below), (4, 2, Support::ContactGraph), (6, 3, Support::Below)]
+    {
+        let cube = voxel_cube(size, seed);
         let n = cube.len();
+        assert!(size < 6 || n > 64, "{n} parts");
         let maps = DistanceMaps::build(&cube, &MapConfig::builder().support(support).build().unwrap()).unwrap();
         let mut state = MapState::new(&maps);
         let mut actions = Vec::new();
-        for (k, start) in random_states(n, 12, seed).into_iter().enumerate() {
+        for (k, start) in random_states(n, if size < 6 { 12 } else { 3 }, seed).into_iter().enumerate() {
             // every other start knows its free parts (as tree nodes do)
             if k % 2 == 0 {
                 state.reset(&start);
