@@ -53,8 +53,6 @@ use rayon::prelude::*;
 pub const MAX_RESOLUTION: usize = 15;
 /// Default map resolution `N_M` (the thesis does not state its value): 9 × 9 = 81 directions.
 pub const DEFAULT_RESOLUTION: usize = 9;
-/// How many directions [`MapState`] tries first when it checks whether a part is free.
-const PROBES: usize = 4;
 /// Largest number of parts distance maps are built for.
 pub const MAX_PARTS: usize = 255;
 /// Default contact tolerance, relative to the assembly's diagonal (as the collision world).
@@ -153,11 +151,10 @@ impl DirMask {
         DirMask { words: w }
     }
 
-    /// The set when `bit` is 1, the empty set when it is 0 (without a branch).
+    /// The smallest direction in the set.
     #[inline]
-    fn keep_if(self, bit: u64) -> DirMask {
-        let keep = bit.wrapping_neg();
-        DirMask { words: self.words.map(|w| w & keep) }
+    fn lowest(&self) -> Option<usize> {
+        self.words.iter().enumerate().find(|(_, w)| **w != 0).map(|(k, w)| k * 64 + w.trailing_zeros() as usize)
     }
 
     /// The directions in increasing index order.
@@ -203,12 +200,6 @@ impl Bits {
     #[inline]
     fn contains(&self, i: usize) -> bool {
         self.0[i >> 6] & (1 << (i & 63)) != 0
-    }
-
-    /// 1 when `i` is in the set, else 0.
-    #[inline]
-    fn bit(&self, i: usize) -> u64 {
-        (self.0[i >> 6] >> (i & 63)) & 1
     }
 
     #[inline]
@@ -498,10 +489,9 @@ pub struct DistanceMaps {
     dominators: Vec<u64>,
     /// For part `i`: `blocked(i, j)` of its blockers, in `blockers[i]` order.
     blocker_masks: Vec<Vec<DirMask>>,
-    /// For part `i`: the parts blocking it along each of the [`PROBES`] directions the fewest
-    /// parts block (a part is often freed along one of them first: a quick test before the
-    /// full one).
-    probes: Vec<[Bits; PROBES]>,
+    /// For part `i` and direction `d`, at `(i * N_M² + d) * words`: the parts that block `i`
+    /// along `d`, `words` words of a bitset.
+    along: Vec<u64>,
     /// For part `k`: the parts `i` that `k` blocks somewhere (`k ∈ blockers[i]`).
     blocks: Vec<Bits>,
     /// For part `i`: the parts directly below it, touching (`M(p_j, p_i)(up) = 0`).
@@ -900,7 +890,7 @@ impl DistanceMaps {
             words: n.div_ceil(64),
             dominators: Vec::new(),
             blocker_masks: Vec::new(),
-            probes: Vec::new(),
+            along: Vec::new(),
             blocks: Vec::new(),
             supporters: Vec::new(),
             dependents: Vec::new(),
@@ -919,8 +909,8 @@ impl DistanceMaps {
         let n = self.n;
         let up = self.hemisphere.up_index();
         let support_tol = 2.0 * self.tolerance;
-        // Blockers that block the most directions first, so a part's blocked directions fill
-        // up after few of them (see `MapState::check_free`).
+        // Blockers that block the most directions first (a part's blocked directions fill up
+        // after few of them when they are ORed in this order).
         self.blockers = (0..n)
             .map(|i| {
                 let mut b: Vec<u16> =
@@ -968,19 +958,15 @@ impl DistanceMaps {
         self.blocker_masks =
             (0..n).map(|i| self.blockers[i].iter().map(|&j| self.blocked(i, j as usize)).collect()).collect();
         let dcount = self.hemisphere.len();
-        self.probes = (0..n)
-            .map(|i| {
-                let mut along = vec![Bits::EMPTY; dcount];
-                for &j in &self.blockers[i] {
-                    for d in self.blocked(i, j as usize).iter() {
-                        along[d].insert(j as usize);
-                    }
+        self.along = vec![0; n * dcount * words];
+        for i in 0..n {
+            for &j in &self.blockers[i] {
+                let j = j as usize;
+                for d in self.blocked(i, j).iter() {
+                    self.along[(i * dcount + d) * words + j / 64] |= 1 << (j % 64);
                 }
-                let mut order: Vec<usize> = (0..dcount).collect();
-                order.sort_by_key(|&d| along[d].iter().count());
-                std::array::from_fn(|k| along[order[k]])
-            })
-            .collect();
+            }
+        }
         self.blocks = vec![Bits::EMPTY; n];
         for i in 0..n {
             for &j in &self.blockers[i] {
@@ -1535,34 +1521,53 @@ impl<'m> MapState<'m> {
         }
     }
 
-    /// Whether present part `i` has a free direction. When it has none, records the blockers
-    /// that fill every direction (taken most-covering first) as its cover.
+    /// Whether present part `i` has a free direction. When it has none, records as its cover
+    /// present blockers that together block every direction.
     fn check_free(&mut self, i: usize) -> bool {
+        // the bitsets in the loop have as many words as the part count needs
+        match self.maps.words {
+            1 => self.check_free_in::<1>(i),
+            2 => self.check_free_in::<2>(i),
+            3 => self.check_free_in::<3>(i),
+            _ => self.check_free_in::<4>(i),
+        }
+    }
+
+    fn check_free_in<const W: usize>(&mut self, i: usize) -> bool {
         let maps = self.maps;
-        if maps.probes[i].iter().any(|p| p.and(&self.present).is_empty()) {
-            return true;
-        }
-        // Without branches on presence (they mispredict): absent blockers add an empty mask.
-        // The cover is the present blockers that add directions, in blocker order.
+        let first = i * (maps.n + 1);
+        let dcount = maps.hemisphere.len();
+        let along = &maps.along[i * dcount * W..(i + 1) * dcount * W];
+        let present: [u64; W] = self.present.0[..W].try_into().expect("W words");
+        // Start from the last cover's present members (they block where they blocked), then
+        // take any direction still open: without a present blocker along it the part is free,
+        // else the first such blocker joins the cover.
         let mut blocked = DirMask::EMPTY;
-        let mut cover = Bits::EMPTY;
-        for (&j, &b) in maps.blockers[i].iter().zip(&maps.blocker_masks[i]) {
-            let j = j as usize;
-            let b = b.keep_if(self.present.bit(j));
-            cover.0[j >> 6] |= u64::from(!b.and_not(blocked).is_empty()) << (j & 63);
-            blocked = blocked.or(b);
-            if blocked == self.all {
-                for k in self.covers[i].iter() {
-                    self.watchers[k].remove(i);
-                }
-                for k in cover.iter() {
-                    self.watchers[k].insert(i);
-                }
-                self.covers[i] = cover;
-                return false;
-            }
+        let mut cover = self.covers[i].and(&self.present);
+        for j in cover.iter() {
+            blocked = blocked.or(maps.blocked[first + j]);
         }
-        true
+        while let Some(d) = self.all.and_not(blocked).lowest() {
+            let mut j = None;
+            for (k, (a, p)) in along[d * W..(d + 1) * W].iter().zip(&present).enumerate() {
+                let w = a & p;
+                if w != 0 {
+                    j = Some(k * 64 + w.trailing_zeros() as usize);
+                    break;
+                }
+            }
+            let Some(j) = j else { return true };
+            blocked = blocked.or(maps.blocked[first + j]);
+            cover.insert(j);
+        }
+        for k in self.covers[i].iter() {
+            self.watchers[k].remove(i);
+        }
+        for k in cover.iter() {
+            self.watchers[k].insert(i);
+        }
+        self.covers[i] = cover;
+        false
     }
 
     fn blocked_now(&self, i: usize) -> DirMask {
