@@ -194,7 +194,16 @@ fn adapt(
     let plan = PlanOutcome {
         status,
         removals,
-        stats: Stats { counters: CounterSnapshot::default(), seconds: outcome.stats.seconds, states_expanded: 0 },
+        stats: Stats {
+            counters: CounterSnapshot {
+                removal_tests: outcome.stats.removal_tests,
+                failed_collision: outcome.stats.failed_collision,
+                failed_gravity: outcome.stats.failed_gravity,
+                path_planner_calls: 0,
+            },
+            seconds: outcome.stats.seconds,
+            states_expanded: 0,
+        },
     };
     let pareto_front = args.pareto.then(|| {
         outcome
@@ -286,6 +295,7 @@ pub fn plan(args: &crate::flags::PlanArgs, assembly: Assembly) -> anyhow::Result
         }
     }
     let mut report = asp_search::report::PlanReport::new(&assembly, &o.outcome, o.tolerance, &warnings);
+    report.stats.checker = asp_search::report::CHECKER_DISTANCE_MAPS.into();
     report.pareto_front = o.pareto_front;
     report.optimisation = Some(o.summary);
     let json = serde_json::to_string_pretty(&report)?;

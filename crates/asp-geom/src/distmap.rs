@@ -208,6 +208,11 @@ impl Bits {
     }
 
     #[inline]
+    fn len(&self) -> usize {
+        self.0.iter().map(|w| w.count_ones() as usize).sum()
+    }
+
+    #[inline]
     fn or(&self, o: &Bits) -> Bits {
         Bits([self.0[0] | o.0[0], self.0[1] | o.0[1], self.0[2] | o.0[2], self.0[3] | o.0[3]])
     }
@@ -1377,12 +1382,29 @@ pub struct MapState<'m> {
     holding: Bits,
     /// The fixed parts.
     fixed: Bits,
+    counters: MapCounters,
     /// Scratch (one slot per part): the rows (`i * (n + 1) + j`) of the blockers `j` that shape
     /// part `i`'s minimum map.
     kept: Vec<usize>,
 }
 
 const UNCOUNTED: u16 = u16::MAX;
+
+/// The removability tests a [`MapState`] ran. Its answers are incremental: a part found free
+/// stays free as parts leave and is not tested again, a stuck part is tested again only when a
+/// part of its cover (blockers that together block every direction) leaves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MapCounters {
+    /// Collision tests: whether a present part has a free direction (eq. 6.5).
+    pub collision_tests: u64,
+    /// Collision tests that found every direction blocked.
+    pub blocked: u64,
+    /// Gravity tests: a collision-free, non-fixed part's removal checked by the [`Support`]
+    /// rule (once per part each time [`MapState::feasible_actions`] runs).
+    pub gravity_tests: u64,
+    /// Gravity tests that found the removal would leave a part without support.
+    pub unsupported: u64,
+}
 
 impl<'m> MapState<'m> {
     /// The assembled state (every part present).
@@ -1405,6 +1427,7 @@ impl<'m> MapState<'m> {
             holding: Bits::EMPTY,
             fixed: Bits::from_set(&PartSet::from_indices(n, (0..n).filter(|&i| maps.fixed[i]))),
             kept: vec![0; n],
+            counters: MapCounters::default(),
         };
         s.reset(&PartSet::full(n));
         s
@@ -1534,6 +1557,7 @@ impl<'m> MapState<'m> {
     }
 
     fn check_free_in<const W: usize>(&mut self, i: usize) -> bool {
+        self.counters.collision_tests += 1;
         let maps = self.maps;
         let first = i * (maps.n + 1);
         let dcount = maps.hemisphere.len();
@@ -1567,6 +1591,7 @@ impl<'m> MapState<'m> {
             self.watchers[k].insert(i);
         }
         self.covers[i] = cover;
+        self.counters.blocked += 1;
         false
     }
 
@@ -1709,6 +1734,14 @@ impl<'m> MapState<'m> {
                 out.extend(candidates.iter().filter(|&a| self.removal_keeps_stable(a)))
             }
         }
+        let tested = candidates.len() as u64;
+        self.counters.gravity_tests += tested;
+        self.counters.unsupported += tested - out.len() as u64;
+    }
+
+    /// What this state has tested so far (over every [`MapState::reset`]).
+    pub fn counters(&self) -> MapCounters {
+        self.counters
     }
 
     /// The removal motion of present part `i` (see [`DistanceMaps::clearance`]) as a direction

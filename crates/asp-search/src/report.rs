@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.1";
+pub const FORMAT_VERSION: &str = "1.2";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -97,6 +97,10 @@ pub enum MotionEntry {
 /// Effort counters.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Default)]
 pub struct StatsEntry {
+    /// What the removal tests ran on: [`CHECKER_COLLISION_WORLD`] (shape casts on the meshes,
+    /// the feasibility planner) or [`CHECKER_DISTANCE_MAPS`] (the optimiser; format 1.2).
+    #[serde(default = "collision_world")]
+    pub checker: String,
     /// Removal tests run.
     pub removal_tests: u64,
     /// Tests failed by collision.
@@ -107,6 +111,15 @@ pub struct StatsEntry {
     pub path_planner_calls: u64,
     /// Wall time in seconds (the only field that differs between identical runs).
     pub seconds: f64,
+}
+
+/// `stats.checker` of plans tested on the collision world.
+pub const CHECKER_COLLISION_WORLD: &str = "collision_world";
+/// `stats.checker` of optimised plans, tested on distance maps.
+pub const CHECKER_DISTANCE_MAPS: &str = "distance_maps";
+
+fn collision_world() -> String {
+    CHECKER_COLLISION_WORLD.into()
 }
 
 /// Why one part could not leave the deepest dead-end state.
@@ -232,6 +245,7 @@ impl PlanReport {
             assembly_sequence,
             disassembly_sequence: outcome.removals.iter().map(|s| s.part).collect(),
             stats: StatsEntry {
+                checker: CHECKER_COLLISION_WORLD.into(),
                 removal_tests: c.removal_tests,
                 failed_collision: c.failed_collision,
                 failed_gravity: c.failed_gravity,

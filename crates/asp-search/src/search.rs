@@ -281,6 +281,14 @@ pub struct SearchStats {
     pub rollout_steps: u64,
     /// Rollouts that ended with parts left that could not be removed.
     pub dead_rollouts: u64,
+    /// Removability tests on the distance maps ([`asp_geom::distmap::MapCounters`], all
+    /// threads): collision tests that found a part blocked plus gravity tests of collision-free
+    /// parts. Answers carried over from an earlier state are not tested again.
+    pub removal_tests: u64,
+    /// Removal tests that found the part blocked in every direction.
+    pub failed_collision: u64,
+    /// Removal tests of collision-free parts whose removal would leave a part unsupported.
+    pub failed_gravity: u64,
     /// Tree nodes (all threads).
     pub tree_nodes: u64,
     /// Wall-clock seconds of the search.
@@ -762,8 +770,13 @@ impl<'p, V: Variant> Worker<'p, V> {
 
         // Rollout with the default policy (from a transposed child too: more evidence).
         let policy = &*self.settings.policy;
+        // a new child's feasible removals are in `actions` already
+        let mut known = new_child;
         loop {
-            self.sim.feasible_actions(&mut self.actions);
+            if !known {
+                self.sim.feasible_actions(&mut self.actions);
+            }
+            known = false;
             if self.actions.is_empty() {
                 break;
             }
@@ -897,6 +910,10 @@ impl<'p, V: Variant> Worker<'p, V> {
         }
         self.stats.tree_nodes = self.tree.nodes.len() as u64;
         self.stats.exhausted = self.root_finished();
+        let c = self.sim.counters();
+        self.stats.removal_tests = c.blocked + c.gravity_tests;
+        self.stats.failed_collision = c.blocked;
+        self.stats.failed_gravity = c.unsupported;
         if self.settings.transpositions {
             self.read_graph();
         }
@@ -1035,6 +1052,9 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Resul
         stats.iterations += s.iterations;
         stats.rollout_steps += s.rollout_steps;
         stats.dead_rollouts += s.dead_rollouts;
+        stats.removal_tests += s.removal_tests;
+        stats.failed_collision += s.failed_collision;
+        stats.failed_gravity += s.failed_gravity;
         stats.tree_nodes += s.tree_nodes;
         stats.exhausted |= s.exhausted;
         dead &= *status == Status::Dead;

@@ -62,6 +62,17 @@ fn single_objective_writes_the_best_sequence() {
     assert_eq!(opt["objectives"], serde_json::json!(["access"]));
     assert!(opt["values"][0].as_f64().unwrap() > 0.0);
     assert!(plan.get("pareto_front").is_none());
+    // the removal tests the search ran on the distance maps
+    let stats = &plan["stats"];
+    assert_eq!(stats["checker"], "distance_maps");
+    let tests = stats["removal_tests"].as_u64().unwrap();
+    let (collision, gravity) = (stats["failed_collision"].as_u64().unwrap(), stats["failed_gravity"].as_u64().unwrap());
+    // every bar slides out along its length; a bar that is the last support of a crossing
+    // bar above it may not leave
+    assert_eq!(collision, 0, "{stats}");
+    assert!(gravity > 0, "{stats}");
+    assert!(tests > collision + gravity, "{stats}");
+    assert_eq!(stats["path_planner_calls"], 0);
     // the top layer goes first in disassembly: the assembly sequence ends with a top bar
     let last = plan["assembly_sequence"][8]["name"].as_str().unwrap();
     assert!(last.starts_with("bar_2"), "{last}");

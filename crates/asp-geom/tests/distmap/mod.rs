@@ -241,15 +241,34 @@ fn incremental_state_matches_direct_definitions_on_voxel_cubes() {
         let mut actions = Vec::new();
         for (k, start) in random_states(n, if size < 6 { 12 } else { 3 }, seed).into_iter().enumerate() {
             // every other start knows its free parts (as tree nodes do)
-            if k % 2 == 0 {
+            let free_now = |s: &PartSet| PartSet::from_indices(n, s.iter().filter(|&p| maps.is_collision_free(p, s)));
+            let known = if k % 2 == 0 {
                 state.reset(&start);
+                PartSet::empty(n)
             } else {
-                let free = PartSet::from_indices(n, start.iter().filter(|&p| maps.is_collision_free(p, &start)));
-                state.reset_with_free(&start, &free);
-            }
+                state.reset_with_free(&start, &free_now(&start));
+                free_now(&start)
+            };
+            let mut first = true;
             while !state.present().is_empty() {
                 let present = state.present();
+                let before = state.counters();
                 state.feasible_actions(&mut actions);
+                // the counters: after a reset every part not known to be free is tested for
+                // collision; the stuck ones are the failures; every collision-free movable part
+                // is tested for gravity, and the ones not feasible failed it
+                let c = state.counters();
+                let free = free_now(&present);
+                let movable_free = free.iter().filter(|&p| !maps.is_fixed(p)).count() as u64;
+                if first {
+                    let untested = present.iter().filter(|&p| !known.contains(p)).count() as u64;
+                    assert_eq!(c.collision_tests - before.collision_tests, untested);
+                    assert_eq!(c.blocked - before.blocked, (present.len() - free.len()) as u64);
+                }
+                assert!(c.blocked - before.blocked <= c.collision_tests - before.collision_tests);
+                assert_eq!(c.gravity_tests - before.gravity_tests, movable_free);
+                assert_eq!(c.unsupported - before.unsupported, movable_free - actions.len() as u64);
+                first = false;
                 // feasible: not fixed, collision-free, and no standing part loses its last support
                 // (below), or every part left hangs from the floor through contacts (contact)
                 let keeps_support = |p: usize| {
