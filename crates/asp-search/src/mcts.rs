@@ -14,37 +14,15 @@
 
 use crate::error::{Result, SearchError};
 use crate::mdp::Mdp;
-use crate::search::{
-    exploration_term, run, SearchBuilder, SearchOutcome, SearchSettings, SelectContext, Tree,
-    Variant,
-};
+use crate::search::{exploration_term, run, search_type, SearchOutcome, SelectContext, Tree, Variant};
 
-/// Single-objective Monte Carlo tree search with max-backup UCT.
-#[derive(Clone, Debug)]
-pub struct Mcts {
-    settings: SearchSettings,
-}
-
-/// The builder of [`Mcts`].
-pub type MctsBuilder = SearchBuilder<Mcts>;
-
-impl From<SearchSettings> for Mcts {
-    fn from(settings: SearchSettings) -> Self {
-        Mcts { settings }
-    }
-}
+search_type!(
+    /// Single-objective Monte Carlo tree search with max-backup UCT.
+    Mcts,
+    MctsBuilder
+);
 
 impl Mcts {
-    /// A builder with the defaults (budget 5, 1000 episodes, 1 thread, seed 0, c = 1/√2).
-    pub fn builder() -> MctsBuilder {
-        SearchBuilder::default()
-    }
-
-    /// The settings.
-    pub fn settings(&self) -> &SearchSettings {
-        &self.settings
-    }
-
     /// Searches for the sequence with the largest total of the problem's single objective.
     pub fn solve(&self, problem: &Mdp) -> Result<SearchOutcome> {
         if problem.num_objectives() != 1 {

@@ -19,40 +19,18 @@
 use crate::error::Result;
 use crate::hypervolume::{hypervolume_2d_in_place, ParetoFront};
 use crate::mdp::{Mdp, MAX_OBJECTIVES};
-use crate::search::{
-    exploration_term, run, SearchBuilder, SearchOutcome, SearchSettings, SelectContext, Tree,
-    Variant,
-};
+use crate::search::{exploration_term, run, search_type, SearchOutcome, SelectContext, Tree, Variant};
 
 /// Reference coordinate of the normalised hypervolume used by MOUCB.
 const NORMALISED_REFERENCE: f64 = -0.1;
 
-/// Multi-objective Monte Carlo tree search over Pareto fronts.
-#[derive(Clone, Debug)]
-pub struct ParetoMcts {
-    settings: SearchSettings,
-}
-
-/// The builder of [`ParetoMcts`].
-pub type ParetoMctsBuilder = SearchBuilder<ParetoMcts>;
-
-impl From<SearchSettings> for ParetoMcts {
-    fn from(settings: SearchSettings) -> Self {
-        ParetoMcts { settings }
-    }
-}
+search_type!(
+    /// Multi-objective Monte Carlo tree search over Pareto fronts.
+    ParetoMcts,
+    ParetoMctsBuilder
+);
 
 impl ParetoMcts {
-    /// A builder with the defaults (budget 5, 1000 episodes, 1 thread, seed 0, c = 1/√2).
-    pub fn builder() -> ParetoMctsBuilder {
-        SearchBuilder::default()
-    }
-
-    /// The settings.
-    pub fn settings(&self) -> &SearchSettings {
-        &self.settings
-    }
-
     /// Searches for the Pareto front of the problem's objectives.
     pub fn solve(&self, problem: &Mdp) -> Result<SearchOutcome> {
         run::<FrontBackup>(problem, &self.settings)

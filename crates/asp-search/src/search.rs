@@ -232,6 +232,41 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
     }
 }
 
+/// Declares a search type that a [`SearchBuilder`] builds: the struct holding its
+/// [`SearchSettings`], the builder's alias, `builder()` and `settings()`. Each variant adds its
+/// own `solve`.
+macro_rules! search_type {
+    ($(#[$attr:meta])* $name:ident, $builder:ident) => {
+        $(#[$attr])*
+        #[derive(Clone, Debug)]
+        pub struct $name {
+            settings: $crate::search::SearchSettings,
+        }
+
+        #[doc = concat!("The builder of [`", stringify!($name), "`].")]
+        pub type $builder = $crate::search::SearchBuilder<$name>;
+
+        impl From<$crate::search::SearchSettings> for $name {
+            fn from(settings: $crate::search::SearchSettings) -> Self {
+                $name { settings }
+            }
+        }
+
+        impl $name {
+            /// A builder with the defaults (budget 5, 1000 episodes, 1 thread, seed 0, c = 1/√2).
+            pub fn builder() -> $builder {
+                $crate::search::SearchBuilder::default()
+            }
+
+            /// The settings.
+            pub fn settings(&self) -> &$crate::search::SearchSettings {
+                &self.settings
+            }
+        }
+    };
+}
+pub(crate) use search_type;
+
 /// How a search ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
