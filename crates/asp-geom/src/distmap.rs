@@ -1814,20 +1814,15 @@ impl FeasibilityChecker for MapChecker {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::{Part, Units};
+    use crate::assembly::Part;
+    use crate::fixtures;
 
     fn part(name: &str, mesh: Mesh) -> Part {
-        Part { name: name.into(), mesh, fixed: false, extras: serde_json::Value::Null }
+        fixtures::part(name, mesh, false)
     }
 
     fn assembly(parts: Vec<Part>) -> Assembly {
-        Assembly {
-            parts,
-            units: Units::metres(),
-            up: Axis::Z,
-            source: "test".into(),
-            warnings: Vec::new(),
-        }
+        fixtures::assemble("test", parts, Axis::Z)
     }
 
     #[test]

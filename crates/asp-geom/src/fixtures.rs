@@ -5,18 +5,34 @@ use crate::assembly::{Assembly, Part, Units};
 use crate::math::{Axis, Vec3};
 use crate::mesh::Mesh;
 
-fn part(name: &str, mesh: Mesh, fixed: bool) -> Part {
+/// A part with no metadata.
+pub fn part(name: &str, mesh: Mesh, fixed: bool) -> Part {
     Part { name: name.into(), mesh, fixed, extras: serde_json::Value::Null }
 }
 
-fn assembly(name: &str, parts: Vec<Part>) -> Assembly {
-    Assembly {
-        parts,
-        units: Units::metres(),
-        up: Axis::Z,
-        source: format!("fixture:{name}").into(),
-        warnings: Vec::new(),
+/// A movable axis-aligned box from `mins` to `maxs`.
+pub fn box_part(name: &str, mins: [f32; 3], maxs: [f32; 3]) -> Part {
+    part(name, cuboid(mins, maxs), false)
+}
+
+/// A movable part made of the unit voxels `cells` scaled by `cell` (metres), carrying them in
+/// its metadata (`extras.asp.voxels`) so distance maps sweep them exactly.
+pub fn voxel_part(name: &str, cells: &[[i32; 3]], cell: f32) -> Part {
+    Part {
+        name: name.into(),
+        mesh: Mesh::from_voxels(cells, Vec3::splat(cell), Vec3::ZERO),
+        fixed: false,
+        extras: serde_json::json!({ "asp": { "voxels": cells } }),
     }
+}
+
+/// An assembly in metres with `up` as the up axis; its source reads `fixture:{name}`.
+pub fn assemble(name: &str, parts: Vec<Part>, up: Axis) -> Assembly {
+    Assembly { parts, units: Units::metres(), up, source: format!("fixture:{name}").into(), warnings: Vec::new() }
+}
+
+fn assembly(name: &str, parts: Vec<Part>) -> Assembly {
+    assemble(name, parts, Axis::Z)
 }
 
 fn cuboid(mins: [f32; 3], maxs: [f32; 3]) -> Mesh {
@@ -25,6 +41,28 @@ fn cuboid(mins: [f32; 3], maxs: [f32; 3]) -> Mesh {
 
 fn voxels(cells: &[[i32; 3]]) -> Mesh {
     Mesh::from_voxels(cells, Vec3::ONE, Vec3::ZERO)
+}
+
+/// The thesis' figure 6.2 in voxels of `cell` metres, on the floor: a base cup (part 0), a top
+/// part inside it that only leaves upward (part 1), and a ball in a side notch under an
+/// overhang that only leaves along +x (part 2).
+pub fn figure_6_2(cell: f32) -> Assembly {
+    let mut base = Vec::new();
+    for x in 0..3 {
+        for y in 0..3 {
+            base.push([x, y, 0]);
+        }
+    }
+    base.extend([[0, 0, 1], [1, 0, 1], [2, 0, 1], [0, 1, 1], [0, 2, 1], [1, 2, 1], [2, 2, 1]]);
+    base.extend([[2, 0, 2], [2, 1, 2], [2, 2, 2]]);
+    assembly(
+        "figure_6_2",
+        vec![
+            voxel_part("base", &base, cell),
+            voxel_part("top", &[[1, 1, 1]], cell),
+            voxel_part("ball", &[[2, 1, 1]], cell),
+        ],
+    )
 }
 
 /// A fixed base slab with two unit boxes stacked on it, same footprint. The top box leaves up or

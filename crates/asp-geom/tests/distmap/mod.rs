@@ -2,30 +2,13 @@
 //! gravity check, the incremental state against the direct definitions.
 
 use asp_geom::distmap::{DistanceMaps, MapChecker, MapConfig, MapState, PartGeometry};
+use asp_geom::fixtures::{self, box_part, voxel_part};
 use asp_geom::math::{Axis, Vec3};
-use asp_geom::{Assembly, FeasibilityChecker, Mesh, MotionKind, Outcome, Part, PartSet, Stability, Units};
+use asp_geom::{Assembly, FeasibilityChecker, MotionKind, Outcome, Part, PartSet, Stability};
 use std::sync::Arc;
 
-fn boxed(name: &str, lo: [f32; 3], hi: [f32; 3]) -> Part {
-    Part {
-        name: name.into(),
-        mesh: Mesh::cuboid(Vec3::from(lo), Vec3::from(hi)),
-        fixed: false,
-        extras: serde_json::Value::Null,
-    }
-}
-
-fn voxels(name: &str, cells: &[[i32; 3]], cell: f32) -> Part {
-    Part {
-        name: name.into(),
-        mesh: Mesh::from_voxels(cells, Vec3::splat(cell), Vec3::ZERO),
-        fixed: false,
-        extras: serde_json::json!({ "asp": { "voxels": cells } }),
-    }
-}
-
 fn assembly(parts: Vec<Part>, up: Axis) -> Assembly {
-    Assembly { parts, units: Units::metres(), up, source: "fixture".into(), warnings: Vec::new() }
+    fixtures::assemble("distmap", parts, up)
 }
 
 fn config(n: usize) -> MapConfig {
@@ -40,32 +23,11 @@ fn dir(maps: &DistanceMaps, v: Vec3) -> usize {
     i
 }
 
-/// The thesis' figure 6.2 in voxels: a base cup, a top part inside it that only leaves upward,
-/// and a ball in a side notch under an overhang that only leaves along +x.
-pub fn figure_6_2(cell: f32) -> Assembly {
-    let mut base = Vec::new();
-    for x in 0..3 {
-        for y in 0..3 {
-            base.push([x, y, 0]);
-        }
-    }
-    base.extend([[0, 0, 1], [1, 0, 1], [2, 0, 1], [0, 1, 1], [0, 2, 1], [1, 2, 1], [2, 2, 1]]);
-    base.extend([[2, 0, 2], [2, 1, 2], [2, 2, 2]]);
-    assembly(
-        vec![
-            voxels("base", &base, cell),
-            voxels("top", &[[1, 1, 1]], cell),
-            voxels("ball", &[[2, 1, 1]], cell),
-        ],
-        Axis::Z,
-    )
-}
-
 #[test]
 fn two_boxes_with_a_gap() {
     // A at the origin, B one unit further along +x: A reaches B after 1 along +x, passes B's
     // corner exactly along the diagonal, never meets it upward.
-    let a = assembly(vec![boxed("a", [0.0; 3], [1.0; 3]), boxed("b", [2.0, 0.0, 0.0], [3.0, 1.0, 1.0])], Axis::Z);
+    let a = assembly(vec![box_part("a", [0.0; 3], [1.0; 3]), box_part("b", [2.0, 0.0, 0.0], [3.0, 1.0, 1.0])], Axis::Z);
     let maps = DistanceMaps::build(&a, &config(5)).unwrap();
     assert_eq!(maps.geometry(0), PartGeometry::Box);
     let d_max = maps.d_max();
@@ -92,9 +54,9 @@ fn floor_map_of_a_raised_box() {
     // a bridge: two pillars and a slab on them, 2 above the floor
     let a = assembly(
         vec![
-            boxed("left", [0.0, 0.0, 0.0], [1.0, 1.0, 2.0]),
-            boxed("right", [2.0, 0.0, 0.0], [3.0, 1.0, 2.0]),
-            boxed("slab", [0.0, 0.0, 2.0], [3.0, 1.0, 3.0]),
+            box_part("left", [0.0, 0.0, 0.0], [1.0, 1.0, 2.0]),
+            box_part("right", [2.0, 0.0, 0.0], [3.0, 1.0, 2.0]),
+            box_part("slab", [0.0, 0.0, 2.0], [3.0, 1.0, 3.0]),
         ],
         Axis::Z,
     );
@@ -125,7 +87,7 @@ fn floor_map_of_a_raised_box() {
 #[test]
 fn figure_6_2_voxel_maps_by_hand() {
     for cell in [1.0, 0.01] {
-        let a = figure_6_2(cell);
+        let a = fixtures::figure_6_2(cell);
         let maps = DistanceMaps::build(&a, &config(3)).unwrap();
         assert_eq!(maps.geometry(0), PartGeometry::Voxels);
         let d_max = maps.d_max();
@@ -171,7 +133,7 @@ fn figure_6_2_voxel_maps_by_hand() {
 
 #[test]
 fn ball_leaves_along_x_and_clears_after_one_cell() {
-    let maps = DistanceMaps::build(&figure_6_2(1.0), &config(3)).unwrap();
+    let maps = DistanceMaps::build(&fixtures::figure_6_2(1.0), &config(3)).unwrap();
     let checker = MapChecker::new(Arc::new(maps));
     let outcome = checker.test_removal(2, &PartSet::from_indices(3, [0, 1, 2]), MotionKind::Linear);
     match outcome {
@@ -195,7 +157,7 @@ fn incremental_state_matches_direct_definitions() {
         vec![[1, 0, 1], [2, 0, 1], [2, 1, 1]],
         vec![[1, 1, 1], [1, 2, 1], [2, 2, 1]],
     ];
-    let parts = cells.iter().enumerate().map(|(i, c)| voxels(&format!("p{i}"), c, 1.0)).collect();
+    let parts = cells.iter().enumerate().map(|(i, c)| voxel_part(&format!("p{i}"), c, 1.0)).collect();
     let maps = DistanceMaps::build(&assembly(parts, Axis::Z), &MapConfig::default()).unwrap();
     let mut state = MapState::new(&maps);
     let mut actions = Vec::new();
@@ -304,7 +266,7 @@ fn incremental_state_matches_direct_definitions_on_voxel_cubes() {
 #[test]
 fn y_up_assemblies_use_y_as_gravity() {
     // the same stack of two boxes, modelled with +y up
-    let a = assembly(vec![boxed("bottom", [0.0; 3], [1.0; 3]), boxed("top", [0.0, 1.0, 0.0], [1.0, 2.0, 1.0])], Axis::Y);
+    let a = assembly(vec![box_part("bottom", [0.0; 3], [1.0; 3]), box_part("top", [0.0, 1.0, 0.0], [1.0, 2.0, 1.0])], Axis::Y);
     let maps = DistanceMaps::build(&a, &config(3)).unwrap();
     assert_eq!(maps.hemisphere().directions()[maps.hemisphere().up_index()], Vec3::Y);
     assert_eq!(maps.supporters(1), &[0]);
@@ -356,7 +318,7 @@ fn voxel_cube(size: i32, seed: u64) -> Assembly {
             owner[idx(n)] = id;
             cells.push(n);
         }
-        parts.push(voxels(&format!("p{id}"), &cells, 1.0));
+        parts.push(voxel_part(&format!("p{id}"), &cells, 1.0));
     }
     assembly(parts, Axis::Z)
 }
