@@ -6,6 +6,7 @@
 //! cargo run --release -p asp-search --example optimise_figures -- speed 5 400      # 5×5×5, 400 episodes
 //! cargo run --release -p asp-search --example optimise_figures -- hv 6 1,10,60     # HV after 1, 10, 60 s
 //! cargo run --release -p asp-search --example optimise_figures -- exact 3 20       # 20 3×3×3 cubes
+//! cargo run --release -p asp-search --example optimise_figures -- small            # classic, profiles
 //! cargo run --release -p asp-search --example optimise_figures -- maps             # map build times
 //! ```
 
@@ -87,42 +88,19 @@ fn main() {
         "exact" => {
             let size: usize = arg(1, "3").parse().expect("size");
             let count: u64 = arg(2, "20").parse().expect("count");
-            let (mut sum, mut min, mut runs) = (0.0, f64::INFINITY, 0);
-            for seed in 0..count {
-                let cube = soma_cube(size, seed);
-                let (mdp, _) = mdp(&cube);
-                let t = Instant::now();
-                let Ok(exact) = exact_front(&mdp, 5_000_000) else {
-                    println!("  cube {seed}: too large for the exact front");
-                    continue;
-                };
-                let exact_seconds = t.elapsed().as_secs_f64();
-                if exact.solutions.is_empty() {
-                    continue;
-                }
-                let reference: Vec<f64> = exact.worst.iter().map(|w| w - 1e-3 * w.abs().max(1.0)).collect();
-                let out = ParetoMcts::builder()
-                    .seed(seed)
-                    .reference(reference.clone())
-                    .build()
-                    .expect("settings")
-                    .solve(&mdp)
-                    .expect("search");
-                let fraction = out.value / exact.hypervolume(&reference);
-                println!(
-                    "  cube {seed}: {} parts, exact front {} points from {} states in {exact_seconds:.2} s; Pareto-MCTS {} points, HV fraction {fraction:.4}, {} episodes{}",
-                    cube.len(),
-                    exact.solutions.len(),
-                    exact.states,
-                    out.solutions.len(),
-                    out.stats.episodes,
-                    if out.stats.exhausted { " (exhausted)" } else { "" }
-                );
-                sum += fraction;
-                min = min.min(fraction);
-                runs += 1;
+            let fractions: Vec<f64> = (0..count)
+                .filter_map(|seed| exact_fraction(&format!("cube {seed}"), &soma_cube(size, seed), seed))
+                .collect();
+            summary(&fractions);
+        }
+        "small" => {
+            let mut instances = vec![("classic Soma cube".to_string(), asp_gen::SomaCube::classic().to_assembly(0.05, "classic"))];
+            for (supports, seed) in [(1, 0), (2, 1)] {
+                instances.push((format!("profiles, {supports} supports, seed {seed}"), small_profiles(supports, seed)));
             }
-            println!("mean HV fraction {:.4}, minimum {min:.4} over {runs} cubes", sum / runs as f64);
+            let fractions: Vec<f64> =
+                instances.iter().filter_map(|(name, a)| exact_fraction(name, a, 0)).collect();
+            summary(&fractions);
         }
         "maps" => {
             let double = asp_gen::ProfileAssembly::generate(&asp_gen::ProfileParams::double_layer(), 1)
@@ -141,6 +119,60 @@ fn main() {
                 println!("{name}: {} parts ({removable} removable), all distance maps in {best:.3} s (best of 5)", a.len());
             }
         }
-        other => eprintln!("unknown mode '{other}' (speed, hv, exact, maps)"),
+        other => eprintln!("unknown mode '{other}' (speed, hv, exact, small, maps)"),
     }
+}
+
+/// A small aluminium profile assembly (thesis 4.1): the base cuboid with `supports` support
+/// profiles and no layers, its connectors fixed to the frame: 6 + 2 × `supports` removable
+/// profiles.
+fn small_profiles(supports: usize, seed: u64) -> Assembly {
+    let params = asp_gen::ProfileParams { layers: 0, supports, ..asp_gen::ProfileParams::single_layer() };
+    let mut a = asp_gen::ProfileAssembly::generate(&params, seed).expect("profiles").to_assembly("profiles");
+    for p in a.parts.iter_mut().filter(|p| p.name.contains("connector")) {
+        p.fixed = true;
+    }
+    a
+}
+
+/// Pareto-MCTS with the default budget (1000 episodes, 1 thread, `seed`) against the exact
+/// front: the fraction of its hypervolume reached, with the tight reference point just below
+/// the worst total of each objective over all feasible sequences. `None` when the exact front
+/// is out of reach or there is no sequence.
+fn exact_fraction(name: &str, assembly: &Assembly, seed: u64) -> Option<f64> {
+    let (mdp, _) = mdp(assembly);
+    let t = Instant::now();
+    let Ok(exact) = exact_front(&mdp, 5_000_000) else {
+        println!("  {name}: too large for the exact front");
+        return None;
+    };
+    let exact_seconds = t.elapsed().as_secs_f64();
+    if exact.solutions.is_empty() {
+        return None;
+    }
+    let reference: Vec<f64> = exact.worst.iter().map(|w| w - 1e-3 * w.abs().max(1.0)).collect();
+    let out = ParetoMcts::builder()
+        .seed(seed)
+        .reference(reference.clone())
+        .build()
+        .expect("settings")
+        .solve(&mdp)
+        .expect("search");
+    let fraction = out.value / exact.hypervolume(&reference);
+    println!(
+        "  {name}: {} parts, exact front {} points from {} states in {exact_seconds:.2} s; Pareto-MCTS {} points, HV fraction {fraction:.4}, {} episodes{}",
+        assembly.len(),
+        exact.solutions.len(),
+        exact.states,
+        out.solutions.len(),
+        out.stats.episodes,
+        if out.stats.exhausted { " (exhausted)" } else { "" }
+    );
+    Some(fraction)
+}
+
+fn summary(fractions: &[f64]) {
+    let mean = fractions.iter().sum::<f64>() / fractions.len() as f64;
+    let min = fractions.iter().copied().fold(f64::INFINITY, f64::min);
+    println!("mean HV fraction {mean:.4}, minimum {min:.4} over {} instances", fractions.len());
 }
