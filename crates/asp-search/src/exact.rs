@@ -62,9 +62,11 @@ struct Dp<'p> {
     memo: HashMap<Key, usize>,
     entries: Vec<Entry>,
     max_states: usize,
+    /// Map states to reuse (one per level of the recursion in use).
+    spare: Vec<MapState<'p>>,
 }
 
-impl Dp<'_> {
+impl<'p> Dp<'p> {
     fn solve(&mut self, present: &PartSet, memories: &[Memory]) -> Result<usize> {
         let key = (present.clone(), memories.to_vec());
         if let Some(&e) = self.memo.get(&key) {
@@ -76,8 +78,8 @@ impl Dp<'_> {
             });
         }
         let m = self.problem.num_objectives();
-        let maps = self.problem.maps();
-        let mut sim = MapState::new(maps);
+        let problem = self.problem;
+        let mut sim = self.spare.pop().unwrap_or_else(|| MapState::new(problem.maps()));
         sim.reset(present);
         let mut front: ParetoFront<(usize, usize, usize)> = ParetoFront::new(m);
         let mut worst = vec![f64::INFINITY; m];
@@ -111,6 +113,7 @@ impl Dp<'_> {
                 }
             }
         }
+        self.spare.push(sim);
         let id = self.entries.len();
         self.entries.push(Entry { front, worst });
         self.memo.insert(key, id);
@@ -135,7 +138,7 @@ impl Dp<'_> {
 /// visiting at most `max_states` states.
 pub fn exact_front(problem: &Mdp, max_states: usize) -> Result<ExactFront> {
     let maps = problem.maps();
-    let mut dp = Dp { problem, memo: HashMap::new(), entries: Vec::new(), max_states };
+    let mut dp = Dp { problem, memo: HashMap::new(), entries: Vec::new(), max_states, spare: Vec::new() };
     let m = problem.num_objectives();
     let root = dp.solve(&PartSet::full(maps.num_parts()), &vec![Memory::default(); m])?;
     let e = &dp.entries[root];
