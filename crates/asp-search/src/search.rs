@@ -384,17 +384,25 @@ pub(crate) enum Status {
 
 /// A disassembly state: the parts present and the objectives' memories (kept in
 /// [`Tree::memory`]). With transpositions every state has one node however it was reached.
+/// What selection reads is here (16 bytes); the node's part sets are in [`Tree::sets`].
 #[derive(Clone, Debug)]
 pub(crate) struct Node {
     pub first_edge: u32,
     pub visits: u32,
-    pub status: Status,
     /// The next node with the same key hash (transposition index chain).
     next_same: u32,
-    pub present: PartSet,
+    /// Removals not expanded yet (the size of [`NodeSets::untried`]).
+    untried_left: u16,
+    pub status: Status,
+}
+
+/// The part sets of a node, read when the search expands it.
+#[derive(Clone, Debug)]
+pub(crate) struct NodeSets {
+    present: PartSet,
     /// Parts known to be collision-free here (they stay so in every descendant).
-    pub free: PartSet,
-    pub untried: PartSet,
+    free: PartSet,
+    untried: PartSet,
 }
 
 /// A removal from a node: the child it leads to, its rewards (in [`Tree::rewards`]) and visits.
@@ -410,6 +418,7 @@ pub(crate) struct Edge {
 /// returns from the node's state to the end, which do not depend on how the state was reached.
 pub(crate) struct Tree<V> {
     pub nodes: Vec<Node>,
+    sets: Vec<NodeSets>,
     pub values: Vec<V>,
     pub edges: Vec<Edge>,
     rewards: Vec<f64>,
@@ -435,7 +444,7 @@ impl<V> Tree<V> {
 
     /// Whether node `n` holds `present` and `memory`.
     fn is(&self, n: u32, present: &PartSet, memory: &[Memory]) -> bool {
-        self.nodes[n as usize].present == *present && self.memory(n) == memory
+        self.sets[n as usize].present == *present && self.memory(n) == memory
     }
 }
 
@@ -575,12 +584,16 @@ impl<'p, V: Variant> Worker<'p, V> {
                 Status::Open
             },
             next_same: NONE,
+            untried_left: actions.len() as u16,
+        };
+        let root_sets = NodeSets {
             present: full,
             free: sim.collision_free(),
             untried: PartSet::from_indices(n, actions.iter().copied()),
         };
         let mut tree = Tree {
             nodes: vec![root],
+            sets: vec![root_sets],
             values: vec![V::Value::default()],
             edges: Vec::new(),
             rewards: Vec::new(),
@@ -589,7 +602,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             m,
         };
         if settings.transpositions {
-            tree.index.insert(state_hash(&tree.nodes[0].present, tree.memory(0)), 0);
+            tree.index.insert(state_hash(&tree.sets[0].present, tree.memory(0)), 0);
         }
         Worker {
             problem,
@@ -701,7 +714,7 @@ impl<'p, V: Variant> Worker<'p, V> {
                 self.truncate(base);
                 return;
             }
-            if !nd.untried.is_empty() {
+            if nd.untried_left != 0 {
                 break;
             }
             self.candidates.clear();
@@ -725,13 +738,13 @@ impl<'p, V: Variant> Worker<'p, V> {
 
         // Expansion: a random untried removal.
         let parent = *self.path.last().expect("path");
-        let pn = &self.tree.nodes[parent as usize];
-        self.sim.reset_with_free(&pn.present, &pn.free);
+        let ps = &self.tree.sets[parent as usize];
+        self.sim.reset_with_free(&ps.present, &ps.free);
         let mut memories = [Memory::default(); MAX_OBJECTIVES];
         memories[..m].copy_from_slice(self.tree.memory(parent));
         let mut ret = [0.0f64; MAX_OBJECTIVES];
         ret[..m].copy_from_slice(&self.path_prefix[self.path_prefix.len() - m..]);
-        let untried = &self.tree.nodes[parent as usize].untried;
+        let untried = &self.tree.sets[parent as usize].untried;
         let pick = self.rng.random_range(0..untried.len());
         let action = untried.iter().nth(pick).expect("pick < len");
         let mut rewards = [0.0f64; MAX_OBJECTIVES];
@@ -756,7 +769,8 @@ impl<'p, V: Variant> Worker<'p, V> {
         let expanded = existing != NONE || self.tree.nodes.len() < self.settings.max_nodes;
         let mut new_child = false;
         if expanded {
-            self.tree.nodes[parent as usize].untried.remove(action);
+            self.tree.sets[parent as usize].untried.remove(action);
+            self.tree.nodes[parent as usize].untried_left -= 1;
             let child = if existing != NONE {
                 existing
             } else {
@@ -780,6 +794,9 @@ impl<'p, V: Variant> Worker<'p, V> {
                     visits: 0,
                     status,
                     next_same,
+                    untried_left: self.actions.len() as u16,
+                });
+                self.tree.sets.push(NodeSets {
                     present,
                     free: self.sim.collision_free(),
                     untried: PartSet::from_indices(self.n, self.actions.iter().copied()),
@@ -864,7 +881,7 @@ impl<'p, V: Variant> Worker<'p, V> {
         }
         let leaf = *self.path.last().expect("path");
         if new_child && self.tree.nodes[leaf as usize].status != Status::Open
-            || self.tree.nodes[parent as usize].untried.is_empty()
+            || self.tree.nodes[parent as usize].untried_left == 0
         {
             self.refresh_path_status();
         }
@@ -880,7 +897,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             if nd.first_edge == NONE {
                 continue; // a leaf: its status is its own
             }
-            if !nd.untried.is_empty() {
+            if nd.untried_left != 0 {
                 return; // open, and so are its ancestors
             }
             let (mut open, mut solved) = (false, false);
