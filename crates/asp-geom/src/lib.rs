@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 pub mod assembly;
+pub mod boxes;
 pub mod checker;
 pub mod distmap;
 pub mod erode;

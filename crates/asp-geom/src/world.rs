@@ -9,7 +9,8 @@
 //! later removal test of that part is a few bitset operations.
 
 use crate::assembly::Assembly;
-use crate::erode::eroded_vertices;
+use crate::boxes;
+use crate::erode::eroded_mesh;
 use crate::error::{GeomError, Result};
 use crate::feasibility::{Motion, Stability};
 use crate::math::{aabb_of, sweep_overlap, Aabb, Pose, Vec3};
@@ -44,6 +45,10 @@ pub struct WorldConfig {
     /// Ignore collisions between parts that overlap beyond `max_overlap_fraction` (warned)
     /// instead of failing. Default false.
     pub ignore_overlapping: bool,
+    /// Test pairs of parts that are known unions of boxes (voxels or boxes in their extras, or a
+    /// box-shaped mesh; see [`crate::boxes`]) exactly on their boxes. Default true; false tests
+    /// every pair on the meshes.
+    pub exact_boxes: bool,
 }
 
 impl Default for WorldConfig {
@@ -56,6 +61,7 @@ impl Default for WorldConfig {
             sphere_directions: 0,
             max_overlap_fraction: 0.4,
             ignore_overlapping: false,
+            exact_boxes: true,
         }
     }
 }
@@ -67,6 +73,9 @@ struct Geom {
     /// Eroded copies keyed by the erosion amount's bits.
     eroded: Mutex<BTreeMap<u32, Arc<TriMesh>>>,
     closed: bool,
+    /// The part's exact boxes when it is a known union of boxes ([`crate::boxes`]): pairs of
+    /// such parts are tested exactly on them instead of on the meshes.
+    boxes: Option<Vec<Aabb>>,
 }
 
 impl Geom {
@@ -80,7 +89,8 @@ impl Geom {
         let aabb = m.aabb().ok_or_else(|| GeomError::config("empty mesh"))?;
         let mesh = TriMesh::with_flags(m.vertices, m.triangles, TriMeshFlags::ORIENTED)
             .map_err(|e| GeomError::config(format!("cannot build a collision mesh: {e}")))?;
-        Ok((Geom { mesh: Arc::new(mesh), aabb, eroded: Mutex::new(BTreeMap::new()), closed }, topology))
+        let geom = Geom { mesh: Arc::new(mesh), aabb, eroded: Mutex::new(BTreeMap::new()), closed, boxes: None };
+        Ok((geom, topology))
     }
 
     fn eroded(&self, amount: f32) -> Arc<TriMesh> {
@@ -89,8 +99,8 @@ impl Geom {
     }
 
     fn erode(&self, amount: f32) -> TriMesh {
-        let v = eroded_vertices(self.mesh.vertices(), self.mesh.indices(), amount);
-        TriMesh::with_flags(v, self.mesh.indices().to_vec(), TriMeshFlags::ORIENTED)
+        let (v, t) = eroded_mesh(self.mesh.vertices(), self.mesh.indices(), amount);
+        TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED)
             .unwrap_or_else(|_| (*self.mesh).clone())
     }
 
@@ -138,10 +148,17 @@ impl World {
         let mut warnings = assembly.warnings.clone();
         let mut geoms = Vec::with_capacity(assembly.len() + 1);
         for p in &assembly.parts {
-            let (g, t) = Geom::new(&p.mesh).map_err(|e| GeomError::Assembly {
+            let (mut g, t) = Geom::new(&p.mesh).map_err(|e| GeomError::Assembly {
                 path: assembly.source.clone(),
                 reason: format!("part '{}': {e}", p.name),
             })?;
+            g.boxes = match boxes::part_boxes(p).map(|b| b.filter(|_| config.exact_boxes)) {
+                Ok(b) => b,
+                Err(e) => {
+                    warnings.push(format!("part '{}': {e}; its tests use the mesh", p.name));
+                    None
+                }
+            };
             if !t.is_closed_manifold() {
                 warnings.push(format!(
                     "part '{}': mesh is not closed and manifold ({} open, {} non-manifold, {} misoriented edges); its removal tests may be conservative",
@@ -154,7 +171,8 @@ impl World {
         let mut fixed = PartSet::from_indices(n + 1, assembly.parts.iter().enumerate().filter(|(_, p)| p.fixed).map(|(i, _)| i));
         let ground = if fixed.is_empty() {
             let bb = assembly.aabb().expect("validated assembly has vertices");
-            let (g, _) = Geom::new(&ground_box(&bb, assembly.up.vector(), diag))?;
+            let (mut g, _) = Geom::new(&ground_box(&bb, assembly.up.vector(), diag))?;
+            g.boxes = config.exact_boxes.then(|| vec![g.aabb]);
             geoms.push(g);
             fixed.insert(n);
             Some(n)
@@ -200,6 +218,15 @@ impl World {
         let found: Vec<Found> = pairs
             .par_iter()
             .map(|&(i, j)| {
+                if let (Some(bi), Some(bj)) = (&self.geoms[i].boxes, &self.geoms[j].boxes) {
+                    // exact: how deep the boxes overlap, and how close they come
+                    let pairs = || bi.iter().flat_map(|a| bj.iter().map(move |b| (a, b)));
+                    let depth = pairs().map(|(a, b)| boxes::overlap_depth(a, b)).fold(f32::NEG_INFINITY, f32::max);
+                    let gap = pairs().map(|(a, b)| boxes::box_distance(a, b, Vec3::ONE)).fold(f32::INFINITY, f32::min);
+                    let extra = (depth - self.tolerance).max(0.0);
+                    let within = |k: usize| (extra <= limit_of(k)).then_some(extra);
+                    return (i, j, gap <= self.contact_distance, within(i), within(j));
+                }
                 let (a, b) = (&*self.geoms[i].mesh, &*self.geoms[j].mesh);
                 let id = Pose::IDENTITY;
                 // parry's mesh-mesh closest points can miss an overlap: measure every candidate
@@ -410,6 +437,11 @@ impl World {
         let Some((_, t1)) = sweep_overlap(&self.geoms[p].aabb, dir, &self.geoms[q].aabb) else {
             return false;
         };
+        if let (Some(bp), Some(bq)) = (&self.geoms[p].boxes, &self.geoms[q].boxes) {
+            // exact on the boxes, each of `p`'s shrunk by the pair's erosion
+            let (_, amount) = self.pair_erosion(p, q);
+            return bp.iter().any(|a| bq.iter().any(|b| boxes::first_overlap(a, dir, b, amount).is_some()));
+        }
         let (moving, fixed) = self.pair_shapes(p, q);
         let options = ShapeCastOptions {
             max_time_of_impact: t1,

@@ -49,22 +49,25 @@ fn beam_plans_caps_then_posts_then_the_beam() {
 
 #[test]
 fn ikea_models_plan_and_every_step_rechecks() {
-    for name in ["bookcase_billy_0191", "bookcase_grevback_0484", "cabinet_akurum_0011", "chair_bertil_0148", "desk_hannes_0529", "table_lack_0825"] {
+    // hemnes' notched rails (6_part6, 2_part2) once measured as a gross overlap: the erosion left
+    // every vertex of a lone ±x face unmoved (a wrong eigen decomposition); they only touch
+    for name in [
+        "bookcase_billy_0191",
+        "bookcase_grevback_0484",
+        "cabinet_akurum_0011",
+        "chair_bertil_0148",
+        "desk_hannes_0529",
+        "table_hemnes_0541",
+        "table_lack_0825",
+    ] {
         found_and_verified(&format!("ikea/{name}.glb"), false);
     }
-    // hemnes has a gross overlap between two parts: with --ignore-overlapping it plans
-    found_and_verified("ikea/table_hemnes_0541.glb", true);
 }
 
 #[test]
 fn gross_overlaps_are_errors_naming_both_parts() {
-    for (name, a, b) in [
-        ("ikea/table_hemnes_0541.glb", "'6_part6'", "'2_part2'"),
-        ("ikea/bed_dalselv_0270.glb", "'0_part0'", "'1_part1'"),
-    ] {
-        let err = world(name, None, false).err().expect("gross overlap is an error").to_string();
-        assert!(err.contains(a) && err.contains(b) && err.contains("--ignore-overlapping"), "{err}");
-    }
+    let err = world("ikea/bed_dalselv_0270.glb", None, false).err().expect("gross overlap is an error").to_string();
+    assert!(err.contains("'0_part0'") && err.contains("'1_part1'") && err.contains("--ignore-overlapping"), "{err}");
 }
 
 #[test]

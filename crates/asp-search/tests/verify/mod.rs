@@ -2,7 +2,7 @@
 //! intersection tests of the part shrunk by the same tolerance — not the planner's shape casts,
 //! caches or blocking rows.
 
-use asp_geom::erode::eroded_vertices;
+use asp_geom::erode::eroded_mesh;
 use asp_geom::feasibility::interpolate_about;
 use asp_geom::math::{Pose, Vec3};
 use asp_geom::{Motion, PartSet, Stability, World};
@@ -13,8 +13,8 @@ use std::collections::HashMap;
 
 fn shrunk(world: &World, p: usize, amount: f32) -> TriMesh {
     let m = world.mesh(p);
-    let v = eroded_vertices(m.vertices(), m.indices(), amount);
-    TriMesh::with_flags(v, m.indices().to_vec(), TriMeshFlags::ORIENTED).unwrap()
+    let (v, t) = eroded_mesh(m.vertices(), m.indices(), amount);
+    TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED).unwrap()
 }
 
 /// Whether part `p` at `pose` penetrates a present part (other than itself) deeper than the
