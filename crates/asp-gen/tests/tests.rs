@@ -575,18 +575,53 @@ fn a_batch_of_fifty_5x5x5_cubes_plans_to_completion() {
 }
 
 #[test]
-fn soma_cubes_also_plan_on_their_meshes_alone() {
-    // the tolerant mesh test (erosion, shape casts) must agree with the exact voxels on the two
-    // cubes whose saddle vertices once broke it (a false gross overlap; a false no_plan)
+fn generated_assemblies_also_plan_on_their_meshes_alone() {
+    // the tolerant mesh test (erosion, triangle sweeps) must not need the exact boxes: the two
+    // cubes whose saddle vertices once broke it (a false gross overlap; a false no_plan), the
+    // classic cube, and profile assemblies with zero-clearance connectors
     let meshes = WorldConfig { exact_boxes: false, ..WorldConfig::default() };
     let dir = tempfile::tempdir().unwrap();
     write(Generator::Soma(SomaParams { size: 5, cell: 0.05 }), 50, 0, dir.path());
     write(Generator::ClassicSoma { cell: 0.05 }, 1, 0, dir.path());
-    let failures: Vec<String> = ["soma5_018.glb", "soma5_036.glb", "soma_classic.glb"]
-        .iter()
-        .filter_map(|f| plans_to_completion_with(&dir.path().join(f), &meshes).err())
-        .collect();
+    let mut files: Vec<std::path::PathBuf> =
+        ["soma5_018.glb", "soma5_036.glb", "soma_classic.glb"].iter().map(|f| dir.path().join(f)).collect();
+    let profiles = write(Generator::Profiles(ProfileParams::single_layer()), 2, 0, &dir.path().join("p"));
+    files.extend(profiles.assemblies.iter().map(|e| dir.path().join("p").join(&e.file)));
+    let failures: Vec<String> = files.iter().filter_map(|f| plans_to_completion_with(f, &meshes).err()).collect();
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn mesh_and_box_removal_tests_agree_on_generated_assemblies_at_any_scale() {
+    // the exact triangle sweeps of the mesh path against the exact boxes: every (part,
+    // direction) blocking set equal, on the profiles' zero-clearance connectors and on voxels
+    let dir = tempfile::tempdir().unwrap();
+    let mut files = Vec::new();
+    for (generator, count) in [
+        (Generator::Profiles(ProfileParams::single_layer()), 1),
+        (Generator::Profiles(ProfileParams::double_layer()), 1),
+        (Generator::Soma(SomaParams { size: 5, cell: 0.05 }), 1),
+    ] {
+        let sub = dir.path().join(files.len().to_string());
+        let manifest = write(generator, count, 0, &sub);
+        files.extend(manifest.assemblies.iter().map(|e| sub.join(&e.file)));
+    }
+    for file in &files {
+        for scale in [0.1f32, 1.0, 3.0, 100.0] {
+            let mut assembly = asp_geom::io::load(file, &Default::default()).unwrap();
+            for p in &mut assembly.parts {
+                p.mesh.vertices.iter_mut().for_each(|v| *v *= scale);
+            }
+            let exact = World::new(assembly.clone(), &WorldConfig::default()).unwrap();
+            let meshes = World::new(assembly, &WorldConfig { exact_boxes: false, ..WorldConfig::default() }).unwrap();
+            assert_eq!(exact.directions(), meshes.directions());
+            for p in 0..exact.num_parts() {
+                for (k, (a, b)) in exact.blocking_row(p).iter().zip(meshes.blocking_row(p)).enumerate() {
+                    assert_eq!(a, b, "{} ×{scale}: '{}' along {:?}", file.display(), exact.name(p), exact.directions()[k]);
+                }
+            }
+        }
+    }
 }
 
 #[test]

@@ -14,6 +14,7 @@ pub mod mesh;
 pub mod partset;
 pub mod physics;
 pub mod rrt;
+pub mod sweep;
 pub mod world;
 
 pub use assembly::{Assembly, Part, Units};

@@ -10,13 +10,14 @@
 
 use crate::assembly::Assembly;
 use crate::boxes;
+use crate::sweep;
 use crate::erode::eroded_mesh;
 use crate::error::{GeomError, Result};
 use crate::feasibility::{Motion, Stability};
 use crate::math::{aabb_of, sweep_overlap, Aabb, Pose, Vec3};
 use crate::mesh::{Mesh, Topology};
 use crate::partset::PartSet;
-use parry3d::query::{self, ClosestPoints, NonlinearRigidMotion, PointQuery, ShapeCastOptions};
+use parry3d::query::{self, ClosestPoints, NonlinearRigidMotion, PointQuery};
 use parry3d::shape::{TriMesh, TriMeshFlags};
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
@@ -107,9 +108,8 @@ impl Geom {
     /// Whether this part shrunk by `amount` still overlaps `other`: surfaces crossing, or one
     /// wholly inside the other.
     fn eroded_hits(&self, amount: f32, other: &Geom) -> bool {
-        let id = Pose::IDENTITY;
         let shrunk = self.erode(amount);
-        query::intersection_test(&id, &shrunk, &id, &*other.mesh).map_or(true, |r| r.intersecting)
+        sweep::meshes_cross(&shrunk, &other.mesh)
             || (other.closed && nests(&self.aabb, &other.aabb) && contains_point(&other.mesh, shrunk.vertices()[0]))
             || (self.closed && nests(&other.aabb, &self.aabb) && contains_point(&shrunk, other.mesh.vertices()[0]))
     }
@@ -239,7 +239,7 @@ impl World {
             .collect();
         self.contacts = vec![PartSet::empty(count); count];
         let units = self.assembly.units.clone();
-        let len = |m: f32| format!("{:.4} {}", units.from_metres(m as f64), units.name);
+        let len = |m: f32| format!("{} {}", significant(units.from_metres(m as f64), 3), units.name);
         for (i, j, touching, e_ij, e_ji) in found {
             if touching {
                 self.contacts[i].insert(j);
@@ -442,18 +442,9 @@ impl World {
             let (_, amount) = self.pair_erosion(p, q);
             return bp.iter().any(|a| bq.iter().any(|b| boxes::first_overlap(a, dir, b, amount).is_some()));
         }
+        // exact triangle sweeps (parry's mesh cast calls some slides at tolerance-sized gaps hits)
         let (moving, fixed) = self.pair_shapes(p, q);
-        let options = ShapeCastOptions {
-            max_time_of_impact: t1,
-            target_distance: 0.0,
-            stop_at_penetration: true,
-            compute_impact_geometry_on_penetration: false,
-        };
-        let id = Pose::IDENTITY;
-        // an unsupported pair would be a parry gap: block, the conservative answer
-        query::cast_shapes(&id, dir, &*moving, &id, Vec3::ZERO, &*fixed, options)
-            .map(|hit| hit.is_some())
-            .unwrap_or(true)
+        sweep::sweep_hits(&moving, dir, &fixed, t1)
     }
 
     /// For each candidate direction, every part (ground included) that blocks `p` along it.
@@ -574,30 +565,25 @@ impl World {
             let bb = &self.geoms[p].aabb;
             (bb.maxs - pivot).abs().max((bb.mins - pivot).abs()).length()
         };
-        let sweep = Aabb::new(ca.min(cb) - Vec3::splat(radius), ca.max(cb) + Vec3::splat(radius));
+        let region = Aabb::new(ca.min(cb) - Vec3::splat(radius), ca.max(cb) + Vec3::splat(radius));
         let rel = b.rotation * a.rotation.inverse();
         let motion = NonlinearRigidMotion::new(*a, pivot, cb - ca, rel.to_scaled_axis());
         let still = NonlinearRigidMotion::constant_position(Pose::IDENTITY);
         let hit = present.iter().filter(|&q| q != p && !self.ignores(p, q)).find(|&q| {
             let qb = &self.geoms[q].aabb;
-            if !(0..3).all(|k| sweep.mins[k] < qb.maxs[k] && qb.mins[k] < sweep.maxs[k]) {
+            if !(0..3).all(|k| region.mins[k] < qb.maxs[k] && qb.mins[k] < region.maxs[k]) {
                 return false;
             }
             let (moving, fixed) = self.pair_shapes(p, q);
             let fixed = &*fixed;
-            let hit = if rel.angle_between(crate::math::Rot::IDENTITY) < 1e-6 {
-                // pure translation: the (faster) linear cast is exact
-                let options = ShapeCastOptions {
-                    max_time_of_impact: 1.0,
-                    target_distance: 0.0,
-                    stop_at_penetration: true,
-                    compute_impact_geometry_on_penetration: false,
-                };
-                query::cast_shapes(a, cb - ca, &*moving, &Pose::IDENTITY, Vec3::ZERO, fixed, options)
+            if rel.angle_between(crate::math::Rot::IDENTITY) < 1e-6 {
+                // pure translation: the exact triangle sweep
+                let shift = cb - ca;
+                let len = shift.length();
+                sweep::sweep_hits_at(&moving, a, shift / len.max(f32::MIN_POSITIVE), fixed, len)
             } else {
-                query::cast_shapes_nonlinear(&motion, &*moving, &still, fixed, 0.0, 1.0, true)
-            };
-            hit.map_or(true, |h| h.is_some())
+                query::cast_shapes_nonlinear(&motion, &*moving, &still, fixed, 0.0, 1.0, true).map_or(true, |h| h.is_some())
+            }
         });
         hit
     }
@@ -615,16 +601,17 @@ impl World {
             }
             let (k, amount) = self.pair_erosion(p, q);
             let shrunk = self.eroded(k, amount);
-            // parry's mesh-mesh intersection test depends on argument order: always ask with the
-            // shrunk part first
             let (shrunk_pose, raw, raw_pose, raw_closed) = if k == p {
                 (*pose, &self.geoms[q].mesh, id, self.geoms[q].closed)
             } else {
                 (id, &self.geoms[p].mesh, *pose, self.geoms[p].closed)
             };
             let (bs, br) = (shrunk.aabb(&shrunk_pose), raw.aabb(&raw_pose));
-            // one wholly inside the other: only for closed surfaces whose boxes nest
-            query::intersection_test(&shrunk_pose, &*shrunk, &raw_pose, &**raw).map_or(true, |r| r.intersecting)
+            // surfaces crossing (exact triangle tests, `p` placed by `pose`), or one wholly inside
+            // the other: only for closed surfaces whose boxes nest
+            let crossing =
+                if k == p { sweep::meshes_cross_at(&shrunk, pose, raw) } else { sweep::meshes_cross_at(raw, pose, &shrunk) };
+            crossing
                 || (raw_closed
                     && nests(&bs, &br)
                     && contains_point(raw, raw_pose.inverse_transform_point(shrunk_pose.transform_point(shrunk.vertices()[0]))))
@@ -634,6 +621,15 @@ impl World {
         });
         hit
     }
+}
+
+/// `x` rounded to `digits` significant digits, without an exponent (0.000123, 12.3, 1230).
+fn significant(x: f64, digits: i32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.decimals$}")
 }
 
 /// Whether box `a` lies within box `b`.
@@ -726,4 +722,16 @@ fn cluster_normals(assembly: &Assembly, angle_deg: f32, count: usize) -> Vec<Vec
     }
     clusters.sort_by(|a, b| b.2.total_cmp(&a.2));
     clusters.into_iter().take(count).map(|c| c.1.normalize_or_zero()).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn lengths_in_messages_keep_three_significant_digits() {
+        assert_eq!(super::significant(0.000123456, 3), "0.000123");
+        assert_eq!(super::significant(0.0021, 3), "0.00210");
+        assert_eq!(super::significant(12.345, 3), "12.3");
+        assert_eq!(super::significant(1234.5, 3), "1234");
+        assert_eq!(super::significant(0.0, 3), "0");
+    }
 }

@@ -158,3 +158,5 @@ fn boxes_that_do_not_describe_a_part_are_warned_about_and_its_mesh_is_used() {
 }
 
 
+
+
