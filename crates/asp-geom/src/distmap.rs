@@ -26,7 +26,7 @@
 //!   mesh is a single axis-aligned box, are unions of boxes ([`crate::boxes`]). Distances are
 //!   exact box sweeps; voxels on a shared grid are swept in integer grid coordinates, so touching
 //!   faces are exactly zero and sliding is exactly free.
-//! * **Meshes.** Other parts use parry shape casting: the moving part is eroded by the contact
+//! * **Meshes.** Other parts use exact triangle sweeps ([`crate::sweep`]): the moving part is eroded by the contact
 //!   tolerance (so touching faces do not count as collisions, see `research/parry-removal-test.md`)
 //!   and cast against the other part's surface; the tolerance is added back to the distance.
 //!
@@ -43,10 +43,9 @@ use crate::error::{GeomError, Result};
 use crate::feasibility::{
     CounterSnapshot, Counters, FeasibilityChecker, Motion, MotionKind, Outcome, Stability,
 };
-use crate::math::{Aabb, Axis, Pose, Vec3};
+use crate::math::{Aabb, Axis, Vec3};
 use crate::partset::PartSet;
 use crate::world::{World, WorldConfig};
-use parry3d::query::{cast_shapes, ShapeCastOptions};
 use parry3d::shape::TriMesh;
 use rayon::prelude::*;
 
@@ -1097,27 +1096,19 @@ fn clear_distance(moving: &Aabb, dir: Vec3, rest: &Aabb) -> f32 {
     }
 }
 
-/// Distance the mesh `moving`, eroded by `erosion`, travels along `dir` before touching `fixed`,
-/// less the erosion (contacts within it read 0), capped at `d_max`.
+/// Distance the mesh `moving`, eroded by `erosion`, travels along `dir` before touching `fixed`
+/// (exact triangle sweeps, [`crate::sweep`]), less the erosion (contacts within it read 0), capped at `d_max`.
 fn cast_distance(moving: &TriMesh, fixed: &TriMesh, dir: Vec3, d_max: f32, erosion: f32) -> f32 {
-    let options = ShapeCastOptions {
-        max_time_of_impact: d_max,
-        target_distance: 0.0,
-        stop_at_penetration: true,
-        compute_impact_geometry_on_penetration: false,
-    };
-    match cast_shapes(&Pose::IDENTITY, dir, moving, &Pose::IDENTITY, Vec3::ZERO, fixed, options) {
-        Ok(Some(hit)) => {
-            let t = hit.time_of_impact - erosion;
+    match crate::sweep::sweep_distance(moving, dir, fixed, d_max) {
+        Some(hit) => {
+            let t = hit - erosion;
             if t <= erosion {
                 0.0
             } else {
                 t.min(d_max)
             }
         }
-        Ok(None) => d_max,
-        // Unsupported never happens for TriMesh pairs; be conservative.
-        Err(_) => 0.0,
+        None => d_max,
     }
 }
 

@@ -71,23 +71,48 @@ fn box_of(t: &[DVec3; 3]) -> Aabb {
     Aabb::new(lo - pad, hi + pad)
 }
 
-/// The box `b` together with `b` moved by `shift`.
-fn swept(b: &Aabb, shift: Vec3) -> Aabb {
-    Aabb::new(b.mins.min(b.mins + shift), b.maxs.max(b.maxs + shift))
+/// Whether box `a`, moved by `t * dir` for some `t` in `[0, t_max]`, meets box `b` (closed
+/// boxes, a little widened against rounding: a cull that never drops a real contact). Unlike
+/// the box around the whole path, this follows a slanted path tightly.
+fn box_path_meets(a: &Aabb, dir: Vec3, b: &Aabb, t_max: f32) -> bool {
+    let (mut t0, mut t1) = (0.0f32, t_max);
+    for k in 0..3 {
+        let slack = 1e-6 * (a.maxs[k].abs().max(a.mins[k].abs()) + b.maxs[k].abs().max(b.mins[k].abs()));
+        // a.max + t d >= b.min and a.min + t d <= b.max
+        let (lo, hi) = (b.mins[k] - a.maxs[k] - slack, b.maxs[k] - a.mins[k] + slack);
+        let d = dir[k];
+        if d == 0.0 {
+            if lo > 0.0 || hi < 0.0 {
+                return false;
+            }
+        } else {
+            let (enter, exit) = if d > 0.0 { (lo / d, hi / d) } else { (hi / d, lo / d) };
+            t0 = t0.max(enter);
+            t1 = t1.min(exit);
+            if t0 > t1 {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// When `moving`, placed by `pose` and then translated along unit `dir`, first overlaps `fixed`
 /// (in its own frame) within `t_max`. With `earliest == false` the search stops at any overlap
 /// and returns its time (not necessarily the earliest).
 fn mesh_sweep(moving: &TriMesh, pose: &Pose, dir: Vec3, fixed: &TriMesh, t_max: f32, earliest: bool) -> Option<f32> {
-    let reach = swept(&fixed.local_aabb(), -dir * t_max).transform_by(&pose.inverse());
+    // the moving triangles whose path meets the fixed mesh's box, found in the moving mesh's
+    // own frame (the box placed there is a little larger, still a safe cull)
+    let inverse = pose.inverse();
+    let fixed_box = fixed.local_aabb().transform_by(&inverse);
+    let local_dir = inverse.rotation * dir;
     let d = dir.as_dvec3();
     let mut best: Option<f64> = None;
-    for i in moving.bvh().intersect_aabb(&reach) {
+    for i in moving.bvh().leaves(|n| box_path_meets(&n.aabb(), local_dir, &fixed_box, t_max)) {
         let limit = best.unwrap_or(t_max as f64);
         let ta = triangle(moving, pose, i);
-        let path = swept(&box_of(&ta), dir * limit as f32);
-        for j in fixed.bvh().intersect_aabb(&path) {
+        let own = box_of(&ta);
+        for j in fixed.bvh().leaves(|n| box_path_meets(&own, dir, &n.aabb(), limit as f32)) {
             if let Some(t) = triangle_sweep(&ta, d, &triangle(fixed, &Pose::IDENTITY, j), best.unwrap_or(t_max as f64)) {
                 if !earliest {
                     return Some(t as f32);
