@@ -136,6 +136,20 @@ pub fn meshes_cross_at(a: &TriMesh, pose: &Pose, b: &TriMesh) -> bool {
     mesh_sweep(a, pose, Vec3::ZERO, b, 1.0, false).is_some()
 }
 
+/// [`meshes_cross`] for a triangle soup `a` (no BVH of its own to build: each of its triangles
+/// queries `b`'s).
+pub fn soup_crosses(vertices: &[Vec3], triangles: &[[u32; 3]], b: &TriMesh) -> bool {
+    let bb = b.local_aabb();
+    triangles.iter().any(|t| {
+        let ta = t.map(|i| vertices[i as usize].as_dvec3());
+        let own = box_of(&ta);
+        box_path_meets(&own, Vec3::ZERO, &bb, 0.0)
+            && b.bvh()
+                .leaves(|n| box_path_meets(&own, Vec3::ZERO, &n.aabb(), 0.0))
+                .any(|j| triangle_sweep(&ta, DVec3::ZERO, &triangle(b, &Pose::IDENTITY, j), 1.0).is_some())
+    })
+}
+
 /// Whether `moving`, translated along unit `dir` by up to `t_max`, overlaps `fixed`.
 pub fn sweep_hits(moving: &TriMesh, dir: Vec3, fixed: &TriMesh, t_max: f32) -> bool {
     mesh_sweep(moving, &Pose::IDENTITY, dir, fixed, t_max, false).is_some()
@@ -205,7 +219,9 @@ mod tests {
         assert!(!meshes_cross(&a, &cube(Vec3::new(1.0 + 1e-6, 0.2, 0.2), Vec3::new(2.0, 0.8, 0.8))));
         // a thin slab crossing one face by a micrometre, at millimetre scale
         let small = cube(Vec3::ZERO, Vec3::splat(0.005));
-        assert!(meshes_cross(&small, &cube(Vec3::new(0.005 - 1e-6, 0.001, 0.001), Vec3::new(0.01, 0.004, 0.004))));
+        let slab = Mesh::cuboid(Vec3::new(0.005 - 1e-6, 0.001, 0.001), Vec3::new(0.01, 0.004, 0.004));
+        assert!(soup_crosses(&slab.vertices, &slab.triangles, &small));
+        assert!(meshes_cross(&small, &trimesh(slab)));
         // placed by a pose: turned a quarter about z and moved next to the unit cube
         let turn = Pose::from_parts(Vec3::new(2.0, 0.0, 0.0), crate::math::Rot::from_rotation_z(std::f32::consts::FRAC_PI_2));
         let bar = cube(Vec3::new(0.0, 0.0, 0.2), Vec3::new(0.5, 0.9, 0.8)); // x in [1.1, 2] once turned

@@ -94,6 +94,10 @@ impl Geom {
         Ok((geom, topology))
     }
 
+    fn eroded_cached(&self, amount: f32) -> bool {
+        self.eroded.lock().unwrap_or_else(|e| e.into_inner()).contains_key(&amount.to_bits())
+    }
+
     fn eroded(&self, amount: f32) -> Arc<TriMesh> {
         let mut cache = self.eroded.lock().unwrap_or_else(|e| e.into_inner());
         cache.entry(amount.to_bits()).or_insert_with(|| Arc::new(self.erode(amount))).clone()
@@ -108,10 +112,21 @@ impl Geom {
     /// Whether this part shrunk by `amount` still overlaps `other`: surfaces crossing, or one
     /// wholly inside the other.
     fn eroded_hits(&self, amount: f32, other: &Geom) -> bool {
-        let shrunk = self.erode(amount);
-        sweep::meshes_cross(&shrunk, &other.mesh)
-            || (other.closed && nests(&self.aabb, &other.aabb) && contains_point(&other.mesh, shrunk.vertices()[0]))
-            || (self.closed && nests(&other.aabb, &self.aabb) && contains_point(&shrunk, other.mesh.vertices()[0]))
+        // the tolerance's erosion is cached (every later test of the part uses it); the deeper
+        // trial erosions of overlapping pairs are tested as triangle soups (no BVH to build)
+        let (vertices, triangles, shrunk) = if self.eroded_cached(amount) {
+            let m = self.eroded(amount);
+            (m.vertices().to_vec(), m.indices().to_vec(), Some(m))
+        } else {
+            let (v, t) = eroded_mesh(self.mesh.vertices(), self.mesh.indices(), amount);
+            (v, t, None)
+        };
+        sweep::soup_crosses(&vertices, &triangles, &other.mesh)
+            || (other.closed && nests(&self.aabb, &other.aabb) && contains_point(&other.mesh, vertices[0]))
+            || (self.closed && nests(&other.aabb, &self.aabb) && {
+                let shrunk = shrunk.unwrap_or_else(|| Arc::new(self.erode(amount)));
+                contains_point(&shrunk, other.mesh.vertices()[0])
+            })
     }
 }
 
@@ -296,6 +311,8 @@ impl World {
     fn extra_erosion(&self, p: usize, q: usize, limit: f32) -> Option<f32> {
         let (a, b) = (&self.geoms[p], &self.geoms[q]);
         let tol = self.tolerance;
+        // the plain tolerance first, from the cache (most pairs merely touch)
+        a.eroded(tol);
         let clear = |extra: f32| !a.eroded_hits(tol + extra, b);
         if clear(0.0) {
             return Some(0.0);
