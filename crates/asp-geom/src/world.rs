@@ -114,14 +114,16 @@ impl Geom {
     fn eroded_hits(&self, amount: f32, other: &Geom) -> bool {
         // the tolerance's erosion is cached (every later test of the part uses it); the deeper
         // trial erosions of overlapping pairs are tested as triangle soups (no BVH to build)
-        let (vertices, triangles, shrunk) = if self.eroded_cached(amount) {
-            let m = self.eroded(amount);
-            (m.vertices().to_vec(), m.indices().to_vec(), Some(m))
-        } else {
-            let (v, t) = eroded_mesh(self.mesh.vertices(), self.mesh.indices(), amount);
-            (v, t, None)
+        let shrunk = self.eroded_cached(amount).then(|| self.eroded(amount));
+        let soup;
+        let (vertices, triangles): (&[Vec3], &[[u32; 3]]) = match &shrunk {
+            Some(m) => (m.vertices(), m.indices()),
+            None => {
+                soup = eroded_mesh(self.mesh.vertices(), self.mesh.indices(), amount);
+                (&soup.0, &soup.1)
+            }
         };
-        sweep::soup_crosses(&vertices, &triangles, &other.mesh)
+        sweep::soup_crosses(vertices, triangles, &other.mesh)
             || (other.closed && nests(&self.aabb, &other.aabb) && contains_point(&other.mesh, vertices[0]))
             || (self.closed && nests(&other.aabb, &self.aabb) && {
                 let shrunk = shrunk.unwrap_or_else(|| Arc::new(self.erode(amount)));
