@@ -21,11 +21,12 @@
 //! `M(p_j, p_i)(up) = 0`, i.e. `p_i` cannot move down at all.
 //!
 //! # Geometry
-//! * **Boxes (exact).** Parts that carry voxels (`extras.asp.voxels`, as the Soma generator
-//!   writes them) or whose mesh is a single axis-aligned box are unions of boxes. Distances are
+//! * **Boxes (exact).** Parts that carry voxels (`extras.asp.cells`, as the Soma generator
+//!   writes them) or boxes (`extras.asp.boxes`, as the profile generator writes them), or whose
+//!   mesh is a single axis-aligned box, are unions of boxes ([`crate::boxes`]). Distances are
 //!   exact box sweeps; voxels on a shared grid are swept in integer grid coordinates, so touching
 //!   faces are exactly zero and sliding is exactly free.
-//! * **Meshes.** Other parts use parry shape casting: the moving part is eroded by the contact
+//! * **Meshes.** Other parts use exact triangle sweeps ([`crate::sweep`]): the moving part is eroded by the contact
 //!   tolerance (so touching faces do not count as collisions, see `research/parry-removal-test.md`)
 //!   and cast against the other part's surface; the tolerance is added back to the distance.
 //!
@@ -37,15 +38,14 @@
 //! supported and never removed.
 
 use crate::assembly::Assembly;
+use crate::boxes::{box_distance, first_overlap, fit_boxes, fit_voxels, listed_boxes, single_box};
 use crate::error::{GeomError, Result};
 use crate::feasibility::{
     CounterSnapshot, Counters, FeasibilityChecker, Motion, MotionKind, Outcome, Stability,
 };
-use crate::math::{Aabb, Axis, Pose, Vec3};
-use crate::mesh::Mesh;
+use crate::math::{Aabb, Axis, Vec3};
 use crate::partset::PartSet;
 use crate::world::{World, WorldConfig};
-use parry3d::query::{cast_shapes, ShapeCastOptions};
 use parry3d::shape::TriMesh;
 use rayon::prelude::*;
 
@@ -454,7 +454,7 @@ impl MapConfigBuilder {
 pub enum PartGeometry {
     /// Exact sweeps of voxels from `extras.asp.voxels`.
     Voxels,
-    /// Exact sweeps of the part's box (its mesh is one axis-aligned box).
+    /// Exact sweeps of the part's boxes (`extras.asp.boxes`, or its mesh is one axis-aligned box).
     Box,
     /// Shape casting of the eroded mesh (both parts of a pair must be boxes for exact sweeps).
     Mesh,
@@ -537,105 +537,6 @@ impl SweepFrame {
     }
 }
 
-/// Whether box `moving + t * dir` ever (`t >= 0`) overlaps `fixed` deeper than `tol` on every
-/// axis (touching or grazing within `tol` is free), and if so when it first touches: the entry
-/// time without the tolerance, so exact contact reads 0. `None`: never.
-#[inline]
-fn first_overlap(moving: &Aabb, dir: Vec3, fixed: &Aabb, tol: f32) -> Option<f32> {
-    let (mut t0, mut t1) = (0.0f32, f32::INFINITY);
-    let mut entry = 0.0f32;
-    for i in 0..3 {
-        let lo0 = fixed.mins[i] - moving.maxs[i];
-        let hi0 = fixed.maxs[i] - moving.mins[i];
-        let (lo, hi) = (lo0 + tol, hi0 - tol);
-        let d = dir[i];
-        if d == 0.0 {
-            if !(lo < 0.0 && hi > 0.0) {
-                return None;
-            }
-        } else {
-            let (a, b) = if d > 0.0 { (lo / d, hi / d) } else { (hi / d, lo / d) };
-            entry = entry.max(if d > 0.0 { lo0 / d } else { hi0 / d });
-            t0 = t0.max(a);
-            t1 = t1.min(b);
-            if t0 >= t1 {
-                return None;
-            }
-        }
-    }
-    (t0 < t1).then_some(entry.min(t0))
-}
-
-/// The voxels of a part from its metadata ([`crate::Part::extras`], the node's `extras.asp`):
-/// `cells` (as the Soma generator writes them) or `voxels`, as `[[i, j, k], ...]` or
-/// `{"cells": [...]}`; also accepted one level down under `asp`. Their size and position are
-/// fitted to the part's mesh, so any cell size and unit work.
-pub fn voxels_of(extras: &serde_json::Value) -> Option<Vec<[i32; 3]>> {
-    let find = |o: &serde_json::Value| o.get("cells").or_else(|| o.get("voxels")).cloned();
-    let v = find(extras).or_else(|| extras.get("asp").and_then(find))?;
-    let v = &v;
-    let cells = match v {
-        serde_json::Value::Array(a) => a,
-        serde_json::Value::Object(o) => o.get("cells")?.as_array()?,
-        _ => return None,
-    };
-    let mut out = Vec::with_capacity(cells.len());
-    for c in cells {
-        let c = c.as_array()?;
-        if c.len() != 3 {
-            return None;
-        }
-        let mut cell = [0i32; 3];
-        for (k, x) in c.iter().enumerate() {
-            let f = x.as_f64()?;
-            if f.fract() != 0.0 || f.abs() > 1e6 {
-                return None;
-            }
-            cell[k] = f as i32;
-        }
-        out.push(cell);
-    }
-    (!out.is_empty()).then_some(out)
-}
-
-/// Fits the voxel grid of a part to its mesh: the integer bounds of the cells span the mesh's box.
-/// Returns (origin, cell) or None when the mesh's volume does not match the cells.
-fn fit_voxels(cells: &[[i32; 3]], mesh: &Mesh) -> Option<(Vec3, Vec3)> {
-    let aabb = mesh.aabb()?;
-    let mut lo = [i32::MAX; 3];
-    let mut hi = [i32::MIN; 3];
-    for c in cells {
-        for k in 0..3 {
-            lo[k] = lo[k].min(c[k]);
-            hi[k] = hi[k].max(c[k] + 1);
-        }
-    }
-    let span = Vec3::new((hi[0] - lo[0]) as f32, (hi[1] - lo[1]) as f32, (hi[2] - lo[2]) as f32);
-    let cell = (aabb.maxs - aabb.mins) / span;
-    if cell.min_element().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        return None;
-    }
-    let origin = aabb.mins - Vec3::new(lo[0] as f32, lo[1] as f32, lo[2] as f32) * cell;
-    let unique: std::collections::HashSet<[i32; 3]> = cells.iter().copied().collect();
-    let expected = unique.len() as f64 * (cell.x as f64 * cell.y as f64 * cell.z as f64);
-    let volume = mesh.signed_volume().abs();
-    ((volume - expected).abs() <= 1e-3 * expected).then_some((origin, cell))
-}
-
-/// Whether the mesh is exactly one axis-aligned box (its vertices are box corners, its volume the
-/// box's volume).
-fn single_box(mesh: &Mesh) -> Option<Aabb> {
-    let b = mesh.aabb()?;
-    let ext = b.maxs - b.mins;
-    let eps = 1e-5 * ext.max_element().max(f32::MIN_POSITIVE);
-    let on = |a: f32, lo: f32, hi: f32| (a - lo).abs() <= eps || (a - hi).abs() <= eps;
-    let corners = mesh.vertices.iter().all(|v| {
-        on(v.x, b.mins.x, b.maxs.x) && on(v.y, b.mins.y, b.maxs.y) && on(v.z, b.mins.z, b.maxs.z)
-    });
-    let vol = ext.x as f64 * ext.y as f64 * ext.z as f64;
-    (corners && vol > 0.0 && (mesh.signed_volume().abs() - vol).abs() <= 1e-4 * vol).then_some(b)
-}
-
 impl DistanceMaps {
     /// Computes every map of `assembly` (rows in parallel with rayon).
     pub fn build(assembly: &Assembly, config: &MapConfig) -> Result<DistanceMaps> {
@@ -669,7 +570,7 @@ impl DistanceMaps {
         let mut voxel_fits: Vec<Option<VoxelFit>> = Vec::with_capacity(n);
         for p in &assembly.parts {
             let fit = if config.use_voxels {
-                voxels_of(&p.extras).and_then(|cells| match fit_voxels(&cells, &p.mesh) {
+                crate::boxes::voxels_of(&p.extras).and_then(|cells| match fit_voxels(&cells, &p.mesh) {
                     Some((o, c)) => Some((cells, o, c)),
                     None => {
                         warnings.push(format!(
@@ -719,6 +620,9 @@ impl DistanceMaps {
                     .collect();
                 geometry.push(PartGeometry::Voxels);
                 shapes.push(Shape::Boxes { boxes, integer: shared_grid });
+            } else if let Some(boxes) = listed_boxes(&p.extras).and_then(|b| fit_boxes(&b, &p.mesh)) {
+                geometry.push(PartGeometry::Box);
+                shapes.push(Shape::Boxes { boxes: boxes.iter().map(|b| frame.frame_box(b)).collect(), integer: false });
             } else if let Some(b) = single_box(&p.mesh) {
                 geometry.push(PartGeometry::Box);
                 shapes.push(Shape::Boxes { boxes: vec![frame.frame_box(&b)], integer: false });
@@ -1227,17 +1131,6 @@ impl DistanceMaps {
     }
 }
 
-/// The distance between two boxes given in a frame whose unit along axis `k` is `cell[k]`
-/// metres, in metres.
-fn box_distance(a: &Aabb, b: &Aabb, cell: Vec3) -> f32 {
-    let mut sq = 0.0;
-    for k in 0..3 {
-        let gap = (a.mins[k] - b.maxs[k]).max(b.mins[k] - a.maxs[k]).max(0.0) * cell[k];
-        sq += gap * gap;
-    }
-    sq.sqrt()
-}
-
 /// The smallest `p · up` over the corners of box `b`.
 fn lowest_along(b: &Aabb, up: Vec3) -> f32 {
     (0..3).map(|k| (b.mins[k] * up[k]).min(b.maxs[k] * up[k])).sum()
@@ -1267,27 +1160,19 @@ fn clear_distance(moving: &Aabb, dir: Vec3, rest: &Aabb) -> f32 {
     }
 }
 
-/// Distance the mesh `moving`, eroded by `erosion`, travels along `dir` before touching `fixed`,
-/// less the erosion (contacts within it read 0), capped at `d_max`.
+/// Distance the mesh `moving`, eroded by `erosion`, travels along `dir` before touching `fixed`
+/// (exact triangle sweeps, [`crate::sweep`]), less the erosion (contacts within it read 0), capped at `d_max`.
 fn cast_distance(moving: &TriMesh, fixed: &TriMesh, dir: Vec3, d_max: f32, erosion: f32) -> f32 {
-    let options = ShapeCastOptions {
-        max_time_of_impact: d_max,
-        target_distance: 0.0,
-        stop_at_penetration: true,
-        compute_impact_geometry_on_penetration: false,
-    };
-    match cast_shapes(&Pose::IDENTITY, dir, moving, &Pose::IDENTITY, Vec3::ZERO, fixed, options) {
-        Ok(Some(hit)) => {
-            let t = hit.time_of_impact - erosion;
+    match crate::sweep::sweep_distance(moving, dir, fixed, d_max) {
+        Some(hit) => {
+            let t = hit - erosion;
             if t <= erosion {
                 0.0
             } else {
                 t.min(d_max)
             }
         }
-        Ok(None) => d_max,
-        // Unsupported never happens for TriMesh pairs; be conservative.
-        Err(_) => 0.0,
+        None => d_max,
     }
 }
 
@@ -1816,6 +1701,7 @@ mod tests {
     use super::*;
     use crate::assembly::Part;
     use crate::fixtures;
+    use crate::mesh::Mesh;
 
     fn part(name: &str, mesh: Mesh) -> Part {
         fixtures::part(name, mesh, false)

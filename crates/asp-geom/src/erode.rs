@@ -6,39 +6,115 @@
 //! `research/parry-removal-test.md`: this was the only strategy right on every fixture).
 
 use crate::math::Vec3;
-use parry3d::math::{Mat3, SymmetricEigen3};
+use parry3d::math::Mat3;
+use std::collections::HashMap;
 
-/// Moves every vertex inward by `amount`: the least-squares miter offset over the distinct
-/// normals of the faces around it (exact at box corners and edges), clamped to `3 × amount`.
-/// The mesh must be closed and wound outward.
-pub fn eroded_vertices(vertices: &[Vec3], triangles: &[[u32; 3]], amount: f32) -> Vec<Vec3> {
+/// Two unit normals closer than this (cosine) are one plane.
+const SAME_PLANE: f32 = 0.9995;
+
+/// Shrinks a closed, outward-wound mesh by `amount`: every vertex moves inward by the
+/// least-squares miter offset over the distinct normals of the faces around it (exact at box
+/// corners and edges), clamped to `3 × amount`.
+///
+/// A *saddle* vertex — where the offset planes of the faces around it have no common point, e.g.
+/// faces facing `+z` and `-z` meet there, as on many voxel shapes — is split: each triangle
+/// corner there takes the offset of its own plane and of the other planes in order of how near
+/// their faces lie to the corner, skipping any plane that would leave no common point. The
+/// shrunk surface then has cracks of about `amount` at such vertices, but no face of it stays
+/// closer than `amount` to the original surface (a single shared point would have to stay on
+/// some of the original faces). Returns the new vertices and triangles.
+pub fn eroded_mesh(vertices: &[Vec3], triangles: &[[u32; 3]], amount: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let face_normals: Vec<Option<Vec3>> = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| vertices[i as usize]);
+            let n = (b - a).cross(c - a);
+            let len = n.length();
+            (len > 0.0 && len.is_finite()).then(|| n / len)
+        })
+        .collect();
     let mut normals: Vec<Vec<Vec3>> = vec![Vec::new(); vertices.len()];
-    for t in triangles {
-        let [a, b, c] = t.map(|i| vertices[i as usize]);
-        let n = (b - a).cross(c - a);
-        let len = n.length();
-        if len <= 0.0 || !len.is_finite() {
-            continue;
-        }
-        let n = n / len;
+    for (t, n) in triangles.iter().zip(&face_normals) {
+        let Some(n) = *n else { continue };
         for &i in t {
-            let list = &mut normals[i as usize];
-            if !list.iter().any(|m| m.dot(n) > 0.9995) {
-                list.push(n);
+            push_distinct(&mut normals[i as usize], n);
+        }
+    }
+    let mut out: Vec<Vec3> = Vec::with_capacity(vertices.len());
+    let mut saddle = vec![false; vertices.len()];
+    for (i, (v, ns)) in vertices.iter().zip(&normals).enumerate() {
+        let (o, consistent) = miter_offset(ns, amount);
+        saddle[i] = !consistent;
+        out.push(*v + o);
+    }
+    if !saddle.iter().any(|&s| s) {
+        return (out, triangles.to_vec());
+    }
+    // each triangle corner at a saddle vertex gets its own vertex, shared by the corners whose
+    // offsets agree
+    let mut corners: HashMap<u32, Vec<(usize, Vec3, Vec3)>> = HashMap::new(); // (triangle, bisector, normal)
+    for (k, t) in triangles.iter().enumerate() {
+        let Some(n) = face_normals[k] else { continue };
+        for c in 0..3 {
+            if saddle[t[c] as usize] {
+                let v = vertices[t[c] as usize];
+                let a = (vertices[t[(c + 1) % 3] as usize] - v).normalize_or_zero();
+                let b = (vertices[t[(c + 2) % 3] as usize] - v).normalize_or_zero();
+                corners.entry(t[c]).or_default().push((k, (a + b).normalize_or_zero(), n));
             }
         }
     }
-    vertices
-        .iter()
-        .zip(&normals)
-        .map(|(v, ns)| *v + miter_offset(ns, amount))
-        .collect()
+    let mut split: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
+    let mut tris = triangles.to_vec();
+    let mut saddles: Vec<u32> = corners.keys().copied().collect();
+    saddles.sort_unstable();
+    for v in saddles {
+        let list = &corners[&v];
+        for &(k, bisector, own) in list {
+            // the planes of the faces nearest this corner (by the angle between the corners'
+            // bisectors), each kept only while all kept planes still meet in one point
+            let mut order: Vec<(f32, Vec3)> = normals[v as usize]
+                .iter()
+                .map(|&n| {
+                    let near = list
+                        .iter()
+                        .filter(|c| c.2.dot(n) > SAME_PLANE)
+                        .map(|c| c.1.dot(bisector))
+                        .fold(f32::NEG_INFINITY, f32::max);
+                    (if n.dot(own) > SAME_PLANE { f32::INFINITY } else { near }, n)
+                })
+                .collect();
+            order.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let mut kept: Vec<Vec3> = Vec::with_capacity(order.len());
+            for (_, n) in order {
+                kept.push(n);
+                if !miter_offset(&kept, amount).1 {
+                    kept.pop();
+                }
+            }
+            let p = vertices[v as usize] + miter_offset(&kept, amount).0;
+            let index = *split.entry((v, [p.x, p.y, p.z].map(f32::to_bits))).or_insert_with(|| {
+                out.push(p);
+                (out.len() - 1) as u32
+            });
+            let c = triangles[k].iter().position(|&x| x == v).expect("corner of its triangle");
+            tris[k][c] = index;
+        }
+    }
+    (out, tris)
 }
 
-/// The offset `o` minimising `Σ (n·o + amount)²` with the least norm (pseudo-inverse).
-fn miter_offset(normals: &[Vec3], amount: f32) -> Vec3 {
+fn push_distinct(list: &mut Vec<Vec3>, n: Vec3) {
+    if !list.iter().any(|m| m.dot(n) > SAME_PLANE) {
+        list.push(n);
+    }
+}
+
+/// The offset `o` minimising `Σ (n·o + amount)²` with the least norm (pseudo-inverse), clamped
+/// to `3 × amount`, and whether it satisfies every plane (all faces' offset planes meet there).
+fn miter_offset(normals: &[Vec3], amount: f32) -> (Vec3, bool) {
     if normals.is_empty() {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, true);
     }
     let mut a = Mat3::ZERO;
     let mut b = Vec3::ZERO;
@@ -46,32 +122,80 @@ fn miter_offset(normals: &[Vec3], amount: f32) -> Vec3 {
         a += Mat3::from_cols(*n * n.x, *n * n.y, *n * n.z);
         b -= *n * amount;
     }
-    let eig = SymmetricEigen3::new(a);
-    let max = eig.eigenvalues.max_element();
+    let (values, vectors) = symmetric_eigen(a);
+    let max = values.iter().copied().fold(0.0f32, f32::max);
     let mut o = Vec3::ZERO;
-    for k in 0..3 {
-        let l = eig.eigenvalues[k];
+    for (l, v) in values.into_iter().zip(vectors) {
         if l > max * 1e-3 {
-            let v = eig.eigenvectors.col(k);
             o += v * (v.dot(b) / l);
         }
     }
+    let consistent = normals.iter().all(|n| (n.dot(o) + amount).abs() <= 0.1 * amount);
     let limit = 3.0 * amount;
     if o.length() > limit {
         o = o.normalize() * limit;
     }
-    o
+    (o, consistent)
+}
+
+/// Eigenvalues and unit eigenvectors of a symmetric 3×3 matrix by cyclic Jacobi rotations
+/// (parry's `SymmetricEigen3` returned wrong eigenvectors for `diag(1, 0, 0)`).
+fn symmetric_eigen(m: Mat3) -> ([f32; 3], [Vec3; 3]) {
+    let mut a = [[0.0f64; 3]; 3];
+    for (i, row) in a.iter_mut().enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            *x = m.col(j)[i] as f64;
+        }
+    }
+    let mut v = [[1.0f64, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for _ in 0..32 {
+        let off = a[0][1].abs() + a[0][2].abs() + a[1][2].abs();
+        if off <= 1e-15 * (a[0][0].abs() + a[1][1].abs() + a[2][2].abs()).max(f64::MIN_POSITIVE) {
+            break;
+        }
+        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
+            if a[p][q] == 0.0 {
+                continue;
+            }
+            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+            let t = if theta == 0.0 { 1.0 } else { t };
+            let (c, s) = (1.0 / (t * t + 1.0).sqrt(), t / (t * t + 1.0).sqrt());
+            // A ← Jᵀ A J: columns p, q, then rows p, q
+            for row in a.iter_mut() {
+                let (akp, akq) = (row[p], row[q]);
+                row[p] = c * akp - s * akq;
+                row[q] = s * akp + c * akq;
+            }
+            let (rp, rq) = (a[p], a[q]);
+            for k in 0..3 {
+                a[p][k] = c * rp[k] - s * rq[k];
+                a[q][k] = s * rp[k] + c * rq[k];
+            }
+            for row in v.iter_mut() {
+                let (vp, vq) = (row[p], row[q]);
+                row[p] = c * vp - s * vq;
+                row[q] = s * vp + c * vq;
+            }
+        }
+    }
+    let values = [a[0][0] as f32, a[1][1] as f32, a[2][2] as f32];
+    let vectors = [0, 1, 2].map(|k| Vec3::new(v[0][k] as f32, v[1][k] as f32, v[2][k] as f32));
+    (values, vectors)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::mesh::Mesh;
+    use parry3d::query::PointQuery;
+    use parry3d::shape::{TriMesh, TriMeshFlags};
 
     #[test]
     fn a_box_shrinks_exactly() {
         let m = Mesh::cuboid(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0));
-        let e = eroded_vertices(&m.vertices, &m.triangles, 0.1);
+        let (e, t) = eroded_mesh(&m.vertices, &m.triangles, 0.1);
+        assert_eq!(t, m.triangles, "no saddle, no split");
         let bb = crate::math::aabb_of(e).unwrap();
         assert!((bb.mins - Vec3::splat(0.1)).abs().max_element() < 1e-5, "{bb:?}");
         assert!((bb.maxs - Vec3::new(0.9, 1.9, 2.9)).abs().max_element() < 1e-5, "{bb:?}");
@@ -80,9 +204,52 @@ mod tests {
     #[test]
     fn an_l_shape_keeps_its_concave_corner_offset() {
         let m = Mesh::from_voxels(&[[0, 0, 0], [1, 0, 0], [0, 1, 0]], Vec3::ONE, Vec3::ZERO);
-        let e = eroded_vertices(&m.vertices, &m.triangles, 0.1);
+        let (e, _) = eroded_mesh(&m.vertices, &m.triangles, 0.1);
         // the concave corner at (1,1,0) moves into the solid by the tolerance along every face normal
         let i = m.vertices.iter().position(|v| *v == Vec3::new(1.0, 1.0, 0.0)).unwrap();
         assert!((e[i] - Vec3::new(0.9, 0.9, 0.1)).length() < 1e-5, "{:?}", e[i]);
+    }
+
+    /// Every vertex of the shrunk mesh lies inside the original solid, at least `amount` from
+    /// its surface.
+    fn assert_shrunk_by(m: &Mesh, amount: f32) {
+        let mut m = m.clone();
+        m.weld();
+        m.orient_outward();
+        let solid = TriMesh::with_flags(m.vertices.clone(), m.triangles.clone(), TriMeshFlags::ORIENTED).unwrap();
+        let (e, t) = eroded_mesh(&m.vertices, &m.triangles, amount);
+        for tri in &t {
+            for &i in tri {
+                let p = solid.project_local_point(e[i as usize], false);
+                let depth = (p.point - e[i as usize]).length();
+                assert!(p.is_inside && depth >= 0.999 * amount, "vertex {:?}: inside {}, depth {depth}", e[i as usize], p.is_inside);
+            }
+        }
+    }
+
+    #[test]
+    fn eigen_decomposition_of_rank_one_and_full_matrices() {
+        for n in [Vec3::X, -Vec3::X, Vec3::Y, Vec3::Z, Vec3::new(1.0, 2.0, -2.0) / 3.0] {
+            let (o, consistent) = miter_offset(&[n], 0.01);
+            assert!(consistent && (o + n * 0.01).length() < 1e-6, "{n:?}: {o:?}");
+        }
+        let m = Mat3::from_cols(Vec3::new(2.0, 1.0, 0.0), Vec3::new(1.0, 3.0, 1.0), Vec3::new(0.0, 1.0, 4.0));
+        let (values, vectors) = symmetric_eigen(m);
+        for (l, v) in values.into_iter().zip(vectors) {
+            assert!((m * v - v * l).length() < 1e-5 && (v.length() - 1.0).abs() < 1e-5, "{l} {v:?}");
+        }
+    }
+
+    #[test]
+    fn saddle_vertices_are_split_so_every_face_moves_inward() {
+        // classic Soma piece B: at (1, 2, 1) faces facing +x and -x meet; the least-squares
+        // offset over all faces left that vertex on the top face of cell (1, 2, 0)
+        let b = Mesh::from_voxels(&[[0, 2, 0], [1, 2, 0], [1, 1, 1], [1, 2, 1]], Vec3::ONE, Vec3::ZERO);
+        assert_shrunk_by(&b, 0.01);
+        let (e, _) = eroded_mesh(&b.vertices, &b.triangles, 0.01);
+        assert!(e.len() > b.vertices.len(), "the saddle vertex was not split");
+        for cells in [&[[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 1, 1]][..], &[[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]] {
+            assert_shrunk_by(&Mesh::from_voxels(cells, Vec3::splat(0.05), Vec3::ZERO), 1e-4);
+        }
     }
 }

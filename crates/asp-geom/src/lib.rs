@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 pub mod assembly;
+pub mod boxes;
 pub mod checker;
 pub mod distmap;
 pub mod erode;
@@ -13,6 +14,7 @@ pub mod mesh;
 pub mod partset;
 pub mod physics;
 pub mod rrt;
+pub mod sweep;
 pub mod world;
 
 pub use assembly::{Assembly, Part, Units};

@@ -9,13 +9,15 @@
 //! later removal test of that part is a few bitset operations.
 
 use crate::assembly::Assembly;
-use crate::erode::eroded_vertices;
+use crate::boxes;
+use crate::sweep;
+use crate::erode::eroded_mesh;
 use crate::error::{GeomError, Result};
 use crate::feasibility::{Motion, Stability};
 use crate::math::{aabb_of, sweep_overlap, Aabb, Pose, Vec3};
 use crate::mesh::{Mesh, Topology};
 use crate::partset::PartSet;
-use parry3d::query::{self, ClosestPoints, NonlinearRigidMotion, PointQuery, ShapeCastOptions};
+use parry3d::query::{self, ClosestPoints, NonlinearRigidMotion, PointQuery};
 use parry3d::shape::{TriMesh, TriMeshFlags};
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
@@ -44,6 +46,10 @@ pub struct WorldConfig {
     /// Ignore collisions between parts that overlap beyond `max_overlap_fraction` (warned)
     /// instead of failing. Default false.
     pub ignore_overlapping: bool,
+    /// Test pairs of parts that are known unions of boxes (voxels or boxes in their extras, or a
+    /// box-shaped mesh; see [`crate::boxes`]) exactly on their boxes. Default true; false tests
+    /// every pair on the meshes.
+    pub exact_boxes: bool,
 }
 
 impl Default for WorldConfig {
@@ -56,6 +62,7 @@ impl Default for WorldConfig {
             sphere_directions: 0,
             max_overlap_fraction: 0.4,
             ignore_overlapping: false,
+            exact_boxes: true,
         }
     }
 }
@@ -67,6 +74,9 @@ struct Geom {
     /// Eroded copies keyed by the erosion amount's bits.
     eroded: Mutex<BTreeMap<u32, Arc<TriMesh>>>,
     closed: bool,
+    /// The part's exact boxes when it is a known union of boxes ([`crate::boxes`]): pairs of
+    /// such parts are tested exactly on them instead of on the meshes.
+    boxes: Option<Vec<Aabb>>,
 }
 
 impl Geom {
@@ -80,7 +90,12 @@ impl Geom {
         let aabb = m.aabb().ok_or_else(|| GeomError::config("empty mesh"))?;
         let mesh = TriMesh::with_flags(m.vertices, m.triangles, TriMeshFlags::ORIENTED)
             .map_err(|e| GeomError::config(format!("cannot build a collision mesh: {e}")))?;
-        Ok((Geom { mesh: Arc::new(mesh), aabb, eroded: Mutex::new(BTreeMap::new()), closed }, topology))
+        let geom = Geom { mesh: Arc::new(mesh), aabb, eroded: Mutex::new(BTreeMap::new()), closed, boxes: None };
+        Ok((geom, topology))
+    }
+
+    fn eroded_cached(&self, amount: f32) -> bool {
+        self.eroded.lock().unwrap_or_else(|e| e.into_inner()).contains_key(&amount.to_bits())
     }
 
     fn eroded(&self, amount: f32) -> Arc<TriMesh> {
@@ -89,19 +104,31 @@ impl Geom {
     }
 
     fn erode(&self, amount: f32) -> TriMesh {
-        let v = eroded_vertices(self.mesh.vertices(), self.mesh.indices(), amount);
-        TriMesh::with_flags(v, self.mesh.indices().to_vec(), TriMeshFlags::ORIENTED)
+        let (v, t) = eroded_mesh(self.mesh.vertices(), self.mesh.indices(), amount);
+        TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED)
             .unwrap_or_else(|_| (*self.mesh).clone())
     }
 
     /// Whether this part shrunk by `amount` still overlaps `other`: surfaces crossing, or one
     /// wholly inside the other.
     fn eroded_hits(&self, amount: f32, other: &Geom) -> bool {
-        let id = Pose::IDENTITY;
-        let shrunk = self.erode(amount);
-        query::intersection_test(&id, &shrunk, &id, &*other.mesh).map_or(true, |r| r.intersecting)
-            || (other.closed && nests(&self.aabb, &other.aabb) && contains_point(&other.mesh, shrunk.vertices()[0]))
-            || (self.closed && nests(&other.aabb, &self.aabb) && contains_point(&shrunk, other.mesh.vertices()[0]))
+        // the tolerance's erosion is cached (every later test of the part uses it); the deeper
+        // trial erosions of overlapping pairs are tested as triangle soups (no BVH to build)
+        let shrunk = self.eroded_cached(amount).then(|| self.eroded(amount));
+        let soup;
+        let (vertices, triangles): (&[Vec3], &[[u32; 3]]) = match &shrunk {
+            Some(m) => (m.vertices(), m.indices()),
+            None => {
+                soup = eroded_mesh(self.mesh.vertices(), self.mesh.indices(), amount);
+                (&soup.0, &soup.1)
+            }
+        };
+        sweep::soup_crosses(vertices, triangles, &other.mesh)
+            || (other.closed && nests(&self.aabb, &other.aabb) && contains_point(&other.mesh, vertices[0]))
+            || (self.closed && nests(&other.aabb, &self.aabb) && {
+                let shrunk = shrunk.unwrap_or_else(|| Arc::new(self.erode(amount)));
+                contains_point(&shrunk, other.mesh.vertices()[0])
+            })
     }
 }
 
@@ -138,10 +165,17 @@ impl World {
         let mut warnings = assembly.warnings.clone();
         let mut geoms = Vec::with_capacity(assembly.len() + 1);
         for p in &assembly.parts {
-            let (g, t) = Geom::new(&p.mesh).map_err(|e| GeomError::Assembly {
+            let (mut g, t) = Geom::new(&p.mesh).map_err(|e| GeomError::Assembly {
                 path: assembly.source.clone(),
                 reason: format!("part '{}': {e}", p.name),
             })?;
+            g.boxes = match boxes::part_boxes(p).map(|b| b.filter(|_| config.exact_boxes)) {
+                Ok(b) => b,
+                Err(e) => {
+                    warnings.push(format!("part '{}': {e}; its tests use the mesh", p.name));
+                    None
+                }
+            };
             if !t.is_closed_manifold() {
                 warnings.push(format!(
                     "part '{}': mesh is not closed and manifold ({} open, {} non-manifold, {} misoriented edges); its removal tests may be conservative",
@@ -154,7 +188,8 @@ impl World {
         let mut fixed = PartSet::from_indices(n + 1, assembly.parts.iter().enumerate().filter(|(_, p)| p.fixed).map(|(i, _)| i));
         let ground = if fixed.is_empty() {
             let bb = assembly.aabb().expect("validated assembly has vertices");
-            let (g, _) = Geom::new(&ground_box(&bb, assembly.up.vector(), diag))?;
+            let (mut g, _) = Geom::new(&ground_box(&bb, assembly.up.vector(), diag))?;
+            g.boxes = config.exact_boxes.then(|| vec![g.aabb]);
             geoms.push(g);
             fixed.insert(n);
             Some(n)
@@ -200,6 +235,15 @@ impl World {
         let found: Vec<Found> = pairs
             .par_iter()
             .map(|&(i, j)| {
+                if let (Some(bi), Some(bj)) = (&self.geoms[i].boxes, &self.geoms[j].boxes) {
+                    // exact: how deep the boxes overlap, and how close they come
+                    let pairs = || bi.iter().flat_map(|a| bj.iter().map(move |b| (a, b)));
+                    let depth = pairs().map(|(a, b)| boxes::overlap_depth(a, b)).fold(f32::NEG_INFINITY, f32::max);
+                    let gap = pairs().map(|(a, b)| boxes::box_distance(a, b, Vec3::ONE)).fold(f32::INFINITY, f32::min);
+                    let extra = (depth - self.tolerance).max(0.0);
+                    let within = |k: usize| (extra <= limit_of(k)).then_some(extra);
+                    return (i, j, gap <= self.contact_distance, within(i), within(j));
+                }
                 let (a, b) = (&*self.geoms[i].mesh, &*self.geoms[j].mesh);
                 let id = Pose::IDENTITY;
                 // parry's mesh-mesh closest points can miss an overlap: measure every candidate
@@ -212,7 +256,7 @@ impl World {
             .collect();
         self.contacts = vec![PartSet::empty(count); count];
         let units = self.assembly.units.clone();
-        let len = |m: f32| format!("{:.4} {}", units.from_metres(m as f64), units.name);
+        let len = |m: f32| format!("{} {}", significant(units.from_metres(m as f64), 3), units.name);
         for (i, j, touching, e_ij, e_ji) in found {
             if touching {
                 self.contacts[i].insert(j);
@@ -269,6 +313,8 @@ impl World {
     fn extra_erosion(&self, p: usize, q: usize, limit: f32) -> Option<f32> {
         let (a, b) = (&self.geoms[p], &self.geoms[q]);
         let tol = self.tolerance;
+        // the plain tolerance first, from the cache (most pairs merely touch)
+        a.eroded(tol);
         let clear = |extra: f32| !a.eroded_hits(tol + extra, b);
         if clear(0.0) {
             return Some(0.0);
@@ -410,18 +456,14 @@ impl World {
         let Some((_, t1)) = sweep_overlap(&self.geoms[p].aabb, dir, &self.geoms[q].aabb) else {
             return false;
         };
+        if let (Some(bp), Some(bq)) = (&self.geoms[p].boxes, &self.geoms[q].boxes) {
+            // exact on the boxes, each of `p`'s shrunk by the pair's erosion
+            let (_, amount) = self.pair_erosion(p, q);
+            return bp.iter().any(|a| bq.iter().any(|b| boxes::first_overlap(a, dir, b, amount).is_some()));
+        }
+        // exact triangle sweeps (parry's mesh cast calls some slides at tolerance-sized gaps hits)
         let (moving, fixed) = self.pair_shapes(p, q);
-        let options = ShapeCastOptions {
-            max_time_of_impact: t1,
-            target_distance: 0.0,
-            stop_at_penetration: true,
-            compute_impact_geometry_on_penetration: false,
-        };
-        let id = Pose::IDENTITY;
-        // an unsupported pair would be a parry gap: block, the conservative answer
-        query::cast_shapes(&id, dir, &*moving, &id, Vec3::ZERO, &*fixed, options)
-            .map(|hit| hit.is_some())
-            .unwrap_or(true)
+        sweep::sweep_hits(&moving, dir, &fixed, t1)
     }
 
     /// For each candidate direction, every part (ground included) that blocks `p` along it.
@@ -542,30 +584,25 @@ impl World {
             let bb = &self.geoms[p].aabb;
             (bb.maxs - pivot).abs().max((bb.mins - pivot).abs()).length()
         };
-        let sweep = Aabb::new(ca.min(cb) - Vec3::splat(radius), ca.max(cb) + Vec3::splat(radius));
+        let region = Aabb::new(ca.min(cb) - Vec3::splat(radius), ca.max(cb) + Vec3::splat(radius));
         let rel = b.rotation * a.rotation.inverse();
         let motion = NonlinearRigidMotion::new(*a, pivot, cb - ca, rel.to_scaled_axis());
         let still = NonlinearRigidMotion::constant_position(Pose::IDENTITY);
         let hit = present.iter().filter(|&q| q != p && !self.ignores(p, q)).find(|&q| {
             let qb = &self.geoms[q].aabb;
-            if !(0..3).all(|k| sweep.mins[k] < qb.maxs[k] && qb.mins[k] < sweep.maxs[k]) {
+            if !(0..3).all(|k| region.mins[k] < qb.maxs[k] && qb.mins[k] < region.maxs[k]) {
                 return false;
             }
             let (moving, fixed) = self.pair_shapes(p, q);
             let fixed = &*fixed;
-            let hit = if rel.angle_between(crate::math::Rot::IDENTITY) < 1e-6 {
-                // pure translation: the (faster) linear cast is exact
-                let options = ShapeCastOptions {
-                    max_time_of_impact: 1.0,
-                    target_distance: 0.0,
-                    stop_at_penetration: true,
-                    compute_impact_geometry_on_penetration: false,
-                };
-                query::cast_shapes(a, cb - ca, &*moving, &Pose::IDENTITY, Vec3::ZERO, fixed, options)
+            if rel.angle_between(crate::math::Rot::IDENTITY) < 1e-6 {
+                // pure translation: the exact triangle sweep
+                let shift = cb - ca;
+                let len = shift.length();
+                sweep::sweep_hits_at(&moving, a, shift / len.max(f32::MIN_POSITIVE), fixed, len)
             } else {
-                query::cast_shapes_nonlinear(&motion, &*moving, &still, fixed, 0.0, 1.0, true)
-            };
-            hit.map_or(true, |h| h.is_some())
+                query::cast_shapes_nonlinear(&motion, &*moving, &still, fixed, 0.0, 1.0, true).map_or(true, |h| h.is_some())
+            }
         });
         hit
     }
@@ -583,16 +620,17 @@ impl World {
             }
             let (k, amount) = self.pair_erosion(p, q);
             let shrunk = self.eroded(k, amount);
-            // parry's mesh-mesh intersection test depends on argument order: always ask with the
-            // shrunk part first
             let (shrunk_pose, raw, raw_pose, raw_closed) = if k == p {
                 (*pose, &self.geoms[q].mesh, id, self.geoms[q].closed)
             } else {
                 (id, &self.geoms[p].mesh, *pose, self.geoms[p].closed)
             };
             let (bs, br) = (shrunk.aabb(&shrunk_pose), raw.aabb(&raw_pose));
-            // one wholly inside the other: only for closed surfaces whose boxes nest
-            query::intersection_test(&shrunk_pose, &*shrunk, &raw_pose, &**raw).map_or(true, |r| r.intersecting)
+            // surfaces crossing (exact triangle tests, `p` placed by `pose`), or one wholly inside
+            // the other: only for closed surfaces whose boxes nest
+            let crossing =
+                if k == p { sweep::meshes_cross_at(&shrunk, pose, raw) } else { sweep::meshes_cross_at(raw, pose, &shrunk) };
+            crossing
                 || (raw_closed
                     && nests(&bs, &br)
                     && contains_point(raw, raw_pose.inverse_transform_point(shrunk_pose.transform_point(shrunk.vertices()[0]))))
@@ -602,6 +640,15 @@ impl World {
         });
         hit
     }
+}
+
+/// `x` rounded to `digits` significant digits, without an exponent (0.000123, 12.3, 1230).
+fn significant(x: f64, digits: i32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.decimals$}")
 }
 
 /// Whether box `a` lies within box `b`.
@@ -694,4 +741,16 @@ fn cluster_normals(assembly: &Assembly, angle_deg: f32, count: usize) -> Vec<Vec
     }
     clusters.sort_by(|a, b| b.2.total_cmp(&a.2));
     clusters.into_iter().take(count).map(|c| c.1.normalize_or_zero()).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn lengths_in_messages_keep_three_significant_digits() {
+        assert_eq!(super::significant(0.000123456, 3), "0.000123");
+        assert_eq!(super::significant(0.0021, 3), "0.00210");
+        assert_eq!(super::significant(12.345, 3), "12.3");
+        assert_eq!(super::significant(1234.5, 3), "1234");
+        assert_eq!(super::significant(0.0, 3), "0");
+    }
 }

@@ -108,3 +108,55 @@ fn arch_keystone_floats_without_pillars() {
         Stability::Unstable { floating: PartSet::from_indices(4, [3]) }
     );
 }
+
+/// A 0.557 m post on a floor, and a ring of 3 mm wall and zero clearance around its top end,
+/// given as voxels in the ring's extras (the ring's mesh alone was falsely blocked sliding up:
+/// parry's mesh cast at this scale); `ring_extras` replaces them.
+fn post_and_ring(ring_extras: serde_json::Value) -> asp_geom::Assembly {
+    use asp_geom::{Mesh, Part};
+    let cells: Vec<[i32; 3]> = (0..7)
+        .flat_map(|k| (0..6).flat_map(move |i| (0..6).map(move |j| [i, j, k])))
+        .filter(|[i, j, _]| !((1..5).contains(i) && (1..5).contains(j)))
+        .collect();
+    let ring = Mesh::from_voxels(&cells, Vec3::splat(0.003), Vec3::new(0.207, 0.207, 0.536));
+    let extras = if ring_extras.is_null() { serde_json::json!({ "cells": cells }) } else { ring_extras };
+    let part = |name: &str, mesh: Mesh, fixed: bool, extras: serde_json::Value| Part { name: name.into(), mesh, fixed, extras };
+    asp_geom::Assembly {
+        parts: vec![
+            part("floor", Mesh::cuboid(Vec3::new(0.0, 0.0, -0.01), Vec3::new(0.5, 0.5, 0.0)), true, serde_json::Value::Null),
+            part("post", Mesh::cuboid(Vec3::new(0.21, 0.21, 0.0), Vec3::new(0.222, 0.222, 0.557)), false, serde_json::Value::Null),
+            part("ring", ring, false, extras),
+        ],
+        units: asp_geom::Units::metres(),
+        up: asp_geom::math::Axis::Z,
+        source: "post_and_ring".into(),
+        warnings: Vec::new(),
+    }
+}
+
+#[test]
+fn a_zero_clearance_ring_slides_along_its_post_on_exact_boxes() {
+    let w = world(post_and_ring(serde_json::Value::Null));
+    assert!(w.warnings().is_empty(), "{:?}", w.warnings());
+    let all = PartSet::full(3);
+    assert_eq!(free_axes(&w, 2, &all), vec!["+z"]);
+    // the post leaves upward through the ring, and never down into the floor
+    assert_eq!(free_axes(&w, 1, &all), vec!["+z"]);
+    assert!(w.contacts(2).contains(1) && w.contacts(1).contains(0) && !w.contacts(2).contains(0));
+    assert!(w.overlaps().is_empty());
+}
+
+#[test]
+fn boxes_that_do_not_describe_a_part_are_warned_about_and_its_mesh_is_used() {
+    let wrong = serde_json::json!({ "boxes": [[0.0, 0.0, 0.0, 1.0, 1.0, 1.0]] });
+    let w = world(post_and_ring(wrong));
+    assert!(
+        w.warnings().iter().any(|m| m.contains("'ring'") && m.contains("extras.asp.boxes") && m.contains("mesh")),
+        "{:?}",
+        w.warnings()
+    );
+}
+
+
+
+

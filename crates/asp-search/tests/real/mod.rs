@@ -49,39 +49,59 @@ fn beam_plans_caps_then_posts_then_the_beam() {
 
 #[test]
 fn ikea_models_plan_and_every_step_rechecks() {
-    for name in ["bookcase_billy_0191", "bookcase_grevback_0484", "cabinet_akurum_0011", "chair_bertil_0148", "desk_hannes_0529", "table_lack_0825"] {
+    // hemnes' notched rails (6_part6, 2_part2) once measured as a gross overlap: the erosion left
+    // every vertex of a lone ±x face unmoved (a wrong eigen decomposition); they only touch
+    for name in [
+        "bookcase_billy_0191",
+        "bookcase_grevback_0484",
+        "cabinet_akurum_0011",
+        "chair_bertil_0148",
+        "desk_hannes_0529",
+        "table_hemnes_0541",
+        "table_lack_0825",
+    ] {
         found_and_verified(&format!("ikea/{name}.glb"), false);
     }
-    // hemnes has a gross overlap between two parts: with --ignore-overlapping it plans
-    found_and_verified("ikea/table_hemnes_0541.glb", true);
 }
 
 #[test]
 fn gross_overlaps_are_errors_naming_both_parts() {
-    for (name, a, b) in [
-        ("ikea/table_hemnes_0541.glb", "'6_part6'", "'2_part2'"),
-        ("ikea/bed_dalselv_0270.glb", "'0_part0'", "'1_part1'"),
-    ] {
-        let err = world(name, None, false).err().expect("gross overlap is an error").to_string();
-        assert!(err.contains(a) && err.contains(b) && err.contains("--ignore-overlapping"), "{err}");
-    }
+    let err = world("ikea/bed_dalselv_0270.glb", None, false).err().expect("gross overlap is an error").to_string();
+    assert!(err.contains("'0_part0'") && err.contains("'1_part1'") && err.contains("--ignore-overlapping"), "{err}");
 }
 
 #[test]
-fn pump_ends_in_no_plan_with_its_stuck_core_explained() {
+fn pump_ends_in_no_plan_with_its_stuck_core_explained_and_the_rest_rechecked() {
     let (checker, outcome) = plan(world("pump", Some("mm"), false).unwrap(), &Dfs::builder().bookkeeping(true).build());
     let Status::NoPlan { stuck, state } = &outcome.status else { panic!("{:?}", outcome.status) };
     let w = checker.world();
     let name = |p: usize| w.name(p).trim_start_matches("PumpAssembly - ").to_string();
-    // five screws leave along their axes; the body, lids, ring, shaft, large screws and three
-    // screws remain, each blocked (its blockers named) — the screws' threads overlap their holes
-    let left: Vec<String> = state.iter().map(name).collect();
-    for part in ["Pump-1", "Lid-1", "BackLid2-1", "Shaft-1", "Ring-1", "LargeScrew1-1", "LargeScrew2-1"] {
-        assert!(left.contains(&part.to_string()), "{part} not in {left:?}");
-    }
+    // the screws, lids, shaft and ring leave; the body, the back lid and the large screw through
+    // both stay: body and lid are blocked (blockers named), and the screw is all that links them
+    // to the ground below (the model lies on its side)
+    let mut left: Vec<String> = state.iter().map(name).collect();
+    left.sort();
+    assert_eq!(left, ["BackLid2-1", "LargeScrew2-1", "Pump-1"]);
     assert_eq!(stuck.len(), state.len());
     for s in stuck {
-        let StuckReason::Blocked(blockers) = &s.reason else { panic!("{s:?}") };
-        assert!(!blockers.is_empty() && blockers.iter().all(|b| b == checker.num_parts() || state.contains(b)), "{s:?}");
+        match &s.reason {
+            StuckReason::Blocked(blockers) => assert!(
+                !blockers.is_empty() && blockers.iter().all(|b| b == checker.num_parts() || state.contains(b)),
+                "{s:?}"
+            ),
+            StuckReason::WouldLeaveUnsupported(parts) => {
+                assert_eq!(name(s.part), "LargeScrew2-1");
+                assert!(!parts.is_empty() && parts.iter().all(|b| state.contains(b)), "{s:?}");
+            }
+            StuckReason::DeadEnd => panic!("{s:?}"),
+        }
     }
+    // every other part comes off that core in a plan the independent sweep re-checks
+    let core = left.iter().map(|n| format!("PumpAssembly - {n}")).collect();
+    let options = LoadOptions { unit: Units::parse("mm"), up: Some(Axis::Z), fixed: core };
+    let rest = World::new(load(&data("pump"), &options).unwrap(), &WorldConfig::default()).unwrap();
+    let (checker, outcome) = plan(rest, &Dfs::builder().bookkeeping(true).build());
+    assert_eq!(outcome.status, Status::Found);
+    assert_eq!(outcome.removals.len(), checker.num_parts() - 3);
+    verify_plan(checker.world(), &outcome);
 }

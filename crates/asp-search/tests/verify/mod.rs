@@ -1,20 +1,21 @@
 //! An independent re-check of plans: every step is swept in small increments with static
-//! intersection tests of the part shrunk by the same tolerance — not the planner's shape casts,
-//! caches or blocking rows.
+//! intersection tests of the part shrunk by the same tolerance (its own erosion, static crossing
+//! tests at sampled poses) — not the planner's sweeps, caches or blocking rows.
 
-use asp_geom::erode::eroded_vertices;
+use asp_geom::erode::eroded_mesh;
 use asp_geom::feasibility::interpolate_about;
 use asp_geom::math::{Pose, Vec3};
 use asp_geom::{Motion, PartSet, Stability, World};
 use asp_search::{PlanOutcome, Status};
-use parry3d::query::{intersection_test, PointQuery};
+use asp_geom::sweep::meshes_cross_at;
+use parry3d::query::PointQuery;
 use parry3d::shape::{TriMesh, TriMeshFlags};
 use std::collections::HashMap;
 
 fn shrunk(world: &World, p: usize, amount: f32) -> TriMesh {
     let m = world.mesh(p);
-    let v = eroded_vertices(m.vertices(), m.indices(), amount);
-    TriMesh::with_flags(v, m.indices().to_vec(), TriMeshFlags::ORIENTED).unwrap()
+    let (v, t) = eroded_mesh(m.vertices(), m.indices(), amount);
+    TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED).unwrap()
 }
 
 /// Whether part `p` at `pose` penetrates a present part (other than itself) deeper than the
@@ -24,8 +25,6 @@ fn penetrates(world: &World, p: usize, pose: &Pose, present: &PartSet, shrunk_ca
     present.iter().filter(|&q| q != p && !world.ignores(p, q)).find(|&q| {
         let (k, amount) = world.pair_erosion(p, q);
         let shrunk_k = shrunk_cache.entry((k, amount.to_bits())).or_insert_with(|| shrunk(world, k, amount)).clone();
-        // parry's mesh-mesh intersection test depends on argument order (see
-        // shared research notes): always ask with the shrunk part first, in its own frame
         let id = Pose::IDENTITY;
         let (shrunk_pose, raw, raw_pose) = if k == p { (*pose, world.mesh(q).clone(), id) } else { (id, world.mesh(p).clone(), *pose) };
         let closed_raw = world.is_closed(if k == p { q } else { p });
@@ -34,7 +33,10 @@ fn penetrates(world: &World, p: usize, pose: &Pose, present: &PartSet, shrunk_ca
             (0..3).all(|i| a.mins[i] >= b.mins[i] && a.maxs[i] <= b.maxs[i])
         };
         // one wholly inside the other: only for closed surfaces whose boxes nest
-        intersection_test(&shrunk_pose, &shrunk_k, &raw_pose, &raw).unwrap().intersecting
+        // static crossing tests of the placed meshes (exact triangle pairs; parry's mesh-mesh
+        // intersection test reports surfaces a tolerance apart as crossing)
+        let crossing = if k == p { meshes_cross_at(&shrunk_k, pose, &raw) } else { meshes_cross_at(&raw, pose, &shrunk_k) };
+        crossing
             || (closed_raw && nests(&bs, &br) && raw.contains_point(&raw_pose, shrunk_pose.transform_point(shrunk_k.vertices()[0])))
             || (world.is_closed(k) && nests(&br, &bs) && shrunk_k.contains_point(&shrunk_pose, raw_pose.transform_point(raw.vertices()[0])))
     })
