@@ -741,3 +741,17 @@ fn batches_reject_bad_arguments() {
     let profiles = Generator::Profiles(ProfileParams { height: 0.1, ..ProfileParams::default() });
     assert!(generate_batch(&profiles, 1, 0, &ok, &|| {}).is_err());
 }
+
+#[test]
+fn distance_maps_sweep_every_generated_part_as_exact_boxes() {
+    use asp_geom::distmap::{DistanceMaps, MapConfig, PartGeometry};
+    let dir = tempfile::tempdir().unwrap();
+    for generator in [Generator::Profiles(ProfileParams::double_layer()), Generator::Soma(SomaParams { size: 4, cell: 0.05 })] {
+        let manifest = write(generator, 1, 3, dir.path());
+        let assembly = asp_geom::io::load(&dir.path().join(&manifest.assemblies[0].file), &Default::default()).unwrap();
+        let maps = DistanceMaps::build(&assembly, &MapConfig::default()).unwrap();
+        for (i, p) in assembly.parts.iter().enumerate() {
+            assert_ne!(maps.geometry(i), PartGeometry::Mesh, "'{}' is swept as a mesh", p.name);
+        }
+    }
+}
