@@ -19,17 +19,9 @@ use crate::mesh::Mesh;
 /// caller warns and falls back to the mesh).
 pub fn part_boxes(part: &Part) -> Result<Option<Vec<Aabb>>, String> {
     if let Some(cells) = voxels_of(&part.extras) {
-        let (origin, cell) = fit_voxels(&cells, &part.mesh)
-            .ok_or_else(|| "its voxels (extras.asp.cells) do not match its mesh".to_string())?;
-        return Ok(Some(
-            cells
-                .iter()
-                .map(|c| {
-                    let lo = origin + Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * cell;
-                    Aabb::new(lo, lo + cell)
-                })
-                .collect(),
-        ));
+        return fit_boxes(&unit_boxes(&cells), &part.mesh)
+            .map(Some)
+            .ok_or_else(|| "its voxels (extras.asp.cells) do not match its mesh".to_string());
     }
     if let Some(boxes) = listed_boxes(&part.extras) {
         return fit_boxes(&boxes, &part.mesh)
@@ -95,37 +87,43 @@ pub fn listed_boxes(extras: &serde_json::Value) -> Option<Vec<Aabb>> {
 /// Fits the voxel grid of a part to its mesh: the integer bounds of the cells span the mesh's
 /// box. Returns (origin, cell size) or `None` when the cells do not describe the mesh.
 pub fn fit_voxels(cells: &[[i32; 3]], mesh: &Mesh) -> Option<(Vec3, Vec3)> {
-    let mut unique: Vec<[i32; 3]> = cells.to_vec();
-    unique.sort_unstable();
-    unique.dedup();
-    let unit: Vec<Aabb> = unique
-        .iter()
-        .map(|c| {
-            let lo = Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32);
-            Aabb::new(lo, lo + Vec3::ONE)
-        })
-        .collect();
-    let (scale, offset) = fit_bounds(&unit, mesh)?;
-    let fitted: Vec<Aabb> = unit.iter().map(|b| Aabb::new(b.mins * scale + offset, b.maxs * scale + offset)).collect();
-    describes(&fitted, mesh).then_some((offset, scale))
+    fit(&unit_boxes(cells), mesh).map(|(_, scale, offset)| (offset, scale))
 }
 
 /// Fits listed boxes to a part's mesh (per axis, the union's bounds onto the mesh's bounds) and
 /// returns them when they describe the mesh.
 pub fn fit_boxes(boxes: &[Aabb], mesh: &Mesh) -> Option<Vec<Aabb>> {
-    let (scale, offset) = fit_bounds(boxes, mesh)?;
-    let fitted: Vec<Aabb> = boxes.iter().map(|b| Aabb::new(b.mins * scale + offset, b.maxs * scale + offset)).collect();
-    describes(&fitted, mesh).then_some(fitted)
+    fit(boxes, mesh).map(|(fitted, _, _)| fitted)
 }
 
-/// The per-axis scale and offset mapping the union bounds of `boxes` onto the mesh's bounds.
-fn fit_bounds(boxes: &[Aabb], mesh: &Mesh) -> Option<(Vec3, Vec3)> {
+/// Distinct cells as unit boxes of the grid.
+fn unit_boxes(cells: &[[i32; 3]]) -> Vec<Aabb> {
+    let mut unique: Vec<[i32; 3]> = cells.to_vec();
+    unique.sort_unstable();
+    unique.dedup();
+    unique
+        .iter()
+        .map(|c| {
+            let lo = Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32);
+            Aabb::new(lo, lo + Vec3::ONE)
+        })
+        .collect()
+}
+
+/// The boxes mapped per axis (scale, offset) so that their union's bounds are the mesh's
+/// bounds, with that scale and offset, when the mapped boxes describe the mesh.
+fn fit(boxes: &[Aabb], mesh: &Mesh) -> Option<(Vec<Aabb>, Vec3, Vec3)> {
     let target = mesh.aabb()?;
     let (lo, hi) = boxes
         .iter()
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), b| (lo.min(b.mins), hi.max(b.maxs)));
     let scale = (target.maxs - target.mins) / (hi - lo);
-    (scale.is_finite() && scale.min_element() > 0.0).then_some((scale, target.mins - lo * scale))
+    if !(scale.is_finite() && scale.min_element() > 0.0) {
+        return None;
+    }
+    let offset = target.mins - lo * scale;
+    let fitted: Vec<Aabb> = boxes.iter().map(|b| Aabb::new(b.mins * scale + offset, b.maxs * scale + offset)).collect();
+    describes(&fitted, mesh).then_some((fitted, scale, offset))
 }
 
 /// Whether disjoint-interior `boxes` describe the closed mesh: the same volume (to 0.1 %), and
@@ -253,6 +251,10 @@ mod tests {
         let top = Aabb::new(Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 1.0, 2.0));
         assert_eq!(first_overlap(&a, Vec3::Z, &top, 1e-3), Some(0.0));
         assert_eq!(first_overlap(&a, Vec3::X, &top, 1e-3), None, "sliding along a face is free");
+        assert_eq!(first_overlap(&a, Vec3::Z, &top, 0.0), Some(0.0));
+        assert_eq!(first_overlap(&a, Vec3::X, &top, 0.0), None);
+        let almost = Aabb::new(Vec3::new(0.0, 0.0, 0.9999), Vec3::new(1.0, 1.0, 2.0));
+        assert_eq!(first_overlap(&a, Vec3::X, &almost, 1e-3), None, "an overlap within the tolerance");
         assert!(overlap_depth(&a, &top) <= 0.0);
         let sunk = Aabb::new(Vec3::new(0.0, 0.0, 0.9), Vec3::new(1.0, 1.0, 2.0));
         assert!((overlap_depth(&a, &sunk) - 0.1).abs() < 1e-6);

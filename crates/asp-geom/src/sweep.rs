@@ -106,11 +106,23 @@ fn mesh_sweep(moving: &TriMesh, pose: &Pose, dir: Vec3, fixed: &TriMesh, t_max: 
     let inverse = pose.inverse();
     let fixed_box = fixed.local_aabb().transform_by(&inverse);
     let local_dir = inverse.rotation * dir;
+    let candidates = moving.bvh().leaves(|n| box_path_meets(&n.aabb(), local_dir, &fixed_box, t_max));
+    sweep_triangles(candidates.map(|i| triangle(moving, pose, i)), dir, fixed, t_max, earliest)
+}
+
+/// [`mesh_sweep`] for moving triangles given one by one: each is swept against the fixed
+/// triangles its path's box culling leaves.
+fn sweep_triangles(
+    moving: impl Iterator<Item = [DVec3; 3]>,
+    dir: Vec3,
+    fixed: &TriMesh,
+    t_max: f32,
+    earliest: bool,
+) -> Option<f32> {
     let d = dir.as_dvec3();
     let mut best: Option<f64> = None;
-    for i in moving.bvh().leaves(|n| box_path_meets(&n.aabb(), local_dir, &fixed_box, t_max)) {
+    for ta in moving {
         let limit = best.unwrap_or(t_max as f64);
-        let ta = triangle(moving, pose, i);
         let own = box_of(&ta);
         for j in fixed.bvh().leaves(|n| box_path_meets(&own, dir, &n.aabb(), limit as f32)) {
             if let Some(t) = triangle_sweep(&ta, d, &triangle(fixed, &Pose::IDENTITY, j), best.unwrap_or(t_max as f64)) {
@@ -139,15 +151,9 @@ pub fn meshes_cross_at(a: &TriMesh, pose: &Pose, b: &TriMesh) -> bool {
 /// [`meshes_cross`] for a triangle soup `a` (no BVH of its own to build: each of its triangles
 /// queries `b`'s).
 pub fn soup_crosses(vertices: &[Vec3], triangles: &[[u32; 3]], b: &TriMesh) -> bool {
-    let bb = b.local_aabb();
-    triangles.iter().any(|t| {
-        let ta = t.map(|i| vertices[i as usize].as_dvec3());
-        let own = box_of(&ta);
-        box_path_meets(&own, Vec3::ZERO, &bb, 0.0)
-            && b.bvh()
-                .leaves(|n| box_path_meets(&own, Vec3::ZERO, &n.aabb(), 0.0))
-                .any(|j| triangle_sweep(&ta, DVec3::ZERO, &triangle(b, &Pose::IDENTITY, j), 1.0).is_some())
-    })
+    let soup = triangles.iter().map(|t| t.map(|i| vertices[i as usize].as_dvec3()));
+    // without motion every axis' interval is all of time or nothing
+    sweep_triangles(soup, Vec3::ZERO, b, 1.0, false).is_some()
 }
 
 /// Whether `moving`, translated along unit `dir` by up to `t_max`, overlaps `fixed`.
