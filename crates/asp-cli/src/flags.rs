@@ -24,9 +24,11 @@ pub enum Command {
 /// Part orderings of the depth-first search.
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
 pub enum OrderArg {
-    /// The model's part order (vanilla AbD).
+    /// The model's part order.
     Given,
-    /// A random order in every state (`--seed`).
+    /// One random order drawn from `--seed` at the start and kept (the thesis' vanilla AbD).
+    Shuffled,
+    /// A fresh random order in every state (from `--seed` and the state).
     Random,
     /// Given order with bookkeeping: a blocked part is retested only after a blocker is gone.
     Bookkeeping,

@@ -15,7 +15,15 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            let geom = match e.downcast_ref::<asp_search::SearchError>() {
+                Some(asp_search::SearchError::Geom(g)) => Some(g),
+                _ => e.downcast_ref::<asp_geom::GeomError>(),
+            };
+            let hint = match geom {
+                Some(asp_geom::GeomError::GrossOverlap { .. }) => " (--tolerance, --ignore-overlapping)",
+                _ => "",
+            };
+            eprintln!("error: {e:#}{hint}");
             ExitCode::from(2)
         }
     }
