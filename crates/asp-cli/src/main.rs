@@ -4,6 +4,7 @@
 
 mod flags;
 mod gen;
+mod learn;
 mod optimise;
 mod output;
 
@@ -33,5 +34,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Plan(args) => output::plan(&args),
         Command::Gen(args) => gen::run(&args),
+        Command::Collect(args) => learn::collect(&args),
+        Command::Bench(args) => learn::bench(&args),
     }
 }

@@ -1,15 +1,14 @@
 //! `asp plan`: load, plan, print the table, write the JSON.
 
-use crate::flags::{OrderArg, PlanArgs, StabilityArg};
+use crate::flags::{ModelArgs, OrderArg, PlanArgs, StabilityArg};
 use anyhow::{bail, Context};
 use asp_geom::math::Axis;
 use asp_geom::Units;
 use asp_search::pipeline::{self, PlanSettings, StabilitySetting};
 use asp_search::report::{MotionEntry, PlanReport};
-use asp_search::{BuiltinOrder, OrderingSource, Progress};
+use asp_search::Progress;
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
-use std::sync::Arc;
 use std::time::Duration;
 
 pub(crate) fn positive(name: &str, v: f64) -> anyhow::Result<f64> {
@@ -20,8 +19,8 @@ pub(crate) fn positive(name: &str, v: f64) -> anyhow::Result<f64> {
     }
 }
 
-/// The pipeline's settings from the flags (flag names in the errors of flag values).
-pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
+/// The pipeline's loading and testing settings from the flags (flag names in the errors).
+pub(crate) fn model_settings(args: &ModelArgs) -> anyhow::Result<PlanSettings> {
     let unit = match &args.unit {
         Some(u) => Some(Units::parse(u).with_context(|| format!("--unit: unknown unit '{u}' (use m, cm, mm, in, ft or a number of metres)"))?),
         None => None,
@@ -31,11 +30,6 @@ pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
         None => None,
     };
     let check = |name: &str, v: Option<f64>| v.map(|v| positive(name, v)).transpose();
-    let order: Arc<dyn OrderingSource> = match args.order {
-        OrderArg::Given | OrderArg::Bookkeeping => Arc::new(BuiltinOrder::Given),
-        OrderArg::Shuffled => Arc::new(BuiltinOrder::Shuffled),
-        OrderArg::Random => Arc::new(BuiltinOrder::Random),
-    };
     Ok(PlanSettings {
         unit,
         up,
@@ -51,15 +45,24 @@ pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
                 StabilitySetting::Physics { threshold: positive("physics-threshold", args.physics_threshold)? }
             }
         },
-        order,
-        bookkeeping: args.bookkeeping || args.order == OrderArg::Bookkeeping,
-        seed: args.seed,
         path_planner: !args.no_path_planner,
         rrt_iterations: args.rrt_iterations,
         rrt_time: positive("rrt-time", args.rrt_time)?,
+        ..PlanSettings::default()
+    })
+}
+
+/// The pipeline's settings of `asp plan`.
+pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
+    let check = |name: &str, v: Option<f64>| v.map(|v| positive(name, v)).transpose();
+    Ok(PlanSettings {
+        order: crate::learn::order_source(args.order, args.onnx.as_deref())?,
+        bookkeeping: args.bookkeeping || args.order == OrderArg::Bookkeeping,
+        seed: args.seed,
         max_tests: args.max_tests,
         timeout: check("timeout", args.timeout)?,
         optimise: args.optimise.settings()?,
+        ..model_settings(&args.load)?
     })
 }
 

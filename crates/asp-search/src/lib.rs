@@ -1,5 +1,7 @@
 #![doc = include_str!("../README.md")]
 
+pub mod bench;
+pub mod collect;
 pub mod dfs;
 pub mod error;
 pub mod exact;
