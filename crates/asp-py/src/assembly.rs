@@ -2,24 +2,50 @@
 //! `asp._asp.load`.
 
 use crate::errors::Error;
+use crate::settings::GraphSettings;
 use crate::{run, settings};
+use asp_geom::{AssemblyGraph, PartSet, World};
 use asp_search::pipeline::{self, PlanSettings};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyByteArray, PyDict};
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
+
+/// What `Assembly.graph` returns: the part indices (int64), `x` (float32), `edge_index` (int64)
+/// and `edge_attr` (float32) as little-endian bytes, `node_dim`, `edge_dim` and the features
+/// string; `asp.Graph` views the bytes as numpy arrays.
+type GraphBuffers<'py> =
+    (Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, usize, usize, String);
 
 /// A loaded model: its parts in file order, units, up axis and the load's warnings. Immutable;
 /// every plan starts from it afresh.
 #[pyclass(frozen, module = "asp._asp", name = "Assembly")]
 pub struct PyAssembly {
     inner: Arc<asp_geom::Assembly>,
+    /// The model's graph for the settings last asked (computed once, states are subgraphs).
+    graph: Mutex<Option<(GraphSettings, Arc<AssemblyGraph>)>>,
 }
 
 impl PyAssembly {
     /// The Rust assembly.
     pub fn assembly(&self) -> &asp_geom::Assembly {
         &self.inner
+    }
+
+    /// The model's graph for `settings`: from the cache, or built (collision world, then
+    /// descriptors) and cached.
+    pub fn model_graph(&self, settings: &GraphSettings) -> Result<Arc<AssemblyGraph>, Error> {
+        let mut cache = self.graph.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((cached, graph)) = cache.as_ref() {
+            if cached.same_graph(settings) {
+                return Ok(graph.clone());
+            }
+        }
+        let config = pipeline::world_config(&self.inner, &settings.world)?;
+        let world = World::new((*self.inner).clone(), &config)?;
+        let graph = Arc::new(AssemblyGraph::build(&world, &settings.config)?);
+        *cache = Some((settings.clone(), graph.clone()));
+        Ok(graph)
     }
 }
 
@@ -36,7 +62,7 @@ pub fn load(py: Python<'_>, path: PathBuf, unit: Option<&str>, up: Option<&str>,
         ..PlanSettings::default()
     };
     let assembly = py.detach(|| pipeline::load(&path, &settings)).map_err(|e| Error::from(e).into_py(py))?;
-    Ok(PyAssembly { inner: Arc::new(assembly) })
+    Ok(PyAssembly { inner: Arc::new(assembly), graph: Mutex::new(None) })
 }
 
 #[pymethods]
@@ -99,6 +125,43 @@ impl PyAssembly {
             None => None,
         };
         Ok((result.report.to_json(), result.found(), trace))
+    }
+
+    /// The graph of the state `present` (part indices) with the keyword settings of
+    /// `asp.Assembly.graph` (a dict), as little-endian buffers (see `GraphBuffers`). The model's
+    /// graph is built once per settings (without the GIL) and cached.
+    fn graph<'py>(&self, py: Python<'py>, present: Vec<i64>, settings: &Bound<'py, PyDict>) -> PyResult<GraphBuffers<'py>> {
+        let settings = settings::graph_settings(settings).map_err(|e| e.into_py(py))?;
+        let n = self.inner.len();
+        let mut state = PartSet::empty(n);
+        for &p in &present {
+            match usize::try_from(p) {
+                Ok(i) if i < n => state.insert(i),
+                _ => {
+                    let message = format!("present: no part {p} (the model has {n} parts, 0 to {})", n.saturating_sub(1));
+                    return Err(Error::config(message).into_py(py));
+                }
+            }
+        }
+        let (graph, features) = py
+            .detach(|| {
+                self.model_graph(&settings).map(|model| {
+                    let features = model.features();
+                    (model.state(&state), features)
+                })
+            })
+            .map_err(|e| e.into_py(py))?;
+        let bytes_i64 = |v: &mut dyn Iterator<Item = i64>| v.flat_map(i64::to_le_bytes).collect::<Vec<u8>>();
+        let bytes_f32 = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+        Ok((
+            PyByteArray::new(py, &bytes_i64(&mut graph.nodes.iter().map(|&i| i as i64))),
+            PyByteArray::new(py, &bytes_f32(&graph.x)),
+            PyByteArray::new(py, &bytes_i64(&mut graph.edge_index.iter().copied())),
+            PyByteArray::new(py, &bytes_f32(&graph.edge_attr)),
+            graph.node_dim,
+            graph.edge_dim,
+            features,
+        ))
     }
 
     fn __repr__(&self) -> String {

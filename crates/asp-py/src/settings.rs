@@ -11,7 +11,7 @@ use crate::errors::Error;
 use crate::errors::Kind;
 use asp_geom::distmap::Support;
 use asp_geom::math::Axis;
-use asp_geom::Units;
+use asp_geom::{GraphConfig, Units};
 use asp_search::pipeline::{OptimiseSettings, PlanSettings, StabilitySetting};
 use asp_search::{BuiltinOrder, OrderingSource};
 use pyo3::conversion::FromPyObjectOwned;
@@ -130,16 +130,7 @@ impl<'py> Keywords<'_, 'py> {
 /// The settings of a planning run from `asp.Assembly.plan`'s keywords (load settings — unit, up,
 /// fixed parts — belong to `asp.load` and are rejected here like any unknown keyword).
 pub fn plan_settings(dict: &Bound<'_, PyDict>) -> Result<PlanSettings, Error> {
-    for key in dict.keys() {
-        let name = key.cast::<PyString>().map(|s| s.to_string()).unwrap_or_else(|_| key.to_string());
-        if !PLAN_KEYS.contains(&name.as_str()) {
-            let hint = match name.as_str() {
-                "unit" | "up" | "fixed" => format!("'{name}' is a setting of asp.load, not of plan"),
-                _ => format!("unknown setting '{name}'"),
-            };
-            return Err(Error::config(hint));
-        }
-    }
+    reject_unknown(dict, &PLAN_KEYS)?;
     let k = Keywords { dict };
     let defaults = PlanSettings::default();
     let (order, implied_bookkeeping) = ordering(&k.string("order")?.unwrap_or_else(|| "given".into()))?;
@@ -209,7 +200,66 @@ fn optimise_settings(k: &Keywords<'_, '_>) -> Result<Option<OptimiseSettings>, E
     }))
 }
 
-/// The defaults of every keyword of [`plan_settings`] as a dict (what `asp.Assembly.plan`'s
+/// The keywords of [`graph_settings`].
+pub const GRAPH_KEYS: [&str; 6] =
+    ["tolerance", "contact_distance", "ignore_overlapping", "radius_bins", "degree", "points_per_part"];
+
+/// What the graph of a model depends on: the collision world's contact settings and the feature
+/// parameters (also the key of the graph cache of an assembly handle).
+#[derive(Clone, Debug)]
+pub struct GraphSettings {
+    /// The world's settings (tolerance, contact distance, overlaps; the rest default).
+    pub world: PlanSettings,
+    /// The feature parameters.
+    pub config: GraphConfig,
+}
+
+impl GraphSettings {
+    /// Whether two settings give the same graph.
+    pub fn same_graph(&self, other: &GraphSettings) -> bool {
+        let w = (&self.world, &other.world);
+        self.config == other.config
+            && w.0.tolerance == w.1.tolerance
+            && w.0.contact_distance == w.1.contact_distance
+            && w.0.ignore_overlapping == w.1.ignore_overlapping
+    }
+}
+
+/// The settings of `asp.Assembly.graph`'s keywords (missing keys take the defaults).
+pub fn graph_settings(dict: &Bound<'_, PyDict>) -> Result<GraphSettings, Error> {
+    reject_unknown(dict, &GRAPH_KEYS)?;
+    let k = Keywords { dict };
+    let d = GraphConfig::default();
+    let config = GraphConfig::builder()
+        .radius_bins(k.count("radius_bins")?.unwrap_or(d.radius_bins))
+        .degree(k.count("degree")?.unwrap_or(d.degree))
+        .points_per_part(k.count("points_per_part")?.unwrap_or(d.points_per_part))
+        .build()
+        .map_err(Error::from)?;
+    let world = PlanSettings {
+        tolerance: k.positive("tolerance")?,
+        contact_distance: k.positive("contact_distance")?,
+        ignore_overlapping: k.flag("ignore_overlapping", false)?,
+        ..PlanSettings::default()
+    };
+    Ok(GraphSettings { world, config })
+}
+
+fn reject_unknown(dict: &Bound<'_, PyDict>, known: &[&str]) -> Result<(), Error> {
+    for key in dict.keys() {
+        let name = key.cast::<PyString>().map(|s| s.to_string()).unwrap_or_else(|_| key.to_string());
+        if !known.contains(&name.as_str()) {
+            let hint = match name.as_str() {
+                "unit" | "up" | "fixed" => format!("'{name}' is a setting of asp.load"),
+                _ => format!("unknown setting '{name}'"),
+            };
+            return Err(Error::config(hint));
+        }
+    }
+    Ok(())
+}
+
+/// The defaults of every keyword of [`plan_settings`] and [`graph_settings`] as a dict (what `asp.Assembly.plan`'s
 /// signature must show; a Python test compares the two).
 pub fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let p = PlanSettings::default();
@@ -240,6 +290,10 @@ pub fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("resolution", o.resolution)?;
     d.set_item("d_max", o.d_max)?;
     d.set_item("support", "below")?;
+    let g = GraphConfig::default();
+    d.set_item("radius_bins", g.radius_bins)?;
+    d.set_item("degree", g.degree)?;
+    d.set_item("points_per_part", g.points_per_part)?;
     Ok(d)
 }
 
