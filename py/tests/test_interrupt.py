@@ -42,7 +42,7 @@ def test_planning_releases_the_gil():
     done = threading.Event()
 
     def plan():
-        a.plan(max_tests=3000)
+        a.plan(max_tests=1500)
         done.set()
 
     t = threading.Thread(target=plan)
