@@ -19,6 +19,12 @@ pub enum Command {
     Plan(PlanArgs),
     /// Generate training assemblies (Soma cubes, aluminium profile assemblies).
     Gen(crate::gen::GenArgs),
+    /// Write a self-contained HTML page that plays a plan step by step (three.js, offline).
+    View(crate::view::ViewArgs),
+    /// Render a plan's storyboard (PNG or SVG): one panel per step.
+    Render(crate::view::RenderArgs),
+    /// Plot the Pareto front of a plan JSON, or the search's progress from --trace CSVs.
+    Plot(crate::plot::PlotArgs),
 }
 
 /// Part orderings of the depth-first search.
@@ -53,6 +59,9 @@ pub struct PlanArgs {
     /// Print the plan JSON on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Also write the assembly animated over time as MCAP for Foxglove (docs/pictures.md).
+    #[arg(long, value_name = "FILE")]
+    pub mcap: Option<PathBuf>,
     /// The unit of the model's coordinates: m, cm, mm, in, ft or metres per unit
     /// [default: m, or what the file says].
     #[arg(long)]

@@ -6,6 +6,8 @@ mod flags;
 mod gen;
 mod optimise;
 mod output;
+mod plot;
+mod view;
 
 use flags::{Cli, Command};
 use std::process::ExitCode;
@@ -25,5 +27,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Plan(args) => output::plan(&args),
         Command::Gen(args) => gen::run(&args),
+        Command::View(args) => view::view(&args),
+        Command::Render(args) => view::render(&args),
+        Command::Plot(args) => plot::run(&args),
     }
 }

@@ -97,6 +97,9 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
     }
     let world = checker.world();
     let report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
+    if let Some(path) = &args.mcap {
+        asp_viz::mcap::write_plan(path, world.assembly(), &report)?;
+    }
     let json = serde_json::to_string_pretty(&report)?;
     if let Some(path) = &args.out {
         std::fs::write(path, format!("{json}\n")).with_context(|| format!("{}: cannot write the plan", path.display()))?;
