@@ -126,7 +126,16 @@ const distance = radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 1
 camera.position.copy(centre).addScaledVector(viewDir, distance);
 camera.near = distance / 1000;
 camera.far = distance * 100;
-camera.updateProjectionMatrix();
+function frameView() {
+  const panel = document.getElementById('asp-panel');
+  const left = window.innerWidth > 700 ? panel.offsetLeft + panel.offsetWidth : 0;
+  // the full view is wider by the panel; the window shows its right part, so the view's centre
+  // sits in the middle of the area right of the panel
+  camera.aspect = (window.innerWidth + left) / window.innerHeight;
+  camera.setViewOffset(window.innerWidth + left, window.innerHeight, 0, 0, window.innerWidth, window.innerHeight);
+  camera.updateProjectionMatrix();
+}
+frameView();
 const controls = new OrbitControls(camera, renderer.domElement);
 controls.target.copy(centre);
 controls.update();
@@ -211,7 +220,7 @@ const baseParts = parts.filter((p) => initial.has(p.index));
 if (baseParts.length) {
   base.innerHTML = '';
   const head = document.createElement('b');
-  head.textContent = data.status === 'found' ? 'Base: ' : 'Never removed: ';
+  head.textContent = data.status === 'found' ? 'Base: ' : 'Dead end (the start): ';
   base.appendChild(head);
   baseParts.forEach((p, i) => {
     const s = document.createElement('span');
@@ -243,7 +252,7 @@ const playButton = document.getElementById('asp-play');
 function updatePanel(cur) {
   counter.textContent = `Step ${state.shown} / ${steps.length}` + (cur >= 0 ? `: ${steps[cur].name}` : '');
   items.forEach((li, k) => { li.className = k === cur ? 'current' : k < state.shown ? 'done' : 'todo'; });
-  playButton.innerHTML = state.playing ? '&#x23F8;' : '&#x25B6;';
+  playButton.textContent = state.playing ? '\u275A\u275A' : '\u25B6';
   document.getElementById('asp-state').textContent = JSON.stringify(api.state());
 }
 document.getElementById('asp-reset').addEventListener('click', () => { pause(); goto(0); });
@@ -257,9 +266,8 @@ window.addEventListener('keydown', (e) => {
   else if (e.key === 'Home') { pause(); goto(0); }
 });
 window.addEventListener('resize', () => {
-  camera.aspect = window.innerWidth / window.innerHeight;
-  camera.updateProjectionMatrix();
   renderer.setSize(window.innerWidth, window.innerHeight);
+  frameView();
 });
 
 // --- the loop
@@ -309,6 +317,8 @@ const api = {
   }),
 };
 window.aspViewer = api;
+// a found plan opens assembled; an unfinished one on its dead end, the stuck parts in red
+if (data.status === 'found') state.shown = steps.length;
 apply_state();
 renderer.render(scene, camera);
 api.ready = true;

@@ -110,7 +110,7 @@ pub fn storyboard(scene: &Scene, options: &RenderOptions) -> Storyboard {
             let dst = (((y + row) * width + x) * 3) as usize;
             pixels[dst..dst + (size * 3) as usize].copy_from_slice(&image[src..src + (size * 3) as usize]);
         }
-        let arrow = spec
+        let mut arrow: Vec<(f32, f32)> = spec
             .arrow
             .iter()
             .map(|p| {
@@ -118,11 +118,34 @@ pub fn storyboard(scene: &Scene, options: &RenderOptions) -> Storyboard {
                 (sx + x as f32, sy + y as f32)
             })
             .collect();
+        if let [start, end] = spec.arrow[..] {
+            lengthen(&mut arrow, &camera, start, end, size as f32 * MIN_ARROW);
+        }
         panels.push(Panel { x, y, size, part: spec.part, colour: spec.colour, title: spec.title.clone(), arrow });
     }
     let shaded = pixels.clone();
     draw_overlay(&mut pixels, width, height, &panels);
     Storyboard { width, height, pixels, shaded, panels }
+}
+
+/// The shortest straight arrow, as a fraction of the panel: short motions (a part that only
+/// has to clear a touching neighbour) still show their direction.
+pub const MIN_ARROW: f32 = 0.16;
+
+/// Makes a straight arrow at least `min_px` long on screen, keeping its end and direction.
+fn lengthen(arrow: &mut [(f32, f32)], camera: &Camera, start: Vec3, end: Vec3, min_px: f32) {
+    let d = (end - start).normalize_or_zero();
+    let (ex, ey, _) = camera.project(end);
+    let (bx, by, _) = camera.project(end - d);
+    let (dx, dy) = (ex - bx, ey - by);
+    let per_metre = (dx * dx + dy * dy).sqrt();
+    if per_metre < 1e-6 || arrow.len() != 2 {
+        return; // the motion runs along the line of sight
+    }
+    let len = (end - start).length() * per_metre;
+    if len < min_px {
+        arrow[0] = (arrow[1].0 - dx / per_metre * min_px, arrow[1].1 - dy / per_metre * min_px);
+    }
 }
 
 /// Writes the storyboard of `scene` to `path`: SVG when the extension is `.svg`, else PNG.
@@ -153,7 +176,7 @@ fn panel_specs(scene: &Scene) -> Vec<PanelSpec> {
             parts: scene.initial.iter().map(|&i| (i, colour_of_placed(i), Pose::IDENTITY)).collect(),
             part: None,
             colour: STUCK,
-            title: format!("{}: never removed", scene.report.status.replace('_', " ")),
+            title: format!("{}: {} parts left", scene.report.status.replace('_', " "), scene.initial.len()),
             arrow: Vec::new(),
         });
     }

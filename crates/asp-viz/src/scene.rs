@@ -191,12 +191,17 @@ pub struct Scene {
     /// The steps in assembly order.
     pub steps: Vec<Step>,
     /// The parts present before the first step: the base (fixed parts), or for a plan that was
-    /// not found the parts that were never removed.
+    /// not found the deepest dead end (the explanation's parts; without an explanation the
+    /// parts the last branch did not remove).
     pub initial: Vec<usize>,
     /// The parts the plan's `explanation` names as stuck (empty unless `no_plan`).
     pub stuck: Vec<usize>,
     /// Metres per model unit (the plan's `units`).
     pub metres_per_unit: f64,
+    /// Whether the steps' order is the plan's. It is not for a `no_plan` whose last branch
+    /// (`disassembly_sequence`) does not lead to the dead end its explanation describes: the
+    /// steps then list the other parts in index order.
+    pub order_recorded: bool,
 }
 
 impl Scene {
@@ -216,7 +221,8 @@ impl Scene {
         let metres = Units::parse(&report.units)
             .ok_or_else(|| VizError::input(source, format!("unknown unit '{}'", report.units)))?
             .metres;
-        let steps: Vec<Step> = if !report.assembly_sequence.is_empty() {
+        let mut order_recorded = true;
+        let steps: Vec<Step> = if report.status == "found" {
             report
                 .assembly_sequence
                 .iter()
@@ -229,15 +235,34 @@ impl Scene {
                 })
                 .collect::<Result<_>>()?
         } else {
-            report
-                .disassembly_sequence
-                .iter()
-                .rev()
-                .map(|&p| {
-                    let part = assembly.parts.get(p).ok_or_else(|| bad(p))?;
-                    Ok(Step { part: p, name: part.name.clone(), motion: None })
-                })
-                .collect::<Result<_>>()?
+            // The explanation lists every movable part of the deepest dead end; with the fixed
+            // parts that is the starting
+            // scene. `disassembly_sequence` is the branch the search was on last, which leads
+            // there only when its complement is that dead end (after a full backtrack it is
+            // empty); the other parts follow in index order, and the scene says the order is
+            // not recorded.
+            let complement: Vec<usize> = (0..n).filter(|i| !report.disassembly_sequence.contains(i)).collect();
+            let mut core: Vec<usize> = report.explanation.iter().map(|e| e.part).filter(|&p| p < n).collect();
+            if core.is_empty() {
+                core = complement.clone();
+            } else {
+                core.extend((0..n).filter(|&i| report.parts[i].fixed)); // never removed
+            }
+            core.sort_unstable();
+            core.dedup();
+            order_recorded = complement == core;
+            let mut order: Vec<usize> = Vec::new();
+            for &p in report.disassembly_sequence.iter().rev() {
+                if p >= n {
+                    return Err(bad(p));
+                }
+                if !core.contains(&p) && !order.contains(&p) {
+                    order.push(p);
+                }
+            }
+            let rest: Vec<usize> = (0..n).filter(|i| !core.contains(i) && !order.contains(i)).collect();
+            order.extend(rest);
+            order.into_iter().map(|p| Step { part: p, name: assembly.parts[p].name.clone(), motion: None }).collect()
         };
         let mut placed = vec![false; n];
         for s in &steps {
@@ -249,7 +274,7 @@ impl Scene {
         let mut stuck: Vec<usize> = report.explanation.iter().map(|e| e.part).filter(|&p| p < n).collect();
         stuck.sort_unstable();
         stuck.dedup();
-        Ok(Scene { assembly, report, steps, initial, stuck, metres_per_unit: metres })
+        Ok(Scene { assembly, report, steps, initial, stuck, metres_per_unit: metres, order_recorded })
     }
 
     /// Whether part `i` is a base part (fixed in the plan).

@@ -147,8 +147,10 @@ fn status_text(scene: &Scene) -> String {
     match scene.report.status.as_str() {
         "found" => format!("Plan found: {n} steps ({} parts, units {}).", scene.assembly.parts.len(), scene.report.units),
         "no_plan" => format!(
-            "No plan: the search took {n} parts off and then got stuck. Shown: that partial sequence in \
-             assembly order (motions not recorded), the stuck parts in red."
+            "No plan: the search got stuck with {} parts left (stuck parts in red). Steps: the other {n} parts, {}, \
+             appearing in place (no motions are recorded for them).",
+            scene.initial.len(),
+            if scene.order_recorded { "in the order of the branch reached" } else { "order not recorded" }
         ),
         other => format!("{}: the partial sequence reached ({n} parts; motions not recorded).", other.replace('_', " ")),
     }

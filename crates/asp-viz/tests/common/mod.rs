@@ -16,8 +16,9 @@ pub fn planned(assembly: Assembly) -> Scene {
     Scene::new(world.assembly().clone(), report, Path::new("fixture")).unwrap()
 }
 
-/// The tube's plan turned into a `no_plan` result: the handle came off, then the stick was
-/// stuck between the receptacle and the cap.
+/// The tube's plan turned into a `no_plan` result as the planner writes one: the handle came
+/// off, then the stick was stuck between the receptacle and the cap, and the cap could leave
+/// but led nowhere.
 pub fn stuck_tube() -> Scene {
     let scene = planned(fixtures::tube());
     let mut report = scene.report.clone();
@@ -31,6 +32,6 @@ pub fn stuck_tube() -> Scene {
         name: "stick".into(),
         reason: "blocked".into(),
         parts: vec![NamedPart { part: receptacle, name: "receptacle".into() }, NamedPart { part: cap, name: "cap".into() }],
-    }];
+    }, Explanation { part: cap, name: "cap".into(), reason: "dead_end".into(), parts: vec![] }];
     Scene::new(scene.assembly.clone(), report, Path::new("fixture")).unwrap()
 }

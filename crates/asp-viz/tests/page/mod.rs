@@ -66,3 +66,17 @@ fn names_cannot_break_out_of_the_data_script() {
     let page = html(&scene);
     assert_eq!(page.matches("</script>").count(), html(&planned(fixtures::tube())).matches("</script>").count());
 }
+
+#[test]
+fn a_no_plan_after_a_full_backtrack_starts_from_the_dead_end_its_explanation_describes() {
+    // the planner backtracked to the root: the last branch is empty, the explanation names the
+    // dead end {stick, cap} (+ the fixed receptacle)
+    let mut scene = stuck_tube();
+    scene.report.disassembly_sequence.clear();
+    let scene = asp_viz::Scene::new(scene.assembly.clone(), scene.report.clone(), std::path::Path::new("fixture")).unwrap();
+    assert_eq!(scene.initial.len(), 3);
+    assert_eq!(scene.steps.len(), 1, "the handle");
+    assert!(!scene.order_recorded || scene.steps.len() == 1);
+    let d = data(&html(&scene));
+    assert_eq!(d["initial"].as_array().unwrap().len(), 3);
+}
