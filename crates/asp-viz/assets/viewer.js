@@ -304,6 +304,11 @@ const api = {
   ready: false,
   goto, step, back, play, pause,
   reset: () => { pause(); return goto(0); },
+  // the pose of step k's part a fraction s through its motion (model units): {t: [x,y,z], q: [x,y,z,w]}
+  poseAt: (k, s) => {
+    const p = poseAt(steps[k].motion, s);
+    return { t: [p.t.x, p.t.y, p.t.z], q: [p.q.x, p.q.y, p.q.z, p.q.w] };
+  },
   state: () => ({
     shown: state.shown,
     total: steps.length,

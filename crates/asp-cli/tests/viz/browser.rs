@@ -14,7 +14,8 @@ type Socket = tungstenite::WebSocket<TcpStream>;
 /// The Chromium binary: `$ASP_CHROMIUM`, else `chromium` or `chromium-browser` on the PATH.
 fn chromium() -> Option<PathBuf> {
     if let Some(p) = std::env::var_os("ASP_CHROMIUM") {
-        return Some(PathBuf::from(p));
+        let p = PathBuf::from(p);
+        return p.is_file().then_some(p);
     }
     let path = std::env::var_os("PATH")?;
     for dir in std::env::split_paths(&path) {
@@ -64,7 +65,7 @@ impl Browser {
     /// Starts Chromium headless, or prints why not and returns `None` when it is not installed.
     pub fn launch() -> Option<Browser> {
         let Some(binary) = chromium() else {
-            eprintln!("skipping the browser test: no chromium on the PATH (install it with `apt-get install -y chromium`, or set ASP_CHROMIUM)");
+            eprintln!("skipping the browser test: no chromium (not on the PATH, or $ASP_CHROMIUM is not a file); install it with `apt-get install -y chromium`");
             return None;
         };
         let profile = tempfile::tempdir().unwrap();

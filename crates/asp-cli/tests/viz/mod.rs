@@ -162,6 +162,33 @@ fn the_viewer_shows_a_no_plan_result_with_the_stuck_parts_in_red() {
 }
 
 #[test]
+fn the_viewer_moves_path_motions_as_the_plan_format_documents() {
+    let Some(mut browser) = Browser::launch() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("l_path.glb");
+    write_glb(&fixtures::l_path(), &model).unwrap();
+    let plan = dir.path().join("l_path.json");
+    let o = asp(&["plan", model.to_str().unwrap(), "--quiet", "--out", plan.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let scene = asp_viz::Scene::from_plan_file(&plan, None).unwrap();
+    let k = scene.steps.iter().position(|s| matches!(s.motion, Some(asp_viz::Insertion::Path { .. }))).expect("the L needs a path");
+    let motion = scene.steps[k].motion.clone().unwrap();
+    browser.open(&view(&plan, "l_path.html"));
+    for s in [0.0f32, 0.2, 0.45, 0.5, 0.8, 1.0] {
+        let js = browser.eval(&format!("aspViewer.poseAt({k}, {s})"));
+        let rust = motion.pose_at(s); // metres; the fixture's unit is the metre
+        let t: Vec<f64> = js["t"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let q: Vec<f64> = js["q"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let rt = rust.translation;
+        let rq = rust.rotation;
+        let dt = ((t[0] - rt.x as f64).powi(2) + (t[1] - rt.y as f64).powi(2) + (t[2] - rt.z as f64).powi(2)).sqrt();
+        let dot = (q[0] * rq.x as f64 + q[1] * rq.y as f64 + q[2] * rq.z as f64 + q[3] * rq.w as f64).abs();
+        assert!(dt < 1e-4 && dot > 1.0 - 1e-5, "s = {s}: page {t:?} {q:?}, library {rust:?}");
+    }
+    browser.assert_no_errors();
+}
+
+#[test]
 fn render_writes_a_storyboard_png_of_the_right_size() {
     let out = shared_dir().join("lack.png");
     let o = asp(&["render", lack_plan().to_str().unwrap(), "--out", out.to_str().unwrap(), "--panel", "200", "--columns", "3"]);
