@@ -59,8 +59,9 @@ pub struct PlanArgs {
     /// Print the plan JSON on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
-    /// Also write the assembly animated over time as MCAP for Foxglove (docs/pictures.md).
-    #[arg(long, value_name = "FILE")]
+    /// Also write the assembly animated over time as MCAP for Foxglove (docs/pictures.md);
+    /// not yet with --objective.
+    #[arg(long, value_name = "FILE", conflicts_with = "objective")]
     pub mcap: Option<PathBuf>,
     /// The unit of the model's coordinates: m, cm, mm, in, ft or metres per unit
     /// [default: m, or what the file says].
