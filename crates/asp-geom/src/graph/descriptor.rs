@@ -55,9 +55,7 @@ where
     let (mut total, mut sum) = (0.0f64, [0.0f64; 3]);
     for (p, w) in valid() {
         total += w;
-        for k in 0..3 {
-            sum[k] += w * p[k];
-        }
+        sum = [sum[0] + w * p[0], sum[1] + w * p[1], sum[2] + w * p[2]];
     }
     if !(total > 0.0 && total.is_finite()) {
         return;

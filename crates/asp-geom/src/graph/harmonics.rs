@@ -27,7 +27,7 @@ pub fn index(l: usize, m: i64) -> usize {
 /// entries are left alone, and a shorter `out` receives only the degrees that fit).
 pub fn real_sh(dir: [f64; 3], degree: usize, out: &mut [f64]) {
     let [x, y, z] = dir;
-    let degree = (0..=degree).rev().find(|&l| count(l) <= out.len()).map_or(0, |l| l);
+    let degree = (0..=degree).rev().find(|&l| count(l) <= out.len()).unwrap_or(0);
     if out.is_empty() {
         return;
     }
