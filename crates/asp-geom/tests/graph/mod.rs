@@ -204,6 +204,66 @@ fn stacked_boxes_have_the_expected_edges_and_gravity_attributes() {
     assert_eq!(&g.edge_attr_flat()[146 * 3..], g.edge_attr(3));
 }
 
+/// Distance from `p` to the surface of the box `[lo, hi]`, for `p` outside or on it.
+fn box_distance(p: Vec3, lo: Vec3, hi: Vec3) -> f32 {
+    (lo - p).max(p - hi).max(Vec3::ZERO).length()
+}
+
+#[test]
+fn edge_attributes_follow_the_contract_order_computed_naively() {
+    // a small box on a big one, with a wide contact distance so the two regions differ: the
+    // top box's region includes bands of its sides, the lower one's a patch of its top face
+    let (lo_a, hi_a) = (Vec3::ZERO, Vec3::ONE);
+    let (lo_b, hi_b) = (Vec3::new(0.2, 0.3, 1.0), Vec3::new(0.7, 0.6, 1.4));
+    let a = assemble(
+        "small_on_big",
+        vec![part("big", Mesh::cuboid(lo_a, hi_a), true), part("small", Mesh::cuboid(lo_b, hi_b), false)],
+        Axis::Z,
+    );
+    let eps = 0.15;
+    let w = world(a, &WorldConfig { contact_distance: Some(eps), ..WorldConfig::default() });
+    let config = GraphConfig::default();
+    let g = AssemblyGraph::build(&w, &config).unwrap();
+    assert_eq!(g.edges(), &[(0, 1), (1, 0)]);
+    let samples: Vec<_> = (0..2)
+        .map(|i| asp_geom::graph::sample::sample_triangles(w.mesh(i).vertices(), w.mesh(i).indices(), 2048))
+        .collect();
+    let boxes = [(lo_a, hi_a), (lo_b, hi_b)];
+    // Q_i^j, the naive way, as (points, weights, normals)
+    let region = |i: usize, j: usize| {
+        let s = &samples[i];
+        let keep: Vec<usize> = (0..s.len()).filter(|&k| box_distance(s.points[k], boxes[j].0, boxes[j].1) < eps).collect();
+        let pts: Vec<Vec3> = keep.iter().map(|&k| s.points[k]).collect();
+        let wts: Vec<f32> = keep.iter().map(|&k| s.weights[k]).collect();
+        let up: f32 = keep.iter().map(|&k| s.weights[k] * s.normals[k].z).sum::<f32>() / wts.iter().sum::<f32>();
+        (sh_descriptor(&pts, &wts, &config), up, pts.len())
+    };
+    let (h01, up01, n01) = region(0, 1); // on the big box, near the small one
+    let (h10, up10, n10) = region(1, 0);
+    assert!(n01 > 10 && n10 > 10 && relative_gap(&h01, &h10) > 0.02, "the regions must differ");
+    let close = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-5);
+    let c = [samples[0].centroid().unwrap(), samples[1].centroid().unwrap()];
+    // edge 0 → 1: [h(Q_1^0), h(Q_0^1), up · unit(c_0 − c_1), normal_up over Q_1^0]
+    let e = g.edge_attr(0);
+    assert!(close(&e[..72], &h10) && close(&e[72..144], &h01));
+    assert!((e[144] - (c[0] - c[1]).normalize().z).abs() < 1e-6 && e[144] < -0.5);
+    assert!((e[145] - up10).abs() < 1e-5, "{} vs {up10}", e[145]);
+    // its bottom faces down, its side bands sideways
+    assert!(e[145] < -0.2 && e[145] > -0.6, "the small box's region: {}", e[145]);
+    // edge 1 → 0: [h(Q_0^1), h(Q_1^0), up · unit(c_1 − c_0), normal_up over Q_0^1]
+    let e = g.edge_attr(1);
+    assert!(close(&e[..72], &h01) && close(&e[72..144], &h10));
+    assert!((e[144] - (c[1] - c[0]).normalize().z).abs() < 1e-6 && e[144] > 0.5);
+    assert!((e[145] - up01).abs() < 1e-5 && e[145] > 0.99, "the big box's region is a floor: {}", e[145]);
+    // node attributes are the whole part's descriptor, fixed and on_base
+    for i in 0..2 {
+        let s = &samples[i];
+        assert!(close(&g.node_attr(i)[..72], &sh_descriptor(&s.points, &s.weights, &config)));
+    }
+    assert_eq!(&g.node_attr(0)[72..], &[1.0, 0.0]);
+    assert_eq!(&g.node_attr(1)[72..], &[0.0, 1.0]);
+}
+
 #[test]
 fn without_a_fixed_part_the_ground_is_the_base_but_no_node() {
     let a = assemble(
