@@ -256,8 +256,7 @@ fn edge_attributes_follow_the_contract_order_computed_naively() {
     assert!((e[144] - (c[1] - c[0]).normalize().z).abs() < 1e-6 && e[144] > 0.5);
     assert!((e[145] - up01).abs() < 1e-5 && e[145] > 0.99, "the big box's region is a floor: {}", e[145]);
     // node attributes are the whole part's descriptor, fixed and on_base
-    for i in 0..2 {
-        let s = &samples[i];
+    for (i, s) in samples.iter().enumerate() {
         assert!(close(&g.node_attr(i)[..72], &sh_descriptor(&s.points, &s.weights, &config)));
     }
     assert_eq!(&g.node_attr(0)[72..], &[1.0, 0.0]);
