@@ -21,7 +21,7 @@
 //! weights are ignored. Never NaN.
 
 use super::config::GraphConfig;
-use super::harmonics::{count, index, real_sh};
+use super::harmonics::{count, index, RealSh};
 use crate::math::Vec3;
 
 /// The descriptor of the cloud `points` with `weights` (paired by position; extra items of the
@@ -65,6 +65,7 @@ where
     let length = |d: [f64; 3]| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
     let radius = valid().map(|(p, _)| length(offset(p))).fold(0.0f64, f64::max);
     let nh = count(degree);
+    let harmonics = RealSh::new(degree);
     scratch.clear();
     scratch.resize(bins * nh + nh, 0.0);
     let (acc, y) = scratch.split_at_mut(bins * nh);
@@ -80,7 +81,7 @@ where
             let t = u - b0 as f64;
             // 3. the harmonics of the direction
             if r > tiny {
-                real_sh([d[0] / r, d[1] / r, d[2] / r], degree, y);
+                harmonics.eval([d[0] / r, d[1] / r, d[2] / r], y);
             } else {
                 y.fill(0.0);
                 y[0] = 0.5 / std::f64::consts::PI.sqrt();
