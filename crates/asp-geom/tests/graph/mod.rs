@@ -460,6 +460,8 @@ fn every_shipped_model_has_finite_consistent_features() {
         let started = std::time::Instant::now();
         let g = graph(&w);
         eprintln!("{name}: {} parts, {} edges, built in {:?}", g.num_parts(), g.num_edges(), started.elapsed());
+        // deterministic under rayon: a second build is bit-identical
+        assert_eq!(graph(&w), g, "{name}: two builds differ");
         let n = g.num_parts();
         assert_eq!(g.nodes_flat().len(), n * 74);
         assert_eq!(g.edge_attr_flat().len(), g.num_edges() * 146);
