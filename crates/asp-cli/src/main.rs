@@ -4,6 +4,7 @@
 
 mod flags;
 mod gen;
+mod learn;
 mod optimise;
 mod output;
 mod plot;
@@ -17,7 +18,15 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            let geom = match e.downcast_ref::<asp_search::SearchError>() {
+                Some(asp_search::SearchError::Geom(g)) => Some(g),
+                _ => e.downcast_ref::<asp_geom::GeomError>(),
+            };
+            let hint = match geom {
+                Some(asp_geom::GeomError::GrossOverlap { .. }) => " (--tolerance, --ignore-overlapping)",
+                _ => "",
+            };
+            eprintln!("error: {e:#}{hint}");
             ExitCode::from(2)
         }
     }
@@ -27,6 +36,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Plan(args) => output::plan(&args),
         Command::Gen(args) => gen::run(&args),
+        Command::Collect(args) => learn::collect(&args),
+        Command::Bench(args) => learn::bench(&args),
         Command::View(args) => view::view(&args),
         Command::Render(args) => view::render(&args),
         Command::Plot(args) => plot::run(&args),

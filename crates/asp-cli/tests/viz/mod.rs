@@ -243,9 +243,13 @@ fn plan_writes_an_mcap_with_the_foxglove_topics() {
     assert_eq!(topics["/asp/parts"], ("foxglove.SceneUpdate".to_string(), 4), "the base, then 3 steps");
     assert_eq!(topics["/asp/paths"].1, 3);
     assert_eq!(topics["/tf"].0, "foxglove.FrameTransforms");
-    // optimising runs do not write it yet: refused rather than silently skipped
-    let o = asp(&["plan", model.to_str().unwrap(), "--objective", "access", "--mcap", out.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    // optimising runs go through the same pipeline and write it too
+    let optimised = dir.path().join("optimised.mcap");
+    let o = asp(&["plan", model.to_str().unwrap(), "--quiet", "--objective", "access", "--threads", "1", "--mcap", optimised.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let bytes = std::fs::read(&optimised).unwrap();
+    let paths = mcap::MessageStream::new(&bytes).unwrap().filter(|m| m.as_ref().unwrap().channel.topic == "/asp/paths").count();
+    assert_eq!(paths, 3);
 }
 
 #[test]
