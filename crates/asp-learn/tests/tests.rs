@@ -1,0 +1,3 @@
+//! Integration tests of asp-learn (one binary; modules in folders).
+
+mod model;
