@@ -19,17 +19,26 @@ pub enum Command {
     Plan(PlanArgs),
     /// Generate training assemblies (Soma cubes, aluminium profile assemblies).
     Gen(crate::gen::GenArgs),
+    /// Collect training data from planning runs (`removability`: labelled states, docs/learning.md).
+    Collect(crate::learn::CollectArgs),
+    /// Benchmarks (`feasible`: the thesis' Table 3.1 for a folder of models).
+    Bench(crate::learn::BenchArgs),
 }
 
 /// Part orderings of the depth-first search.
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
 pub enum OrderArg {
-    /// The model's part order (vanilla AbD).
+    /// The model's part order.
     Given,
-    /// A random order in every state (`--seed`).
+    /// One random order drawn from `--seed` at the start and kept (the thesis' vanilla AbD).
+    Shuffled,
+    /// A fresh random order in every state (from `--seed` and the state).
     Random,
     /// Given order with bookkeeping: a blocked part is retested only after a blocker is gone.
     Bookkeeping,
+    /// Parts in order of the removability a graph neural network predicts (`--model`),
+    /// predicted again after each removal (thesis 3.5.3).
+    Gnn,
 }
 
 /// Stability criteria.
@@ -42,17 +51,9 @@ pub enum StabilityArg {
     Physics,
 }
 
-/// Flags of `asp plan`.
-#[derive(Args, Debug)]
-pub struct PlanArgs {
-    /// The model: a .glb/.gltf file, or a folder of .obj/.stl files (one part per file).
-    pub model: PathBuf,
-    /// Also write the plan as JSON to this file (format: docs/plan-format.md).
-    #[arg(long, value_name = "FILE")]
-    pub out: Option<PathBuf>,
-    /// Print the plan JSON on stdout instead of the table.
-    #[arg(long)]
-    pub json: bool,
+/// How a model is loaded and its removals tested: shared by `plan`, `collect` and `bench`.
+#[derive(Args, Debug, Clone)]
+pub struct ModelArgs {
     /// The unit of the model's coordinates: m, cm, mm, in, ft or metres per unit
     /// [default: m, or what the file says].
     #[arg(long)]
@@ -81,12 +82,6 @@ pub struct PlanArgs {
     /// Extra removal directions sampled evenly on the sphere.
     #[arg(long, default_value_t = 0)]
     pub sphere_directions: usize,
-    /// Part ordering.
-    #[arg(long, value_enum, default_value_t = OrderArg::Given)]
-    pub order: OrderArg,
-    /// Bookkeeping on top of any ordering (implied by `--order bookkeeping`).
-    #[arg(long)]
-    pub bookkeeping: bool,
     /// Stability criterion.
     #[arg(long, value_enum, default_value_t = StabilityArg::Contact)]
     pub stability: StabilityArg,
@@ -94,15 +89,6 @@ pub struct PlanArgs {
     /// simulation before the state counts as unstable.
     #[arg(long, default_value_t = 0.01)]
     pub physics_threshold: f64,
-    /// Seed of every random choice (random order, path planner, optimisation).
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
-    /// Stop after this many removal tests.
-    #[arg(long)]
-    pub max_tests: Option<u64>,
-    /// Stop after this many seconds.
-    #[arg(long)]
-    pub timeout: Option<f64>,
     /// Never call the path planner (straight lines only).
     #[arg(long)]
     pub no_path_planner: bool,
@@ -113,6 +99,41 @@ pub struct PlanArgs {
     /// reproducible; this only guards against pathological models).
     #[arg(long, default_value_t = 5.0)]
     pub rrt_time: f64,
+}
+
+/// Flags of `asp plan`.
+#[derive(Args, Debug)]
+pub struct PlanArgs {
+    /// The model: a .glb/.gltf file, or a folder of .obj/.stl files (one part per file).
+    pub model: PathBuf,
+    /// Also write the plan as JSON to this file (format: docs/plan-format.md).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Print the plan JSON on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Loading and testing.
+    #[command(flatten)]
+    pub load: ModelArgs,
+    /// Part ordering of the depth-first search.
+    #[arg(long, value_enum, default_value_t = OrderArg::Given)]
+    pub order: OrderArg,
+    /// The removability model of `--order gnn` (ONNX, docs/learning.md) [default: the model
+    /// shipped with asp, models/removability.onnx].
+    #[arg(long = "model", value_name = "FILE")]
+    pub onnx: Option<PathBuf>,
+    /// Bookkeeping on top of any ordering (implied by `--order bookkeeping`).
+    #[arg(long)]
+    pub bookkeeping: bool,
+    /// Seed of every random choice (random order, path planner, optimisation).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Stop after this many removal tests.
+    #[arg(long)]
+    pub max_tests: Option<u64>,
+    /// Stop after this many seconds.
+    #[arg(long)]
+    pub timeout: Option<f64>,
     /// No progress bar, no warnings.
     #[arg(long, short)]
     pub quiet: bool,

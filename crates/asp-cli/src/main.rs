@@ -4,6 +4,7 @@
 
 mod flags;
 mod gen;
+mod learn;
 mod optimise;
 mod output;
 
@@ -15,7 +16,15 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            let geom = match e.downcast_ref::<asp_search::SearchError>() {
+                Some(asp_search::SearchError::Geom(g)) => Some(g),
+                _ => e.downcast_ref::<asp_geom::GeomError>(),
+            };
+            let hint = match geom {
+                Some(asp_geom::GeomError::GrossOverlap { .. }) => " (--tolerance, --ignore-overlapping)",
+                _ => "",
+            };
+            eprintln!("error: {e:#}{hint}");
             ExitCode::from(2)
         }
     }
@@ -25,5 +34,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Plan(args) => output::plan(&args),
         Command::Gen(args) => gen::run(&args),
+        Command::Collect(args) => learn::collect(&args),
+        Command::Bench(args) => learn::bench(&args),
     }
 }

@@ -1,14 +1,12 @@
 //! `asp plan`: load, plan, print the table, write the JSON.
 
-use crate::flags::{OrderArg, PlanArgs, StabilityArg};
+use crate::flags::{ModelArgs, OrderArg, PlanArgs, StabilityArg};
 use anyhow::{bail, Context};
-use asp_geom::io::{load, LoadOptions};
 use asp_geom::math::Axis;
-use asp_geom::physics::PhysicsConfig;
-use asp_geom::rrt::RrtConfig;
-use asp_geom::{Checker, CheckerConfig, StabilityMode, Units, World, WorldConfig};
+use asp_geom::Units;
+use asp_search::pipeline::{self, PlanSettings, StabilitySetting};
 use asp_search::report::{MotionEntry, PlanReport};
-use asp_search::{Budget, Dfs, Ordering, Planner, Problem, Progress, Status};
+use asp_search::Progress;
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 use std::time::Duration;
@@ -21,8 +19,8 @@ pub(crate) fn positive(name: &str, v: f64) -> anyhow::Result<f64> {
     }
 }
 
-/// Runs `asp plan`.
-pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
+/// The pipeline's loading and testing settings from the flags (flag names in the errors).
+pub(crate) fn model_settings(args: &ModelArgs) -> anyhow::Result<PlanSettings> {
     let unit = match &args.unit {
         Some(u) => Some(Units::parse(u).with_context(|| format!("--unit: unknown unit '{u}' (use m, cm, mm, in, ft or a number of metres)"))?),
         None => None,
@@ -31,57 +29,48 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
         Some(a) => Some(Axis::parse(a).with_context(|| format!("--up: '{a}' is not an axis (use x, y, z, -x, -y, -z)"))?),
         None => None,
     };
-    let options = LoadOptions { unit, up, fixed: args.fixed.clone() };
-    let assembly = load(&args.model, &options)?;
-    if args.optimise.is_active() {
-        return crate::optimise::plan(args, assembly);
-    }
-    let metres = assembly.units.metres;
-    let to_m = |name: &str, v: Option<f64>| -> anyhow::Result<Option<f32>> {
-        v.map(|v| positive(name, v).map(|v| (v * metres) as f32)).transpose()
-    };
-    let config = WorldConfig {
-        tolerance: to_m("tolerance", args.tolerance)?,
-        contact_distance: to_m("contact-distance", args.contact_distance)?,
-        normal_clusters: args.normals,
+    let check = |name: &str, v: Option<f64>| v.map(|v| positive(name, v)).transpose();
+    Ok(PlanSettings {
+        unit,
+        up,
+        fixed: args.fixed.clone(),
+        tolerance: check("tolerance", args.tolerance)?,
+        contact_distance: check("contact-distance", args.contact_distance)?,
+        normals: args.normals,
         sphere_directions: args.sphere_directions,
         ignore_overlapping: args.ignore_overlapping,
-        ..WorldConfig::default()
-    };
-    let world = World::new(assembly, &config)?;
-    if !args.quiet {
-        for w in world.warnings() {
-            eprintln!("warning: {}: {w}", args.model.display());
-        }
-    }
-    let stability = match args.stability {
-        StabilityArg::Contact => StabilityMode::ContactGraph,
-        StabilityArg::Physics => {
-            let physics = PhysicsConfig {
-                displacement_fraction: positive("physics-threshold", args.physics_threshold)? as f32,
-                ..PhysicsConfig::default()
-            };
-            physics.validate()?;
-            StabilityMode::Physics(physics)
-        }
-    };
-    let rrt = RrtConfig {
-        max_iterations: args.rrt_iterations,
-        max_time: Duration::from_secs_f64(positive("rrt-time", args.rrt_time)?),
-        ..RrtConfig::default()
-    };
-    let checker = Checker::new(world, CheckerConfig { stability, rrt });
-    let planner = Dfs::builder()
-        .ordering(if args.order == OrderArg::Random { Ordering::Random } else { Ordering::Given })
-        .bookkeeping(args.bookkeeping || args.order == OrderArg::Bookkeeping)
-        .path_planner(!args.no_path_planner)
-        .seed(args.seed)
-        .build();
-    let budget = Budget {
+        stability: match args.stability {
+            StabilityArg::Contact => StabilitySetting::Contact,
+            StabilityArg::Physics => {
+                StabilitySetting::Physics { threshold: positive("physics-threshold", args.physics_threshold)? }
+            }
+        },
+        path_planner: !args.no_path_planner,
+        rrt_iterations: args.rrt_iterations,
+        rrt_time: positive("rrt-time", args.rrt_time)?,
+        ..PlanSettings::default()
+    })
+}
+
+/// The pipeline's settings of `asp plan`.
+pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
+    let check = |name: &str, v: Option<f64>| v.map(|v| positive(name, v)).transpose();
+    Ok(PlanSettings {
+        order: crate::learn::order_source(args.order, args.onnx.as_deref())?,
+        bookkeeping: args.bookkeeping || args.order == OrderArg::Bookkeeping,
+        seed: args.seed,
         max_tests: args.max_tests,
-        timeout: args.timeout.map(|t| positive("timeout", t).map(Duration::from_secs_f64)).transpose()?,
-    };
-    let bar = progress_bar(args.quiet);
+        timeout: check("timeout", args.timeout)?,
+        optimise: args.optimise.settings()?,
+        ..model_settings(&args.load)?
+    })
+}
+
+/// Runs `asp plan`.
+pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
+    let settings = settings(args)?;
+    let assembly = pipeline::load(&args.model, &settings)?;
+    let bar = progress_bar(args.quiet || settings.optimise.is_some());
     let report_progress = |p: &Progress| {
         if let Some(bar) = &bar {
             bar.set_length(p.total as u64);
@@ -89,28 +78,37 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
             bar.set_message(format!("{} tests", p.tests));
         }
     };
-    let mut problem = Problem::full(&checker);
-    problem.progress = Some(&report_progress);
-    let outcome = planner.solve(&problem, &budget);
+    let result = pipeline::plan_assembly(assembly, &settings, Some(&report_progress));
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
-    let world = checker.world();
-    let report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
-    let json = serde_json::to_string_pretty(&report)?;
+    let result = result?;
+    let report = &result.report;
+    if !args.quiet {
+        for w in &report.warnings {
+            eprintln!("warning: {}: {w}", args.model.display());
+        }
+    }
+    if let (Some(path), Some(search)) = (&args.optimise.trace, &result.search) {
+        let file = std::fs::File::create(path).with_context(|| format!("{}: cannot write the trace", path.display()))?;
+        search
+            .write_trace_csv(std::io::BufWriter::new(file))
+            .with_context(|| format!("{}: cannot write the trace", path.display()))?;
+    }
+    let json = report.to_json();
     if let Some(path) = &args.out {
-        std::fs::write(path, format!("{json}\n")).with_context(|| format!("{}: cannot write the plan", path.display()))?;
+        std::fs::write(path, &json).with_context(|| format!("{}: cannot write the plan", path.display()))?;
     }
     let mut stdout = std::io::stdout().lock();
     if args.json {
-        writeln!(stdout, "{json}")?;
+        write!(stdout, "{json}")?;
     } else {
-        write_table(&mut stdout, &report)?;
+        write_table(&mut stdout, report)?;
+        if let Some(summary) = &report.optimisation {
+            crate::optimise::write_summary(&mut stdout, summary, report.pareto_front.as_deref())?;
+        }
     }
-    Ok(match outcome.status {
-        Status::Found => ExitCode::SUCCESS,
-        _ => ExitCode::from(1),
-    })
+    Ok(if result.found() { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
 fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {

@@ -372,11 +372,11 @@ impl ProfileAssembly {
             .profiles
             .iter()
             .enumerate()
-            .map(|(i, p)| Part {
-                name: profile_name(i),
-                mesh: p.cuboid.mesh(),
-                fixed: p.fixed,
-                extras: json!({
+            .map(|(i, p)| Part::new(
+                profile_name(i),
+                p.cuboid.mesh(),
+                p.fixed,
+                json!({
                     "kind": "profile",
                     "role": p.role,
                     "layer": p.layer,
@@ -386,25 +386,25 @@ impl ProfileAssembly {
                     "boxes": [box_array(&p.cuboid)],
                     "grasp_points": self.grasp_points(i),
                 }),
-            })
+            ))
             .collect();
         for (k, c) in self.connectors.iter().enumerate() {
             let shape = match c.shape {
                 ConnectorShape::U => "U",
                 ConnectorShape::O => "O",
             };
-            parts.push(Part {
-                name: format!("{}_connector_{k:02}", shape.to_lowercase()),
-                mesh: c.mesh.clone(),
-                fixed: c.fixed,
-                extras: json!({
+            parts.push(Part::new(
+                format!("{}_connector_{k:02}", shape.to_lowercase()),
+                c.mesh.clone(),
+                c.fixed,
+                json!({
                     "kind": "connector",
                     "shape": shape,
                     "holds": profile_name(c.holds),
                     "attached_to": profile_name(c.attached_to),
                     "boxes": c.cells.iter().map(box_array).collect::<Vec<_>>(),
                 }),
-            });
+            ));
         }
         Assembly { parts, units: Units::metres(), up: Axis::Z, source: source.into(), warnings: Vec::new() }
     }

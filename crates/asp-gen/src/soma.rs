@@ -208,26 +208,26 @@ impl SomaCube {
             .pieces
             .iter()
             .zip(&self.names)
-            .map(|(cells, name)| Part {
-                name: name.clone(),
-                mesh: Mesh::from_voxels(cells, Vec3::splat(c), Vec3::ZERO),
-                fixed: false,
-                extras: json!({
+            .map(|(cells, name)| Part::new(
+                name.clone(),
+                Mesh::from_voxels(cells, Vec3::splat(c), Vec3::ZERO),
+                false,
+                json!({
                     "kind": "soma_piece",
                     "cube_size": self.size,
                     "cell_size": cell,
                     "origin": [0.0, 0.0, 0.0],
                     "cells": cells,
                 }),
-            })
+            ))
             .collect();
         let edge = self.size as f32 * c;
-        parts.push(Part {
-            name: "floor".into(),
-            mesh: Mesh::cuboid(Vec3::new(-c, -c, -0.5 * c), Vec3::new(edge + c, edge + c, 0.0)),
-            fixed: true,
-            extras: json!({"kind": "floor"}),
-        });
+        parts.push(Part::new(
+            "floor",
+            Mesh::cuboid(Vec3::new(-c, -c, -0.5 * c), Vec3::new(edge + c, edge + c, 0.0)),
+            true,
+            json!({"kind": "floor"}),
+        ));
         Assembly { parts, units: Units::metres(), up: Axis::Z, source: source.into(), warnings: Vec::new() }
     }
 

@@ -3,6 +3,7 @@
 use crate::error::{GeomError, Result};
 use crate::math::{aabb_of, Aabb, Axis};
 use crate::mesh::Mesh;
+use crate::meta::PartMeta;
 use std::path::PathBuf;
 
 /// One part of an assembly, its mesh baked in its assembled pose (world frame, metres).
@@ -14,8 +15,20 @@ pub struct Part {
     pub mesh: Mesh,
     /// Base parts stay in place and are never removed.
     pub fixed: bool,
-    /// Metadata from the file (`extras.asp` of a glTF node: voxels, grasp points, ...).
+    /// Metadata from the file (`extras.asp` of a glTF node: voxels, grasp points, ...), as
+    /// written; kept so that writing the model back preserves it.
     pub extras: serde_json::Value,
+    /// The same metadata, typed and parsed once ([`PartMeta::from_extras`]).
+    pub meta: PartMeta,
+}
+
+impl Part {
+    /// A part with its metadata parsed from `extras` (malformed keys are ignored; loaders use
+    /// [`PartMeta::from_extras`] themselves to warn about them).
+    pub fn new(name: impl Into<String>, mesh: Mesh, fixed: bool, extras: serde_json::Value) -> Part {
+        let (meta, _) = PartMeta::from_extras(&extras);
+        Part { name: name.into(), mesh, fixed, extras, meta }
+    }
 }
 
 /// The unit the model was given in; asp works in metres and reports in this unit.
@@ -102,7 +115,7 @@ impl Assembly {
             let i = self.part_index(name).ok_or_else(|| GeomError::Assembly {
                 path: self.source.clone(),
                 reason: format!(
-                    "--fixed names no part '{name}' (parts: {})",
+                    "no part is named '{name}' to fix in place (parts: {})",
                     self.parts.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
                 ),
             })?;

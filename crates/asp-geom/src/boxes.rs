@@ -14,74 +14,21 @@ use crate::math::{Aabb, Vec3};
 use crate::mesh::Mesh;
 
 /// The boxes of a part, in world coordinates (metres), when the part is a known union of boxes:
-/// from `extras.asp.cells`/`voxels`, from `extras.asp.boxes`, or its mesh being one box.
+/// from its metadata's cells or boxes ([`crate::PartMeta`]), or its mesh being one box.
 /// `Err` names the problem when the extras declare boxes that do not describe the mesh (the
 /// caller warns and falls back to the mesh).
 pub fn part_boxes(part: &Part) -> Result<Option<Vec<Aabb>>, String> {
-    if let Some(cells) = voxels_of(&part.extras) {
-        return fit_boxes(&unit_boxes(&cells), &part.mesh)
+    if let Some(cells) = &part.meta.cells {
+        return fit_boxes(&unit_boxes(cells), &part.mesh)
             .map(Some)
             .ok_or_else(|| "its voxels (extras.asp.cells) do not match its mesh".to_string());
     }
-    if let Some(boxes) = listed_boxes(&part.extras) {
-        return fit_boxes(&boxes, &part.mesh)
+    if let Some(boxes) = &part.meta.boxes {
+        return fit_boxes(boxes, &part.mesh)
             .map(Some)
             .ok_or_else(|| "its boxes (extras.asp.boxes) do not match its mesh".to_string());
     }
     Ok(single_box(&part.mesh).map(|b| vec![b]))
-}
-
-/// The metadata object: the node's `extras.asp` (as loaded into [`Part::extras`]), or an
-/// `asp` object one level down.
-fn lookup<'a>(extras: &'a serde_json::Value, key: &str) -> Option<&'a serde_json::Value> {
-    extras.get(key).or_else(|| extras.get("asp").and_then(|a| a.get(key)))
-}
-
-/// The voxels of a part from its metadata ([`crate::Part::extras`], the node's `extras.asp`):
-/// `cells` (as the Soma generator writes them) or `voxels`, as `[[i, j, k], ...]` or
-/// `{"cells": [...]}`; also accepted one level down under `asp`. Their size and position are
-/// fitted to the part's mesh, so any cell size and unit work.
-pub fn voxels_of(extras: &serde_json::Value) -> Option<Vec<[i32; 3]>> {
-    let v = lookup(extras, "cells").or_else(|| lookup(extras, "voxels"))?;
-    let cells = match v {
-        serde_json::Value::Array(a) => a,
-        serde_json::Value::Object(o) => o.get("cells")?.as_array()?,
-        _ => return None,
-    };
-    let mut out = Vec::with_capacity(cells.len());
-    for c in cells {
-        let c = c.as_array()?;
-        if c.len() != 3 {
-            return None;
-        }
-        let mut cell = [0i32; 3];
-        for (k, x) in c.iter().enumerate() {
-            let f = x.as_f64()?;
-            if f.fract() != 0.0 || f.abs() > 1e6 {
-                return None;
-            }
-            cell[k] = f as i32;
-        }
-        out.push(cell);
-    }
-    (!out.is_empty()).then_some(out)
-}
-
-/// The boxes listed in a part's metadata (`boxes: [[min x, min y, min z, max x, max y, max z], ...]`),
-/// in the file's coordinates; `None` when absent or malformed.
-pub fn listed_boxes(extras: &serde_json::Value) -> Option<Vec<Aabb>> {
-    let list = lookup(extras, "boxes")?.as_array()?;
-    let mut out = Vec::with_capacity(list.len());
-    for b in list {
-        let v: Vec<f32> = b.as_array()?.iter().map(|x| x.as_f64().map(|f| f as f32)).collect::<Option<_>>()?;
-        let [x0, y0, z0, x1, y1, z1] = <[f32; 6]>::try_from(v).ok()?;
-        let (lo, hi) = (Vec3::new(x0, y0, z0), Vec3::new(x1, y1, z1));
-        if !(lo.is_finite() && hi.is_finite() && (hi - lo).min_element() > 0.0) {
-            return None;
-        }
-        out.push(Aabb::new(lo, hi));
-    }
-    (!out.is_empty()).then_some(out)
 }
 
 /// Fits the voxel grid of a part to its mesh: the integer bounds of the cells span the mesh's
@@ -206,7 +153,7 @@ mod tests {
     use serde_json::json;
 
     fn part(mesh: Mesh, extras: serde_json::Value) -> Part {
-        Part { name: "p".into(), mesh, fixed: false, extras }
+        Part::new("p", mesh, false, extras)
     }
 
     #[test]

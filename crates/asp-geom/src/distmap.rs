@@ -38,7 +38,7 @@
 //! supported and never removed.
 
 use crate::assembly::Assembly;
-use crate::boxes::{box_distance, first_overlap, fit_boxes, fit_voxels, listed_boxes, single_box};
+use crate::boxes::{box_distance, first_overlap, fit_boxes, fit_voxels, single_box};
 use crate::error::{GeomError, Result};
 use crate::feasibility::{
     CounterSnapshot, Counters, FeasibilityChecker, Motion, MotionKind, Outcome, Stability,
@@ -570,8 +570,8 @@ impl DistanceMaps {
         let mut voxel_fits: Vec<Option<VoxelFit>> = Vec::with_capacity(n);
         for p in &assembly.parts {
             let fit = if config.use_voxels {
-                crate::boxes::voxels_of(&p.extras).and_then(|cells| match fit_voxels(&cells, &p.mesh) {
-                    Some((o, c)) => Some((cells, o, c)),
+                p.meta.cells.as_ref().and_then(|cells| match fit_voxels(cells, &p.mesh) {
+                    Some((o, c)) => Some((cells.clone(), o, c)),
                     None => {
                         warnings.push(format!(
                             "part '{}': its voxels do not match its mesh; using the mesh",
@@ -620,7 +620,7 @@ impl DistanceMaps {
                     .collect();
                 geometry.push(PartGeometry::Voxels);
                 shapes.push(Shape::Boxes { boxes, integer: shared_grid });
-            } else if let Some(boxes) = listed_boxes(&p.extras).and_then(|b| fit_boxes(&b, &p.mesh)) {
+            } else if let Some(boxes) = p.meta.boxes.as_ref().and_then(|b| fit_boxes(b, &p.mesh)) {
                 geometry.push(PartGeometry::Box);
                 shapes.push(Shape::Boxes { boxes: boxes.iter().map(|b| frame.frame_box(b)).collect(), integer: false });
             } else if let Some(b) = single_box(&p.mesh) {

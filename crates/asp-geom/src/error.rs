@@ -30,6 +30,14 @@ pub enum GeomError {
         /// What is wrong.
         reason: String,
     },
+    /// Two parts overlap in the input so far that no shrinking separates them.
+    #[error("{path}: {reason}")]
+    GrossOverlap {
+        /// The model.
+        path: PathBuf,
+        /// The two parts and the measured overlap.
+        reason: String,
+    },
     /// A configuration value is out of range.
     #[error("invalid configuration: {reason}")]
     Config {

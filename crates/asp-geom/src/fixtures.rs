@@ -7,7 +7,7 @@ use crate::mesh::Mesh;
 
 /// A part with no metadata.
 pub fn part(name: &str, mesh: Mesh, fixed: bool) -> Part {
-    Part { name: name.into(), mesh, fixed, extras: serde_json::Value::Null }
+    Part::new(name, mesh, fixed, serde_json::Value::Null)
 }
 
 /// A movable axis-aligned box from `mins` to `maxs`.
@@ -18,12 +18,12 @@ pub fn box_part(name: &str, mins: [f32; 3], maxs: [f32; 3]) -> Part {
 /// A movable part made of the unit voxels `cells` scaled by `cell` (metres), carrying them in
 /// its metadata (`extras.asp.voxels`) so distance maps sweep them exactly.
 pub fn voxel_part(name: &str, cells: &[[i32; 3]], cell: f32) -> Part {
-    Part {
-        name: name.into(),
-        mesh: Mesh::from_voxels(cells, Vec3::splat(cell), Vec3::ZERO),
-        fixed: false,
-        extras: serde_json::json!({ "asp": { "voxels": cells } }),
-    }
+    Part::new(
+        name,
+        Mesh::from_voxels(cells, Vec3::splat(cell), Vec3::ZERO),
+        false,
+        serde_json::json!({ "asp": { "voxels": cells } }),
+    )
 }
 
 /// An assembly in metres with `up` as the up axis; its source reads `fixture:{name}`.

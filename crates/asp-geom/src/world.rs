@@ -293,12 +293,12 @@ impl World {
                         max_overlap_fraction * 100.0
                     );
                     if !ignore_overlapping {
-                        return Err(GeomError::Assembly {
+                        return Err(GeomError::GrossOverlap {
                             path: self.assembly.source.clone(),
-                            reason: format!("{msg}; fix the model, raise --tolerance, or pass --ignore-overlapping"),
+                            reason: format!("{msg}; fix the model, raise the tolerance, or ignore overlapping parts"),
                         });
                     }
-                    self.warnings.push(format!("{msg}; their collisions with each other are ignored (--ignore-overlapping)"));
+                    self.warnings.push(format!("{msg}; their collisions with each other are ignored"));
                     self.ignored.insert((i, j));
                     self.ignored.insert((j, i));
                 }

@@ -6,51 +6,49 @@
 //! along a straight line, the slow test (a path planner) is tried for each blocked part. Dead-end
 //! states are remembered so that no state is expanded twice.
 
+use crate::ordering::{state_seed, BuiltinOrder, OrderingFactory, PartOrdering, WithBookkeeping};
 use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, Stuck, StuckReason};
 use crate::Planner;
 use asp_geom::{MotionKind, Outcome, PartSet};
-use rand::seq::SliceRandom;
-use rand::{RngExt, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use std::collections::HashSet;
+use std::sync::Arc;
 use std::time::Instant;
-
-/// The order in which the parts of a state are tested.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Ordering {
-    /// Index order (the model's part order): the thesis' "vanilla" AbD.
-    #[default]
-    Given,
-    /// A fresh random permutation in every state, from the planner's seed.
-    Random,
-}
 
 /// Settings of [`Dfs`]; build with [`Dfs::builder`].
 #[derive(Clone, Debug)]
 pub struct Dfs {
-    ordering: Ordering,
-    bookkeeping: bool,
+    ordering: Arc<dyn OrderingFactory>,
     path_planner: bool,
     seed: u64,
 }
 
 /// Builder of [`Dfs`].
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct DfsBuilder {
-    ordering: Ordering,
+    ordering: Arc<dyn OrderingFactory>,
     bookkeeping: bool,
     no_path_planner: bool,
     seed: u64,
 }
 
+impl Default for DfsBuilder {
+    fn default() -> Self {
+        DfsBuilder { ordering: Arc::new(BuiltinOrder::Given), bookkeeping: false, no_path_planner: false, seed: 0 }
+    }
+}
+
 impl DfsBuilder {
-    /// The part ordering (default [`Ordering::Given`]).
-    pub fn ordering(mut self, ordering: Ordering) -> Self {
-        self.ordering = ordering;
+    /// One of the built-in part orderings (default [`BuiltinOrder::Given`]).
+    pub fn ordering(self, ordering: BuiltinOrder) -> Self {
+        self.ordering_factory(Arc::new(ordering))
+    }
+    /// Any part ordering, e.g. a learned one (`asp-learn`).
+    pub fn ordering_factory(mut self, factory: Arc<dyn OrderingFactory>) -> Self {
+        self.ordering = factory;
         self
     }
-    /// Bookkeeping (seed 3.1.1): a part blocked by collision is retested only after one of its
-    /// recorded blockers is gone. Default off.
+    /// Bookkeeping (seed 3.1.1) on top of the ordering: a part blocked by collision is retested
+    /// only after one of its recorded blockers is gone. Default off.
     pub fn bookkeeping(mut self, on: bool) -> Self {
         self.bookkeeping = on;
         self
@@ -60,19 +58,16 @@ impl DfsBuilder {
         self.no_path_planner = !on;
         self
     }
-    /// Seed of every random choice (random ordering, path planner). Default 0.
+    /// Seed of every random choice (shuffled and random orderings, path planner). Default 0.
     pub fn seed(mut self, seed: u64) -> Self {
         self.seed = seed;
         self
     }
     /// The planner (every combination of settings is valid).
     pub fn build(self) -> Dfs {
-        Dfs {
-            ordering: self.ordering,
-            bookkeeping: self.bookkeeping,
-            path_planner: !self.no_path_planner,
-            seed: self.seed,
-        }
+        let ordering: Arc<dyn OrderingFactory> =
+            if self.bookkeeping { Arc::new(WithBookkeeping(self.ordering)) } else { self.ordering };
+        Dfs { ordering, path_planner: !self.no_path_planner, seed: self.seed }
     }
 }
 
@@ -81,17 +76,22 @@ impl Dfs {
     pub fn builder() -> DfsBuilder {
         DfsBuilder::default()
     }
+
+    /// The name of the part ordering (with `+bookkeeping` when decorated).
+    pub fn ordering_name(&self) -> String {
+        self.ordering.name()
+    }
 }
 
 /// The mutable state of one search.
-struct Search<'p, 'a> {
+struct Search<'p, 'a, 'v> {
     problem: &'p Problem<'a>,
     config: &'p Dfs,
     budget: &'p Budget,
     started: Instant,
-    rng: ChaCha8Rng,
-    /// Bookkeeping: the blockers of each part's last collision failure.
-    blocked_by: Vec<Option<PartSet>>,
+    ordering: Box<dyn PartOrdering>,
+    /// Called with every visited state (data collection).
+    visit: Option<&'v mut dyn FnMut(&PartSet)>,
     dead: HashSet<PartSet>,
     /// Locked cores: sets of parts each blocked only by parts of the set (and fixed parts), so
     /// no state containing one can ever be taken apart (see [`locked_core`]).
@@ -104,7 +104,7 @@ struct Search<'p, 'a> {
     deepest: Option<(PartSet, Vec<Stuck>)>,
 }
 
-impl Search<'_, '_> {
+impl Search<'_, '_, '_> {
     fn tests(&self) -> u64 {
         self.problem.checker.counters().removal_tests
     }
@@ -118,10 +118,14 @@ impl Search<'_, '_> {
 
     fn order(&mut self, state: &PartSet) -> Vec<usize> {
         let mut parts = self.problem.removable(state);
-        if self.config.ordering == Ordering::Random {
-            parts.shuffle(&mut self.rng);
-        }
+        self.ordering.order(state, &mut parts);
         parts
+    }
+
+    fn test(&mut self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome {
+        let outcome = self.problem.checker.test_removal(part, state, kind);
+        self.ordering.observe(part, state, kind, &outcome);
+        outcome
     }
 
     /// Depth-first search from `state`; true when a full sequence was found (in `self.path`).
@@ -133,6 +137,9 @@ impl Search<'_, '_> {
             return false;
         }
         self.expanded += 1;
+        if let Some(visit) = self.visit.as_mut() {
+            visit(state);
+        }
         if let Some(report) = self.problem.progress {
             report(&Progress { removed: self.path.len(), total: self.total, tests: self.tests() });
         }
@@ -143,15 +150,14 @@ impl Search<'_, '_> {
             if self.out_of_budget() {
                 return false;
             }
-            if self.config.bookkeeping {
-                if let Some(b) = &self.blocked_by[part] {
-                    if b.is_subset(state) {
-                        reasons.push(Stuck { part, reason: StuckReason::Blocked(b.clone()) });
-                        continue;
-                    }
-                }
+            if let Some(blockers) = self.ordering.known_blocked(part, state) {
+                // the skipped test would collide again; the part still gets its path-planner
+                // chance below, so the search is the same as without bookkeeping
+                collided.push(part);
+                reasons.push(Stuck { part, reason: StuckReason::Blocked(blockers) });
+                continue;
             }
-            let outcome = self.problem.checker.test_removal(part, state, MotionKind::Linear);
+            let outcome = self.test(part, state, MotionKind::Linear);
             if let Outcome::Collision { .. } = &outcome {
                 collided.push(part);
             }
@@ -165,8 +171,10 @@ impl Search<'_, '_> {
                 if self.out_of_budget() {
                     return false;
                 }
-                let seed = self.rng.random::<u64>();
-                let outcome = self.problem.checker.test_removal(part, state, MotionKind::Path { seed });
+                // seeded by the state and the part, not by the search's history: the same
+                // state gets the same path-planner runs whatever the ordering skipped before
+                let seed = state_seed(self.config.seed, state, part as u64);
+                let outcome = self.test(part, state, MotionKind::Path { seed });
                 reasons.retain(|s| s.part != part);
                 if self.follow(part, state, outcome, &mut reasons) {
                     return true;
@@ -198,9 +206,6 @@ impl Search<'_, '_> {
                 reasons.push(Stuck { part, reason: StuckReason::DeadEnd });
             }
             Outcome::Collision { blockers } => {
-                if self.config.bookkeeping {
-                    self.blocked_by[part] = Some(blockers.clone());
-                }
                 reasons.push(Stuck { part, reason: StuckReason::Blocked(blockers) });
             }
             Outcome::Unstable { floating, .. } => {
@@ -242,6 +247,19 @@ impl Planner for Dfs {
     }
 
     fn solve(&self, problem: &Problem, budget: &Budget) -> PlanOutcome {
+        self.solve_visiting(problem, budget, None)
+    }
+}
+
+impl Dfs {
+    /// [`Planner::solve`], calling `visit` with every state the search expands (in order; each
+    /// state once). Data collection records these states.
+    pub fn solve_visiting(
+        &self,
+        problem: &Problem,
+        budget: &Budget,
+        visit: Option<&mut dyn FnMut(&PartSet)>,
+    ) -> PlanOutcome {
         let started = Instant::now();
         let before = problem.checker.counters();
         let mut search = Search {
@@ -249,8 +267,8 @@ impl Planner for Dfs {
             config: self,
             budget,
             started,
-            rng: ChaCha8Rng::seed_from_u64(self.seed),
-            blocked_by: vec![None; problem.checker.num_parts()],
+            ordering: self.ordering.make(problem.checker.num_parts(), self.seed),
+            visit,
             dead: HashSet::new(),
             cores: Vec::new(),
             path: Vec::new(),

@@ -1,5 +1,7 @@
 #![doc = include_str!("../README.md")]
 
+pub mod bench;
+pub mod collect;
 pub mod dfs;
 pub mod error;
 pub mod exact;
@@ -7,17 +9,20 @@ pub mod hypervolume;
 pub mod mcts;
 pub mod mdp;
 pub mod objective;
+pub mod ordering;
 pub mod pareto;
+pub mod pipeline;
 pub mod policy;
 pub mod problem;
 pub mod report;
 pub mod search;
 
-pub use dfs::{Dfs, Ordering};
+pub use dfs::Dfs;
 pub use error::{Result, SearchError};
 pub use mcts::Mcts;
 pub use mdp::Mdp;
 pub use objective::{Accessibility, DirectionChanges, Memory, Objective, PathLength};
+pub use ordering::{Bookkeeping, BuiltinOrder, OrderingFactory, OrderingSource, PartOrdering, WithBookkeeping};
 pub use pareto::ParetoMcts;
 pub use policy::{EpsilonGreedy, Policy, QFunction, RandomPolicy};
 pub use problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, Stuck, StuckReason};

@@ -194,6 +194,14 @@ pub struct OptimisationEntry {
 }
 
 impl PlanReport {
+    /// The plan JSON as written to files and stdout: pretty-printed, with a final newline. The
+    /// CLI and the Python package both write exactly this.
+    pub fn to_json(&self) -> String {
+        let mut s = serde_json::to_string_pretty(self).expect("plan reports serialise (no maps with non-string keys)");
+        s.push('\n');
+        s
+    }
+
     /// The report of `outcome` on `assembly`; `tolerance` in metres.
     pub fn new(assembly: &Assembly, outcome: &PlanOutcome, tolerance: f32, warnings: &[String]) -> Self {
         let u = |m: f32| assembly.units.from_metres(m as f64);

@@ -27,12 +27,12 @@ fn jenga(dir: &Path) -> PathBuf {
         for k in 0..3 {
             let cells: Vec<[i32; 3]> =
                 (0..3).map(|t| if z % 2 == 0 { [t, k, z] } else { [k, t, z] }).collect();
-            parts.push(Part {
-                name: format!("bar_{z}{k}"),
-                mesh: Mesh::from_voxels(&cells, Vec3::splat(0.05), Vec3::ZERO),
-                fixed: false,
-                extras: serde_json::json!({ "asp": { "cells": cells } }),
-            });
+            parts.push(Part::new(
+                format!("bar_{z}{k}"),
+                Mesh::from_voxels(&cells, Vec3::splat(0.05), Vec3::ZERO),
+                false,
+                serde_json::json!({ "asp": { "cells": cells } }),
+            ));
         }
     }
     let a = Assembly { parts, units: Units::metres(), up: Axis::Z, source: "jenga".into(), warnings: Vec::new() };

@@ -67,7 +67,7 @@ fn assemble(source: &Path, files: &[PathBuf], options: &LoadOptions) -> Result<A
             let mut mesh = read_mesh(file)?;
             mesh.scale(scale);
             let name = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-            Ok(Part { name, mesh, fixed: false, extras: serde_json::Value::Null })
+            Ok(Part::new(name, mesh, false, serde_json::Value::Null))
         })
         .collect::<Result<Vec<Part>>>()?;
     Ok(Assembly {

@@ -8,7 +8,8 @@
 use super::{io_error, lowercase_first, LoadOptions};
 use crate::assembly::{Assembly, Part, Units};
 use crate::error::{GeomError, Result};
-use crate::math::{Axis, Vec3};
+use crate::math::{Axis, Pose, Vec3};
+use crate::meta::PartMeta;
 use crate::mesh::Mesh;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
@@ -350,7 +351,15 @@ impl<'a> PartBuilder<'a> {
         }
         let (extras, fixed) = node_metadata(node, &label)?;
         let mesh = bake(&local, world, self.scale);
-        self.parts.push(Part { name, mesh, fixed, extras });
+        let (meta, problems) = PartMeta::from_extras(&extras);
+        for problem in problems {
+            self.warnings.push(format!("part '{name}': {problem}"));
+        }
+        let (_, rotation, translation) = world.to_scale_rotation_translation();
+        let pose = Pose::from_parts((translation * self.scale).as_vec3(), rotation.as_quat());
+        let mut part = Part::new(name, mesh, fixed, extras);
+        part.meta = meta.transformed(&pose, self.scale as f32);
+        self.parts.push(part);
         Ok(())
     }
 

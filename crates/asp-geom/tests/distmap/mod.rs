@@ -342,7 +342,7 @@ fn random_states(n: usize, count: usize, seed: u64) -> Vec<PartSet> {
 
 /// The cells of part `p` of a voxel assembly.
 fn cells_of(a: &Assembly, p: usize) -> Vec<[i32; 3]> {
-    asp_geom::boxes::voxels_of(&a.parts[p].extras).unwrap()
+    a.parts[p].meta.cells.clone().unwrap()
 }
 
 /// Exact reference on unit voxels: `q` blocks `p` moving along the axis `(axis, sign)` when a

@@ -612,13 +612,13 @@ fn sample_assembly() -> Assembly {
     let peg = Mesh::cuboid(Vec3::new(0.0123, 0.0101, 0.01), Vec3::new(0.0177, 0.0149, 0.0437));
     Assembly {
         parts: vec![
-            Part { name: "base".into(), mesh: base, fixed: true, extras: Value::Null },
-            Part {
-                name: "peg".into(),
-                mesh: peg,
-                fixed: false,
-                extras: json!({"grasp": [[15.0, 12.5, 43.7]], "voxels": {"size": 1.5, "cells": [[0, 0, 1]]}}),
-            },
+            Part::new("base", base, true, Value::Null),
+            Part::new(
+                "peg",
+                peg,
+                false,
+                json!({"grasp": [[15.0, 12.5, 43.7]], "voxels": {"size": 1.5, "cells": [[0, 0, 1]]}}),
+            ),
         ],
         units: Units::parse("mm").unwrap(),
         up: Axis::Z,

@@ -24,7 +24,7 @@ fn unstable(n: usize, parts: &[usize]) -> Stability {
 }
 
 fn part(name: &str, mesh: Mesh, fixed: bool) -> Part {
-    Part { name: name.into(), mesh, fixed, extras: serde_json::Value::Null }
+    Part::new(name, mesh, fixed, serde_json::Value::Null)
 }
 
 fn cuboid(mins: [f32; 3], maxs: [f32; 3]) -> Mesh {

@@ -120,7 +120,7 @@ fn post_and_ring(ring_extras: serde_json::Value) -> asp_geom::Assembly {
         .collect();
     let ring = Mesh::from_voxels(&cells, Vec3::splat(0.003), Vec3::new(0.207, 0.207, 0.536));
     let extras = if ring_extras.is_null() { serde_json::json!({ "cells": cells }) } else { ring_extras };
-    let part = |name: &str, mesh: Mesh, fixed: bool, extras: serde_json::Value| Part { name: name.into(), mesh, fixed, extras };
+    let part = |name: &str, mesh: Mesh, fixed: bool, extras: serde_json::Value| Part::new(name, mesh, fixed, extras);
     asp_geom::Assembly {
         parts: vec![
             part("floor", Mesh::cuboid(Vec3::new(0.0, 0.0, -0.01), Vec3::new(0.5, 0.5, 0.0)), true, serde_json::Value::Null),

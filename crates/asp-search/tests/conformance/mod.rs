@@ -3,14 +3,14 @@
 
 use crate::verify::verify_plan;
 use asp_geom::{fixtures, Assembly, Checker, CheckerConfig, FeasibilityChecker, World, WorldConfig};
-use asp_search::{Budget, Dfs, Ordering, PlanOutcome, Planner, Problem, Status};
+use asp_search::{Budget, BuiltinOrder, Dfs, PlanOutcome, Planner, Problem, Status};
 
 fn planners() -> Vec<(&'static str, Dfs)> {
     vec![
         ("given", Dfs::builder().build()),
-        ("random", Dfs::builder().ordering(Ordering::Random).seed(3).build()),
+        ("random", Dfs::builder().ordering(BuiltinOrder::Random).seed(3).build()),
         ("bookkeeping", Dfs::builder().bookkeeping(true).build()),
-        ("random+bookkeeping", Dfs::builder().ordering(Ordering::Random).bookkeeping(true).seed(5).build()),
+        ("random+bookkeeping", Dfs::builder().ordering(BuiltinOrder::Random).bookkeeping(true).seed(5).build()),
     ]
 }
 
@@ -100,9 +100,57 @@ fn budget_of_one_test_is_exhausted() {
 
 #[test]
 fn same_seed_same_plan() {
-    let p = Dfs::builder().ordering(Ordering::Random).seed(11).build();
+    let p = Dfs::builder().ordering(BuiltinOrder::Random).seed(11).build();
     let (_, a) = plan(fixtures::tube(), &p);
     let (_, b) = plan(fixtures::tube(), &p);
     assert_eq!(a.removals, b.removals);
     assert_eq!(a.stats.counters, b.stats.counters);
+}
+
+/// Issue 8: bookkeeping on top of `--order random` took 18,936 tests where the same ordering
+/// without it took 460 (a double-layer profile assembly), because skipped tests shifted the
+/// random stream and kept skipped parts from the path planner. Bookkeeping must only skip tests
+/// whose answer is known: the same states in the same order, the same plan, never more tests.
+#[test]
+fn issue_8_bookkeeping_never_makes_a_run_worse() {
+    let mut saved = 0;
+    for seed in [0, 1] {
+        let assembly = asp_gen::ProfileAssembly::generate(&asp_gen::ProfileParams::double_layer(), 4242 + seed)
+            .expect("profiles")
+            .to_assembly("double-layer");
+        let checker = |a: &Assembly| {
+            Checker::new(World::new(a.clone(), &WorldConfig::default()).unwrap(), CheckerConfig::default())
+        };
+        let (plain_checker, bk_checker) = (checker(&assembly), checker(&assembly));
+        for order in [BuiltinOrder::Given, BuiltinOrder::Shuffled, BuiltinOrder::Random] {
+            for run in 0..3 {
+                let build = |bk| Dfs::builder().ordering(order).bookkeeping(bk).seed(run).build();
+                let plain = build(false).solve(&Problem::full(&plain_checker), &Budget::default());
+                let bk = build(true).solve(&Problem::full(&bk_checker), &Budget::default());
+                let label = format!("{order:?} seed {run} on profiles {seed}");
+                assert_eq!(plain.status, Status::Found, "{label}");
+                assert_eq!(bk.removals, plain.removals, "{label}: bookkeeping changed the search");
+                let (p, b) = (plain.stats.counters, bk.stats.counters);
+                assert!(b.removal_tests <= p.removal_tests, "{label}: {} tests with bookkeeping, {} without", b.removal_tests, p.removal_tests);
+                assert_eq!(b.failed_gravity, p.failed_gravity, "{label}: bookkeeping skips only collisions");
+                assert_eq!(p.removal_tests - b.removal_tests, p.failed_collision - b.failed_collision, "{label}");
+                saved += p.removal_tests - b.removal_tests;
+            }
+        }
+    }
+    assert!(saved > 0, "bookkeeping saved no test at all on double-layer profile assemblies");
+}
+
+/// The thesis' vanilla AbD (`shuffled`) keeps one order for the whole search: the same seed gives
+/// the same plan, another seed (almost always) another one.
+#[test]
+fn shuffled_orders_are_reproducible_per_seed() {
+    let a = asp_gen::ProfileAssembly::generate(&asp_gen::ProfileParams::single_layer(), 7).unwrap().to_assembly("p");
+    let run = |seed| plan(a.clone(), &Dfs::builder().ordering(BuiltinOrder::Shuffled).seed(seed).build()).1;
+    let (x, y) = (run(1), run(1));
+    assert_eq!(x.removals, y.removals);
+    assert_eq!(x.stats.counters, y.stats.counters);
+    let orders: std::collections::HashSet<Vec<usize>> =
+        (0..5).map(|s| run(s).removals.iter().map(|s| s.part).collect()).collect();
+    assert!(orders.len() > 1, "five seeds gave one removal order");
 }

@@ -67,7 +67,8 @@ fn ikea_models_plan_and_every_step_rechecks() {
 #[test]
 fn gross_overlaps_are_errors_naming_both_parts() {
     let err = world("ikea/bed_dalselv_0270.glb", None, false).err().expect("gross overlap is an error").to_string();
-    assert!(err.contains("'0_part0'") && err.contains("'1_part1'") && err.contains("--ignore-overlapping"), "{err}");
+    assert!(err.contains("'0_part0'") && err.contains("'1_part1'") && err.contains("ignore overlapping"), "{err}");
+    assert!(!err.contains("--"), "library errors name settings, not command-line flags: {err}");
 }
 
 #[test]

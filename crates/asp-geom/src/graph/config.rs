@@ -1,0 +1,142 @@
+//! [`GraphConfig`]: the parameters of the graph features, and the `features` string that names them.
+
+use crate::error::{GeomError, Result};
+
+/// The largest spherical-harmonic degree asp evaluates (the recurrences are tested to here).
+pub const MAX_DEGREE: usize = 20;
+/// The most radius shells a descriptor may have.
+pub const MAX_RADIUS_BINS: usize = 64;
+/// The most sample points per part a configuration may ask for.
+pub const MAX_POINTS_PER_PART: usize = 1 << 20;
+
+/// Parameters of the graph features (`docs/learning.md`, thesis 3.4.2). A model trained on one
+/// configuration only runs on features of the same configuration: compare [`GraphConfig::features`].
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct GraphConfig {
+    /// Radius shells of the descriptor (thesis: the bins of `r`). Default 8.
+    pub radius_bins: usize,
+    /// Highest spherical-harmonic degree `L` (thesis eq. 3.8). Default 8.
+    pub degree: usize,
+    /// Target number of surface sample points per part (every triangle with area gets at least
+    /// one, so a finely meshed part may get more). Default 2048.
+    pub points_per_part: usize,
+}
+
+impl Default for GraphConfig {
+    fn default() -> Self {
+        GraphConfig { radius_bins: 8, degree: 8, points_per_part: 2048 }
+    }
+}
+
+impl GraphConfig {
+    /// A builder starting from the defaults; [`GraphConfigBuilder::build`] validates.
+    pub fn builder() -> GraphConfigBuilder {
+        GraphConfigBuilder { config: GraphConfig::default() }
+    }
+
+    /// Checks the ranges: `1..=64` radius bins, degree `0..=20`, `1..=2^20` points per part.
+    pub fn validate(&self) -> Result<()> {
+        if !(1..=MAX_RADIUS_BINS).contains(&self.radius_bins) {
+            return Err(GeomError::config(format!(
+                "graph radius_bins must be 1..={MAX_RADIUS_BINS}, got {}",
+                self.radius_bins
+            )));
+        }
+        if self.degree > MAX_DEGREE {
+            return Err(GeomError::config(format!(
+                "graph degree must be 0..={MAX_DEGREE}, got {}",
+                self.degree
+            )));
+        }
+        if !(1..=MAX_POINTS_PER_PART).contains(&self.points_per_part) {
+            return Err(GeomError::config(format!(
+                "graph points_per_part must be 1..={MAX_POINTS_PER_PART}, got {}",
+                self.points_per_part
+            )));
+        }
+        Ok(())
+    }
+
+    /// The name of the feature set with its parameters, e.g.
+    /// `asp-graph/1 radius_bins=8 degree=8 points=2048`. Models record it; asp refuses a model
+    /// whose string differs from the features it computes.
+    pub fn features(&self) -> String {
+        format!(
+            "asp-graph/1 radius_bins={} degree={} points={}",
+            self.radius_bins, self.degree, self.points_per_part
+        )
+    }
+
+    /// Length `D` of one descriptor: `radius_bins × (degree + 1)` (72 by default).
+    pub fn descriptor_dim(&self) -> usize {
+        self.radius_bins * (self.degree + 1)
+    }
+
+    /// Length of a node's attributes: `D + 2` (descriptor, `fixed`, `on_base`).
+    pub fn node_dim(&self) -> usize {
+        self.descriptor_dim() + 2
+    }
+
+    /// Length of an edge's attributes: `2D + 2` (two descriptors, `above`, `normal_up`).
+    pub fn edge_dim(&self) -> usize {
+        2 * self.descriptor_dim() + 2
+    }
+}
+
+/// Builds a validated [`GraphConfig`].
+#[derive(Clone, Debug)]
+pub struct GraphConfigBuilder {
+    config: GraphConfig,
+}
+
+impl GraphConfigBuilder {
+    /// Sets [`GraphConfig::radius_bins`].
+    pub fn radius_bins(mut self, bins: usize) -> Self {
+        self.config.radius_bins = bins;
+        self
+    }
+
+    /// Sets [`GraphConfig::degree`].
+    pub fn degree(mut self, degree: usize) -> Self {
+        self.config.degree = degree;
+        self
+    }
+
+    /// Sets [`GraphConfig::points_per_part`].
+    pub fn points_per_part(mut self, points: usize) -> Self {
+        self.config.points_per_part = points;
+        self
+    }
+
+    /// The configuration, or a [`GeomError::Config`] naming the value out of range.
+    pub fn build(self) -> Result<GraphConfig> {
+        self.config.validate()?;
+        Ok(self.config)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_name_the_contract_features() {
+        let c = GraphConfig::default();
+        assert_eq!(c.features(), "asp-graph/1 radius_bins=8 degree=8 points=2048");
+        assert_eq!((c.descriptor_dim(), c.node_dim(), c.edge_dim()), (72, 74, 146));
+        let c = GraphConfig::builder().radius_bins(4).degree(3).points_per_part(100).build().unwrap();
+        assert_eq!(c.features(), "asp-graph/1 radius_bins=4 degree=3 points=100");
+        assert_eq!((c.descriptor_dim(), c.node_dim(), c.edge_dim()), (16, 18, 34));
+    }
+
+    #[test]
+    fn nonsense_is_rejected_with_the_field_named() {
+        let e = GraphConfig::builder().radius_bins(0).build().unwrap_err().to_string();
+        assert!(e.contains("radius_bins"), "{e}");
+        let e = GraphConfig::builder().degree(21).build().unwrap_err().to_string();
+        assert!(e.contains("degree"), "{e}");
+        let e = GraphConfig::builder().points_per_part(0).build().unwrap_err().to_string();
+        assert!(e.contains("points_per_part"), "{e}");
+        assert!(GraphConfig::builder().degree(0).radius_bins(1).points_per_part(1).build().is_ok());
+    }
+}

@@ -1,0 +1,315 @@
+//! Training data for the removability model (thesis 3.6.1): labelled states from vanilla DFS
+//! runs, written in the `asp-removability` format (`docs/learning.md`).
+//!
+//! For every model, the collision world and the chapter-3 graph (descriptors of every part and
+//! contact region) are built once. Then `runs` depth-first searches start from random initial
+//! orderings (the thesis' vanilla: `shuffled`, one seed per run) and every state they expand is
+//! recorded with the label of every present, non-fixed part: removable (it leaves along a
+//! straight candidate direction and the rest stays stable) or not. Runs go in parallel; the
+//! output depends only on the models, the settings and the seed.
+
+use crate::ordering::BuiltinOrder;
+use crate::pipeline::{self, PlanSettings};
+use crate::problem::{Budget, Problem};
+use crate::{Dfs, Result, SearchError};
+use asp_geom::graph::{AssemblyGraph, GraphConfig};
+use asp_geom::{FeasibilityChecker, MotionKind, Outcome, PartSet};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// The data set's format name.
+pub const FORMAT: &str = "asp-removability";
+/// The data set's format version.
+pub const VERSION: u32 = 1;
+
+/// Settings of a collection.
+#[derive(Clone, Debug)]
+pub struct CollectSettings {
+    /// DFS runs per model, each from its own random initial ordering (thesis: 20).
+    pub runs: usize,
+    /// Base seed; run `r` of model `m` uses a seed derived from it, `m` and `r`.
+    pub seed: u64,
+    /// How models are loaded and tested (unit, up, tolerances, stability, path planner).
+    pub plan: PlanSettings,
+    /// Feature parameters.
+    pub graph: GraphConfig,
+    /// Removal tests per run before it stops (the states seen so far are kept).
+    pub max_tests: Option<u64>,
+    /// Wall-time cap per run, seconds.
+    pub timeout: Option<f64>,
+}
+
+impl Default for CollectSettings {
+    fn default() -> Self {
+        CollectSettings {
+            runs: 20,
+            seed: 0,
+            plan: PlanSettings::default(),
+            graph: GraphConfig::default(),
+            max_tests: None,
+            timeout: Some(60.0),
+        }
+    }
+}
+
+/// One model's entry in `index.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct CollectedModel {
+    /// The model's name (file or folder stem).
+    pub name: String,
+    /// Its folder in the data set.
+    pub dir: String,
+    /// Where it came from.
+    pub source: String,
+    /// Number of parts.
+    pub parts: usize,
+    /// Directed contact edges.
+    pub edges: usize,
+    /// States recorded over all runs.
+    pub states: usize,
+    /// Runs that found a complete sequence.
+    pub runs_found: usize,
+}
+
+/// What a collection wrote.
+#[derive(Clone, Debug, Serialize)]
+pub struct Collected {
+    /// `asp-removability`.
+    pub format: String,
+    /// [`VERSION`].
+    pub version: u32,
+    /// The feature string models must be trained and run on.
+    pub features: String,
+    /// Node attribute width.
+    pub node_dim: usize,
+    /// Edge attribute width.
+    pub edge_dim: usize,
+    /// Base seed.
+    pub seed: u64,
+    /// Runs per model.
+    pub runs: usize,
+    /// The models.
+    pub assemblies: Vec<CollectedModel>,
+}
+
+#[derive(Serialize)]
+struct GraphFile<'a> {
+    name: &'a str,
+    source: String,
+    parts: Vec<PartFile<'a>>,
+    edges: Vec<[usize; 2]>,
+}
+
+#[derive(Serialize)]
+struct PartFile<'a> {
+    name: &'a str,
+    fixed: bool,
+}
+
+#[derive(Serialize)]
+struct StateLine {
+    run: usize,
+    step: usize,
+    present: Vec<usize>,
+    removable: Vec<usize>,
+}
+
+/// The models named by `paths`: each `.glb`/`.gltf` file; a folder holding glTF files gives each
+/// of them (sorted); any other folder (of OBJ/STL parts) is one model.
+pub fn model_paths(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            let entries = std::fs::read_dir(p).map_err(|e| io_error(p, e))?;
+            let mut gltf: Vec<PathBuf> = entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|f| {
+                    f.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"))
+                })
+                .collect();
+            gltf.sort();
+            if gltf.is_empty() {
+                out.push(p.clone());
+            } else {
+                out.extend(gltf);
+            }
+        } else {
+            out.push(p.clone());
+        }
+    }
+    if out.is_empty() {
+        return Err(SearchError::config("no models given"));
+    }
+    Ok(out)
+}
+
+fn io_error(path: &Path, e: std::io::Error) -> SearchError {
+    SearchError::Geom(asp_geom::GeomError::Io { path: path.to_path_buf(), source: e })
+}
+
+/// The name of a model: its file stem, or its folder's name.
+pub fn model_name(path: &Path) -> String {
+    path.file_stem().or_else(|| path.file_name()).map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "model".into())
+}
+
+fn seed_of(base: u64, model: usize, run: usize) -> u64 {
+    crate::ordering::state_seed(base, &PartSet::empty(0), ((model as u64) << 32) | run as u64)
+}
+
+/// Collects the data set of `models` into `out` (created; existing files of the format are
+/// overwritten). `progress` is called after each model with its name and entry.
+pub fn collect(models: &[PathBuf], out: &Path, settings: &CollectSettings, progress: &(dyn Fn(&CollectedModel) + Sync)) -> Result<Collected> {
+    if settings.runs == 0 {
+        return Err(SearchError::config("the number of runs must be at least 1"));
+    }
+    settings.graph.validate()?;
+    std::fs::create_dir_all(out).map_err(|e| io_error(out, e))?;
+    let mut index = Collected {
+        format: FORMAT.into(),
+        version: VERSION,
+        features: settings.graph.features(),
+        node_dim: settings.graph.node_dim(),
+        edge_dim: settings.graph.edge_dim(),
+        seed: settings.seed,
+        runs: settings.runs,
+        assemblies: Vec::new(),
+    };
+    let mut used = std::collections::HashSet::new();
+    for (m, path) in models.iter().enumerate() {
+        let name = model_name(path);
+        let mut dir: String = name.chars().map(|c| if c.is_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+        while !used.insert(dir.clone()) {
+            dir.push('_');
+        }
+        let entry = collect_model(path, m, &name, &dir, out, settings)?;
+        progress(&entry);
+        index.assemblies.push(entry);
+    }
+    let json = serde_json::to_string_pretty(&index).expect("the index serialises");
+    write_atomic(&out.join("index.json"), format!("{json}\n").as_bytes())?;
+    Ok(index)
+}
+
+fn collect_model(path: &Path, m: usize, name: &str, dir: &str, out: &Path, settings: &CollectSettings) -> Result<CollectedModel> {
+    let assembly = pipeline::load(path, &settings.plan)?;
+    let checker = pipeline::checker(assembly, &settings.plan)?;
+    let world = checker.world();
+    let graph = AssemblyGraph::build(world, &settings.graph)?;
+    let n = world.num_parts();
+    let budget = Budget { max_tests: settings.max_tests, timeout: settings.timeout.map(Duration::from_secs_f64) };
+    let runs: Vec<(Vec<PartSet>, bool)> = (0..settings.runs)
+        .into_par_iter()
+        .map(|r| {
+            let dfs = Dfs::builder()
+                .ordering(BuiltinOrder::Shuffled)
+                .path_planner(settings.plan.path_planner)
+                .seed(seed_of(settings.seed, m, r))
+                .build();
+            let mut states = Vec::new();
+            let mut visit = |s: &PartSet| states.push(s.clone());
+            let outcome = dfs.solve_visiting(&Problem::full(&checker), &budget, Some(&mut visit));
+            (states, outcome.status == crate::Status::Found)
+        })
+        .collect();
+    let lines: Vec<Vec<StateLine>> = runs
+        .par_iter()
+        .enumerate()
+        .map(|(run, (states, _))| {
+            states
+                .iter()
+                .enumerate()
+                .map(|(step, state)| StateLine {
+                    run,
+                    step,
+                    present: state.iter().collect(),
+                    removable: state
+                        .iter()
+                        .filter(|&p| !checker.is_fixed(p))
+                        .filter(|&p| matches!(checker.test_removal(p, state, MotionKind::Linear), Outcome::Removed(_)))
+                        .collect(),
+                })
+                .collect()
+        })
+        .collect();
+    let folder = out.join(dir);
+    std::fs::create_dir_all(&folder).map_err(|e| io_error(&folder, e))?;
+    let assembly = world.assembly();
+    let graph_file = GraphFile {
+        name,
+        source: path.display().to_string(),
+        parts: assembly.parts.iter().map(|p| PartFile { name: &p.name, fixed: p.fixed }).collect(),
+        edges: graph.edges().iter().map(|&(s, t)| [s, t]).collect(),
+    };
+    let json = serde_json::to_string(&graph_file).expect("the graph serialises");
+    write_atomic(&folder.join("graph.json"), format!("{json}\n").as_bytes())?;
+    write_atomic(&folder.join("nodes.npy"), &npy_f32(graph.nodes_flat(), n, graph.node_dim()))?;
+    write_atomic(&folder.join("edge_attr.npy"), &npy_f32(graph.edge_attr_flat(), graph.edges().len(), graph.edge_dim()))?;
+    let mut text = Vec::new();
+    let mut count = 0;
+    for line in lines.iter().flatten() {
+        serde_json::to_writer(&mut text, line).expect("state lines serialise");
+        text.push(b'\n');
+        count += 1;
+    }
+    write_atomic(&folder.join("states.jsonl"), &text)?;
+    Ok(CollectedModel {
+        name: name.into(),
+        dir: dir.into(),
+        source: path.display().to_string(),
+        parts: n,
+        edges: graph.edges().len(),
+        states: count,
+        runs_found: runs.iter().filter(|(_, found)| *found).count(),
+    })
+}
+
+/// A NumPy `.npy` (version 1.0) file of a C-order float32 matrix.
+pub fn npy_f32(data: &[f32], rows: usize, cols: usize) -> Vec<u8> {
+    debug_assert_eq!(data.len(), rows * cols);
+    let mut header = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({rows}, {cols}), }}");
+    // magic (6) + version (2) + header length (2) + header + newline, padded to 64 bytes
+    let total = 10 + header.len() + 1;
+    header.push_str(&" ".repeat((64 - total % 64) % 64));
+    header.push('\n');
+    let mut out = Vec::with_capacity(10 + header.len() + 4 * data.len());
+    out.extend_from_slice(b"\x93NUMPY\x01\x00");
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    for v in data {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so a
+/// reader never sees half a file.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = path.with_extension(format!("{}.tmp", path.extension().and_then(|e| e.to_str()).unwrap_or("")));
+    let write = || -> std::io::Result<()> {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    };
+    write().map_err(|e| io_error(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn npy_header_is_aligned_and_parsable() {
+        let bytes = npy_f32(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0], 2, 3);
+        assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
+        let len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+        assert_eq!((10 + len) % 64, 0);
+        let header = std::str::from_utf8(&bytes[10..10 + len]).unwrap();
+        assert!(header.contains("'shape': (2, 3)") && header.ends_with('\n'), "{header}");
+        assert_eq!(bytes.len(), 10 + len + 24);
+        assert_eq!(f32::from_le_bytes(bytes[10 + len + 20..].try_into().unwrap()), 6.0);
+    }
+}

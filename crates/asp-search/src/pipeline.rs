@@ -1,0 +1,407 @@
+//! The planning pipeline that the CLI and the Python package both call:
+//! load → collision world → checker → planner → report, and the optimiser's
+//! load → distance maps → MCTS / Pareto-MCTS → report.
+//!
+//! Settings are in the model's units (as a user gives them) and validated here, with messages
+//! that name the setting, not a command-line flag. Every step is also public on its own, so a
+//! caller that plans many times on one model (data collection, benchmarks) builds the world once.
+
+use crate::objective::parse_objectives;
+use crate::ordering::{BuiltinOrder, OrderingSource};
+use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step};
+use crate::report::{OptimisationEntry, ParetoEntry, PlanReport, CHECKER_DISTANCE_MAPS};
+use crate::search::{SearchOutcome, SearchStatus, DEFAULT_BUDGET, DEFAULT_EPISODES};
+use crate::{Dfs, Mcts, Mdp, ParetoMcts, Planner, Result, SearchError};
+use asp_geom::distmap::{DistanceMaps, MapConfig, Support};
+use asp_geom::io::LoadOptions;
+use asp_geom::math::Axis;
+use asp_geom::physics::PhysicsConfig;
+use asp_geom::rrt::RrtConfig;
+use asp_geom::{Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, StabilityMode, Units, World, WorldConfig};
+use std::path::Path;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// How the stability of a state is judged.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum StabilitySetting {
+    /// Every part linked through contacts to a fixed part (thesis 3.3).
+    #[default]
+    Contact,
+    /// Simulated under gravity (rapier3d); unstable when a part moves more than `threshold`
+    /// (a fraction of the model's diagonal).
+    Physics {
+        /// Displacement threshold as a fraction of the model's diagonal (default 0.01).
+        threshold: f64,
+    },
+}
+
+/// Everything `asp plan` can be asked, in the model's units.
+#[derive(Clone)]
+pub struct PlanSettings {
+    /// The unit of the model's coordinates (default: what the file says, else metres).
+    pub unit: Option<Units>,
+    /// The up axis (default: what the file says, else the format's convention).
+    pub up: Option<Axis>,
+    /// Names of base parts, on top of those the file marks as fixed.
+    pub fixed: Vec<String>,
+    /// Contact tolerance in model units (default 1e-4 × the model's diagonal).
+    pub tolerance: Option<f64>,
+    /// Contact distance for stability, model units (default 1e-3 × the diagonal).
+    pub contact_distance: Option<f64>,
+    /// Clustered surface-normal directions tried besides the six axes.
+    pub normals: usize,
+    /// Extra removal directions sampled evenly on the sphere.
+    pub sphere_directions: usize,
+    /// Ignore collisions between parts that overlap in the input beyond repair.
+    pub ignore_overlapping: bool,
+    /// The stability criterion.
+    pub stability: StabilitySetting,
+    /// The part ordering of the depth-first search.
+    pub order: Arc<dyn OrderingSource>,
+    /// Bookkeeping on top of the ordering.
+    pub bookkeeping: bool,
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// Fall back to the path planner when no straight line works.
+    pub path_planner: bool,
+    /// Path planner iterations per call.
+    pub rrt_iterations: usize,
+    /// Path planner wall-time cap per call, seconds.
+    pub rrt_time: f64,
+    /// Stop after this many removal tests.
+    pub max_tests: Option<u64>,
+    /// Stop after this many seconds.
+    pub timeout: Option<f64>,
+    /// Optimise instead of finding a feasible sequence.
+    pub optimise: Option<OptimiseSettings>,
+}
+
+impl Default for PlanSettings {
+    fn default() -> Self {
+        PlanSettings {
+            unit: None,
+            up: None,
+            fixed: Vec::new(),
+            tolerance: None,
+            contact_distance: None,
+            normals: WorldConfig::default().normal_clusters,
+            sphere_directions: 0,
+            ignore_overlapping: false,
+            stability: StabilitySetting::Contact,
+            order: Arc::new(BuiltinOrder::Given),
+            bookkeeping: false,
+            seed: 0,
+            path_planner: true,
+            rrt_iterations: RrtConfig::default().max_iterations,
+            rrt_time: RrtConfig::default().max_time.as_secs_f64(),
+            max_tests: None,
+            timeout: None,
+            optimise: None,
+        }
+    }
+}
+
+impl std::fmt::Debug for PlanSettings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PlanSettings")
+            .field("order", &self.order.name())
+            .field("bookkeeping", &self.bookkeeping)
+            .field("seed", &self.seed)
+            .field("optimise", &self.optimise)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The optimiser's settings (`asp plan --objective`).
+#[derive(Clone, Debug)]
+pub struct OptimiseSettings {
+    /// Objective names, comma-separated (`access`, `dirchange`, `pathlen`).
+    pub objectives: String,
+    /// Search the Pareto front (several objectives need it).
+    pub pareto: bool,
+    /// MCTS episodes.
+    pub episodes: usize,
+    /// MCTS iterations per step.
+    pub budget: usize,
+    /// Threads (default: all cores).
+    pub threads: Option<usize>,
+    /// Wall-time limit of the search, seconds.
+    pub time_limit: Option<f64>,
+    /// Exploration constant of UCT / MOUCB.
+    pub exploration: f64,
+    /// Distance map resolution N_M.
+    pub resolution: usize,
+    /// Cap of the distance maps, model units (default the model's diagonal).
+    pub d_max: Option<f64>,
+    /// The optimiser's gravity check.
+    pub support: Support,
+}
+
+impl Default for OptimiseSettings {
+    fn default() -> Self {
+        OptimiseSettings {
+            objectives: String::new(),
+            pareto: false,
+            episodes: DEFAULT_EPISODES,
+            budget: DEFAULT_BUDGET,
+            threads: None,
+            time_limit: None,
+            exploration: std::f64::consts::FRAC_1_SQRT_2,
+            resolution: asp_geom::distmap::DEFAULT_RESOLUTION,
+            d_max: None,
+            support: Support::Below,
+        }
+    }
+}
+
+/// What a planning run gives back.
+#[derive(Debug)]
+pub struct PlanResult {
+    /// The plan, as written to the plan JSON.
+    pub report: PlanReport,
+    /// How the search ended.
+    pub status: Status,
+    /// The optimiser's outcome (its trace, every solution), for optimising runs.
+    pub search: Option<SearchOutcome>,
+}
+
+impl PlanResult {
+    /// Whether a complete sequence was found.
+    pub fn found(&self) -> bool {
+        self.status == Status::Found
+    }
+}
+
+fn positive(name: &str, v: f64) -> Result<f64> {
+    if v > 0.0 && v.is_finite() {
+        Ok(v)
+    } else {
+        Err(SearchError::config(format!("{name} must be a positive number, got {v}")))
+    }
+}
+
+/// Loads the model at `path` with the settings' unit, up axis and fixed parts.
+pub fn load(path: &Path, settings: &PlanSettings) -> Result<Assembly> {
+    let options = LoadOptions { unit: settings.unit.clone(), up: settings.up, fixed: settings.fixed.clone() };
+    Ok(asp_geom::io::load(path, &options)?)
+}
+
+/// The collision world's settings, converted to metres.
+pub fn world_config(assembly: &Assembly, settings: &PlanSettings) -> Result<WorldConfig> {
+    let metres = assembly.units.metres;
+    let to_m = |name: &str, v: Option<f64>| -> Result<Option<f32>> {
+        v.map(|v| positive(name, v).map(|v| (v * metres) as f32)).transpose()
+    };
+    Ok(WorldConfig {
+        tolerance: to_m("the tolerance", settings.tolerance)?,
+        contact_distance: to_m("the contact distance", settings.contact_distance)?,
+        normal_clusters: settings.normals,
+        sphere_directions: settings.sphere_directions,
+        ignore_overlapping: settings.ignore_overlapping,
+        ..WorldConfig::default()
+    })
+}
+
+/// The checker's settings (stability, path planner budget).
+pub fn checker_config(settings: &PlanSettings) -> Result<CheckerConfig> {
+    let stability = match settings.stability {
+        StabilitySetting::Contact => StabilityMode::ContactGraph,
+        StabilitySetting::Physics { threshold } => {
+            let physics = PhysicsConfig {
+                displacement_fraction: positive("the physics threshold", threshold)? as f32,
+                ..PhysicsConfig::default()
+            };
+            physics.validate()?;
+            StabilityMode::Physics(physics)
+        }
+    };
+    let rrt = RrtConfig {
+        max_iterations: settings.rrt_iterations,
+        max_time: Duration::from_secs_f64(positive("the path planner's time cap", settings.rrt_time)?),
+        ..RrtConfig::default()
+    };
+    Ok(CheckerConfig { stability, rrt })
+}
+
+/// Builds the collision world of `assembly` and its checker.
+pub fn checker(assembly: Assembly, settings: &PlanSettings) -> Result<Checker> {
+    let config = world_config(&assembly, settings)?;
+    let world = World::new(assembly, &config)?;
+    Ok(Checker::new(world, checker_config(settings)?))
+}
+
+/// The depth-first planner the settings ask for, its ordering prepared on `world` (a learned
+/// ordering computes the model's graph features here, once).
+pub fn planner(settings: &PlanSettings, world: &World) -> Result<Dfs> {
+    let factory = settings.order.prepare(world)?;
+    Ok(Dfs::builder()
+        .ordering_factory(factory)
+        .bookkeeping(settings.bookkeeping)
+        .path_planner(settings.path_planner)
+        .seed(settings.seed)
+        .build())
+}
+
+/// The search budget.
+pub fn budget(settings: &PlanSettings) -> Result<Budget> {
+    Ok(Budget {
+        max_tests: settings.max_tests,
+        timeout: settings.timeout.map(|t| positive("the timeout", t).map(Duration::from_secs_f64)).transpose()?,
+    })
+}
+
+/// Plans the model at `path`: [`load`], then [`plan_assembly`].
+pub fn plan_file(path: &Path, settings: &PlanSettings, progress: Option<&(dyn Fn(&Progress) + Sync)>) -> Result<PlanResult> {
+    plan_assembly(load(path, settings)?, settings, progress)
+}
+
+/// Plans `assembly`: a feasible sequence by depth-first AbD, or, with
+/// [`PlanSettings::optimise`], an optimised one.
+pub fn plan_assembly(
+    assembly: Assembly,
+    settings: &PlanSettings,
+    progress: Option<&(dyn Fn(&Progress) + Sync)>,
+) -> Result<PlanResult> {
+    if let Some(optimise) = &settings.optimise {
+        return self::optimise(&assembly, settings, optimise);
+    }
+    let checker = checker(assembly, settings)?;
+    let dfs = planner(settings, checker.world())?;
+    let budget = budget(settings)?;
+    let mut problem = Problem::full(&checker);
+    problem.progress = progress;
+    let outcome = dfs.solve(&problem, &budget);
+    let world = checker.world();
+    let report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
+    Ok(PlanResult { report, status: outcome.status, search: None })
+}
+
+/// Optimises a sequence of `assembly` on distance maps (MCTS for one objective, Pareto-MCTS
+/// for several).
+pub fn optimise(assembly: &Assembly, settings: &PlanSettings, o: &OptimiseSettings) -> Result<PlanResult> {
+    let objectives = parse_objectives(&o.objectives)?;
+    if objectives.len() > 1 && !o.pareto {
+        return Err(SearchError::config(format!(
+            "objectives {}: several objectives need a Pareto search (or give one objective)",
+            o.objectives
+        )));
+    }
+    let world = world_config(assembly, settings)?;
+    let metres = assembly.units.metres;
+    let mut config = MapConfig::builder().resolution(o.resolution).support(o.support);
+    if let Some(d) = o.d_max {
+        config = config.d_max((positive("d_max", d)? * metres) as f32);
+    }
+    if let Some(t) = world.tolerance {
+        config = config.tolerance(t);
+    }
+    if let Some(c) = world.contact_distance {
+        config = config.contact_distance(c);
+    }
+    let config = config.build()?;
+    let started = Instant::now();
+    let maps = Arc::new(DistanceMaps::build(assembly, &config)?);
+    let map_seconds = started.elapsed().as_secs_f64();
+    let mdp = Mdp::new(maps.clone(), objectives)?;
+    let threads = o.threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    macro_rules! configure {
+        ($builder:expr) => {{
+            let mut b = $builder
+                .budget(o.budget)
+                .episodes(o.episodes)
+                .threads(threads)
+                .seed(settings.seed)
+                .exploration(o.exploration);
+            if let Some(t) = o.time_limit {
+                b = b.time_limit(Duration::from_secs_f64(positive("the time limit", t)?));
+            }
+            b.build()?
+        }};
+    }
+    let outcome = if o.pareto {
+        configure!(ParetoMcts::builder()).solve(&mdp)?
+    } else {
+        configure!(Mcts::builder()).solve(&mdp)?
+    };
+    let plan = adapt(&maps, &outcome);
+    let mut warnings = assembly.warnings.clone();
+    for w in maps.warnings() {
+        if !warnings.contains(w) {
+            warnings.push(w.clone());
+        }
+    }
+    let mut report = PlanReport::new(assembly, &plan, maps.tolerance(), &warnings);
+    report.stats.checker = CHECKER_DISTANCE_MAPS.into();
+    report.pareto_front = o.pareto.then(|| {
+        outcome
+            .solutions
+            .iter()
+            .map(|s| ParetoEntry { objectives: s.values.clone(), disassembly_sequence: s.sequence.clone() })
+            .collect()
+    });
+    let s = &outcome.stats;
+    report.optimisation = Some(OptimisationEntry {
+        method: if o.pareto { "pareto_mcts" } else { "mcts" }.into(),
+        objectives: outcome.objectives.clone(),
+        values: outcome.best().map(|b| b.values.clone()).unwrap_or_default(),
+        hypervolume: o.pareto.then_some(outcome.value),
+        reference: outcome.reference.clone(),
+        exhaustive: s.exhausted,
+        episodes: s.episodes,
+        iterations: s.iterations,
+        tree_nodes: s.tree_nodes,
+        budget: o.budget,
+        threads: s.threads,
+        seed: settings.seed,
+        resolution: maps.hemisphere().resolution(),
+        d_max: maps.d_max() as f64,
+        map_seconds,
+        search_seconds: s.seconds,
+    });
+    Ok(PlanResult { report, status: plan.status, search: Some(outcome) })
+}
+
+/// The optimiser's outcome as a plan outcome: motions get the maps' contact margin (the plan
+/// format's removal ends that far beyond the remaining bounds).
+fn adapt(maps: &DistanceMaps, outcome: &SearchOutcome) -> PlanOutcome {
+    let margin = maps.contact_distance();
+    let removals = outcome
+        .best()
+        .map(|s| {
+            s.sequence
+                .iter()
+                .zip(&s.motions)
+                .map(|(&part, m)| Step {
+                    part,
+                    motion: match m {
+                        Motion::Linear { direction, distance } => {
+                            Motion::Linear { direction: *direction, distance: distance + margin }
+                        }
+                        other => other.clone(),
+                    },
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    let status = match outcome.status {
+        SearchStatus::Found => Status::Found,
+        SearchStatus::NoPlan => Status::NoPlan { stuck: Vec::new(), state: asp_geom::PartSet::full(maps.num_parts()) },
+        SearchStatus::BudgetExhausted => Status::BudgetExhausted,
+    };
+    let s = &outcome.stats;
+    PlanOutcome {
+        status,
+        removals,
+        stats: Stats {
+            counters: CounterSnapshot {
+                removal_tests: s.removal_tests,
+                failed_collision: s.failed_collision,
+                failed_gravity: s.failed_gravity,
+                path_planner_calls: 0,
+            },
+            seconds: s.seconds,
+            states_expanded: 0,
+        },
+    }
+}
