@@ -1,0 +1,4 @@
+//! Integration tests of asp-learn (one binary; modules in folders).
+
+mod model;
+mod ordering;

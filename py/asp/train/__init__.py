@@ -1,0 +1,24 @@
+"""Training of asp's learned guidance (needs PyTorch; the rest of ``asp`` does not).
+
+* :mod:`asp.train.gnn`: the removability GNN of thesis 3.5.2 (:class:`RemovabilityGNN`);
+* :mod:`asp.train.trainer`: supervised training on ``asp-removability`` data sets (thesis 3.6.2);
+* :mod:`asp.train.export`: ONNX export as docs/learning.md specifies, with a parity check;
+* :mod:`asp.train.fixture`: the ONNX fixtures of the Rust crate ``asp-learn``.
+
+Command line: ``python -m asp.train removability DATA_DIR... --out model.onnx`` (see ``--help``).
+"""
+
+from .export import ExportError, export_onnx, parity_check
+from .gnn import RemovabilityGNN
+from .trainer import TrainConfig, evaluate, load_assemblies, train
+
+__all__ = [
+    "ExportError",
+    "RemovabilityGNN",
+    "TrainConfig",
+    "evaluate",
+    "export_onnx",
+    "load_assemblies",
+    "parity_check",
+    "train",
+]

@@ -1,0 +1,160 @@
+"""``python -m asp.train removability DATA_DIR... --out model.onnx [options]``.
+
+Trains the removability GNN on ``asp-removability`` data sets and writes an ONNX model plus a
+JSON summary beside it (``model.onnx.json``: features, dimensions, epochs, seed, per-assembly
+accuracy). ``--holdout NAME...`` keeps assemblies out of training and reports their accuracy;
+``--leave-one-out OUT_DIR`` trains one model per assembly on all the others
+(``OUT_DIR/<name>.onnx``) and reports each on its own assembly (the thesis' five-fold protocol).
+Exit status 0 on success, 2 on bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import statistics
+import sys
+from pathlib import Path
+
+from ..data import DataError
+from .export import ExportError, export_onnx
+from .trainer import AssemblyData, TrainConfig, evaluate, load_assemblies, train
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m asp.train", description="Train asp's learned guidance models.")
+    sub = p.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("removability", help="train the part removability GNN (thesis 3.5)")
+    r.add_argument("data", nargs="+", metavar="DATA_DIR", help="asp-removability data set folders")
+    r.add_argument("--out", type=Path, help="the ONNX model to write (its summary goes to OUT.json)")
+    r.add_argument("--epochs", type=int, default=50, help="passes over the training states (default 50)")
+    r.add_argument("--lr", type=float, default=1e-3, help="Adam learning rate (default 1e-3)")
+    r.add_argument("--batch", type=int, default=32, help="states per batch (default 32)")
+    r.add_argument("--seed", type=int, default=0, help="seed of weights and batch order (default 0)")
+    r.add_argument("--layers", type=int, default=3, help="GNN layers (default 3)")
+    r.add_argument("--width", type=int, default=64, help="hidden width (default 64)")
+    r.add_argument("--threads", type=int, default=1, help="PyTorch CPU threads (default 1)")
+    r.add_argument("--seconds", type=float, help="cap the training time of each model")
+    r.add_argument(
+        "--aggregation", choices=["scatter", "dense"], default="scatter",
+        help="aggregation ops in the ONNX file: ScatterND (default) or one-hot MatMul",
+    )
+    g = r.add_mutually_exclusive_group()
+    g.add_argument("--holdout", nargs="+", metavar="NAME", default=[], help="assemblies to evaluate on, not train on")
+    g.add_argument("--leave-one-out", type=Path, metavar="OUT_DIR", help="one model per assembly, trained on the others")
+    return p
+
+
+def _log(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+def _safe(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9._-]", "_", name) or "assembly"
+
+
+def _fit_and_export(
+    args: argparse.Namespace,
+    train_set: list[AssemblyData],
+    test_set: list[AssemblyData],
+    features: str,
+    node_dim: int,
+    edge_dim: int,
+    out: Path,
+) -> dict:
+    config = TrainConfig(
+        epochs=args.epochs, lr=args.lr, batch=args.batch, seed=args.seed,
+        width=args.width, layers=args.layers, seconds=args.seconds, threads=args.threads,
+    )
+    names = ", ".join(a.name for a in train_set)
+    _log(f"training on {sum(len(a.states) for a in train_set)} states of {len(train_set)} assemblies ({names})")
+    model, summary = train(train_set, node_dim, edge_dim, config, log=_log)
+    parity = export_onnx(model, out, features, aggregation=args.aggregation)
+    _log(f"wrote {out} (ONNX matches PyTorch to {parity:.2g})")
+    train_acc = {a.name: evaluate(model, a) for a in train_set}
+    held = {a.name: evaluate(model, a) for a in test_set}
+    for name, r in held.items():
+        print(f"{name}: accuracy {r['accuracy']:.4f} on {r['labels']} labels of {r['states']} states")
+    median = statistics.median(r["accuracy"] for r in held.values()) if held else None
+    if median is not None:
+        print(f"median held-out accuracy: {median:.4f}")
+    doc = {
+        "kind": "removability",
+        "features": features,
+        "node_dim": node_dim,
+        "edge_dim": edge_dim,
+        "epochs": summary["epochs"],
+        "epochs_requested": args.epochs,
+        "time_capped": summary["time_capped"],
+        "seed": args.seed,
+        "lr": args.lr,
+        "batch": args.batch,
+        "layers": args.layers,
+        "width": args.width,
+        "aggregation": args.aggregation,
+        "final_loss": summary["loss"],
+        "train_seconds": summary["seconds"],
+        "onnx_parity_max_abs_diff": parity,
+        "train_assemblies": [a.name for a in train_set],
+        "train_accuracy": {k: v["accuracy"] for k, v in train_acc.items()},
+        "holdout_accuracy": {k: v["accuracy"] for k, v in held.items()},
+        "holdout": held,
+        "median_holdout_accuracy": median,
+    }
+    Path(str(out) + ".json").write_text(json.dumps(doc, indent=2) + "\n")
+    return doc
+
+
+def _removability(args: argparse.Namespace) -> int:
+    if args.out is None and args.leave_one_out is None:
+        raise DataError("give --out MODEL.onnx, --leave-one-out OUT_DIR, or both")
+    assemblies, features, node_dim, edge_dim = load_assemblies(args.data)
+    by_name = {a.name: a for a in assemblies}
+    if args.leave_one_out is not None:
+        if len(assemblies) < 2:
+            raise DataError("--leave-one-out needs at least two assemblies")
+        out_dir: Path = args.leave_one_out
+        out_dir.mkdir(parents=True, exist_ok=True)
+        results = {}
+        for a in assemblies:
+            _log(f"== leaving out {a.name}")
+            others = [o for o in assemblies if o is not a]
+            doc = _fit_and_export(args, others, [a], features, node_dim, edge_dim, out_dir / f"{_safe(a.name)}.onnx")
+            results[a.name] = doc["holdout_accuracy"][a.name]
+        median = statistics.median(results.values())
+        print("leave-one-out accuracy: " + ", ".join(f"{k} {v:.4f}" for k, v in results.items()))
+        print(f"median leave-one-out accuracy: {median:.4f}")
+        summary = {"features": features, "seed": args.seed, "epochs": args.epochs, "accuracy": results, "median_accuracy": median}
+        (out_dir / "leave-one-out.json").write_text(json.dumps(summary, indent=2) + "\n")
+    if args.out is not None:
+        unknown = [n for n in args.holdout if n not in by_name]
+        if unknown:
+            raise DataError(f"--holdout names no assembly '{unknown[0]}' (known: {', '.join(by_name)})")
+        test_set = [by_name[n] for n in args.holdout]
+        train_set = [a for a in assemblies if a.name not in args.holdout]
+        if not train_set:
+            raise DataError("--holdout leaves no assembly to train on")
+        _fit_and_export(args, train_set, test_set, features, node_dim, edge_dim, args.out)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit status."""
+    args = _parser().parse_args(argv)
+    for flag in ("epochs", "batch", "layers", "width", "threads"):
+        if getattr(args, flag) < 1:
+            print(f"error: --{flag} must be at least 1", file=sys.stderr)
+            return 2
+    if args.seconds is not None and args.seconds <= 0:
+        print("error: --seconds must be positive", file=sys.stderr)
+        return 2
+    try:
+        return _removability(args)
+    except (DataError, ExportError) as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

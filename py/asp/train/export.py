@@ -1,0 +1,161 @@
+"""ONNX export of a :class:`~asp.train.gnn.RemovabilityGNN` as docs/learning.md specifies.
+
+The file has opset 17, inputs ``x`` float32 ``[n, node_dim]``, ``edge_index`` int64 ``[2, e]``,
+``edge_attr`` float32 ``[e, edge_dim]``, output ``removability`` float32 ``[n]`` with ``n`` and
+``e`` dynamic, and the metadata properties ``asp.kind``, ``asp.features``, ``asp.node_dim``,
+``asp.edge_dim`` (plus ``asp.aggregation``, ``asp.layers``, ``asp.width`` for information).
+
+Export uses PyTorch's TorchScript-based exporter (``dynamo=False``): it needs no ``onnxscript``,
+gives a small graph of elementary ops (Gemm, Gather, ScatterND or MatMul, Exp, ...) and honours
+``dynamic_axes``. After writing, :func:`export_onnx` runs the file with ``onnxruntime`` when it is
+installed, else with ``onnx.reference.ReferenceEvaluator``, on random graphs of sizes the model
+never saw (one of them without edges) and fails unless it agrees with PyTorch to ``tolerance``.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+import onnx
+import torch
+
+from .gnn import RemovabilityGNN
+
+__all__ = ["OPSET", "INPUT_NAMES", "OUTPUT_NAME", "ExportError", "export_onnx", "parity_check", "run_onnx", "random_graph"]
+
+#: The ONNX opset of exported models.
+OPSET = 17
+#: Input names, in order.
+INPUT_NAMES = ("x", "edge_index", "edge_attr")
+#: The output name.
+OUTPUT_NAME = "removability"
+#: ``(n, e)`` of the graphs the exporter checks parity on.
+PARITY_SIZES = ((7, 0), (53, 212), (131, 610))
+
+
+class ExportError(RuntimeError):
+    """The exported file does not reproduce the PyTorch model."""
+
+
+def random_graph(n: int, e: int, node_dim: int, edge_dim: int, rng: np.random.Generator):
+    """A random state graph ``(x, edge_index, edge_attr)`` as NumPy arrays.
+
+    Node attributes are non-negative with flag-like last two columns, as real descriptors are;
+    edges are random ordered pairs of distinct nodes (duplicates allowed, which a model must
+    tolerate too).
+    """
+    x = rng.gamma(2.0, 0.5, size=(n, node_dim)).astype(np.float32)
+    if node_dim >= 2:
+        x[:, -2:] = rng.integers(0, 2, size=(n, 2)).astype(np.float32)
+    if n >= 2 and e > 0:
+        s = rng.integers(0, n, size=e)
+        t = (s + rng.integers(1, n, size=e)) % n
+        edge_index = np.stack([s, t]).astype(np.int64)
+    else:
+        edge_index = np.zeros((2, 0), dtype=np.int64)
+    e = edge_index.shape[1]
+    edge_attr = rng.gamma(2.0, 0.5, size=(e, edge_dim)).astype(np.float32)
+    if edge_dim >= 2:
+        edge_attr[:, -2:] = rng.uniform(-1.0, 1.0, size=(e, 2)).astype(np.float32)
+    return x, edge_index, edge_attr
+
+
+def run_onnx(path: os.PathLike | str, x: np.ndarray, edge_index: np.ndarray, edge_attr: np.ndarray) -> np.ndarray:
+    """Run an exported model with onnxruntime if installed, else with ONNX's reference evaluator."""
+    feeds = {"x": x, "edge_index": edge_index, "edge_attr": edge_attr}
+    try:
+        import onnxruntime  # type: ignore[import-not-found]
+    except ImportError:
+        from onnx.reference import ReferenceEvaluator
+
+        return np.asarray(ReferenceEvaluator(str(path)).run(None, feeds)[0])
+    session = onnxruntime.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    return np.asarray(session.run(None, feeds)[0])
+
+
+def parity_check(
+    model: RemovabilityGNN, path: os.PathLike | str, seed: int = 12345, tolerance: float = 1e-5
+) -> float:
+    """Compare the ONNX file with the PyTorch model on :data:`PARITY_SIZES` graphs.
+
+    Returns the largest absolute difference; raises :class:`ExportError` above ``tolerance``.
+    """
+    rng = np.random.default_rng(seed)
+    worst = 0.0
+    model = model.eval()
+    for n, e in PARITY_SIZES:
+        x, edge_index, edge_attr = random_graph(n, e, model.node_dim, model.edge_dim, rng)
+        with torch.no_grad():
+            expected = model(torch.from_numpy(x), torch.from_numpy(edge_index), torch.from_numpy(edge_attr)).numpy()
+        got = run_onnx(path, x, edge_index, edge_attr)
+        if got.shape != expected.shape:
+            raise ExportError(f"{path}: output shape {list(got.shape)} for n={n}, expected {list(expected.shape)}")
+        diff = float(np.max(np.abs(got.astype(np.float64) - expected))) if n else 0.0
+        if not np.isfinite(got).all() or diff > tolerance:
+            raise ExportError(f"{path}: ONNX and PyTorch differ by {diff:.3g} on a graph with n={n}, e={e} (tolerance {tolerance:g})")
+        worst = max(worst, diff)
+    return worst
+
+
+def export_onnx(
+    model: RemovabilityGNN,
+    path: os.PathLike | str,
+    features: str,
+    aggregation: str | None = None,
+    check: bool = True,
+    extra_metadata: dict[str, str] | None = None,
+) -> float | None:
+    """Write ``model`` to ``path`` as a removability ONNX model and check it.
+
+    ``aggregation`` picks the exported implementation (default: the model's); the model itself is
+    not modified. Returns the parity check's largest difference (``None`` with ``check=False``).
+    """
+    path = Path(path)
+    model = copy.deepcopy(model).eval()
+    if aggregation is not None:
+        model.set_aggregation(aggregation)
+    rng = np.random.default_rng(0)
+    x, edge_index, edge_attr = random_graph(5, 8, model.node_dim, model.edge_dim, rng)
+    args = (torch.from_numpy(x), torch.from_numpy(edge_index), torch.from_numpy(edge_attr))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with warnings.catch_warnings():
+        # the TorchScript exporter announces its deprecation; it is the one that needs no onnxscript
+        warnings.simplefilter("ignore")
+        torch.onnx.export(
+            model,
+            args,
+            str(path),
+            dynamo=False,
+            opset_version=OPSET,
+            input_names=list(INPUT_NAMES),
+            output_names=[OUTPUT_NAME],
+            dynamic_axes={
+                "x": {0: "n"},
+                "edge_index": {1: "e"},
+                "edge_attr": {0: "e"},
+                OUTPUT_NAME: {0: "n"},
+            },
+            do_constant_folding=True,
+        )
+    proto = onnx.load(str(path))
+    metadata = {
+        "asp.kind": "removability",
+        "asp.features": features,
+        "asp.node_dim": str(model.node_dim),
+        "asp.edge_dim": str(model.edge_dim),
+        "asp.aggregation": model.aggregation,
+        "asp.layers": str(model.layers),
+        "asp.width": str(model.width),
+    }
+    metadata.update(extra_metadata or {})
+    onnx.helper.set_model_props(proto, metadata)
+    proto.producer_name = "asp.train"
+    onnx.checker.check_model(proto)
+    onnx.save(proto, str(path))
+    if not check:
+        return None
+    return parity_check(model, path)

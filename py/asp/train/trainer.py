@@ -1,0 +1,224 @@
+"""Supervised training of the removability GNN (thesis 3.6.2): BCE on labelled nodes, Adam.
+
+States are kept as small index arrays (present parts, induced edge ids, renumbered edges, labels);
+their attributes are gathered from the assemblies' memory-mapped arrays batch by batch, so memory
+grows with the number of states, not with their attributes. A batch merges its states into one
+disjoint graph. Training is seeded and deterministic on CPU (one thread by default).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Iterable, Sequence
+
+import numpy as np
+import torch
+
+from ..data import Assembly, DataError, RemovabilityDataset
+from .gnn import RemovabilityGNN
+
+__all__ = ["TrainConfig", "StateRecord", "AssemblyData", "load_assemblies", "train", "evaluate", "Batch", "make_batch"]
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """Training hyper-parameters."""
+
+    epochs: int = 50
+    """Passes over the training states."""
+    lr: float = 1e-3
+    """Adam's learning rate."""
+    batch: int = 32
+    """States per batch."""
+    seed: int = 0
+    """Seeds the weights and the batch order."""
+    width: int = 64
+    """Hidden width."""
+    layers: int = 3
+    """GNN layers."""
+    seconds: float | None = None
+    """Stop after this many seconds of training (checked after every batch)."""
+    threads: int = 1
+    """PyTorch CPU threads (results are reproducible for one thread count)."""
+
+
+@dataclass(frozen=True)
+class StateRecord:
+    """One state of an assembly, as indices into the assembly's arrays."""
+
+    present: np.ndarray
+    """int64 part indices (the nodes)."""
+    edge_ids: np.ndarray
+    """int64 rows of the assembly's edge arrays (the edges)."""
+    edge_index: np.ndarray
+    """int64 ``[2, e]`` renumbered edges."""
+    labels: np.ndarray
+    """float32 ``[n]``."""
+    mask: np.ndarray
+    """bool ``[n]``: labelled nodes."""
+
+
+@dataclass
+class AssemblyData:
+    """An assembly with its states, ready for batching."""
+
+    assembly: Assembly
+    """The assembly (memory-mapped arrays)."""
+    states: list[StateRecord] = field(default_factory=list)
+    """Its states, in file order."""
+
+    @property
+    def name(self) -> str:
+        """The assembly's name."""
+        return self.assembly.name
+
+
+def load_assemblies(dirs: Sequence[str]) -> tuple[list[AssemblyData], str, int, int]:
+    """Open data sets and read their states. Returns ``(assemblies, features, node_dim, edge_dim)``.
+
+    All data sets must share features and dimensions; assembly names must be unique across them.
+    """
+    if not dirs:
+        raise DataError("no data set given")
+    out: list[AssemblyData] = []
+    features = node_dim = edge_dim = None
+    first = None
+    for d in dirs:
+        ds = RemovabilityDataset.open(d)
+        if first is None:
+            first, features, node_dim, edge_dim = d, ds.features, ds.node_dim, ds.edge_dim
+        elif (ds.features, ds.node_dim, ds.edge_dim) != (features, node_dim, edge_dim):
+            raise DataError(
+                f"{ds.root / 'index.json'}: features '{ds.features}' ({ds.node_dim}/{ds.edge_dim}) differ from "
+                f"{first}'s '{features}' ({node_dim}/{edge_dim})"
+            )
+        for a in ds.assemblies:
+            if any(o.name == a.name for o in out):
+                raise DataError(f"{ds.root / 'index.json'}: assembly '{a.name}' also appears in an earlier data set")
+            data = AssemblyData(a)
+            for s in a.states():
+                edge_ids, edge_index = s.subgraph()
+                labels, mask = s.labels()
+                data.states.append(StateRecord(s.present, edge_ids, edge_index, labels, mask))
+            out.append(data)
+    return out, features, node_dim, edge_dim  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class Batch:
+    """Several states merged into one disjoint graph."""
+
+    x: torch.Tensor
+    """float32 ``[n, node_dim]``."""
+    edge_index: torch.Tensor
+    """int64 ``[2, e]``."""
+    edge_attr: torch.Tensor
+    """float32 ``[e, edge_dim]``."""
+    labels: torch.Tensor
+    """float32 ``[n]``."""
+    mask: torch.Tensor
+    """bool ``[n]``."""
+
+
+def make_batch(items: Iterable[tuple[AssemblyData, StateRecord]]) -> Batch:
+    """Merge states into one disjoint graph (edge indices offset by the preceding node counts)."""
+    xs, eis, eas, ls, ms = [], [], [], [], []
+    offset = 0
+    for data, s in items:
+        xs.append(np.asarray(data.assembly.nodes[s.present], dtype=np.float32))
+        eas.append(np.asarray(data.assembly.edge_attr[s.edge_ids], dtype=np.float32))
+        eis.append(s.edge_index + offset)
+        ls.append(s.labels)
+        ms.append(s.mask)
+        offset += len(s.present)
+    return Batch(
+        x=torch.from_numpy(np.concatenate(xs)),
+        edge_index=torch.from_numpy(np.concatenate(eis, axis=1)),
+        edge_attr=torch.from_numpy(np.concatenate(eas)),
+        labels=torch.from_numpy(np.concatenate(ls)),
+        mask=torch.from_numpy(np.concatenate(ms)),
+    )
+
+
+def _seed_everything(config: TrainConfig) -> None:
+    torch.manual_seed(config.seed)
+    torch.set_num_threads(max(1, config.threads))
+    torch.use_deterministic_algorithms(True, warn_only=True)
+
+
+def train(
+    assemblies: Sequence[AssemblyData],
+    node_dim: int,
+    edge_dim: int,
+    config: TrainConfig,
+    log: Callable[[str], None] | None = None,
+) -> tuple[RemovabilityGNN, dict]:
+    """Train a model on every state of ``assemblies``. Returns ``(model, summary)``.
+
+    The summary holds the epochs run, the final epoch's mean loss and the seconds spent.
+    """
+    items = [(a, s) for a in assemblies for s in a.states if s.mask.any()]
+    if not items:
+        raise DataError("no labelled state to train on (" + ", ".join(a.name for a in assemblies) + ")")
+    _seed_everything(config)
+    model = RemovabilityGNN(node_dim, edge_dim, width=config.width, layers=config.layers)
+    nodes = np.concatenate([np.asarray(a.assembly.nodes) for a in assemblies])
+    edges = np.concatenate([np.asarray(a.assembly.edge_attr) for a in assemblies])
+    model.fit_normalisation(torch.from_numpy(nodes), torch.from_numpy(edges))
+    optimiser = torch.optim.Adam(model.parameters(), lr=config.lr)
+    rng = np.random.default_rng(config.seed)
+    start = time.monotonic()
+    epochs_run = 0
+    mean_loss = math.nan
+    stopped = False
+    for epoch in range(config.epochs):
+        model.train()
+        order = rng.permutation(len(items))
+        total, count = 0.0, 0
+        for b in range(0, len(order), config.batch):
+            batch = make_batch(items[k] for k in order[b : b + config.batch])
+            logits = model.logits(batch.x, batch.edge_index, batch.edge_attr)
+            loss = torch.nn.functional.binary_cross_entropy_with_logits(logits[batch.mask], batch.labels[batch.mask])
+            optimiser.zero_grad()
+            loss.backward()
+            optimiser.step()
+            total += loss.item() * int(batch.mask.sum())
+            count += int(batch.mask.sum())
+            if config.seconds is not None and time.monotonic() - start > config.seconds:
+                stopped = True
+                break
+        epochs_run = epoch + 1
+        mean_loss = total / max(count, 1)
+        if log:
+            log(f"epoch {epochs_run}/{config.epochs}: loss {mean_loss:.4f} ({time.monotonic() - start:.1f} s)")
+        if stopped:
+            if log:
+                log(f"stopped after {config.seconds:g} s")
+            break
+    model.eval()
+    summary = {"epochs": epochs_run, "loss": mean_loss, "seconds": round(time.monotonic() - start, 3), "time_capped": stopped}
+    return model, summary
+
+
+@torch.no_grad()
+def evaluate(model: RemovabilityGNN, data: AssemblyData, batch: int = 64) -> dict:
+    """Accuracy (threshold 0.5) over the labelled nodes of every state of one assembly."""
+    model.eval()
+    correct = total = 0
+    positives = 0
+    states = [s for s in data.states if s.mask.any()]
+    for b in range(0, len(states), batch):
+        merged = make_batch((data, s) for s in states[b : b + batch])
+        pred = model(merged.x, merged.edge_index, merged.edge_attr)[merged.mask] > 0.5
+        truth = merged.labels[merged.mask] > 0.5
+        correct += int((pred == truth).sum())
+        total += int(truth.numel())
+        positives += int(truth.sum())
+    return {
+        "accuracy": correct / total if total else math.nan,
+        "labels": total,
+        "states": len(states),
+        "positive_fraction": positives / total if total else math.nan,
+    }

@@ -1,0 +1,153 @@
+"""Tests of the removability GNN (``asp.train.gnn``) and its ONNX export (``asp.train.export``)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+torch = pytest.importorskip("torch", reason="asp.train needs PyTorch (pip install torch)")
+onnx = pytest.importorskip("onnx", reason="the ONNX export needs the onnx package")
+
+from asp.train.export import ExportError, export_onnx, parity_check, random_graph, run_onnx  # noqa: E402
+from asp.train.gnn import RemovabilityGNN  # noqa: E402
+
+NODE_DIM, EDGE_DIM = 12, 7
+
+
+def _model(seed: int = 0, **kw) -> RemovabilityGNN:
+    torch.manual_seed(seed)
+    model = RemovabilityGNN(NODE_DIM, EDGE_DIM, **kw).eval()
+    rng = np.random.default_rng(seed)
+    x, _, a = random_graph(50, 200, NODE_DIM, EDGE_DIM, rng)
+    model.fit_normalisation(torch.from_numpy(x), torch.from_numpy(a))
+    return model
+
+
+def _graph(n: int, e: int, seed: int = 1):
+    x, ei, ea = random_graph(n, e, NODE_DIM, EDGE_DIM, np.random.default_rng(seed))
+    return torch.from_numpy(x), torch.from_numpy(ei), torch.from_numpy(ea)
+
+
+def test_output_shape_and_range():
+    model = _model()
+    with torch.no_grad():
+        for n, e in [(1, 0), (5, 0), (9, 30), (40, 160)]:
+            y = model(*_graph(n, e))
+            assert y.shape == (n,)
+            assert torch.isfinite(y).all() and (y > 0).all() and (y < 1).all()
+
+
+def test_permutation_equivariance():
+    model = _model()
+    x, ei, ea = _graph(17, 60)
+    perm = torch.from_numpy(np.random.default_rng(3).permutation(17))
+    inverse = torch.argsort(perm)  # node i of the original graph is node inverse[i] of the relabelled one
+    edge_perm = torch.from_numpy(np.random.default_rng(4).permutation(ei.shape[1]))
+    with torch.no_grad():
+        y = model(x, ei, ea)
+        y_perm = model(x[perm], inverse[ei][:, edge_perm], ea[edge_perm])
+    torch.testing.assert_close(y_perm, y[perm], rtol=0, atol=1e-6)
+
+
+def test_messages_flow_from_source_to_target():
+    # one edge 0 -> 1: the target's output depends on the source's attributes, not the reverse
+    model = _model()
+    x, _, _ = _graph(2, 0)
+    ei = torch.tensor([[0], [1]])
+    ea = torch.from_numpy(np.random.default_rng(5).gamma(2.0, 0.5, (1, EDGE_DIM)).astype(np.float32))
+    x2 = x.clone()
+    x2[0, :3] += 5.0
+    x3 = x.clone()
+    x3[1, :3] += 5.0
+    with torch.no_grad():
+        y, y_source_changed = model(x, ei, ea), model(x2, ei, ea)
+        y_target_changed = model(x3, ei, ea)
+    assert abs(float(y_source_changed[1] - y[1])) > 1e-6  # the target hears its source
+    assert abs(float(y_target_changed[0] - y[0])) < 1e-7  # the source hears nothing
+
+
+def test_isolated_nodes_and_no_edges():
+    model = _model()
+    x, ei, ea = _graph(6, 0)
+    with torch.no_grad():
+        alone = model(x[:1], ei, ea)
+        y = model(x, ei, ea)
+    assert torch.isfinite(y).all()
+    torch.testing.assert_close(y[:1], alone, rtol=0, atol=1e-7)  # no edges: nodes are independent
+
+
+def test_dense_and_scatter_aggregations_agree():
+    model = _model()
+    x, ei, ea = _graph(31, 120)
+    with torch.no_grad():
+        a = model(x, ei, ea)
+        model.set_aggregation("dense")
+        b = model(x, ei, ea)
+    torch.testing.assert_close(a, b, rtol=0, atol=1e-6)
+
+
+def test_large_scores_stay_finite():
+    model = _model()
+    with torch.no_grad():
+        model.temperature.fill_(1e4)  # a huge temperature: exp would overflow without the shift/clamp
+        y = model(*_graph(20, 80))
+    assert torch.isfinite(y).all()
+
+
+def test_gradients_reach_every_parameter():
+    model = _model().train()
+    x, ei, ea = _graph(20, 80)
+    model.logits(x, ei, ea).sum().backward()
+    for name, p in model.named_parameters():
+        assert p.grad is not None and torch.isfinite(p.grad).all(), name
+        assert float(p.grad.abs().sum()) > 0, name
+
+
+def test_normalisation_is_baked_in():
+    model = _model()
+    assert float(model.node_std[0]) != 1.0 and float(model.node_mean[0]) != 0.0
+    assert set(dict(model.named_buffers())) >= {"node_mean", "node_std", "edge_mean", "edge_std"}
+
+
+@pytest.mark.parametrize("aggregation", ["scatter", "dense"])
+def test_export_matches_pytorch_on_unseen_sizes(tmp_path, aggregation):
+    model = _model(seed=2)
+    path = tmp_path / "m.onnx"
+    diff = export_onnx(model, path, "test/1 a=1", aggregation=aggregation)
+    assert diff is not None and diff <= 1e-5
+    proto = onnx.load(str(path))
+    assert proto.opset_import[0].version == 17
+    assert [i.name for i in proto.graph.input] == ["x", "edge_index", "edge_attr"]
+    assert [o.name for o in proto.graph.output] == ["removability"]
+    dims = {i.name: [d.dim_param or d.dim_value for d in i.type.tensor_type.shape.dim] for i in proto.graph.input}
+    assert dims == {"x": ["n", NODE_DIM], "edge_index": [2, "e"], "edge_attr": ["e", EDGE_DIM]}
+    out_dims = [d.dim_param or d.dim_value for d in proto.graph.output[0].type.tensor_type.shape.dim]
+    assert out_dims == ["n"]
+    elem = {i.name: i.type.tensor_type.elem_type for i in proto.graph.input}
+    assert elem == {"x": onnx.TensorProto.FLOAT, "edge_index": onnx.TensorProto.INT64, "edge_attr": onnx.TensorProto.FLOAT}
+    meta = {p.key: p.value for p in proto.metadata_props}
+    assert meta["asp.kind"] == "removability"
+    assert meta["asp.features"] == "test/1 a=1"
+    assert meta["asp.node_dim"] == str(NODE_DIM) and meta["asp.edge_dim"] == str(EDGE_DIM)
+    ops = {n.op_type for n in proto.graph.node}
+    assert ("ScatterND" in ops) == (aggregation == "scatter")
+    # one more unseen size, with an isolated node
+    x, ei, ea = _graph(77, 300, seed=9)
+    ei = ei[:, ei[1] != 0]
+    ea = ea[: ei.shape[1]]
+    with torch.no_grad():
+        expected = model(x, ei, ea).numpy()
+    got = run_onnx(path, x.numpy(), ei.numpy(), ea.numpy())
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-5)
+
+
+def test_parity_check_catches_a_different_model(tmp_path):
+    path = tmp_path / "m.onnx"
+    export_onnx(_model(seed=2), path, "test/1")
+    with pytest.raises(ExportError, match="ONNX and PyTorch differ"):
+        parity_check(_model(seed=3), path)
