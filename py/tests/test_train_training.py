@@ -10,8 +10,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-PY = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(PY))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 torch = pytest.importorskip("torch", reason="asp.train needs PyTorch (pip install torch)")
@@ -120,7 +118,7 @@ def test_module_runs_as_a_program(stacks, tmp_path):
     out = tmp_path / "m.onnx"
     proc = subprocess.run(
         [sys.executable, "-m", "asp.train", "removability", str(stacks), "--out", str(out), "--epochs", "1"],
-        cwd=tmp_path, env={"PYTHONPATH": str(PY), "PATH": "/usr/bin:/bin"}, capture_output=True, text=True, timeout=300,
+        cwd=tmp_path, env={"PATH": "/usr/bin:/bin"}, capture_output=True, text=True, timeout=300,
     )
     assert proc.returncode == 0, proc.stderr
     assert "epoch 1/1" in proc.stderr
