@@ -36,7 +36,7 @@ def run(*args: str, cwd: Path) -> subprocess.CompletedProcess:
     return r
 
 
-def tests_of(asp: str, model: Path, *flags: str, cwd: Path) -> int:
+def removal_tests_of(asp: str, model: Path, *flags: str, cwd: Path) -> int:
     r = run(asp, "plan", str(model), "--json", "--quiet", *flags, cwd=cwd)
     plan = json.loads(r.stdout)
     assert plan["status"] == "found", plan["status"]
@@ -63,6 +63,6 @@ def test_learned_ordering_beats_vanilla_on_held_out_assemblies(tmp_path: Path) -
     vanilla, learned = [], []
     for model in held:
         for seed in range(3):
-            vanilla.append(tests_of(asp, model, "--order", "shuffled", "--seed", str(seed), cwd=tmp_path))
-            learned.append(tests_of(asp, model, "--order", "gnn", "--model", "rem.onnx", "--seed", str(seed), cwd=tmp_path))
+            vanilla.append(removal_tests_of(asp, model, "--order", "shuffled", "--seed", str(seed), cwd=tmp_path))
+            learned.append(removal_tests_of(asp, model, "--order", "gnn", "--model", "rem.onnx", "--seed", str(seed), cwd=tmp_path))
     assert statistics.mean(learned) < statistics.mean(vanilla), (learned, vanilla)
