@@ -23,6 +23,12 @@ pub enum Command {
     Collect(crate::learn::CollectArgs),
     /// Benchmarks (`feasible`: the thesis' Table 3.1 for a folder of models).
     Bench(crate::learn::BenchArgs),
+    /// Write a self-contained HTML page that plays a plan step by step (three.js, offline).
+    View(crate::view::ViewArgs),
+    /// Render a plan's storyboard (PNG or SVG): one panel per step.
+    Render(crate::view::RenderArgs),
+    /// Plot the Pareto front of a plan JSON, or the search's progress from --trace CSVs.
+    Plot(crate::plot::PlotArgs),
 }
 
 /// Part orderings of the depth-first search.
@@ -112,6 +118,9 @@ pub struct PlanArgs {
     /// Print the plan JSON on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Also write the assembly animated over time as MCAP for Foxglove (docs/pictures.md).
+    #[arg(long, value_name = "FILE")]
+    pub mcap: Option<PathBuf>,
     /// Loading and testing.
     #[command(flatten)]
     pub load: ModelArgs,

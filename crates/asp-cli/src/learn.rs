@@ -61,9 +61,11 @@ pub struct RemovabilityArgs {
     /// Base seed (run r of model m uses a seed derived from it).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Removal tests per run before it stops (its states so far are kept).
-    #[arg(long)]
-    pub max_tests: Option<u64>,
+    /// Removal tests per run before it stops (its states so far are kept). The default keeps
+    /// one unlucky initial ordering, which can search hundreds of thousands of dead-end states,
+    /// from swamping the data set.
+    #[arg(long, default_value_t = 20_000)]
+    pub max_tests: u64,
     /// Seconds per run before it stops (its states so far are kept; the data then depends on timing).
     #[arg(long, default_value_t = 60.0)]
     pub timeout: f64,
@@ -128,7 +130,7 @@ pub fn collect(args: &CollectArgs) -> anyhow::Result<std::process::ExitCode> {
         runs: a.runs,
         seed: a.seed,
         plan: crate::output::model_settings(&a.load)?,
-        max_tests: a.max_tests,
+        max_tests: Some(a.max_tests),
         timeout: Some(crate::output::positive("timeout", a.timeout)?),
         ..CollectSettings::default()
     };
@@ -162,11 +164,11 @@ pub fn collect(args: &CollectArgs) -> anyhow::Result<std::process::ExitCode> {
     Ok(std::process::ExitCode::SUCCESS)
 }
 
-/// The methods of `asp bench feasible` for the model at `path`.
-fn methods(args: &FeasibleArgs, path: &Path) -> anyhow::Result<Vec<Method>> {
+/// The methods of `asp bench feasible` for the model called `name`.
+fn methods(args: &FeasibleArgs, name: &str) -> anyhow::Result<Vec<Method>> {
     let model = match (&args.model, &args.models_dir) {
         (Some(m), _) => Some(m.clone()),
-        (None, Some(dir)) => Some(dir.join(format!("{}.onnx", collect::model_name(path)))),
+        (None, Some(dir)) => Some(dir.join(format!("{name}.onnx"))),
         (None, None) => None,
     };
     let list = match &args.methods {
@@ -208,12 +210,12 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<std::process::ExitCode> {
     let models = collect::model_paths(&a.models)?;
     let tty = std::io::stderr().is_terminal();
     let mut rows: Vec<BenchRow> = Vec::new();
-    for (k, path) in models.iter().enumerate() {
+    for (k, (path, name)) in models.iter().zip(collect::unique_names(&models)).enumerate() {
         if tty {
             eprintln!("[{}/{}] {}", k + 1, models.len(), path.display());
         }
-        let methods = methods(a, path)?;
-        rows.extend(bench::bench_model(path, &settings, &methods, a.orderings)?);
+        let methods = methods(a, &name)?;
+        rows.extend(bench::bench_model(path, &name, &settings, &methods, a.orderings)?);
     }
     let mut stdout = std::io::stdout().lock();
     bench::write_table(&mut stdout, &rows)?;

@@ -7,6 +7,8 @@ mod gen;
 mod learn;
 mod optimise;
 mod output;
+mod plot;
+mod view;
 
 use flags::{Cli, Command};
 use std::process::ExitCode;
@@ -36,5 +38,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Gen(args) => gen::run(&args),
         Command::Collect(args) => learn::collect(&args),
         Command::Bench(args) => learn::bench(&args),
+        Command::View(args) => view::view(&args),
+        Command::Render(args) => view::render(&args),
+        Command::Plot(args) => plot::run(&args),
     }
 }

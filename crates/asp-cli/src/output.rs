@@ -70,6 +70,7 @@ pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
 pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
     let settings = settings(args)?;
     let assembly = pipeline::load(&args.model, &settings)?;
+    let for_mcap = args.mcap.as_ref().map(|_| assembly.clone());
     let bar = progress_bar(args.quiet || settings.optimise.is_some());
     let report_progress = |p: &Progress| {
         if let Some(bar) = &bar {
@@ -94,6 +95,9 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
         search
             .write_trace_csv(std::io::BufWriter::new(file))
             .with_context(|| format!("{}: cannot write the trace", path.display()))?;
+    }
+    if let (Some(path), Some(assembly)) = (&args.mcap, &for_mcap) {
+        asp_viz::mcap::write_plan(path, assembly, report)?;
     }
     let json = report.to_json();
     if let Some(path) = &args.out {

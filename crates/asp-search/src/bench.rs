@@ -72,9 +72,9 @@ pub struct BenchRow {
     pub path_planner_calls: MeanStd,
 }
 
-/// Runs every method `orderings` times on the model at `path` (seeds `0..orderings`, shared by
+/// Runs every method `orderings` times on the model at `path` (reported as `name`) (seeds `0..orderings`, shared by
 /// the methods) and summarises each. `settings` give the model's loading and testing.
-pub fn bench_model(path: &Path, settings: &PlanSettings, methods: &[Method], orderings: usize) -> Result<Vec<BenchRow>> {
+pub fn bench_model(path: &Path, name: &str, settings: &PlanSettings, methods: &[Method], orderings: usize) -> Result<Vec<BenchRow>> {
     if orderings == 0 {
         return Err(SearchError::config("the number of orderings must be at least 1"));
     }
@@ -82,7 +82,6 @@ pub fn bench_model(path: &Path, settings: &PlanSettings, methods: &[Method], ord
     let world_config = pipeline::world_config(&assembly, settings)?;
     let checker_config = pipeline::checker_config(settings)?;
     let budget = pipeline::budget(settings)?;
-    let name = crate::collect::model_name(path);
     let mut rows = Vec::new();
     for method in methods {
         let mut m = PlanSettings { order: method.order.clone(), bookkeeping: method.bookkeeping, ..settings.clone() };
@@ -104,7 +103,7 @@ pub fn bench_model(path: &Path, settings: &PlanSettings, methods: &[Method], ord
             found += usize::from(outcome.status == Status::Found);
         }
         rows.push(BenchRow {
-            model: name.clone(),
+            model: name.to_string(),
             method: method.name.clone(),
             runs: orderings,
             found,

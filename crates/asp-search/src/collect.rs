@@ -36,7 +36,8 @@ pub struct CollectSettings {
     pub plan: PlanSettings,
     /// Feature parameters.
     pub graph: GraphConfig,
-    /// Removal tests per run before it stops (the states seen so far are kept).
+    /// Removal tests per run before it stops (the states seen so far are kept). Default 20,000:
+    /// one unlucky initial ordering can search hundreds of thousands of dead-end states.
     pub max_tests: Option<u64>,
     /// Wall-time cap per run, seconds.
     pub timeout: Option<f64>,
@@ -49,7 +50,7 @@ impl Default for CollectSettings {
             seed: 0,
             plan: PlanSettings::default(),
             graph: GraphConfig::default(),
-            max_tests: None,
+            max_tests: Some(20_000),
             timeout: Some(60.0),
         }
     }
@@ -155,6 +156,24 @@ pub fn model_name(path: &Path) -> String {
     path.file_stem().or_else(|| path.file_name()).map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "model".into())
 }
 
+/// The models' names: their [`model_name`]s, with the parent folder's name in front
+/// (`p1_profiles_000`) where two models would otherwise share one.
+pub fn unique_names(models: &[PathBuf]) -> Vec<String> {
+    let plain: Vec<String> = models.iter().map(|p| model_name(p)).collect();
+    plain
+        .iter()
+        .zip(models)
+        .map(|(name, path)| {
+            if plain.iter().filter(|n| *n == name).count() > 1 {
+                let parent = path.parent().and_then(|p| p.file_name()).map(|s| s.to_string_lossy().into_owned());
+                parent.map_or_else(|| name.clone(), |p| format!("{p}_{name}"))
+            } else {
+                name.clone()
+            }
+        })
+        .collect()
+}
+
 fn seed_of(base: u64, model: usize, run: usize) -> u64 {
     crate::ordering::state_seed(base, &PartSet::empty(0), ((model as u64) << 32) | run as u64)
 }
@@ -178,8 +197,7 @@ pub fn collect(models: &[PathBuf], out: &Path, settings: &CollectSettings, progr
         assemblies: Vec::new(),
     };
     let mut used = std::collections::HashSet::new();
-    for (m, path) in models.iter().enumerate() {
-        let name = model_name(path);
+    for (m, (path, name)) in models.iter().zip(unique_names(models)).enumerate() {
         let mut dir: String = name.chars().map(|c| if c.is_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
         while !used.insert(dir.clone()) {
             dir.push('_');

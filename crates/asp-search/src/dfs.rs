@@ -90,6 +90,8 @@ struct Search<'p, 'a, 'v> {
     budget: &'p Budget,
     started: Instant,
     ordering: Box<dyn PartOrdering>,
+    /// The tests this search ran.
+    counters: asp_geom::CounterSnapshot,
     /// Called with every visited state (data collection).
     visit: Option<&'v mut dyn FnMut(&PartSet)>,
     dead: HashSet<PartSet>,
@@ -106,7 +108,7 @@ struct Search<'p, 'a, 'v> {
 
 impl Search<'_, '_, '_> {
     fn tests(&self) -> u64 {
-        self.problem.checker.counters().removal_tests
+        self.counters.removal_tests
     }
 
     fn out_of_budget(&mut self) -> bool {
@@ -124,6 +126,12 @@ impl Search<'_, '_, '_> {
 
     fn test(&mut self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome {
         let outcome = self.problem.checker.test_removal(part, state, kind);
+        // counted here, not read off the checker: searches may share one checker in parallel
+        let c = &mut self.counters;
+        c.removal_tests += 1;
+        c.path_planner_calls += u64::from(matches!(kind, MotionKind::Path { .. }));
+        c.failed_collision += u64::from(matches!(outcome, Outcome::Collision { .. }));
+        c.failed_gravity += u64::from(matches!(outcome, Outcome::Unstable { .. }));
         self.ordering.observe(part, state, kind, &outcome);
         outcome
     }
@@ -261,7 +269,6 @@ impl Dfs {
         visit: Option<&mut dyn FnMut(&PartSet)>,
     ) -> PlanOutcome {
         let started = Instant::now();
-        let before = problem.checker.counters();
         let mut search = Search {
             problem,
             config: self,
@@ -269,6 +276,7 @@ impl Dfs {
             started,
             ordering: self.ordering.make(problem.checker.num_parts(), self.seed),
             visit,
+            counters: asp_geom::CounterSnapshot::default(),
             dead: HashSet::new(),
             cores: Vec::new(),
             path: Vec::new(),
@@ -286,13 +294,7 @@ impl Dfs {
             let (state, stuck) = search.deepest.take().unwrap_or_default();
             Status::NoPlan { stuck, state }
         };
-        let after = problem.checker.counters();
-        let counters = asp_geom::CounterSnapshot {
-            removal_tests: after.removal_tests - before.removal_tests,
-            failed_collision: after.failed_collision - before.failed_collision,
-            failed_gravity: after.failed_gravity - before.failed_gravity,
-            path_planner_calls: after.path_planner_calls - before.path_planner_calls,
-        };
+        let counters = search.counters;
         PlanOutcome {
             status,
             removals: search.path,

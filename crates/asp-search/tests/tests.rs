@@ -1,5 +1,6 @@
 //! Integration tests of asp-search (one binary; modules in subfolders).
 
+mod collect;
 mod conformance;
 mod exact;
 mod fixtures;

@@ -21,7 +21,7 @@
 //! weights are ignored. Never NaN.
 
 use super::config::GraphConfig;
-use super::harmonics::{count, index, real_sh};
+use super::harmonics::{count, index, RealSh};
 use crate::math::Vec3;
 
 /// The descriptor of the cloud `points` with `weights` (paired by position; extra items of the
@@ -55,9 +55,7 @@ where
     let (mut total, mut sum) = (0.0f64, [0.0f64; 3]);
     for (p, w) in valid() {
         total += w;
-        for k in 0..3 {
-            sum[k] += w * p[k];
-        }
+        sum = [sum[0] + w * p[0], sum[1] + w * p[1], sum[2] + w * p[2]];
     }
     if !(total > 0.0 && total.is_finite()) {
         return;
@@ -67,6 +65,7 @@ where
     let length = |d: [f64; 3]| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
     let radius = valid().map(|(p, _)| length(offset(p))).fold(0.0f64, f64::max);
     let nh = count(degree);
+    let harmonics = RealSh::new(degree);
     scratch.clear();
     scratch.resize(bins * nh + nh, 0.0);
     let (acc, y) = scratch.split_at_mut(bins * nh);
@@ -82,7 +81,7 @@ where
             let t = u - b0 as f64;
             // 3. the harmonics of the direction
             if r > tiny {
-                real_sh([d[0] / r, d[1] / r, d[2] / r], degree, y);
+                harmonics.eval([d[0] / r, d[1] / r, d[2] / r], y);
             } else {
                 y.fill(0.0);
                 y[0] = 0.5 / std::f64::consts::PI.sqrt();

@@ -24,45 +24,88 @@ pub fn index(l: usize, m: i64) -> usize {
 
 /// Writes `Y_l^m(dir)` for every `l <= degree`, `-l <= m <= l` into `out[index(l, m)]`.
 /// `dir` must be a unit vector; `out` must hold at least [`count`]`(degree)` values (extra
-/// entries are left alone, and a shorter `out` receives only the degrees that fit).
+/// entries are left alone, and a shorter `out` receives only the degrees that fit). Builds the
+/// recurrence coefficients on each call: evaluate many directions with [`RealSh`].
 pub fn real_sh(dir: [f64; 3], degree: usize, out: &mut [f64]) {
-    let [x, y, z] = dir;
-    let degree = (0..=degree).rev().find(|&l| count(l) <= out.len()).map_or(0, |l| l);
-    if out.is_empty() {
-        return;
+    let degree = (0..=degree).rev().find(|&l| count(l) <= out.len()).unwrap_or(0);
+    if !out.is_empty() {
+        RealSh::new(degree).eval(dir, out);
     }
-    let sqrt2 = std::f64::consts::SQRT_2;
-    let mut qmm = 0.5 / std::f64::consts::PI.sqrt();
-    // (c, s) = (x + iy)^m
-    let (mut c, mut s) = (1.0f64, 0.0f64);
-    for m in 0..=degree {
-        if m > 0 {
+}
+
+/// The real spherical harmonics up to one degree, with their recurrence coefficients computed
+/// once (no square roots per direction).
+#[derive(Clone, Debug)]
+pub struct RealSh {
+    degree: usize,
+    /// `√((2m+1)/2m)` at `m` (unused at 0).
+    diag: Vec<f64>,
+    /// `√(2m+3)` at `m`.
+    next: Vec<f64>,
+    /// `(a, b)` of the three-term recurrence at `index(l, m)`, `l >= m + 2`.
+    ab: Vec<(f64, f64)>,
+}
+
+impl RealSh {
+    /// The harmonics up to `degree`.
+    pub fn new(degree: usize) -> RealSh {
+        let diag = (0..=degree).map(|m| if m == 0 { 0.0 } else { ((2 * m + 1) as f64 / (2 * m) as f64).sqrt() }).collect();
+        let next = (0..=degree).map(|m| ((2 * m + 3) as f64).sqrt()).collect();
+        let mut ab = vec![(0.0, 0.0); count(degree)];
+        for m in 0..=degree {
             let mf = m as f64;
-            qmm *= ((2.0 * mf + 1.0) / (2.0 * mf)).sqrt();
-            (c, s) = (c * x - s * y, c * y + s * x);
-        }
-        let mut put = |l: usize, q: f64| {
-            if m == 0 {
-                out[index(l, 0)] = q;
-            } else {
-                out[index(l, m as i64)] = sqrt2 * q * c;
-                out[index(l, -(m as i64))] = sqrt2 * q * s;
+            for l in (m + 2)..=degree {
+                let lf = l as f64;
+                let a = ((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf)).sqrt();
+                let b = (((lf - 1.0) * (lf - 1.0) - mf * mf) / (4.0 * (lf - 1.0) * (lf - 1.0) - 1.0)).sqrt();
+                ab[index(l, m as i64)] = (a, b);
             }
-        };
-        put(m, qmm);
-        if m == degree {
-            break;
         }
-        let mf = m as f64;
-        let (mut q2, mut q1) = (qmm, (2.0 * mf + 3.0).sqrt() * z * qmm);
-        put(m + 1, q1);
-        for l in (m + 2)..=degree {
-            let lf = l as f64;
-            let a = ((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf)).sqrt();
-            let b = (((lf - 1.0) * (lf - 1.0) - mf * mf) / (4.0 * (lf - 1.0) * (lf - 1.0) - 1.0)).sqrt();
-            let q = a * (z * q1 - b * q2);
-            put(l, q);
-            (q2, q1) = (q1, q);
+        RealSh { degree, diag, next, ab }
+    }
+
+    /// The highest degree.
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+
+    /// Writes `Y_l^m(dir)` for every `l <= degree()` into `out[index(l, m)]`; `dir` must be a
+    /// unit vector. Panics when `out` holds fewer than [`count`]`(degree())` values.
+    pub fn eval(&self, dir: [f64; 3], out: &mut [f64]) {
+        let [x, y, z] = dir;
+        let degree = self.degree;
+        let out = &mut out[..count(degree)];
+        let sqrt2 = std::f64::consts::SQRT_2;
+        let mut qmm = 0.5 / std::f64::consts::PI.sqrt();
+        // (c, s) = (x + iy)^m
+        let (mut c, mut s) = (1.0f64, 0.0f64);
+        for m in 0..=degree {
+            if m > 0 {
+                qmm *= self.diag[m];
+                (c, s) = (c * x - s * y, c * y + s * x);
+            }
+            let (fc, fs) = (sqrt2 * c, sqrt2 * s);
+            let mut put = |l: usize, q: f64| {
+                let i = l * l + l;
+                if m == 0 {
+                    out[i] = q;
+                } else {
+                    out[i + m] = q * fc;
+                    out[i - m] = q * fs;
+                }
+            };
+            put(m, qmm);
+            if m == degree {
+                break;
+            }
+            let (mut q2, mut q1) = (qmm, self.next[m] * z * qmm);
+            put(m + 1, q1);
+            for l in (m + 2)..=degree {
+                let (a, b) = self.ab[l * l + l + m];
+                let q = a * (z * q1 - b * q2);
+                put(l, q);
+                (q2, q1) = (q1, q);
+            }
         }
     }
 }

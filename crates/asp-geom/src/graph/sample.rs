@@ -39,10 +39,9 @@ impl SurfaceSample {
     pub fn centroid(&self) -> Option<Vec3> {
         let (mut total, mut sum) = (0.0f64, [0.0f64; 3]);
         for (p, &w) in self.points.iter().zip(&self.weights) {
-            total += w as f64;
-            for k in 0..3 {
-                sum[k] += w as f64 * p[k] as f64;
-            }
+            let w = w as f64;
+            total += w;
+            sum = [sum[0] + w * p.x as f64, sum[1] + w * p.y as f64, sum[2] + w * p.z as f64];
         }
         (total > 0.0).then(|| Vec3::new((sum[0] / total) as f32, (sum[1] / total) as f32, (sum[2] / total) as f32))
     }

@@ -71,11 +71,12 @@ fn random_rotation(rng: &mut ChaCha8Rng) -> Rot {
     }
 }
 
-/// A random similarity with scale in 0.01..100 (log-uniform) and a shift of up to 10 model sizes.
-fn random_similarity(rng: &mut ChaCha8Rng, rot: Rot) -> Similarity {
+/// A random similarity with scale in 0.01..100 (log-uniform) and a shift of up to 10 times
+/// `size` (the model's size: f32 coordinates far from the model lose its details).
+fn random_similarity(rng: &mut ChaCha8Rng, rot: Rot, size: f32) -> Similarity {
     let scale = 10f32.powf(rng.random_range(-2.0..2.0));
     let shift = Vec3::new(rng.random_range(-10.0..10.0), rng.random_range(-10.0..10.0), rng.random_range(-10.0..10.0));
-    Similarity { rot, scale, shift: shift * scale }
+    Similarity { rot, scale, shift: shift * scale * size }
 }
 
 /// A random rotation that maps `up` to an axis: a turn about `up`, then one of the 24 rotations
@@ -127,7 +128,8 @@ fn descriptors_are_invariant_to_rotation_translation_and_scale() {
         let mut worst = 0.0f32;
         for _ in 0..6 {
             let rot = random_rotation(&mut rng);
-            let sim = random_similarity(&mut rng, rot);
+            let size = mesh.aabb().map_or(1.0, |b| (b.maxs - b.mins).length());
+            let sim = random_similarity(&mut rng, rot, size);
             let g = descriptor_of(&sim.mesh(&mesh), &config);
             let gap = relative_gap(&h, &g);
             worst = worst.max(gap);
@@ -202,6 +204,65 @@ fn stacked_boxes_have_the_expected_edges_and_gravity_attributes() {
     assert_eq!(&g.edge_attr_flat()[146 * 3..], g.edge_attr(3));
 }
 
+/// Distance from `p` to the surface of the box `[lo, hi]`, for `p` outside or on it.
+fn box_distance(p: Vec3, lo: Vec3, hi: Vec3) -> f32 {
+    (lo - p).max(p - hi).max(Vec3::ZERO).length()
+}
+
+#[test]
+fn edge_attributes_follow_the_contract_order_computed_naively() {
+    // a small box on a big one, with a wide contact distance so the two regions differ: the
+    // top box's region includes bands of its sides, the lower one's a patch of its top face
+    let (lo_a, hi_a) = (Vec3::ZERO, Vec3::ONE);
+    let (lo_b, hi_b) = (Vec3::new(0.2, 0.3, 1.0), Vec3::new(0.7, 0.6, 1.4));
+    let a = assemble(
+        "small_on_big",
+        vec![part("big", Mesh::cuboid(lo_a, hi_a), true), part("small", Mesh::cuboid(lo_b, hi_b), false)],
+        Axis::Z,
+    );
+    let eps = 0.15;
+    let w = world(a, &WorldConfig { contact_distance: Some(eps), ..WorldConfig::default() });
+    let config = GraphConfig::default();
+    let g = AssemblyGraph::build(&w, &config).unwrap();
+    assert_eq!(g.edges(), &[(0, 1), (1, 0)]);
+    let samples: Vec<_> = (0..2)
+        .map(|i| asp_geom::graph::sample::sample_triangles(w.mesh(i).vertices(), w.mesh(i).indices(), 2048))
+        .collect();
+    let boxes = [(lo_a, hi_a), (lo_b, hi_b)];
+    // Q_i^j, the naive way, as (points, weights, normals)
+    let region = |i: usize, j: usize| {
+        let s = &samples[i];
+        let keep: Vec<usize> = (0..s.len()).filter(|&k| box_distance(s.points[k], boxes[j].0, boxes[j].1) < eps).collect();
+        let pts: Vec<Vec3> = keep.iter().map(|&k| s.points[k]).collect();
+        let wts: Vec<f32> = keep.iter().map(|&k| s.weights[k]).collect();
+        let up: f32 = keep.iter().map(|&k| s.weights[k] * s.normals[k].z).sum::<f32>() / wts.iter().sum::<f32>();
+        (sh_descriptor(&pts, &wts, &config), up, pts.len())
+    };
+    let (h01, up01, n01) = region(0, 1); // on the big box, near the small one
+    let (h10, up10, n10) = region(1, 0);
+    assert!(n01 > 10 && n10 > 10 && relative_gap(&h01, &h10) > 0.02, "the regions must differ");
+    let close = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-5);
+    let c = [samples[0].centroid().unwrap(), samples[1].centroid().unwrap()];
+    // edge 0 → 1: [h(Q_1^0), h(Q_0^1), up · unit(c_0 − c_1), normal_up over Q_1^0]
+    let e = g.edge_attr(0);
+    assert!(close(&e[..72], &h10) && close(&e[72..144], &h01));
+    assert!((e[144] - (c[0] - c[1]).normalize().z).abs() < 1e-6 && e[144] < -0.5);
+    assert!((e[145] - up10).abs() < 1e-5, "{} vs {up10}", e[145]);
+    // its bottom faces down, its side bands sideways
+    assert!(e[145] < -0.2 && e[145] > -0.6, "the small box's region: {}", e[145]);
+    // edge 1 → 0: [h(Q_0^1), h(Q_1^0), up · unit(c_1 − c_0), normal_up over Q_0^1]
+    let e = g.edge_attr(1);
+    assert!(close(&e[..72], &h01) && close(&e[72..144], &h10));
+    assert!((e[144] - (c[1] - c[0]).normalize().z).abs() < 1e-6 && e[144] > 0.5);
+    assert!((e[145] - up01).abs() < 1e-5 && e[145] > 0.99, "the big box's region is a floor: {}", e[145]);
+    // node attributes are the whole part's descriptor, fixed and on_base
+    for (i, s) in samples.iter().enumerate() {
+        assert!(close(&g.node_attr(i)[..72], &sh_descriptor(&s.points, &s.weights, &config)));
+    }
+    assert_eq!(&g.node_attr(0)[72..], &[1.0, 0.0]);
+    assert_eq!(&g.node_attr(1)[72..], &[0.0, 1.0]);
+}
+
 #[test]
 fn without_a_fixed_part_the_ground_is_the_base_but_no_node() {
     let a = assemble(
@@ -256,12 +317,47 @@ fn graph_attributes_are_invariant_when_the_model_moves_with_its_up_axis() {
         assert!(!g.edges().is_empty(), "{name}");
         for _ in 0..4 {
             let rot = random_up_rotation(&mut rng, a.up);
-            let sim = random_similarity(&mut rng, rot);
+            let sim = random_similarity(&mut rng, rot, a.diagonal());
             let moved = sim.assembly(&a);
             let config = WorldConfig { tolerance: Some(tol * sim.scale), contact_distance: Some(eps * sim.scale), ..WorldConfig::default() };
             let h = graph(&world(moved, &config));
             assert_same_graph(&g, &h, 1e-4, &format!("{name} under {sim:?}"));
         }
+    }
+}
+
+#[test]
+fn a_real_model_keeps_its_part_features_when_moved_with_its_up_axis() {
+    // the pump (mm, z up): 15 parts of curved, finely meshed surfaces
+    let a = pump();
+    let base_world = world(a.clone(), &WorldConfig::default());
+    let (tol, eps) = (base_world.tolerance(), base_world.contact_distance());
+    let g = graph(&base_world);
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    for _ in 0..2 {
+        let rot = random_up_rotation(&mut rng, a.up);
+        let sim = random_similarity(&mut rng, rot, a.diagonal());
+        let config = WorldConfig { tolerance: Some(tol * sim.scale), contact_distance: Some(eps * sim.scale), ..WorldConfig::default() };
+        let h = graph(&world(sim.assembly(&a), &config));
+        // the part descriptors and flags move with the model (on_base may not: see below)
+        for i in 0..g.num_parts() {
+            let gap = relative_gap(&g.node_attr(i)[..73], &h.node_attr(i)[..73]);
+            assert!(gap < 1e-4, "pump part {i} under {sim:?}: {gap}");
+        }
+        // the world's contact graph (parry's closest points within ε_c) flips for screws that
+        // sit about ε_c from a neighbour, so compare the edges both graphs have
+        let mut differ = 0;
+        for (k, e) in g.edges().iter().enumerate() {
+            match h.edges().binary_search(e) {
+                Ok(j) => {
+                    let (ga, ha) = (g.edge_attr(k), h.edge_attr(j));
+                    assert!((ga[144] - ha[144]).abs() < 1e-4, "pump edge {e:?}: above {} vs {}", ga[144], ha[144]);
+                }
+                Err(_) => differ += 1,
+            }
+        }
+        differ += h.edges().iter().filter(|e| g.edges().binary_search(e).is_err()).count();
+        assert!(differ <= 6, "pump under {sim:?}: {differ} edges differ");
     }
 }
 
@@ -364,6 +460,8 @@ fn every_shipped_model_has_finite_consistent_features() {
         let started = std::time::Instant::now();
         let g = graph(&w);
         eprintln!("{name}: {} parts, {} edges, built in {:?}", g.num_parts(), g.num_edges(), started.elapsed());
+        // deterministic under rayon: a second build is bit-identical
+        assert_eq!(graph(&w), g, "{name}: two builds differ");
         let n = g.num_parts();
         assert_eq!(g.nodes_flat().len(), n * 74);
         assert_eq!(g.edge_attr_flat().len(), g.num_edges() * 146);

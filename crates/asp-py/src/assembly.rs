@@ -1,0 +1,170 @@
+//! `asp._asp.Assembly`: a loaded model, owned by the handle (no borrow of anything else), and
+//! `asp._asp.load`.
+
+use crate::errors::Error;
+use crate::settings::GraphSettings;
+use crate::{run, settings};
+use asp_geom::{AssemblyGraph, PartSet, World};
+use asp_search::pipeline::{self, PlanSettings};
+use pyo3::prelude::*;
+use pyo3::types::{PyByteArray, PyDict};
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+/// What `Assembly.graph` returns: the part indices (int64), `x` (float32), `edge_index` (int64)
+/// and `edge_attr` (float32) as little-endian bytes, `node_dim`, `edge_dim` and the features
+/// string; `asp.Graph` views the bytes as numpy arrays.
+type GraphBuffers<'py> =
+    (Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, usize, usize, String);
+
+/// A loaded model: its parts in file order, units, up axis and the load's warnings. Immutable;
+/// every plan starts from it afresh.
+#[pyclass(frozen, module = "asp._asp", name = "Assembly")]
+pub struct PyAssembly {
+    inner: Arc<asp_geom::Assembly>,
+    /// The model's graph for the settings last asked (computed once, states are subgraphs).
+    graph: Mutex<Option<(GraphSettings, Arc<AssemblyGraph>)>>,
+}
+
+impl PyAssembly {
+    /// The Rust assembly.
+    pub fn assembly(&self) -> &asp_geom::Assembly {
+        &self.inner
+    }
+
+    /// The model's graph for `settings`: from the cache, or built (collision world, then
+    /// descriptors) and cached.
+    pub fn model_graph(&self, settings: &GraphSettings) -> Result<Arc<AssemblyGraph>, Error> {
+        let mut cache = self.graph.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((cached, graph)) = cache.as_ref() {
+            if cached.same_graph(settings) {
+                return Ok(graph.clone());
+            }
+        }
+        let config = pipeline::world_config(&self.inner, &settings.world)?;
+        let world = World::new((*self.inner).clone(), &config)?;
+        let graph = Arc::new(AssemblyGraph::build(&world, &settings.config)?);
+        *cache = Some((settings.clone(), graph.clone()));
+        Ok(graph)
+    }
+}
+
+/// Loads the model at `path` (a `.glb`/`.gltf` file or a folder of `.obj`/`.stl` files, one part
+/// each) with an optional unit (`m`, `mm`, ... or metres per unit), up axis (`z`, `-y`, ...) and
+/// base part names; errors are `asp.LoadError` (naming the file) or `asp.ConfigError`.
+#[pyfunction]
+#[pyo3(signature = (path, unit=None, up=None, fixed=Vec::new()))]
+pub fn load(py: Python<'_>, path: PathBuf, unit: Option<&str>, up: Option<&str>, fixed: Vec<String>) -> PyResult<PyAssembly> {
+    let settings = PlanSettings {
+        unit: unit.map(settings::unit).transpose().map_err(|e| e.into_py(py))?,
+        up: up.map(settings::axis).transpose().map_err(|e| e.into_py(py))?,
+        fixed,
+        ..PlanSettings::default()
+    };
+    let assembly = py.detach(|| pipeline::load(&path, &settings)).map_err(|e| Error::from(e).into_py(py))?;
+    Ok(PyAssembly { inner: Arc::new(assembly), graph: Mutex::new(None) })
+}
+
+#[pymethods]
+impl PyAssembly {
+    /// The parts in file order: `(index, name, fixed)`.
+    fn parts(&self) -> Vec<(usize, String, bool)> {
+        self.inner.parts.iter().enumerate().map(|(i, p)| (i, p.name.clone(), p.fixed)).collect()
+    }
+
+    /// The model file or folder, as given to `load`.
+    #[getter]
+    fn source(&self) -> String {
+        self.inner.source.display().to_string()
+    }
+
+    /// The model's unit name (`m`, `mm`, ...).
+    #[getter]
+    fn units(&self) -> String {
+        self.inner.units.name.clone()
+    }
+
+    /// Metres per model unit.
+    #[getter]
+    fn metres_per_unit(&self) -> f64 {
+        self.inner.units.metres
+    }
+
+    /// The up axis (`+z`, `-y`, ...).
+    #[getter]
+    fn up(&self) -> String {
+        self.inner.up.to_string()
+    }
+
+    /// Non-fatal problems found while loading, one line each.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner.warnings.clone()
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+
+    /// Plans with the keyword settings of `asp.Assembly.plan` (a dict; missing keys take the
+    /// defaults). Returns `(plan_json, found, trace_csv)`: the plan JSON exactly as
+    /// `asp plan --json` prints it, whether a sequence was found, and for optimising runs the
+    /// search trace as CSV (as `--trace` writes it). Releases the GIL; Ctrl-C interrupts a
+    /// depth-first search.
+    fn plan(&self, py: Python<'_>, settings: &Bound<'_, PyDict>) -> PyResult<(String, bool, Option<String>)> {
+        let settings = settings::plan_settings(settings).map_err(|e| e.into_py(py))?;
+        let result = run::plan(py, (*self.inner).clone(), &settings)?;
+        let trace = match &result.search {
+            Some(search) => {
+                let mut csv = Vec::new();
+                search
+                    .write_trace_csv(&mut csv)
+                    .map_err(|e| Error::config(format!("cannot write the trace: {e}")).into_py(py))?;
+                Some(String::from_utf8_lossy(&csv).into_owned())
+            }
+            None => None,
+        };
+        Ok((result.report.to_json(), result.found(), trace))
+    }
+
+    /// The graph of the state `present` (part indices) with the keyword settings of
+    /// `asp.Assembly.graph` (a dict), as little-endian buffers (see `GraphBuffers`). The model's
+    /// graph is built once per settings (without the GIL) and cached.
+    fn graph<'py>(&self, py: Python<'py>, present: Vec<i64>, settings: &Bound<'py, PyDict>) -> PyResult<GraphBuffers<'py>> {
+        let settings = settings::graph_settings(settings).map_err(|e| e.into_py(py))?;
+        let n = self.inner.len();
+        let mut state = PartSet::empty(n);
+        for &p in &present {
+            match usize::try_from(p) {
+                Ok(i) if i < n => state.insert(i),
+                _ => {
+                    let message = format!("present: no part {p} (the model has {n} parts, 0 to {})", n.saturating_sub(1));
+                    return Err(Error::config(message).into_py(py));
+                }
+            }
+        }
+        let (graph, features) = py
+            .detach(|| {
+                self.model_graph(&settings).map(|model| {
+                    let features = model.features();
+                    (model.state(&state), features)
+                })
+            })
+            .map_err(|e| e.into_py(py))?;
+        let bytes_i64 = |v: &mut dyn Iterator<Item = i64>| v.flat_map(i64::to_le_bytes).collect::<Vec<u8>>();
+        let bytes_f32 = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+        Ok((
+            PyByteArray::new(py, &bytes_i64(&mut graph.nodes.iter().map(|&i| i as i64))),
+            PyByteArray::new(py, &bytes_f32(&graph.x)),
+            PyByteArray::new(py, &bytes_i64(&mut graph.edge_index.iter().copied())),
+            PyByteArray::new(py, &bytes_f32(&graph.edge_attr)),
+            graph.node_dim,
+            graph.edge_dim,
+            features,
+        ))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<asp._asp.Assembly {} ({} parts, {}, up {})>", self.source(), self.inner.len(), self.units(), self.up())
+    }
+}

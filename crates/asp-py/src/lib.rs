@@ -1,0 +1,42 @@
+//! The native module `asp._asp` of the `asp` Python package, built by maturin from this crate
+//! (`py/pyproject.toml`). It is private: Python code uses the pure-Python package `asp` around
+//! it (`py/asp/`), which documents the API, defines the exception types and builds numpy
+//! arrays. This is the only crate of the workspace that depends on pyo3.
+//!
+//! - [`assembly`]: `load` and the `Assembly` handle (owns its data);
+//! - [`settings`]: Python keywords into [`asp_search::pipeline::PlanSettings`], order names;
+//! - [`run`]: the pipeline with the GIL released, interruptible by Ctrl-C;
+//! - [`errors`]: asp's errors as `asp.errors` exceptions.
+
+pub mod assembly;
+pub mod errors;
+pub mod run;
+pub mod settings;
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// The defaults of every keyword of `Assembly.plan`.
+#[pyfunction]
+fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    settings::default_settings(py)
+}
+
+/// The part orderings `order=` accepts.
+#[pyfunction]
+fn order_names() -> Vec<&'static str> {
+    settings::ORDER_NAMES.to_vec()
+}
+
+/// asp's native module (private: use the `asp` package).
+#[pymodule]
+#[pyo3(name = "_asp")]
+fn asp_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("PLAN_FORMAT_VERSION", asp_search::report::FORMAT_VERSION)?;
+    m.add_function(wrap_pyfunction!(assembly::load, m)?)?;
+    m.add_function(wrap_pyfunction!(default_settings, m)?)?;
+    m.add_function(wrap_pyfunction!(order_names, m)?)?;
+    m.add_class::<assembly::PyAssembly>()?;
+    Ok(())
+}

@@ -1,0 +1,330 @@
+// asp's plan viewer: the model, the assembly sequence step by step, each part flying in along
+// its motion. The data (meshes, plan) is the JSON in #asp-data, written by `asp view`.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/OrbitControls.js';
+
+const data = JSON.parse(document.getElementById('asp-data').textContent);
+const STEP_SECONDS = 1.2;
+const PAUSE_SECONDS = 0.35;
+
+function decode(base64, Type) {
+  const bin = atob(base64);
+  const bytes = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
+  return new Type(bytes.buffer);
+}
+const rgb = (c) => new THREE.Color(c[0] / 255, c[1] / 255, c[2] / 255);
+const vec = (a) => new THREE.Vector3(a[0], a[1], a[2]);
+const css = (c) => `rgb(${c[0]},${c[1]},${c[2]})`;
+
+// --- motions (docs/plan-format.md, "Motions"; the same timing as asp-viz's Insertion::pose_at)
+function poseOf(p) {
+  return { t: new THREE.Vector3(p[0], p[1], p[2]), q: new THREE.Quaternion(p[3], p[4], p[5], p[6]).normalize() };
+}
+function apply(pose, point) {
+  return point.clone().applyQuaternion(pose.q).add(pose.t);
+}
+function prepareMotion(m) {
+  if (!m || m.kind !== 'path') return m;
+  const poses = m.poses.map(poseOf);
+  const pivot = vec(m.pivot);
+  const weights = [];
+  for (let i = 0; i + 1 < poses.length; i++) {
+    const travel = apply(poses[i + 1], pivot).distanceTo(apply(poses[i], pivot));
+    weights.push(travel + poses[i].q.angleTo(poses[i + 1].q) * m.radius);
+  }
+  return { ...m, poses, pivotV: pivot, weights, total: weights.reduce((a, b) => a + b, 0) };
+}
+// The pose {t, q} of a part a fraction s (0 outside, 1 assembled) through its motion.
+function poseAt(m, s) {
+  s = Math.min(1, Math.max(0, s));
+  const identity = { t: new THREE.Vector3(), q: new THREE.Quaternion() };
+  if (!m) return identity;
+  if (m.kind === 'linear') return { t: vec(m.direction).multiplyScalar(-m.distance * (1 - s)), q: new THREE.Quaternion() };
+  const poses = m.poses;
+  if (poses.length === 0) return identity;
+  if (poses.length === 1 || m.total <= 0) return poses[poses.length - 1];
+  let left = s * m.total;
+  for (let i = 0; i < m.weights.length; i++) {
+    const w = m.weights[i];
+    if (left <= w || i + 1 === m.weights.length) {
+      const f = w > 0 ? Math.min(1, Math.max(0, left / w)) : 1;
+      const a = poses[i], b = poses[i + 1];
+      const centre = apply(a, m.pivotV).lerp(apply(b, m.pivotV), f);
+      const q = a.q.clone().slerp(b.q, f);
+      return { t: centre.sub(m.pivotV.clone().applyQuaternion(q)), q };
+    }
+    left -= w;
+  }
+  return poses[poses.length - 1];
+}
+
+// --- the scene
+const container = document.getElementById('asp-canvas');
+const up = vec(data.up);
+THREE.Object3D.DEFAULT_UP.copy(up);
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio || 1);
+renderer.setSize(window.innerWidth, window.innerHeight);
+renderer.setClearColor(0xf4f5f7);
+container.appendChild(renderer.domElement);
+const scene = new THREE.Scene();
+const camera = new THREE.PerspectiveCamera(35, window.innerWidth / window.innerHeight, 1e-3, 1e6);
+camera.up.copy(up);
+scene.add(new THREE.HemisphereLight(0xffffff, 0x8090a0, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+camera.add(sun);
+sun.position.set(0.4, 1, 0.6);
+scene.add(camera);
+
+const parts = data.parts.map((p, i) => {
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(decode(p.positions, Float32Array), 3));
+  geometry.setIndex(new THREE.BufferAttribute(decode(p.indices, p.index_bits === 16 ? Uint16Array : Uint32Array), 1));
+  geometry.computeBoundingBox();
+  const colour = rgb(p.colour);
+  const material = new THREE.MeshStandardMaterial({ color: colour, flatShading: true, side: THREE.DoubleSide, roughness: 0.75, metalness: 0.0 });
+  const mesh = new THREE.Mesh(geometry, material);
+  mesh.name = p.name;
+  mesh.visible = false;
+  scene.add(mesh);
+  const centre = new THREE.Vector3();
+  geometry.boundingBox.getCenter(centre);
+  return { ...p, index: i, mesh, material, colour, centre };
+});
+const steps = data.steps.map((s) => ({ ...s, motion: prepareMotion(s.motion) }));
+
+// the bounds of the model and of every motion's start: the camera sees all of it
+const bounds = new THREE.Box3();
+for (const p of parts) bounds.union(p.mesh.geometry.boundingBox);
+for (const s of steps) {
+  if (!s.motion) continue;
+  const box = parts[s.part].mesh.geometry.boundingBox;
+  for (let k = 0; k <= 8; k++) {
+    const pose = poseAt(s.motion, k / 8);
+    for (const x of [box.min.x, box.max.x]) for (const y of [box.min.y, box.max.y]) for (const z of [box.min.z, box.max.z])
+      bounds.expandByPoint(apply(pose, new THREE.Vector3(x, y, z)));
+  }
+}
+const centre = bounds.getCenter(new THREE.Vector3());
+const radius = Math.max(bounds.getSize(new THREE.Vector3()).length() / 2, 1e-9);
+
+// a grid on the floor under the model, square to the up axis
+const grid = new THREE.GridHelper(radius * 3, 12, 0xb8bec8, 0xd6dae0);
+grid.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), up);
+const modelBox = new THREE.Box3();
+for (const p of parts) modelBox.union(p.mesh.geometry.boundingBox);
+const lowest = Math.min(...[modelBox.min, modelBox.max].map((c) => c.dot(up)));
+grid.position.copy(centre).addScaledVector(up, lowest - centre.dot(up));
+scene.add(grid);
+
+// an isometric-ish view: from the side, a little above
+const side = Math.abs(up.x) > 0.9 ? new THREE.Vector3(0, 1, 0) : new THREE.Vector3(1, 0, 0);
+const other = new THREE.Vector3().crossVectors(up, side);
+const viewDir = side.clone().multiplyScalar(1).addScaledVector(other, -0.9).addScaledVector(up, 0.75).normalize();
+const distance = radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 1.05;
+camera.position.copy(centre).addScaledVector(viewDir, distance);
+camera.near = distance / 1000;
+camera.far = distance * 100;
+function frameView() {
+  const panel = document.getElementById('asp-panel');
+  const left = window.innerWidth > 700 ? panel.offsetLeft + panel.offsetWidth : 0;
+  // the full view is wider by the panel; the window shows its right part, so the view's centre
+  // sits in the middle of the area right of the panel
+  camera.aspect = (window.innerWidth + left) / window.innerHeight;
+  camera.setViewOffset(window.innerWidth + left, window.innerHeight, 0, 0, window.innerWidth, window.innerHeight);
+  camera.updateProjectionMatrix();
+}
+frameView();
+const controls = new OrbitControls(camera, renderer.domElement);
+controls.target.copy(centre);
+controls.update();
+
+// the motion of the part in flight, drawn as a line from its start to its place
+const pathMaterial = new THREE.LineBasicMaterial({ color: 0xe65100 });
+let pathLine = null;
+function showPath(step) {
+  if (pathLine) { scene.remove(pathLine); pathLine.geometry.dispose(); pathLine = null; }
+  if (!step || !step.motion) return;
+  const c = parts[step.part].centre;
+  const samples = step.motion.kind === 'path' ? 64 : 1;
+  const points = [];
+  for (let k = 0; k <= samples; k++) points.push(apply(poseAt(step.motion, k / samples), c));
+  pathLine = new THREE.Line(new THREE.BufferGeometry().setFromPoints(points), pathMaterial);
+  scene.add(pathLine);
+}
+
+// --- the sequence
+const state = { shown: 0, playing: false, flying: -1, t: 1, wait: 0 };
+const initial = new Set(data.initial);
+const stuck = new Set(data.stuck);
+const label = document.getElementById('asp-label');
+
+function place(part, pose) {
+  part.mesh.position.copy(pose.t);
+  part.mesh.quaternion.copy(pose.q);
+}
+function apply_state() {
+  for (const p of parts) {
+    p.mesh.visible = initial.has(p.index);
+    place(p, poseAt(null, 1));
+    p.material.emissive.setRGB(0, 0, 0);
+  }
+  for (let k = 0; k < state.shown; k++) parts[steps[k].part].mesh.visible = true;
+  const flying = state.flying >= 0 ? steps[state.flying] : null;
+  if (flying) {
+    const p = parts[flying.part];
+    place(p, poseAt(flying.motion, flying.motion ? state.t : 1));
+    p.material.emissive.setRGB(0.25, 0.18, 0.0);
+  }
+  const current = state.flying >= 0 ? state.flying : state.shown - 1;
+  showPath(current >= 0 ? steps[current] : null);
+  updatePanel(current);
+}
+
+function current() { return state.flying >= 0 ? state.flying : state.shown - 1; }
+function goto(k) {
+  state.shown = Math.max(0, Math.min(steps.length, k | 0));
+  state.flying = -1;
+  state.t = 1;
+  apply_state();
+  return api.state();
+}
+function step() {
+  if (state.flying >= 0) { state.flying = -1; state.t = 1; }
+  if (state.shown < steps.length) {
+    state.shown += 1;
+    state.flying = state.shown - 1;
+    state.t = 0;
+  }
+  apply_state();
+  return api.state();
+}
+function back() { return goto(state.shown - 1); }
+function play() {
+  if (state.shown >= steps.length && state.flying < 0) goto(0);
+  state.playing = true;
+  state.wait = 0;
+  updatePanel(current());
+  return api.state();
+}
+function pause() { state.playing = false; updatePanel(current()); return api.state(); }
+
+// --- the panel
+document.getElementById('asp-title').textContent = data.title;
+const status = document.getElementById('asp-status');
+status.textContent = data.status_text;
+if (data.status !== 'found') status.className = 'bad';
+const base = document.getElementById('asp-base');
+const baseParts = parts.filter((p) => initial.has(p.index));
+if (baseParts.length) {
+  base.innerHTML = '';
+  const head = document.createElement('b');
+  head.textContent = data.status === 'found' ? 'Base: ' : 'Dead end (the start): ';
+  base.appendChild(head);
+  baseParts.forEach((p, i) => {
+    const s = document.createElement('span');
+    s.innerHTML = `<span class="swatch" style="background:${css(p.colour)}"></span>`;
+    s.appendChild(document.createTextNode(p.name + (i + 1 < baseParts.length ? ', ' : '')));
+    base.appendChild(s);
+  });
+} else {
+  base.textContent = 'Base: the ground plane';
+}
+const list = document.getElementById('asp-steps');
+const items = steps.map((s, k) => {
+  const li = document.createElement('li');
+  li.innerHTML = `<span class="swatch" style="background:${css(parts[s.part].colour)}"></span>`;
+  const how = s.motion ? (s.motion.kind === 'path' ? ' (path)' : '') : '';
+  li.appendChild(document.createTextNode(s.name + how));
+  li.addEventListener('click', () => { pause(); goto(k + 1); });
+  list.appendChild(li);
+  return li;
+});
+const explanation = document.getElementById('asp-explanation');
+for (const e of data.explanation) {
+  const li = document.createElement('li');
+  li.textContent = e.text;
+  explanation.appendChild(li);
+}
+const counter = document.getElementById('asp-counter');
+const playButton = document.getElementById('asp-play');
+function updatePanel(cur) {
+  counter.textContent = `Step ${state.shown} / ${steps.length}` + (cur >= 0 ? `: ${steps[cur].name}` : '');
+  items.forEach((li, k) => { li.className = k === cur ? 'current' : k < state.shown ? 'done' : 'todo'; });
+  playButton.textContent = state.playing ? '\u275A\u275A' : '\u25B6';
+  document.getElementById('asp-state').textContent = JSON.stringify(api.state());
+}
+document.getElementById('asp-reset').addEventListener('click', () => { pause(); goto(0); });
+document.getElementById('asp-back').addEventListener('click', () => { pause(); back(); });
+document.getElementById('asp-step').addEventListener('click', () => { pause(); step(); });
+playButton.addEventListener('click', () => (state.playing ? pause() : play()));
+window.addEventListener('keydown', (e) => {
+  if (e.key === ' ') { e.preventDefault(); state.playing ? pause() : play(); }
+  else if (e.key === 'ArrowRight') { pause(); step(); }
+  else if (e.key === 'ArrowLeft') { pause(); back(); }
+  else if (e.key === 'Home') { pause(); goto(0); }
+});
+window.addEventListener('resize', () => {
+  renderer.setSize(window.innerWidth, window.innerHeight);
+  frameView();
+});
+
+// --- the loop
+const clock = new THREE.Clock();
+const screen = new THREE.Vector3();
+function frame() {
+  const dt = Math.min(clock.getDelta(), 0.1);
+  if (state.flying >= 0) {
+    state.t = Math.min(1, state.t + dt / STEP_SECONDS);
+    if (state.t >= 1) { state.flying = -1; state.wait = 0; }
+    apply_state();
+  } else if (state.playing) {
+    state.wait += dt;
+    if (state.shown >= steps.length) pause();
+    else if (state.wait >= PAUSE_SECONDS) step();
+  }
+  controls.update();
+  renderer.render(scene, camera);
+  const cur = current();
+  if (cur >= 0) {
+    const p = parts[steps[cur].part];
+    screen.copy(p.centre).applyQuaternion(p.mesh.quaternion).add(p.mesh.position).project(camera);
+    label.style.display = screen.z < 1 ? 'block' : 'none';
+    label.style.left = `${(screen.x + 1) / 2 * window.innerWidth}px`;
+    label.style.top = `${(1 - screen.y) / 2 * window.innerHeight}px`;
+    label.textContent = `${cur + 1}. ${steps[cur].name}`;
+  } else {
+    label.style.display = 'none';
+  }
+  requestAnimationFrame(frame);
+}
+
+const api = {
+  ready: false,
+  goto, step, back, play, pause,
+  reset: () => { pause(); return goto(0); },
+  // the pose of step k's part a fraction s through its motion (model units): {t: [x,y,z], q: [x,y,z,w]}
+  poseAt: (k, s) => {
+    const p = poseAt(steps[k].motion, s);
+    return { t: [p.t.x, p.t.y, p.t.z], q: [p.q.x, p.q.y, p.q.z, p.q.w] };
+  },
+  state: () => ({
+    shown: state.shown,
+    total: steps.length,
+    status: data.status,
+    playing: state.playing,
+    flying: state.flying >= 0 ? steps[state.flying].part : null,
+    t: state.t,
+    current: current() >= 0 ? steps[current()].part : null,
+    visible: parts.filter((p) => p.mesh.visible).map((p) => p.index),
+    stuck: [...stuck],
+  }),
+};
+window.aspViewer = api;
+// a found plan opens assembled; an unfinished one on its dead end, the stuck parts in red
+if (data.status === 'found') state.shown = steps.length;
+apply_state();
+renderer.render(scene, camera);
+api.ready = true;
+requestAnimationFrame(frame);

@@ -1,0 +1,11 @@
+#![doc = include_str!("../README.md")]
+
+pub mod error;
+pub mod mcap;
+pub mod plot;
+pub mod render;
+pub mod scene;
+pub mod view;
+
+pub use error::{Result, VizError};
+pub use scene::{Insertion, Scene, Step};

@@ -1,0 +1,37 @@
+//! Plans of fixtures as scenes, and a `no_plan` scene.
+
+use asp_geom::{fixtures, Assembly, Checker, CheckerConfig, World, WorldConfig};
+use asp_search::report::{Explanation, NamedPart, PlanReport};
+use asp_search::{Budget, Dfs, Planner, Problem};
+use asp_viz::Scene;
+use std::path::Path;
+
+/// The plan of `assembly` (feasibility DFS, path planner on) and its scene.
+pub fn planned(assembly: Assembly) -> Scene {
+    let checker = Checker::new(World::new(assembly, &WorldConfig::default()).unwrap(), CheckerConfig::default());
+    let outcome = Dfs::builder().build().solve(&Problem::full(&checker), &Budget::default());
+    let world = checker.world();
+    let report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
+    assert_eq!(report.status, "found");
+    Scene::new(world.assembly().clone(), report, Path::new("fixture")).unwrap()
+}
+
+/// The tube's plan turned into a `no_plan` result as the planner writes one: the handle came
+/// off, then the stick was stuck between the receptacle and the cap, and the cap could leave
+/// but led nowhere.
+pub fn stuck_tube() -> Scene {
+    let scene = planned(fixtures::tube());
+    let mut report = scene.report.clone();
+    let index = |name: &str| report.parts.iter().position(|p| p.name == name).unwrap();
+    let (handle, stick, receptacle, cap) = (index("handle"), index("stick"), index("receptacle"), index("cap"));
+    report.status = "no_plan".into();
+    report.assembly_sequence.clear();
+    report.disassembly_sequence = vec![handle];
+    report.explanation = vec![Explanation {
+        part: stick,
+        name: "stick".into(),
+        reason: "blocked".into(),
+        parts: vec![NamedPart { part: receptacle, name: "receptacle".into() }, NamedPart { part: cap, name: "cap".into() }],
+    }, Explanation { part: cap, name: "cap".into(), reason: "dead_end".into(), parts: vec![] }];
+    Scene::new(scene.assembly.clone(), report, Path::new("fixture")).unwrap()
+}

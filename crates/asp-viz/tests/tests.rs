@@ -1,0 +1,7 @@
+//! Integration tests of asp-viz on planned fixtures.
+
+mod common;
+mod mcap_file;
+mod page;
+mod plots;
+mod storyboard;

@@ -1,0 +1,64 @@
+""":class:`Graph`: the graph of a disassembly state as numpy arrays (``docs/learning.md``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Tuple
+
+import numpy as np
+
+__all__ = ["Graph"]
+
+
+@dataclass(frozen=True)
+class Graph:
+    """The graph of a disassembly state, in the layout of a removability model's inputs.
+
+    Nodes are the present parts in ascending order; a directed edge ``s → t`` joins every ordered
+    pair of present parts in contact (both directions), ordered by (source, target).
+    """
+
+    #: int64 ``[n]``: the part index of each node.
+    nodes: np.ndarray
+    #: float32 ``[n, node_dim]``: node attributes (model input ``x``).
+    x: np.ndarray
+    #: int64 ``[2, e]``: sources then targets, as node positions (model input ``edge_index``).
+    edge_index: np.ndarray
+    #: float32 ``[e, edge_dim]``: edge attributes (model input ``edge_attr``).
+    edge_attr: np.ndarray
+    #: The feature set and its parameters (``asp-graph/1 radius_bins=8 degree=8 points=2048``).
+    features: str
+
+    @property
+    def num_nodes(self) -> int:
+        """``n``."""
+        return int(self.x.shape[0])
+
+    @property
+    def num_edges(self) -> int:
+        """``e``."""
+        return int(self.edge_index.shape[1])
+
+    @property
+    def node_dim(self) -> int:
+        """Floats per node."""
+        return int(self.x.shape[1])
+
+    @property
+    def edge_dim(self) -> int:
+        """Floats per edge."""
+        return int(self.edge_attr.shape[1])
+
+    @classmethod
+    def _from_native(cls, raw: Tuple[bytearray, bytearray, bytearray, bytearray, int, int, str]) -> "Graph":
+        """From ``asp._asp.Assembly.graph``'s little-endian buffers (writable arrays, no copy)."""
+        nodes, x, edge_index, edge_attr, node_dim, edge_dim, features = raw
+        n = len(nodes) // 8
+        e = len(edge_index) // 16
+        return cls(
+            nodes=np.frombuffer(nodes, dtype="<i8").astype(np.int64, copy=False),
+            x=np.frombuffer(x, dtype="<f4").astype(np.float32, copy=False).reshape(n, node_dim),
+            edge_index=np.frombuffer(edge_index, dtype="<i8").astype(np.int64, copy=False).reshape(2, e),
+            edge_attr=np.frombuffer(edge_attr, dtype="<f4").astype(np.float32, copy=False).reshape(e, edge_dim),
+            features=features,
+        )

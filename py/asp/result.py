@@ -1,0 +1,122 @@
+""":class:`Plan`: the result of a planning run, around the plan JSON (``docs/plan-format.md``)."""
+
+from __future__ import annotations
+
+import json as _json
+import os
+from typing import Any, Dict, List, Optional, Tuple, Union
+
+from asp import _asp
+
+__all__ = ["ORDERS", "Plan"]
+
+#: The part orderings ``order=`` accepts (``bookkeeping`` is ``given`` with bookkeeping; ``gnn``
+#: needs the learned-ordering crate).
+ORDERS: Tuple[str, ...] = tuple(_asp.order_names())
+
+
+class Plan:
+    """A planning run's result. :attr:`json` is the plan JSON exactly as ``asp plan --json``
+    prints it; every other attribute is read from it.
+
+    A search that finds nothing is a result too: :attr:`status` is ``"no_plan"`` (with an
+    :attr:`explanation` of what holds which part) or ``"budget_exhausted"``.
+    """
+
+    __slots__ = ("_json", "_found", "_trace", "_dict")
+
+    def __init__(self, json: str, found: bool, trace_csv: Optional[str] = None) -> None:
+        self._json = json
+        self._found = bool(found)
+        self._trace = trace_csv
+        self._dict: Dict[str, Any] = _json.loads(json)
+
+    @property
+    def json(self) -> str:
+        """The plan JSON (pretty-printed, ending in a newline), as the CLI writes it."""
+        return self._json
+
+    @property
+    def found(self) -> bool:
+        """Whether a complete sequence was found."""
+        return self._found
+
+    @property
+    def status(self) -> str:
+        """``"found"``, ``"no_plan"`` or ``"budget_exhausted"``."""
+        return self._dict["status"]
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The plan JSON as a fresh dict (changing it does not change the plan)."""
+        return _json.loads(self._json)
+
+    @property
+    def model(self) -> str:
+        """The model file or folder, as given."""
+        return self._dict["model"]
+
+    @property
+    def units(self) -> str:
+        """The model's unit; every length of the plan is in it."""
+        return self._dict["units"]
+
+    @property
+    def up(self) -> str:
+        """The up axis (``"+z"``, ...)."""
+        return self._dict["up"]
+
+    @property
+    def parts(self) -> List[Dict[str, Any]]:
+        """Every part: ``{"index", "name", "fixed"}``."""
+        return self.to_dict()["parts"]
+
+    @property
+    def assembly_sequence(self) -> List[Dict[str, Any]]:
+        """One entry per non-fixed part in assembly order: ``{"part", "name", "motion"}``
+        (empty unless found)."""
+        return self.to_dict()["assembly_sequence"]
+
+    @property
+    def disassembly_sequence(self) -> List[int]:
+        """Part indices in removal order (the branch reached, when not found)."""
+        return list(self._dict["disassembly_sequence"])
+
+    @property
+    def stats(self) -> Dict[str, Any]:
+        """Removal tests, failures by collision and gravity, path planner calls, seconds."""
+        return dict(self._dict["stats"])
+
+    @property
+    def explanation(self) -> List[Dict[str, Any]]:
+        """For ``no_plan``: each part of the deepest dead end, why it is stuck and which parts
+        hold it (empty otherwise)."""
+        return self.to_dict().get("explanation", [])
+
+    @property
+    def warnings(self) -> List[str]:
+        """Non-fatal problems found in the model, one line each."""
+        return list(self._dict.get("warnings", []))
+
+    @property
+    def optimisation(self) -> Optional[Dict[str, Any]]:
+        """For optimising runs (``objective=``): objectives, values and the search's settings."""
+        return self.to_dict().get("optimisation")
+
+    @property
+    def pareto_front(self) -> Optional[List[Dict[str, Any]]]:
+        """For Pareto runs: every non-dominated sequence with its objective vector."""
+        return self.to_dict().get("pareto_front")
+
+    @property
+    def trace_csv(self) -> Optional[str]:
+        """For optimising runs: the search's trace as CSV (what ``asp plan --trace`` writes)."""
+        return self._trace
+
+    def write(self, path: Union[str, "os.PathLike[str]"]) -> None:
+        """Writes the plan JSON to ``path`` (what ``asp plan --out`` writes)."""
+        with open(path, "w", encoding="utf-8", newline="") as f:
+            f.write(self._json)
+
+    def __repr__(self) -> str:
+        s = self._dict["stats"]
+        return f"<asp.Plan {self.model}: {self.status}, {s['removal_tests']} removal tests>"

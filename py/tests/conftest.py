@@ -1,0 +1,57 @@
+"""Shared fixtures: the repository root, the shipped models, and the `asp` binary the plan JSON is
+compared with (``ASP_BIN``, else a built ``target/*/asp``, else ``cargo run -p asp-cli``)."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Callable, List, Tuple
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+LACK = "tests/data/ikea/table_lack_0825.glb"
+PUMP = "tests/data/pump"
+
+# every wall-time figure of a plan JSON: the one thing two runs of the same plan may differ in
+_SECONDS = re.compile(r'("(?:seconds|map_seconds|search_seconds)": )[-+0-9.eE]+')
+
+
+def without_seconds(plan_json: str) -> str:
+    """The plan JSON with its wall times replaced by 0 (bytes otherwise untouched)."""
+    return _SECONDS.sub(r"\g<1>0", plan_json)
+
+
+@pytest.fixture
+def root(monkeypatch: pytest.MonkeyPatch) -> Path:
+    """The repository root, also made the working directory (model paths as the CLI gets them)."""
+    monkeypatch.chdir(ROOT)
+    return ROOT
+
+
+def _asp_command() -> List[str]:
+    env = os.environ.get("ASP_BIN")
+    if env:
+        return [env]
+    for profile in ("debug", "release"):
+        exe = ROOT / "target" / profile / "asp"
+        if exe.is_file():
+            return [str(exe)]
+    if shutil.which("cargo"):
+        return ["cargo", "run", "-q", "--locked", "-p", "asp-cli", "--"]
+    pytest.skip("no asp binary: set ASP_BIN or build it (cargo build -p asp-cli)")
+
+
+@pytest.fixture
+def asp_cli(root: Path) -> Callable[..., Tuple[int, str, str]]:
+    """Runs ``asp ARGS...`` in the repository root: ``(exit code, stdout, stderr)``."""
+    command = _asp_command()
+
+    def run(*args: str) -> Tuple[int, str, str]:
+        p = subprocess.run(command + list(args), cwd=root, capture_output=True, text=True, timeout=600)
+        return p.returncode, p.stdout, p.stderr
+
+    return run

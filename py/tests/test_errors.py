@@ -1,0 +1,114 @@
+"""Bad input raises asp's own exceptions, naming the file and the cause; nothing panics."""
+
+from __future__ import annotations
+
+import pickle
+
+import pytest
+
+import asp
+from conftest import LACK
+
+
+def test_missing_file_is_a_load_error_naming_it(root):
+    with pytest.raises(asp.LoadError) as e:
+        asp.load("tests/data/no_such_model.glb")
+    message = str(e.value)
+    assert message.startswith("tests/data/no_such_model.glb: "), message
+    assert "no such file" in message.lower()
+    assert e.value.path == "tests/data/no_such_model.glb"
+    assert isinstance(e.value, asp.AspError)
+
+
+def test_garbage_file_is_a_load_error_naming_it(tmp_path):
+    bad = tmp_path / "broken.glb"
+    bad.write_bytes(b"glTF\x02\x00\x00\x00 this is not a binary glTF")
+    with pytest.raises(asp.LoadError) as e:
+        asp.load(bad)
+    assert str(e.value).startswith(f"{bad}: "), str(e.value)
+    assert e.value.path == str(bad)
+
+
+def test_unknown_format_is_a_load_error(tmp_path):
+    bad = tmp_path / "model.xyz"
+    bad.write_text("1 2 3\n")
+    with pytest.raises(asp.LoadError, match="model.xyz"):
+        asp.load(bad)
+
+
+def test_load_errors_pickle_with_their_path():
+    e = asp.LoadError("m.glb: broken", "m.glb")
+    back = pickle.loads(pickle.dumps(e))
+    assert type(back) is asp.LoadError and str(back) == "m.glb: broken" and back.path == "m.glb"
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({"unit": "furlong"}, "unknown unit 'furlong'"),
+        ({"up": "w"}, "'w' is not an axis"),
+        ({"fixed": ["no such part"]}, "no such part"),
+    ],
+)
+def test_bad_load_settings(root, kwargs, words):
+    with pytest.raises((asp.ConfigError, asp.LoadError), match=words):
+        asp.load(LACK, **kwargs)
+
+
+def test_unknown_unit_and_axis_are_config_errors(root):
+    with pytest.raises(asp.ConfigError):
+        asp.load(LACK, unit="furlong")
+    with pytest.raises(asp.ConfigError):
+        asp.load(LACK, up="sideways")
+
+
+@pytest.fixture(scope="module")
+def lack():
+    import os
+
+    from conftest import ROOT
+
+    return asp.load(os.path.join(ROOT, LACK), up="z")
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({"order": "sideways"}, "unknown order 'sideways'"),
+        ({"order": "gnn"}, "order 'gnn' needs the learned-ordering crate"),
+        ({"normals": -1}, "normals must be a non-negative integer, got -1"),
+        ({"seed": "zero"}, "seed must be a non-negative integer, got 'zero'"),
+        ({"tolerance": -1.0}, "tolerance must be a positive number, got -1"),
+        ({"tolerance": "small"}, "tolerance must be a number"),
+        ({"timeout": 0}, "timeout must be a positive number"),
+        ({"rrt_time": float("nan")}, "rrt_time must be a positive number"),
+        ({"bookkeeping": "yes"}, "bookkeeping must be True or False"),
+        ({"stability": "glue"}, "unknown criterion 'glue'"),
+        ({"stability": "physics", "physics_threshold": -0.5}, "physics_threshold must be a positive number"),
+        ({"objective": "beauty"}, "unknown objective 'beauty'"),
+        ({"objective": "access,dirchange"}, "several objectives need a Pareto search"),
+        ({"objective": ["access", 3]}, "objective must be a string or a list of strings"),
+        ({"objective": "access", "resolution": 4}, "resolution"),
+        ({"objective": "access", "support": "glue"}, "unknown gravity check 'glue'"),
+    ],
+)
+def test_bad_plan_settings_are_config_errors(lack, kwargs, words):
+    with pytest.raises(asp.ConfigError) as e:
+        lack.plan(**kwargs)
+    assert words in str(e.value), str(e.value)
+    assert isinstance(e.value, ValueError) and isinstance(e.value, asp.AspError)
+
+
+def test_unknown_keywords_are_type_errors(lack):
+    with pytest.raises(TypeError):
+        lack.plan(colour="red")
+    with pytest.raises(TypeError):
+        asp.plan(LACK, colour="red")
+
+
+def test_native_module_rejects_unknown_settings(lack):
+    # the dict the Python layer passes is checked again natively (no key is silently dropped)
+    with pytest.raises(asp.ConfigError, match="unknown setting 'colour'"):
+        lack._native.plan({"colour": "red"})
+    with pytest.raises(asp.ConfigError, match="setting of asp.load"):
+        lack._native.plan({"up": "z"})

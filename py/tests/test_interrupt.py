@@ -1,0 +1,55 @@
+"""Ctrl-C stops a depth-first search from Python, and planning releases the GIL."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import threading
+import time
+
+import asp
+from conftest import PUMP, ROOT
+
+# the pump has no plan: the search tries every state (thousands of removal tests, seconds)
+INTERRUPTED = f"""
+import _thread, threading, time, asp
+a = asp.load({str(ROOT / PUMP)!r}, unit="mm", up="z")
+threading.Timer(0.3, _thread.interrupt_main).start()
+start = time.monotonic()
+try:
+    a.plan()
+    print("finished", time.monotonic() - start)
+except KeyboardInterrupt:
+    print("interrupted", time.monotonic() - start)
+"""
+
+
+def test_ctrl_c_interrupts_a_search():
+    full = time.monotonic()
+    asp.load(ROOT / PUMP, unit="mm", up="z").plan()
+    full = time.monotonic() - full
+    p = subprocess.run([sys.executable, "-c", INTERRUPTED], capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    word, seconds = p.stdout.split()
+    assert word == "interrupted", p.stdout
+    # interrupted well before the search would have ended by itself
+    assert float(seconds) < 0.3 + max(1.0, 0.5 * full), (seconds, full)
+
+
+def test_planning_releases_the_gil():
+    a = asp.load(ROOT / PUMP, unit="mm", up="z")
+    ticks = 0
+    done = threading.Event()
+
+    def plan():
+        a.plan(max_tests=3000)
+        done.set()
+
+    t = threading.Thread(target=plan)
+    t.start()
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0.001)
+    t.join()
+    # with the GIL held for the whole plan this loop could not run while it ran
+    assert ticks > 20

@@ -1,0 +1,109 @@
+"""Planning from Python gives the CLI's plan JSON, byte for byte apart from wall times."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+import asp
+from conftest import LACK, PUMP, without_seconds
+
+
+@pytest.mark.parametrize(
+    "kwargs, flags",
+    [
+        ({}, []),
+        ({"order": "random", "seed": 3, "bookkeeping": True}, ["--order", "random", "--seed", "3", "--bookkeeping"]),
+        ({"order": "shuffled", "seed": 7, "normals": 4, "sphere_directions": 6},
+         ["--order", "shuffled", "--seed", "7", "--normals", "4", "--sphere-directions", "6"]),
+        ({"order": "bookkeeping", "tolerance": 0.0005, "path_planner": False},
+         ["--order", "bookkeeping", "--tolerance", "0.0005", "--no-path-planner"]),
+    ],
+)
+def test_plan_json_is_the_clis(root, asp_cli, kwargs, flags):
+    code, out, err = asp_cli("plan", LACK, "--up", "z", "--json", *flags)
+    assert code == 0, err
+    plan = asp.plan(LACK, up="z", **kwargs)
+    assert plan.found and plan.status == "found"
+    assert without_seconds(plan.json) == without_seconds(out)
+    # and the wall time really is the only difference that was masked
+    assert plan.json.count('"seconds"') == out.count('"seconds"') == 1
+
+
+def test_optimised_plan_json_is_the_clis(root, asp_cli):
+    flags = ["--objective", "access", "--episodes", "40", "--threads", "1", "--seed", "2"]
+    code, out, err = asp_cli("plan", LACK, "--up", "z", "--json", *flags)
+    assert code == 0, err
+    plan = asp.load(LACK, up="z").plan(objective="access", episodes=40, threads=1, seed=2)
+    assert without_seconds(plan.json) == without_seconds(out)
+    assert plan.optimisation["method"] == "mcts"
+    assert plan.trace_csv is not None and plan.trace_csv.count("\n") >= 2
+
+
+def test_no_plan_pump_explains_what_holds_what(root, asp_cli):
+    a = asp.load(PUMP, unit="mm", up="z")
+    plan = a.plan()
+    assert plan.status == "no_plan" and not plan.found
+    assert plan.assembly_sequence == []
+    explanation = plan.explanation
+    assert explanation, "a no_plan result explains the dead end"
+    names = {p.name for p in a.parts}
+    for entry in explanation:
+        assert entry["name"] in names
+        assert entry["reason"] in ("blocked", "unsupported", "dead_end")
+    assert any(e["reason"] == "blocked" and e["parts"] for e in explanation)
+    code, out, err = asp_cli("plan", PUMP, "--unit", "mm", "--up", "z", "--json")
+    assert code == 1, err
+    assert without_seconds(plan.json) == without_seconds(out)
+
+
+def test_assembly_owns_its_data_and_plans_again(root, tmp_path):
+    copy = tmp_path / "lack.glb"
+    copy.write_bytes((root / LACK).read_bytes())
+    a = asp.load(copy, up="z")
+    copy.unlink()  # the handle no longer needs the file
+    first, second = a.plan(), a.plan()
+    assert without_seconds(first.json) == without_seconds(second.json)
+    assert a.source == str(copy) and first.model == str(copy)
+
+
+def test_plan_result_views(root, tmp_path):
+    a = asp.load(LACK, up="z")
+    assert len(a) == len(a.parts) == 5
+    assert [p.index for p in a.parts] == list(range(5))
+    assert a.units == "m" and a.up == "+z"
+    plan = a.plan()
+    d = plan.to_dict()
+    assert d == json.loads(plan.json)
+    d["status"] = "changed"
+    assert plan.status == "found", "to_dict returns a copy"
+    assert [p["name"] for p in plan.parts] == [p.name for p in a.parts]
+    movable = [p for p in a.parts if not p.fixed]
+    assert len(plan.assembly_sequence) == len(movable)
+    assert sorted(plan.disassembly_sequence) == sorted(p.index for p in movable)
+    assert plan.stats["removal_tests"] >= len(movable)
+    assert plan.optimisation is None and plan.pareto_front is None and plan.trace_csv is None
+    out = tmp_path / "plan.json"
+    plan.write(out)
+    assert out.read_text() == plan.json
+    assert a.part(a.parts[2].name) == a.parts[2]
+
+
+def test_budget_exhausted_is_a_status(root):
+    plan = asp.plan(PUMP, unit="mm", up="z", max_tests=5)
+    assert plan.status == "budget_exhausted" and not plan.found
+    assert plan.stats["removal_tests"] == 5
+
+
+def test_defaults_are_the_librarys():
+    import inspect
+
+    from asp import _asp
+
+    defaults = _asp.default_settings()
+    plan = {k: p.default for k, p in inspect.signature(asp.Assembly.plan).parameters.items() if k != "self"}
+    graph = {k: p.default for k, p in inspect.signature(asp.Assembly.graph).parameters.items()
+             if k not in ("self", "present")}
+    assert {**plan, **graph} == defaults
+    assert set(asp.ORDERS) == {"given", "shuffled", "random", "bookkeeping", "gnn"}
