@@ -10,9 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-PY = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(PY))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # the shared synthetic data set writer
 
 torch = pytest.importorskip("torch", reason="asp.train needs PyTorch (pip install torch)")
 pytest.importorskip("onnx", reason="the ONNX export needs the onnx package")
