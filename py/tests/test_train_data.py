@@ -4,13 +4,11 @@ the training tests share (:func:`write_dataset`, :func:`write_stacks_dataset`)."
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from asp.data import DataError, RemovabilityDataset, induced_subgraph  # noqa: E402
 
