@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+
 from asp.data import DataError, RemovabilityDataset, induced_subgraph  # noqa: E402
 
 

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+
 import numpy as np
 import pytest
+
 
 torch = pytest.importorskip("torch", reason="asp.train needs PyTorch (pip install torch)")
 onnx = pytest.importorskip("onnx", reason="the ONNX export needs the onnx package")

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # the shared synthetic data set writer
 
 torch = pytest.importorskip("torch", reason="asp.train needs PyTorch (pip install torch)")
 pytest.importorskip("onnx", reason="the ONNX export needs the onnx package")
@@ -115,10 +115,13 @@ def test_cli_errors_are_one_line(stacks, tmp_path, capsys):
 
 
 def test_module_runs_as_a_program(stacks, tmp_path):
+    import asp.data
+
     out = tmp_path / "m.onnx"
+    root = Path(asp.data.__file__).parent.parent  # the `asp` this test imported, not another one
     proc = subprocess.run(
         [sys.executable, "-m", "asp.train", "removability", str(stacks), "--out", str(out), "--epochs", "1"],
-        cwd=tmp_path, env={"PATH": "/usr/bin:/bin"}, capture_output=True, text=True, timeout=300,
+        cwd=tmp_path, env={"PYTHONPATH": str(root), "PATH": "/usr/bin:/bin"}, capture_output=True, text=True, timeout=300,
     )
     assert proc.returncode == 0, proc.stderr
     assert "epoch 1/1" in proc.stderr

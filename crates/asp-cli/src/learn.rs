@@ -26,8 +26,10 @@ pub fn order_source(order: OrderArg, model: Option<&Path>) -> anyhow::Result<Arc
 
 /// The learned ordering (`asp-learn`) with the model at `path`, or the shipped one.
 fn gnn_source(path: Option<&Path>) -> anyhow::Result<Arc<dyn OrderingSource>> {
-    let _ = path;
-    bail!("--order gnn: this build has no learned ordering")
+    Ok(Arc::new(match path {
+        Some(p) => asp_learn::GnnSource::load(p, asp_geom::graph::GraphConfig::default())?,
+        None => asp_learn::GnnSource::shipped()?,
+    }))
 }
 
 /// `asp collect`.

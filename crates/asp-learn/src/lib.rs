@@ -6,4 +6,4 @@ pub mod ordering;
 
 pub use error::{LearnError, Result};
 pub use model::{RemovabilityModel, ShapePolicy};
-pub use ordering::{GnnFactory, GnnOrdering, GnnSource};
+pub use ordering::{GnnFactory, GnnOrdering, GnnSource, SHIPPED_MODEL};

@@ -45,6 +45,29 @@ pub enum ShapePolicy {
 
 type Plan = TypedRunnableModel;
 
+/// A plan with its idle run states (reused: spawning a state per call allocates per node).
+struct Pooled {
+    plan: Arc<Plan>,
+    idle: Mutex<Vec<TypedSimpleState>>,
+}
+
+impl Pooled {
+    fn new(plan: Arc<Plan>) -> Arc<Self> {
+        Arc::new(Pooled { plan, idle: Mutex::new(Vec::new()) })
+    }
+
+    fn run(&self, inputs: TVec<TValue>) -> TractResult<TVec<TValue>> {
+        let state = self.idle.lock().unwrap_or_else(|p| p.into_inner()).pop();
+        let mut state = match state {
+            Some(s) => s,
+            None => self.plan.spawn()?,
+        };
+        let out = state.run(inputs)?;
+        self.idle.lock().unwrap_or_else(|p| p.into_inner()).push(state);
+        Ok(out)
+    }
+}
+
 /// A loaded removability model (thread-safe: plans are shared, every call has its own state).
 pub struct RemovabilityModel {
     path: String,
@@ -59,8 +82,8 @@ pub struct RemovabilityModel {
     /// The symbols of `n` and `e`, when the inputs declare them as plain symbols.
     symbols: Option<(Symbol, Symbol)>,
     policy: ShapePolicy,
-    symbolic: Mutex<Option<Arc<Plan>>>,
-    buckets: Mutex<HashMap<(usize, usize), Arc<Plan>>>,
+    symbolic: Mutex<Option<Arc<Pooled>>>,
+    buckets: Mutex<HashMap<(usize, usize), Arc<Pooled>>>,
 }
 
 impl std::fmt::Debug for RemovabilityModel {
@@ -297,24 +320,24 @@ impl RemovabilityModel {
         Ok(())
     }
 
-    fn symbolic_plan(&self) -> TractResult<Arc<Plan>> {
+    fn symbolic_plan(&self) -> TractResult<Arc<Pooled>> {
         let mut slot = self.symbolic.lock().unwrap_or_else(|p| p.into_inner());
         if let Some(plan) = &*slot {
             return Ok(plan.clone());
         }
-        let plan = self.typed.clone().into_optimized()?.into_runnable()?;
+        let plan = Pooled::new(self.typed.clone().into_optimized()?.into_runnable()?);
         *slot = Some(plan.clone());
         Ok(plan)
     }
 
-    fn bucket_plan(&self, n: usize, e: usize) -> TractResult<Arc<Plan>> {
+    fn bucket_plan(&self, n: usize, e: usize) -> TractResult<Arc<Pooled>> {
         let mut plans = self.buckets.lock().unwrap_or_else(|p| p.into_inner());
         if let Some(plan) = plans.get(&(n, e)) {
             return Ok(plan.clone());
         }
         let (sn, se) = self.symbols.clone().ok_or_else(|| TractError::msg("the model's sizes are not plain symbols"))?;
         let subs = HashMap::from([(sn, TDim::Val(n as i64)), (se, TDim::Val(e as i64))]);
-        let plan = self.typed.set_symbols(&subs)?.into_optimized()?.into_runnable()?;
+        let plan = Pooled::new(self.typed.set_symbols(&subs)?.into_optimized()?.into_runnable()?);
         plans.insert((n, e), plan.clone());
         Ok(plan)
     }

@@ -4,12 +4,15 @@
 //! [`GnnSource`] is the [`OrderingSource`] of `--order gnn`: it holds the loaded model and the
 //! graph configuration, computes the [`AssemblyGraph`] of a model once in
 //! [`prepare`](OrderingSource::prepare), and hands out [`GnnOrdering`]s, one per search, each with
-//! its own scratch buffers. Ties (equal scores) keep the incoming order: the sort is stable.
+//! its own scratch buffers. Ties (equal scores) keep the order of the thesis' initial ordering:
+//! the parts are first put in the search's `shuffled` order of its seed, then sorted stably, so
+//! `gnn` and `shuffled` runs of one seed start from the same predefined order (thesis 3.6.4).
 
 use std::sync::Arc;
 
 use asp_geom::graph::{AssemblyGraph, GraphConfig, StateGraph};
 use asp_geom::{PartSet, World};
+use asp_search::ordering::Shuffled;
 use asp_search::{OrderingFactory, OrderingSource, PartOrdering, SearchError};
 
 use crate::error::Result;
@@ -30,6 +33,8 @@ impl RemovabilityModel {
 
 /// Orders the candidate parts of a state by descending predicted removability.
 pub struct GnnOrdering {
+    /// The initial ordering that breaks ties (`None`: the incoming order).
+    tie: Option<Shuffled>,
     graph: Arc<AssemblyGraph>,
     model: Arc<RemovabilityModel>,
     scratch: StateGraph,
@@ -51,7 +56,7 @@ impl GnnOrdering {
     pub fn new(graph: Arc<AssemblyGraph>, model: Arc<RemovabilityModel>) -> Result<Self> {
         model.check_graph(&graph)?;
         let parts = graph.num_parts();
-        Ok(GnnOrdering { graph, model, scratch: StateGraph::default(), by_part: vec![f32::NEG_INFINITY; parts], failures: 0, first_failure: None })
+        Ok(GnnOrdering { tie: None, graph, model, scratch: StateGraph::default(), by_part: vec![f32::NEG_INFINITY; parts], failures: 0, first_failure: None })
     }
 
     /// The predicted removability of every part of the model in `state` (`-inf` for parts
@@ -82,6 +87,9 @@ impl PartOrdering for GnnOrdering {
     /// inference does not fail on valid state graphs; if it does, `parts` keeps its order and
     /// the failure is counted ([`GnnOrdering::failures`]).
     fn order(&mut self, state: &PartSet, parts: &mut Vec<usize>) {
+        if let Some(tie) = &mut self.tie {
+            tie.order(state, parts);
+        }
         match self.scores(state) {
             Ok(_) => {
                 let by_part = &self.by_part;
@@ -126,9 +134,10 @@ impl OrderingFactory for GnnFactory {
         "gnn".into()
     }
 
-    fn make(&self, _num_parts: usize, _seed: u64) -> Box<dyn PartOrdering> {
+    fn make(&self, num_parts: usize, seed: u64) -> Box<dyn PartOrdering> {
         let parts = self.graph.num_parts();
         Box::new(GnnOrdering {
+            tie: Some(Shuffled::new(num_parts, seed)),
             graph: self.graph.clone(),
             model: self.model.clone(),
             scratch: StateGraph::default(),
@@ -138,6 +147,9 @@ impl OrderingFactory for GnnFactory {
         })
     }
 }
+
+/// The bytes of `models/removability.onnx`, the removability model shipped with asp.
+pub const SHIPPED_MODEL: &[u8] = include_bytes!("../../../models/removability.onnx");
 
 /// The `gnn` ordering source: a removability model and the graph features it expects.
 #[derive(Debug)]
@@ -152,6 +164,14 @@ impl GnnSource {
     pub fn new(model: Arc<RemovabilityModel>, config: GraphConfig) -> Result<Self> {
         model.check_features(&config.features(), config.node_dim(), config.edge_dim())?;
         Ok(GnnSource { model, config })
+    }
+
+    /// The model shipped with asp (`models/removability.onnx`, embedded in the binary; trained by
+    /// `scripts/train-removability`), for graphs with the default features.
+    pub fn shipped() -> Result<Self> {
+        let config = GraphConfig::default();
+        let model = RemovabilityModel::from_bytes(SHIPPED_MODEL, "models/removability.onnx (shipped)")?;
+        Self::new(Arc::new(model), config)
     }
 
     /// Load the model at `path` for graphs computed with `config`.
