@@ -113,6 +113,7 @@ class Assembly:
         self,
         *,
         order: str = "given",
+        model: Optional[str] = None,
         bookkeeping: bool = False,
         seed: int = 0,
         tolerance: Optional[float] = None,
@@ -146,6 +147,8 @@ class Assembly:
             ``shuffled`` (one order drawn from ``seed`` and kept: the thesis' vanilla AbD),
             ``random`` (a fresh order in every state), ``bookkeeping`` (``given`` with
             bookkeeping), ``gnn`` (the learned ordering).
+        :param model: the removability model (ONNX) of ``order="gnn"`` (default: the model
+            shipped with asp).
         :param bookkeeping: skip retesting a part until one of its blockers is gone.
         :param seed: seed of every random choice.
         :param tolerance: contact tolerance (default 1e-4 × the model's diagonal).
@@ -187,6 +190,7 @@ class Assembly:
             objective = list(objective)
         settings = {
             "order": order,
+            "model": None if model is None else str(model),
             "bookkeeping": bookkeeping,
             "seed": seed,
             "tolerance": tolerance,

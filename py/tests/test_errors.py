@@ -75,7 +75,8 @@ def lack():
     "kwargs, words",
     [
         ({"order": "sideways"}, "unknown order 'sideways'"),
-        ({"order": "gnn"}, "order 'gnn' needs the learned-ordering crate"),
+        ({"order": "gnn", "model": "/no/such/model.onnx"}, "/no/such/model.onnx"),
+        ({"order": "given", "model": "m.onnx"}, "no effect with order='given'"),
         ({"normals": -1}, "normals must be a non-negative integer, got -1"),
         ({"seed": "zero"}, "seed must be a non-negative integer, got 'zero'"),
         ({"tolerance": -1.0}, "tolerance must be a positive number, got -1"),

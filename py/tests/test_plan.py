@@ -17,6 +17,7 @@ from conftest import LACK, PUMP, without_seconds
         ({"order": "random", "seed": 3, "bookkeeping": True}, ["--order", "random", "--seed", "3", "--bookkeeping"]),
         ({"order": "shuffled", "seed": 7, "normals": 4, "sphere_directions": 6},
          ["--order", "shuffled", "--seed", "7", "--normals", "4", "--sphere-directions", "6"]),
+        ({"order": "gnn", "seed": 2, "bookkeeping": True}, ["--order", "gnn", "--seed", "2", "--bookkeeping"]),
         ({"order": "bookkeeping", "tolerance": 0.0005, "path_planner": False},
          ["--order", "bookkeeping", "--tolerance", "0.0005", "--no-path-planner"]),
     ],

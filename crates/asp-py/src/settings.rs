@@ -26,8 +26,9 @@ pub const DEFAULT_PHYSICS_THRESHOLD: f64 = 0.01;
 pub const ORDER_NAMES: [&str; 5] = ["given", "shuffled", "random", "bookkeeping", "gnn"];
 
 /// The keywords of [`plan_settings`], in the order of `asp.Assembly.plan`'s signature.
-pub const PLAN_KEYS: [&str; 25] = [
+pub const PLAN_KEYS: [&str; 26] = [
     "order",
+    "model",
     "bookkeeping",
     "seed",
     "tolerance",
@@ -59,13 +60,23 @@ pub const PLAN_KEYS: [&str; 25] = [
 ///
 /// This is the one place where order names meet [`OrderingSource`]s: a learned ordering
 /// (`gnn`, from the learned-ordering crate) is added here.
-pub fn ordering(name: &str) -> Result<(Arc<dyn OrderingSource>, bool), Error> {
+pub fn ordering(name: &str, model: Option<&str>) -> Result<(Arc<dyn OrderingSource>, bool), Error> {
+    if model.is_some() && name != "gnn" {
+        return Err(Error::config(format!("model: the removability model of order='gnn'; it has no effect with order='{name}'")));
+    }
     match name {
         "given" => Ok((Arc::new(BuiltinOrder::Given), false)),
         "bookkeeping" => Ok((Arc::new(BuiltinOrder::Given), true)),
         "shuffled" => Ok((Arc::new(BuiltinOrder::Shuffled), false)),
         "random" => Ok((Arc::new(BuiltinOrder::Random), false)),
-        "gnn" => Err(Error::config("order 'gnn' needs the learned-ordering crate")),
+        "gnn" => {
+            let source = match model {
+                Some(path) => asp_learn::GnnSource::load(path, asp_geom::graph::GraphConfig::default()),
+                None => asp_learn::GnnSource::shipped(),
+            };
+            let source = source.map_err(|e| Error::config(format!("model: {e}")))?;
+            Ok((Arc::new(source), false))
+        }
         other => Err(Error::config(format!("unknown order '{other}' (use {})", ORDER_NAMES.join(", ")))),
     }
 }
@@ -133,7 +144,8 @@ pub fn plan_settings(dict: &Bound<'_, PyDict>) -> Result<PlanSettings, Error> {
     reject_unknown(dict, &PLAN_KEYS)?;
     let k = Keywords { dict };
     let defaults = PlanSettings::default();
-    let (order, implied_bookkeeping) = ordering(&k.string("order")?.unwrap_or_else(|| "given".into()))?;
+    let model = k.string("model")?;
+    let (order, implied_bookkeeping) = ordering(&k.string("order")?.unwrap_or_else(|| "given".into()), model.as_deref())?;
     let stability = match k.string("stability")?.as_deref() {
         None | Some("contact") => StabilitySetting::Contact,
         Some("physics") => StabilitySetting::Physics {
@@ -266,6 +278,7 @@ pub fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let o = OptimiseSettings::default();
     let d = PyDict::new(py);
     d.set_item("order", BuiltinOrder::default().as_str())?;
+    d.set_item("model", None::<String>)?;
     d.set_item("bookkeeping", p.bookkeeping)?;
     d.set_item("seed", p.seed)?;
     d.set_item("tolerance", p.tolerance)?;
@@ -310,19 +323,22 @@ mod tests {
     #[test]
     fn order_names_map_to_sources() {
         for name in ["given", "shuffled", "random"] {
-            let (source, bookkeeping) = ordering(name).unwrap();
+            let (source, bookkeeping) = ordering(name, None).unwrap();
             assert_eq!(source.name(), name);
             assert!(!bookkeeping);
         }
-        let (source, bookkeeping) = ordering("bookkeeping").unwrap();
+        let (source, bookkeeping) = ordering("bookkeeping", None).unwrap();
         assert_eq!((source.name().as_str(), bookkeeping), ("given", true));
     }
 
     #[test]
-    fn gnn_and_unknown_orders_are_config_errors() {
-        let e = ordering("gnn").err().unwrap();
-        assert_eq!(e.message, "order 'gnn' needs the learned-ordering crate");
-        assert_eq!(kind_of(ordering("sideways")), Some(Kind::Config));
+    fn gnn_uses_the_shipped_model_and_unknown_orders_are_config_errors() {
+        let (source, bookkeeping) = ordering("gnn", None).unwrap();
+        assert_eq!((source.name().as_str(), bookkeeping), ("gnn", false));
+        let e = ordering("gnn", Some("/no/such/model.onnx")).err().unwrap();
+        assert!(e.message.contains("/no/such/model.onnx"), "{}", e.message);
+        assert_eq!(kind_of(ordering("given", Some("m.onnx"))), Some(Kind::Config));
+        assert_eq!(kind_of(ordering("sideways", None)), Some(Kind::Config));
     }
 
     #[test]
