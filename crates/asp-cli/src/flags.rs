@@ -23,6 +23,8 @@ pub enum Command {
     Collect(crate::learn::CollectArgs),
     /// Benchmarks (`feasible`: the thesis' Table 3.1 for a folder of models).
     Bench(crate::learn::BenchArgs),
+    /// Robots (`check`: joints, limits, reach and an FK/IK sanity check of a URDF).
+    Robot(crate::robot::RobotArgs),
 }
 
 /// Part orderings of the depth-first search.

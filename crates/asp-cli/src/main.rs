@@ -7,6 +7,7 @@ mod gen;
 mod learn;
 mod optimise;
 mod output;
+mod robot;
 
 use flags::{Cli, Command};
 use std::process::ExitCode;
@@ -36,5 +37,6 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Gen(args) => gen::run(&args),
         Command::Collect(args) => learn::collect(&args),
         Command::Bench(args) => learn::bench(&args),
+        Command::Robot(args) => robot::run(&args),
     }
 }
