@@ -29,6 +29,8 @@ pub enum Command {
     Render(crate::view::RenderArgs),
     /// Plot the Pareto front of a plan JSON, or the search's progress from --trace CSVs.
     Plot(crate::plot::PlotArgs),
+    /// Robots (`check`: joints, limits, reach and an FK/IK sanity check of a URDF).
+    Robot(crate::robot::RobotArgs),
 }
 
 /// Part orderings of the depth-first search.

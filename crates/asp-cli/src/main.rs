@@ -9,6 +9,7 @@ mod optimise;
 mod output;
 mod plot;
 mod view;
+mod robot;
 
 use flags::{Cli, Command};
 use std::process::ExitCode;
@@ -41,5 +42,6 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::View(args) => view::view(&args),
         Command::Render(args) => view::render(&args),
         Command::Plot(args) => plot::run(&args),
+        Command::Robot(args) => robot::run(&args),
     }
 }

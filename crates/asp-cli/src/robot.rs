@@ -1,0 +1,116 @@
+//! `asp robot`: inspect robots. `asp robot check [URDF]` loads a URDF (default: the shipped panda)
+//! and prints its joints and limits, its reach, and an FK/IK round-trip sanity check.
+
+use asp_robot::{ChainSpec, IkConfig, IkOutcome, JointKind, Robot};
+use clap::{Args, Subcommand};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Flags of `asp robot`.
+#[derive(Args, Debug)]
+pub struct RobotArgs {
+    /// What to do.
+    #[command(subcommand)]
+    pub action: RobotAction,
+}
+
+/// The robot actions.
+#[derive(Subcommand, Debug)]
+pub enum RobotAction {
+    /// Joints, limits, reach and an FK/IK round-trip check of a URDF robot (exit 1 if the check fails).
+    Check(CheckArgs),
+}
+
+/// Flags of `asp robot check`.
+#[derive(Args, Debug)]
+pub struct CheckArgs {
+    /// The URDF file; the shipped Franka-Panda-like arm when omitted.
+    pub urdf: Option<PathBuf>,
+    /// The chain's base link (default: the root link).
+    #[arg(long)]
+    pub base_link: Option<String>,
+    /// The chain's tool-centre link (default: a link named *tcp or *tool0, else the deepest leaf).
+    #[arg(long)]
+    pub tip_link: Option<String>,
+    /// Random configurations sampled for the reach.
+    #[arg(long, default_value_t = 5000)]
+    pub samples: usize,
+    /// Random configurations of the FK/IK round trip.
+    #[arg(long, default_value_t = 100)]
+    pub trials: usize,
+    /// Seed of the sampled configurations and of the IK restarts.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+/// Runs `asp robot`.
+pub fn run(args: &RobotArgs) -> anyhow::Result<ExitCode> {
+    match &args.action {
+        RobotAction::Check(a) => check(a),
+    }
+}
+
+fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
+    let spec = ChainSpec { base_link: args.base_link.clone(), tip_link: args.tip_link.clone() };
+    let robot = match &args.urdf {
+        Some(p) => Robot::from_urdf_file_with(p, &spec)?,
+        None => Robot::from_urdf_str(asp_robot::PANDA_URDF, std::path::Path::new("<builtin panda>"), &spec)?,
+    };
+    println!("robot {} from {}", robot.name, robot.source.display());
+    println!(
+        "chain {} -> {}: {} joints, {} movable",
+        robot.links()[0].name,
+        robot.links().last().map_or("", |l| l.name.as_str()),
+        robot.joints().len(),
+        robot.dof()
+    );
+    for j in robot.joints() {
+        let (unit, kind) = match j.kind {
+            JointKind::Revolute => ("rad", "revolute"),
+            JointKind::Prismatic => ("m", "prismatic"),
+            JointKind::Fixed => ("", "fixed"),
+        };
+        if j.kind == JointKind::Fixed {
+            println!("  {:<24} {kind}", j.name);
+        } else {
+            println!("  {:<24} {kind:<9} [{:+.4}, {:+.4}] {unit}", j.name, j.limits.0, j.limits.1);
+        }
+    }
+    println!("gripper: {} fingers, opening up to {:.4} m", robot.fingers().len(), robot.max_opening());
+    for n in &robot.notes {
+        println!("note: {n}");
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    let base = robot.base_pose().translation;
+    let reach = (0..args.samples)
+        .map(|_| (robot.tool_pose(&robot.random_configuration(&mut rng)).translation - base).length())
+        .fold(0.0f32, f32::max);
+    println!("reach: {reach:.4} m (max tool-centre distance from the base over {} sampled configurations)", args.samples);
+    let (mut reached, mut worst_p, mut worst_r, mut limits_ok) = (0, 0.0f64, 0.0f64, true);
+    let start = std::time::Instant::now();
+    for t in 0..args.trials {
+        let q = robot.random_configuration(&mut rng);
+        let target = robot.tool_pose(&q);
+        let cfg = IkConfig { seed: args.seed.wrapping_add(t as u64), ..Default::default() };
+        if let IkOutcome::Reached(s) = robot.ik(&target, None, &cfg) {
+            reached += 1;
+            limits_ok &= robot.within_limits(&s.joints);
+            let p = robot.tool_pose(&s.joints);
+            worst_p = worst_p.max((p.translation - target.translation).length() as f64);
+            worst_r = worst_r.max(p.rotation.angle_between(target.rotation) as f64);
+        }
+    }
+    let per = start.elapsed().as_secs_f64() * 1e3 / args.trials.max(1) as f64;
+    println!(
+        "fk/ik round trip: {reached}/{} random configurations reached, worst error {:.2e} m, {:.2e} rad, limits {}, {per:.2} ms per pose",
+        args.trials,
+        worst_p,
+        worst_r,
+        if limits_ok { "respected" } else { "VIOLATED" }
+    );
+    let ok = limits_ok && reached * 10 >= args.trials * 9 && worst_p < 1e-4 && worst_r < 1e-3;
+    println!("sanity check: {}", if ok { "ok" } else { "FAILED" });
+    Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}

@@ -1,0 +1,3 @@
+//! Integration tests of asp-robot.
+
+mod robot;
