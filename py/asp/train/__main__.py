@@ -40,6 +40,10 @@ def _parser() -> argparse.ArgumentParser:
         "--aggregation", choices=["scatter", "dense"], default="dense",
         help="aggregation ops in the ONNX file: one-hot MatMul (default, the faster in tract) or ScatterND",
     )
+    r.add_argument(
+        "--parity-tolerance", type=float, default=1e-5,
+        help="largest ONNX/PyTorch difference the export check accepts (default 1e-5)",
+    )
     g = r.add_mutually_exclusive_group()
     g.add_argument("--holdout", nargs="+", metavar="NAME", default=[], help="assemblies to evaluate on, not train on")
     g.add_argument("--leave-one-out", type=Path, metavar="OUT_DIR", help="one model per assembly, trained on the others")
@@ -70,7 +74,7 @@ def _fit_and_export(
     names = ", ".join(a.name for a in train_set)
     _log(f"training on {sum(len(a.states) for a in train_set)} states of {len(train_set)} assemblies ({names})")
     model, summary = train(train_set, node_dim, edge_dim, config, log=_log)
-    parity = export_onnx(model, out, features, aggregation=args.aggregation)
+    parity = export_onnx(model, out, features, aggregation=args.aggregation, tolerance=args.parity_tolerance)
     _log(f"wrote {out} (ONNX matches PyTorch to {parity:.2g})")
     train_acc = {a.name: evaluate(model, a) for a in train_set}
     held = {a.name: evaluate(model, a) for a in test_set}

@@ -137,6 +137,7 @@ def export_onnx(
     features: str,
     aggregation: str | None = None,
     check: bool = True,
+    tolerance: float = 1e-5,
     extra_metadata: dict[str, str] | None = None,
 ) -> float | None:
     """Write ``model`` to ``path`` as a removability ONNX model and check it.
@@ -188,4 +189,4 @@ def export_onnx(
     onnx.save(proto, str(path))
     if not check:
         return None
-    return parity_check(model, path)
+    return parity_check(model, path, tolerance=tolerance)
