@@ -119,6 +119,16 @@ pub struct CounterSnapshot {
     pub path_planner_calls: u64,
 }
 
+impl CounterSnapshot {
+    /// Records one test and its outcome (for a search that counts its own tests).
+    pub fn record(&mut self, kind: MotionKind, outcome: &Outcome) {
+        self.removal_tests += 1;
+        self.path_planner_calls += u64::from(matches!(kind, MotionKind::Path { .. }));
+        self.failed_collision += u64::from(matches!(outcome, Outcome::Collision { .. }));
+        self.failed_gravity += u64::from(matches!(outcome, Outcome::Unstable { .. }));
+    }
+}
+
 impl Counters {
     /// Records one test and its outcome.
     pub fn record(&self, kind: MotionKind, outcome: &Outcome) {

@@ -127,11 +127,7 @@ impl Search<'_, '_, '_> {
     fn test(&mut self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome {
         let outcome = self.problem.checker.test_removal(part, state, kind);
         // counted here, not read off the checker: searches may share one checker in parallel
-        let c = &mut self.counters;
-        c.removal_tests += 1;
-        c.path_planner_calls += u64::from(matches!(kind, MotionKind::Path { .. }));
-        c.failed_collision += u64::from(matches!(outcome, Outcome::Collision { .. }));
-        c.failed_gravity += u64::from(matches!(outcome, Outcome::Unstable { .. }));
+        self.counters.record(kind, &outcome);
         self.ordering.observe(part, state, kind, &outcome);
         outcome
     }
