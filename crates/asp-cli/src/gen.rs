@@ -126,10 +126,8 @@ pub fn run(args: &GenArgs) -> anyhow::Result<ExitCode> {
         }
         GenKind::Profiles(a) => {
             let preset = a.preset.unwrap_or(Preset::SingleLayer);
-            let mut p = match preset {
-                Preset::SingleLayer => ProfileParams::single_layer(),
-                Preset::DoubleLayer => ProfileParams::double_layer(),
-            };
+            let name = preset.to_possible_value().map(|v| v.get_name().to_string()).unwrap_or_default();
+            let Some(mut p) = ProfileParams::preset(&name) else { bail!("no preset '{name}'") };
             let set = |field: &mut f64, v: Option<f64>| *field = v.unwrap_or(*field);
             set(&mut p.width, a.width);
             set(&mut p.length, a.length);
@@ -141,8 +139,7 @@ pub fn run(args: &GenArgs) -> anyhow::Result<ExitCode> {
             count(&mut p.supports, a.supports);
             count(&mut p.front, a.front);
             count(&mut p.back, a.back);
-            let name = preset.to_possible_value().map(|v| v.get_name().to_string());
-            (Generator::Profiles(p), a.preset.and(name), &a.batch)
+            (Generator::Profiles(p), a.preset.and(Some(name)), &a.batch)
         }
     };
     let batch = Batch { generator, preset, count: batch_args.count, seed: batch_args.seed };

@@ -173,31 +173,8 @@ fn methods(args: &FeasibleArgs, name: &str) -> anyhow::Result<Vec<Method>> {
         (None, Some(dir)) => Some(dir.join(format!("{name}.onnx"))),
         (None, None) => None,
     };
-    let list = match &args.methods {
-        Some(l) => l.clone(),
-        None if model.is_some() => "vanilla,bk,random,random+bk,gnn,gnn+bk".into(),
-        None => "vanilla,bk,random,random+bk".into(),
-    };
-    let mut out = Vec::new();
-    for name in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let (base, bookkeeping) = match name.strip_suffix("+bk") {
-            Some(b) => (b, true),
-            None if name == "bk" => ("vanilla", true),
-            None => (name, false),
-        };
-        let order: Arc<dyn OrderingSource> = match base {
-            "vanilla" | "shuffled" => Arc::new(BuiltinOrder::Shuffled),
-            "random" => Arc::new(BuiltinOrder::Random),
-            "given" => Arc::new(BuiltinOrder::Given),
-            "gnn" => gnn_source(model.as_deref())?,
-            other => bail!("--methods: unknown method '{other}' (vanilla, bk, random, given, gnn, each optionally +bk)"),
-        };
-        out.push(Method { name: name.to_string(), order, bookkeeping });
-    }
-    if out.is_empty() {
-        bail!("--methods names no method");
-    }
-    Ok(out)
+    let list = args.methods.clone().unwrap_or_else(|| bench::default_methods(model.is_some()).to_string());
+    bench::parse_methods(&list, &|| gnn_source(model.as_deref())).context("--methods")
 }
 
 /// Runs `asp bench`.

@@ -125,6 +125,27 @@ pub fn file_name(generator: &Generator, index: usize, count: usize) -> String {
     format!("{stem}_{index:0width$}.glb")
 }
 
+/// Generates assembly `index` of a batch of `count` with batch seed `seed`: the assembly, and
+/// its manifest entry (its file name and seed are [`file_name`] and [`assembly_seed`]). Depends
+/// on nothing else, so batches can be split over threads, processes or machines (`asp.batch`)
+/// and still give the same files.
+pub fn generate_item(generator: &Generator, index: usize, count: usize, seed: u64) -> Result<(Generated, ManifestEntry)> {
+    let file = file_name(generator, index, count);
+    let seed = assembly_seed(seed, index);
+    let generated = generator.generate(seed, &file)?;
+    let parts = &generated.assembly.parts;
+    let entry = ManifestEntry {
+        file,
+        index,
+        seed,
+        parts: parts.len(),
+        fixed_parts: parts.iter().filter(|p| p.fixed).count(),
+        counts: generated.counts.clone(),
+        checks: generated.checks.clone(),
+    };
+    Ok((generated, entry))
+}
+
 /// Generates assemblies `0..count` of a batch in parallel (rayon), calling `done` after each
 /// and `sink` with each assembly and its entry (e.g. to write it); returns the entries in index
 /// order. Stops at the first error.
@@ -142,19 +163,7 @@ pub fn generate_batch(
     (0..count)
         .into_par_iter()
         .map(|index| {
-            let file = file_name(generator, index, count);
-            let seed = assembly_seed(seed, index);
-            let generated = generator.generate(seed, &file)?;
-            let parts = &generated.assembly.parts;
-            let entry = ManifestEntry {
-                file,
-                index,
-                seed,
-                parts: parts.len(),
-                fixed_parts: parts.iter().filter(|p| p.fixed).count(),
-                counts: generated.counts.clone(),
-                checks: generated.checks.clone(),
-            };
+            let (generated, entry) = generate_item(generator, index, count, seed)?;
             sink(&generated, &entry)?;
             done();
             Ok(entry)
@@ -187,6 +196,17 @@ pub fn write_batch(batch: &Batch, out: &Path, done: &(dyn Fn() + Sync)) -> Resul
     std::fs::create_dir_all(out).map_err(io(out))?;
     let write = |g: &Generated, e: &ManifestEntry| Ok(asp_geom::io::write_glb(&g.assembly, &out.join(&e.file))?);
     let assemblies = generate_batch(&batch.generator, batch.count, batch.seed, &write, done)?;
+    write_manifest(batch, assemblies, out)
+}
+
+/// The manifest of `batch` from the entries of all its assemblies (in any order), written to
+/// `out/manifest.json` (through a temporary file, so a reader never sees half of it).
+pub fn write_manifest(batch: &Batch, mut assemblies: Vec<ManifestEntry>, out: &Path) -> Result<Manifest> {
+    assemblies.sort_by_key(|e| e.index);
+    let expected = (0..batch.count).collect::<Vec<_>>();
+    if assemblies.iter().map(|e| e.index).collect::<Vec<_>>() != expected {
+        return Err(GenError::parameter("count", format!("the manifest needs one entry for each of the {} assemblies", batch.count)));
+    }
     let manifest = Manifest {
         format_version: FORMAT_VERSION,
         generator: batch.generator.clone(),
@@ -199,6 +219,9 @@ pub fn write_batch(batch: &Batch, out: &Path, done: &(dyn Fn() + Sync)) -> Resul
     let path = out.join("manifest.json");
     let json =
         serde_json::to_string_pretty(&manifest).map_err(|e| GenError::Io { path: path.clone(), source: e.into() })?;
-    std::fs::write(&path, format!("{json}\n")).map_err(io(&path))?;
+    let tmp = out.join(".manifest.json.tmp");
+    std::fs::write(&tmp, format!("{json}\n"))
+        .and_then(|()| std::fs::rename(&tmp, &path))
+        .map_err(|source| GenError::Io { path: path.clone(), source })?;
     Ok(manifest)
 }

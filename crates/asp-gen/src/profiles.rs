@@ -101,6 +101,18 @@ impl ProfileParams {
         ProfileParams { layers: 2, back: 3, ..ProfileParams::single_layer() }
     }
 
+    /// The names of the thesis' data sets, as [`ProfileParams::preset`] takes them.
+    pub const PRESETS: [&'static str; 2] = ["single-layer", "double-layer"];
+
+    /// The parameters of a thesis data set by name (`single-layer`, `double-layer`).
+    pub fn preset(name: &str) -> Option<Self> {
+        match name {
+            "single-layer" => Some(Self::single_layer()),
+            "double-layer" => Some(Self::double_layer()),
+            _ => None,
+        }
+    }
+
     /// How many profiles are not fixed: 2 front posts and 4 top profiles of the base, a support
     /// and its top connection per support, and per layer its frame of 4 plus back and front.
     pub fn removable_profiles(&self) -> usize {

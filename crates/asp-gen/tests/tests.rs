@@ -730,6 +730,32 @@ fn batches_are_identical_on_any_number_of_threads() {
 }
 
 #[test]
+fn items_generated_one_by_one_make_the_batch_and_its_manifest() {
+    // asp.batch generates items in separate processes, in any order, and writes the manifest
+    // from their entries: the same files as write_batch
+    let generator = Generator::Soma(SomaParams { size: 3, cell: 0.05 });
+    let batch = Batch { generator: generator.clone(), preset: None, count: 3, seed: 9 };
+    let whole = tempfile::tempdir().unwrap();
+    write_batch(&batch, whole.path(), &|| {}).unwrap();
+    let parts = tempfile::tempdir().unwrap();
+    let mut entries = Vec::new();
+    for index in [2, 0, 1] {
+        let (g, e) = asp_gen::batch::generate_item(&generator, index, 3, 9).unwrap();
+        asp_geom::io::write_glb(&g.assembly, &parts.path().join(&e.file)).unwrap();
+        entries.push(e);
+    }
+    let missing = asp_gen::batch::write_manifest(&batch, entries[..2].to_vec(), parts.path()).unwrap_err();
+    assert!(missing.to_string().contains("one entry for each of the 3"), "{missing}");
+    asp_gen::batch::write_manifest(&batch, entries, parts.path()).unwrap();
+    for file in ["manifest.json", "soma3_000.glb", "soma3_001.glb", "soma3_002.glb"] {
+        let read = |dir: &tempfile::TempDir| std::fs::read(dir.path().join(file)).unwrap();
+        assert!(read(&whole) == read(&parts), "{file} differs");
+    }
+    assert_eq!(ProfileParams::preset("double-layer"), Some(ProfileParams::double_layer()));
+    assert_eq!(ProfileParams::preset("triple-layer"), None);
+}
+
+#[test]
 fn batches_reject_bad_arguments() {
     let ok = |_: &Generated, _: &ManifestEntry| Ok(());
     let soma = Generator::Soma(SomaParams { size: 1, cell: 0.05 });

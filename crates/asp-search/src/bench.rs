@@ -6,7 +6,7 @@
 //! Each run gets a fresh collision world (built outside the timer), so every method pays for its
 //! own first tests of each part: cached blocking rows would otherwise favour later runs.
 
-use crate::ordering::OrderingSource;
+use crate::ordering::{BuiltinOrder, OrderingSource};
 use crate::pipeline::{self, PlanSettings};
 use crate::problem::Problem;
 use crate::{Planner, Result, SearchError, Status};
@@ -27,8 +27,50 @@ pub struct Method {
     pub bookkeeping: bool,
 }
 
+/// The methods a benchmark runs when none are named: the four cheap orderings, and the learned
+/// ones when a removability model is at hand.
+pub fn default_methods(learned: bool) -> &'static str {
+    if learned {
+        "vanilla,bk,random,random+bk,gnn,gnn+bk"
+    } else {
+        "vanilla,bk,random,random+bk"
+    }
+}
+
+/// The methods of a comma-separated list: `vanilla` (shuffled), `bk` (vanilla with
+/// bookkeeping), `random`, `given`, `gnn`, each optionally `+bk`. `gnn` makes the learned
+/// ordering, called only when the list names it.
+pub fn parse_methods<E: From<SearchError>>(
+    list: &str,
+    gnn: &dyn Fn() -> std::result::Result<Arc<dyn OrderingSource>, E>,
+) -> std::result::Result<Vec<Method>, E> {
+    let mut out = Vec::new();
+    for name in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let (base, bookkeeping) = match name.strip_suffix("+bk") {
+            Some(b) => (b, true),
+            None if name == "bk" => ("vanilla", true),
+            None => (name, false),
+        };
+        let order: Arc<dyn OrderingSource> = match base {
+            "vanilla" | "shuffled" => Arc::new(BuiltinOrder::Shuffled),
+            "random" => Arc::new(BuiltinOrder::Random),
+            "given" => Arc::new(BuiltinOrder::Given),
+            "gnn" => gnn()?,
+            other => {
+                let message = format!("unknown method '{other}' (vanilla, bk, random, given, gnn, each optionally +bk)");
+                return Err(SearchError::config(message).into());
+            }
+        };
+        out.push(Method { name: name.to_string(), order, bookkeeping });
+    }
+    if out.is_empty() {
+        return Err(SearchError::config(format!("the method list '{list}' names no method")).into());
+    }
+    Ok(out)
+}
+
 /// Mean and standard deviation (population) of a measure over the runs.
-#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, Serialize, serde::Deserialize, PartialEq)]
 pub struct MeanStd {
     /// Mean.
     pub mean: f64,
@@ -50,7 +92,7 @@ impl MeanStd {
 }
 
 /// One row of the table: a model under one method.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct BenchRow {
     /// The model's name.
     pub model: String,
@@ -149,6 +191,19 @@ pub fn write_table(out: &mut impl std::io::Write, rows: &[BenchRow]) -> std::io:
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn method_lists_parse_and_bad_names_are_errors() {
+        let no_gnn = || -> Result<Arc<dyn OrderingSource>> { Err(SearchError::config("no model here")) };
+        let methods = parse_methods(default_methods(false), &no_gnn).unwrap();
+        let names: Vec<(&str, bool)> = methods.iter().map(|m| (m.name.as_str(), m.bookkeeping)).collect();
+        assert_eq!(names, [("vanilla", false), ("bk", true), ("random", false), ("random+bk", true)]);
+        let err = parse_methods("vanilla,gnn+bk", &no_gnn).err().unwrap();
+        assert!(err.to_string().contains("no model here"), "{err}");
+        let err = parse_methods("vanilla,fastest", &no_gnn).err().unwrap();
+        assert!(err.to_string().contains("unknown method 'fastest'"), "{err}");
+        assert!(parse_methods(" , ", &no_gnn).is_err());
+    }
 
     #[test]
     fn mean_and_population_std() {

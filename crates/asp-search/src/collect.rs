@@ -57,7 +57,7 @@ impl Default for CollectSettings {
 }
 
 /// One model's entry in `index.json`.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct CollectedModel {
     /// The model's name (file or folder stem).
     pub name: String,
@@ -186,7 +186,50 @@ pub fn collect(models: &[PathBuf], out: &Path, settings: &CollectSettings, progr
     }
     settings.graph.validate()?;
     std::fs::create_dir_all(out).map_err(|e| io_error(out, e))?;
-    let mut index = Collected {
+    let mut assemblies = Vec::new();
+    for item in model_items(models) {
+        let entry = collect_model(&item, out, settings)?;
+        progress(&entry);
+        assemblies.push(entry);
+    }
+    write_index(out, settings, assemblies)
+}
+
+/// One model of a data set: its file, its position in the list (run seeds derive from it), its
+/// unique name and the folder of its files.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ModelItem {
+    /// The model's file or folder.
+    pub path: PathBuf,
+    /// Its position in the list of models.
+    pub index: usize,
+    /// Its unique name ([`unique_names`]).
+    pub name: String,
+    /// The folder of its files in the data set: the name with unsafe characters replaced.
+    pub dir: String,
+}
+
+/// The models of a data set as [`collect`] names and files them.
+pub fn model_items(models: &[PathBuf]) -> Vec<ModelItem> {
+    let mut used = std::collections::HashSet::new();
+    models
+        .iter()
+        .zip(unique_names(models))
+        .enumerate()
+        .map(|(index, (path, name))| {
+            let mut dir: String =
+                name.chars().map(|c| if c.is_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+            while !used.insert(dir.clone()) {
+                dir.push('_');
+            }
+            ModelItem { path: path.clone(), index, name, dir }
+        })
+        .collect()
+}
+
+/// Writes the data set's `index.json` for the models collected into `out` (in list order).
+pub fn write_index(out: &Path, settings: &CollectSettings, assemblies: Vec<CollectedModel>) -> Result<Collected> {
+    let index = Collected {
         format: FORMAT.into(),
         version: VERSION,
         features: settings.graph.features(),
@@ -194,24 +237,22 @@ pub fn collect(models: &[PathBuf], out: &Path, settings: &CollectSettings, progr
         edge_dim: settings.graph.edge_dim(),
         seed: settings.seed,
         runs: settings.runs,
-        assemblies: Vec::new(),
+        assemblies,
     };
-    let mut used = std::collections::HashSet::new();
-    for (m, (path, name)) in models.iter().zip(unique_names(models)).enumerate() {
-        let mut dir: String = name.chars().map(|c| if c.is_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
-        while !used.insert(dir.clone()) {
-            dir.push('_');
-        }
-        let entry = collect_model(path, m, &name, &dir, out, settings)?;
-        progress(&entry);
-        index.assemblies.push(entry);
-    }
     let json = serde_json::to_string_pretty(&index).expect("the index serialises");
     write_atomic(&out.join("index.json"), format!("{json}\n").as_bytes())?;
     Ok(index)
 }
 
-fn collect_model(path: &Path, m: usize, name: &str, dir: &str, out: &Path, settings: &CollectSettings) -> Result<CollectedModel> {
+/// Collects the states of one model into `out/<item.dir>/` (the folder is created): its graph
+/// and the labelled states of `settings.runs` DFS runs. Depends only on the item, the settings
+/// and the seed, so models can be collected in any order or on other machines (`asp.batch`).
+pub fn collect_model(item: &ModelItem, out: &Path, settings: &CollectSettings) -> Result<CollectedModel> {
+    if settings.runs == 0 {
+        return Err(SearchError::config("the number of runs must be at least 1"));
+    }
+    settings.graph.validate()?;
+    let (path, m, name, dir) = (item.path.as_path(), item.index, item.name.as_str(), item.dir.as_str());
     let assembly = pipeline::load(path, &settings.plan)?;
     let checker = pipeline::checker(assembly, &settings.plan)?;
     let world = checker.world();
