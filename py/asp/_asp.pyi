@@ -35,3 +35,46 @@ class Assembly:
     ) -> Tuple[bytearray, bytearray, bytearray, bytearray, int, int, str]:
         """``(nodes int64, x float32, edge_index int64, edge_attr float32, node_dim, edge_dim, features)``,
         the arrays as little-endian bytes."""
+
+# the items of asp.batch (crates/asp-py/src/batch.rs): JSON strings in and out
+def profile_preset(name: str) -> str: ...
+def generator_canonical(generator_json: str) -> str: ...
+def gen_item(generator_json: str, index: int, count: int, seed: int, out: Union[str, PathLike[str]]) -> str: ...
+def gen_manifest(
+    generator_json: str,
+    preset: Optional[str],
+    count: int,
+    seed: int,
+    entries: Sequence[str],
+    out: Union[str, PathLike[str]],
+) -> str: ...
+def model_items(paths: Sequence[Union[str, PathLike[str]]]) -> List[Tuple[str, int, str, str]]:
+    """``(path, index, name, dir)`` of each model, as a data set names them."""
+def collect_item(
+    path: Union[str, PathLike[str]],
+    index: int,
+    name: str,
+    dir: str,
+    out: Union[str, PathLike[str]],
+    runs: int,
+    seed: int,
+    max_tests: Optional[int],
+    timeout: Optional[float],
+    settings: Dict[str, Any],
+    unit: Optional[str] = None,
+    up: Optional[str] = None,
+    fixed: Sequence[str] = ...,
+) -> str: ...
+def collect_index(out: Union[str, PathLike[str]], runs: int, seed: int, entries: Sequence[str]) -> str: ...
+def bench_item(
+    path: Union[str, PathLike[str]],
+    name: str,
+    orderings: int,
+    settings: Dict[str, Any],
+    methods: Optional[str] = None,
+    model: Optional[str] = None,
+    unit: Optional[str] = None,
+    up: Optional[str] = None,
+    fixed: Sequence[str] = ...,
+) -> str: ...
+def bench_table(rows: Sequence[str]) -> str: ...

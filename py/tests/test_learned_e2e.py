@@ -14,7 +14,9 @@ from pathlib import Path
 
 import pytest
 
-torch = pytest.importorskip("torch", reason="asp.train needs torch (pip install ./py[train])")
+from conftest import need
+
+torch = need("torch", "asp.train needs torch (pip install ./py[train])")
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -11,7 +11,9 @@ import subprocess
 
 import pytest
 
-mcap_reader = pytest.importorskip("mcap.reader", reason="pip install mcap")
+from conftest import need
+
+mcap_reader = need("mcap.reader", "pip install mcap")
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 

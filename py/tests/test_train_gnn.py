@@ -6,9 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from conftest import need
 
-torch = pytest.importorskip("torch", reason="asp.train needs PyTorch (pip install torch)")
-onnx = pytest.importorskip("onnx", reason="the ONNX export needs the onnx package")
+
+torch = need("torch", "asp.train needs PyTorch (pip install torch)")
+onnx = need("onnx", "the ONNX export needs the onnx package")
 
 from asp.train.export import ExportError, export_onnx, parity_check, random_graph, run_onnx  # noqa: E402
 from asp.train.gnn import RemovabilityGNN  # noqa: E402

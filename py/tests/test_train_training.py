@@ -10,10 +10,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import need
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # the shared synthetic data set writer
 
-torch = pytest.importorskip("torch", reason="asp.train needs PyTorch (pip install torch)")
-pytest.importorskip("onnx", reason="the ONNX export needs the onnx package")
+torch = need("torch", "asp.train needs PyTorch (pip install torch)")
+need("onnx", "the ONNX export needs the onnx package")
 
 from asp.train.__main__ import main  # noqa: E402
 from asp.train.export import run_onnx  # noqa: E402

@@ -94,6 +94,16 @@ impl From<SearchError> for Error {
     }
 }
 
+impl From<asp_gen::GenError> for Error {
+    fn from(e: asp_gen::GenError) -> Self {
+        match e {
+            asp_gen::GenError::Geom(g) => g.into(),
+            e @ asp_gen::GenError::Parameter { .. } => Error::config(e.to_string()),
+            e => Error { kind: Kind::Other, message: e.to_string(), path: None },
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

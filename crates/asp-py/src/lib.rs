@@ -6,9 +6,11 @@
 //! - [`assembly`]: `load` and the `Assembly` handle (owns its data);
 //! - [`settings`]: Python keywords into [`asp_search::pipeline::PlanSettings`], order names;
 //! - [`run`]: the pipeline with the GIL released, interruptible by Ctrl-C;
+//! - [`batch`]: the items of `asp.batch` (generation, collection, benchmarks), JSON in and out;
 //! - [`errors`]: asp's errors as `asp.errors` exceptions.
 
 pub mod assembly;
+pub mod batch;
 pub mod errors;
 pub mod run;
 pub mod settings;
@@ -38,5 +40,14 @@ fn asp_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(order_names, m)?)?;
     m.add_class::<assembly::PyAssembly>()?;
+    m.add_function(wrap_pyfunction!(batch::profile_preset, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::generator_canonical, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::gen_item, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::gen_manifest, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::model_items, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::collect_item, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::collect_index, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::bench_item, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::bench_table, m)?)?;
     Ok(())
 }

@@ -1,0 +1,201 @@
+//! The items of `asp.batch` (py/asp/batch/): one generated assembly, one model's collected states,
+//! one model's benchmark rows. Each is a function of its own inputs only, so a batch gives the
+//! same files whether it runs in a serial loop, as Ray tasks or on other machines, and a resumed
+//! batch can skip what is done. Results cross the boundary as JSON strings (the formats of
+//! `docs/generators.md` and `docs/learning.md`), which Ray ships between processes as they are.
+//! Every item releases the GIL.
+
+use crate::errors::Error;
+use crate::settings;
+use asp_gen::batch::{self, Batch, Generator};
+use asp_gen::manifest::ManifestEntry;
+use asp_gen::{GenError, ProfileParams};
+use asp_search::bench::{self, BenchRow};
+use asp_search::collect::{self, CollectSettings, CollectedModel, ModelItem};
+use asp_search::pipeline::PlanSettings;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::{Path, PathBuf};
+
+fn json_error(what: &str, e: serde_json::Error) -> Error {
+    Error::config(format!("{what}: {e}"))
+}
+
+fn generator(json: &str) -> Result<Generator, Error> {
+    let generator: Generator = serde_json::from_str(json).map_err(|e| json_error("generator", e))?;
+    generator.validate()?;
+    Ok(generator)
+}
+
+/// The parameters of a profile-assembly preset (`single-layer`, `double-layer`) as JSON.
+#[pyfunction]
+pub fn profile_preset(py: Python<'_>, name: &str) -> PyResult<String> {
+    let Some(params) = ProfileParams::preset(name) else {
+        let message = format!("unknown preset '{name}' (use {})", ProfileParams::PRESETS.join(" or "));
+        return Err(Error::config(message).into_py(py));
+    };
+    Ok(serde_json::to_string(&params).expect("parameters serialise"))
+}
+
+/// The generator of `generator_json` checked and in its canonical JSON form (every field, in
+/// order), the form a batch records to recognise its own settings when it resumes.
+#[pyfunction]
+pub fn generator_canonical(py: Python<'_>, generator_json: &str) -> PyResult<String> {
+    let g = generator(generator_json).map_err(|e| e.into_py(py))?;
+    Ok(serde_json::to_string(&g).expect("generators serialise"))
+}
+
+/// Generates assembly `index` of a batch of `count` with batch seed `seed` into `out` (its GLB,
+/// written through a temporary file and a rename) and returns its manifest entry as JSON.
+#[pyfunction]
+pub fn gen_item(py: Python<'_>, generator_json: &str, index: usize, count: usize, seed: u64, out: PathBuf) -> PyResult<String> {
+    let g = generator(generator_json).map_err(|e| e.into_py(py))?;
+    if index >= count {
+        return Err(Error::config(format!("index {index} is not below the count {count}")).into_py(py));
+    }
+    py.detach(|| -> Result<String, Error> {
+        let (generated, entry) = batch::generate_item(&g, index, count, seed)?;
+        std::fs::create_dir_all(&out).map_err(|source| GenError::Io { path: out.clone(), source })?;
+        let path = out.join(&entry.file);
+        let tmp = out.join(format!(".{}.tmp", entry.file));
+        asp_geom::io::write_glb(&generated.assembly, &tmp)?;
+        std::fs::rename(&tmp, &path).map_err(|source| GenError::Io { path: path.clone(), source })?;
+        Ok(serde_json::to_string(&entry).expect("entries serialise"))
+    })
+    .map_err(|e| e.into_py(py))
+}
+
+/// Writes `out/manifest.json` of a batch from the entries [`gen_item`] returned (any order) and
+/// returns it as JSON: the same file `asp gen` writes for the same generator, count and seed.
+#[pyfunction]
+#[pyo3(signature = (generator_json, preset, count, seed, entries, out))]
+pub fn gen_manifest(
+    py: Python<'_>,
+    generator_json: &str,
+    preset: Option<String>,
+    count: usize,
+    seed: u64,
+    entries: Vec<String>,
+    out: PathBuf,
+) -> PyResult<String> {
+    let run = || -> Result<String, Error> {
+        let generator = generator(generator_json)?;
+        let entries = entries
+            .iter()
+            .map(|e| serde_json::from_str::<ManifestEntry>(e).map_err(|e| json_error("manifest entry", e)))
+            .collect::<Result<Vec<_>, _>>()?;
+        let manifest = batch::write_manifest(&Batch { generator, preset, count, seed }, entries, &out)?;
+        Ok(serde_json::to_string(&manifest).expect("manifests serialise"))
+    };
+    run().map_err(|e| e.into_py(py))
+}
+
+/// The models of `paths` (files, folders of GLB/glTF files, folders of parts) as a data set
+/// names them: `(path, index, name, dir)` each.
+#[pyfunction]
+pub fn model_items(py: Python<'_>, paths: Vec<PathBuf>) -> PyResult<Vec<(String, usize, String, String)>> {
+    let models = collect::model_paths(&paths).map_err(|e| Error::from(e).into_py(py))?;
+    Ok(collect::model_items(&models)
+        .into_iter()
+        .map(|m| (m.path.display().to_string(), m.index, m.name, m.dir))
+        .collect())
+}
+
+/// Plan settings from `asp.Assembly.plan`'s keywords and `asp.load`'s.
+fn model_settings(dict: &Bound<'_, PyDict>, unit: Option<&str>, up: Option<&str>, fixed: Vec<String>) -> Result<PlanSettings, Error> {
+    Ok(PlanSettings {
+        unit: unit.map(settings::unit).transpose()?,
+        up: up.map(settings::axis).transpose()?,
+        fixed,
+        ..settings::plan_settings(dict)?
+    })
+}
+
+fn collect_settings(runs: usize, seed: u64, max_tests: Option<u64>, timeout: Option<f64>, plan: PlanSettings) -> CollectSettings {
+    CollectSettings { runs, seed, plan, max_tests, timeout, ..CollectSettings::default() }
+}
+
+/// Collects the labelled states of one model (`asp collect removability`'s work for one model)
+/// into `out/<dir>/` and returns its index entry as JSON.
+#[pyfunction]
+#[pyo3(signature = (path, index, name, dir, out, runs, seed, max_tests, timeout, settings, unit=None, up=None, fixed=Vec::new()))]
+#[allow(clippy::too_many_arguments)]
+pub fn collect_item(
+    py: Python<'_>,
+    path: PathBuf,
+    index: usize,
+    name: String,
+    dir: String,
+    out: PathBuf,
+    runs: usize,
+    seed: u64,
+    max_tests: Option<u64>,
+    timeout: Option<f64>,
+    settings: &Bound<'_, PyDict>,
+    unit: Option<&str>,
+    up: Option<&str>,
+    fixed: Vec<String>,
+) -> PyResult<String> {
+    let plan = model_settings(settings, unit, up, fixed).map_err(|e| e.into_py(py))?;
+    let settings = collect_settings(runs, seed, max_tests, timeout, plan);
+    let item = ModelItem { path, index, name, dir };
+    let entry = py.detach(|| collect::collect_model(&item, &out, &settings)).map_err(|e| Error::from(e).into_py(py))?;
+    Ok(serde_json::to_string(&entry).expect("entries serialise"))
+}
+
+/// Writes the data set's `index.json` from the entries [`collect_item`] returned (in model
+/// order) and returns it as JSON.
+#[pyfunction]
+pub fn collect_index(py: Python<'_>, out: PathBuf, runs: usize, seed: u64, entries: Vec<String>) -> PyResult<String> {
+    let run = || -> Result<String, Error> {
+        let entries = entries
+            .iter()
+            .map(|e| serde_json::from_str::<CollectedModel>(e).map_err(|e| json_error("index entry", e)))
+            .collect::<Result<Vec<_>, _>>()?;
+        let settings = collect_settings(runs, seed, None, None, PlanSettings::default());
+        let index = collect::write_index(&out, &settings, entries)?;
+        Ok(serde_json::to_string(&index).expect("the index serialises"))
+    };
+    run().map_err(|e| e.into_py(py))
+}
+
+/// The benchmark rows of one model (`asp bench feasible`'s work for one model) as JSON.
+/// `methods` is the comma-separated list (default: the cheap orderings, and the learned ones
+/// when `model` is given); `model` is the ONNX file of the `gnn` methods (default: shipped).
+#[pyfunction]
+#[pyo3(signature = (path, name, orderings, settings, methods=None, model=None, unit=None, up=None, fixed=Vec::new()))]
+#[allow(clippy::too_many_arguments)]
+pub fn bench_item(
+    py: Python<'_>,
+    path: PathBuf,
+    name: String,
+    orderings: usize,
+    settings: &Bound<'_, PyDict>,
+    methods: Option<String>,
+    model: Option<String>,
+    unit: Option<&str>,
+    up: Option<&str>,
+    fixed: Vec<String>,
+) -> PyResult<String> {
+    let settings = model_settings(settings, unit, up, fixed).map_err(|e| e.into_py(py))?;
+    let list = methods.unwrap_or_else(|| bench::default_methods(model.is_some()).to_string());
+    let gnn = || settings::ordering("gnn", model.as_deref()).map(|(source, _)| source);
+    let methods = bench::parse_methods(&list, &gnn).map_err(|e| e.into_py(py))?;
+    let rows = py
+        .detach(|| bench::bench_model(Path::new(&path), &name, &settings, &methods, orderings))
+        .map_err(|e| Error::from(e).into_py(py))?;
+    Ok(serde_json::to_string(&rows).expect("rows serialise"))
+}
+
+/// The table `asp bench feasible` prints, of rows (JSON lists of rows, concatenated in order).
+#[pyfunction]
+pub fn bench_table(py: Python<'_>, rows: Vec<String>) -> PyResult<String> {
+    let mut all: Vec<BenchRow> = Vec::new();
+    for r in &rows {
+        let part: Vec<BenchRow> = serde_json::from_str(r).map_err(|e| json_error("benchmark rows", e).into_py(py))?;
+        all.extend(part);
+    }
+    let mut out = Vec::new();
+    bench::write_table(&mut out, &all).expect("writing to memory");
+    Ok(String::from_utf8_lossy(&out).into_owned())
+}

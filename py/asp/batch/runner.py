@@ -1,0 +1,265 @@
+"""Running a job: the journal that makes a batch resumable, and the two executors (a serial loop
+in this process, and Ray tasks on a local Ray or a cluster).
+
+The journal lives in ``OUT/.asp-batch/``: ``job.json`` (the job's kind and spec) and
+``done.jsonl`` (one line per finished item: its key and result, appended and flushed by this
+process only, as results arrive). A batch run again with the same job skips every item whose line
+is there and whose output files still exist; one killed half way finishes the rest. A line torn
+by a kill is ignored (that item runs again). A different job in the same folder is refused
+unless ``fresh`` is set, which starts over.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Dict, List, Optional, TextIO
+
+from .jobs import Item, Job, run_item
+
+JOURNAL_DIR = ".asp-batch"
+
+
+class BatchError(Exception):
+    """A batch cannot start or finish: its folder holds another job, Ray is missing, ..."""
+
+
+@dataclass
+class Outcome:
+    """What a batch did: items run now, skipped as done before, and failed (with the error)."""
+
+    total: int
+    ran: int = 0
+    skipped: int = 0
+    failed: Dict[str, str] = field(default_factory=dict)
+    seconds: float = 0.0
+    summary: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return not self.failed
+
+
+class Journal:
+    """``OUT/.asp-batch/``: the job record and the finished items."""
+
+    def __init__(self, out: Path, job: Job, fresh: bool = False) -> None:
+        self.out = out
+        self.dir = out / JOURNAL_DIR
+        record = job.record()
+        job_file = self.dir / "job.json"
+        if fresh and self.dir.exists():
+            shutil.rmtree(self.dir)
+        if job_file.is_file():
+            try:
+                before = json.loads(job_file.read_text(encoding="utf-8"))
+            except (OSError, ValueError) as e:
+                raise BatchError(f"{job_file}: unreadable journal ({e}); start over with --fresh") from e
+            if before != record:
+                if not isinstance(before, dict) or before.get("kind") != record["kind"]:
+                    what = f"a {before.get('kind') if isinstance(before, dict) else 'different'} batch"
+                    difference = f"{what}, not {record['kind']}"
+                else:
+                    difference = _difference(before.get("spec"), record["spec"])
+                raise BatchError(
+                    f"{out}: holds a batch of other settings ({difference}); "
+                    "use another --out, or --fresh to start over here"
+                )
+        else:
+            self.dir.mkdir(parents=True, exist_ok=True)
+            tmp = self.dir / ".job.json.tmp"
+            tmp.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
+            os.replace(tmp, job_file)
+        self.path = self.dir / "done.jsonl"
+        self.done: Dict[str, Dict[str, Any]] = {}
+        if self.path.is_file():
+            with open(self.path, encoding="utf-8") as f:
+                for line in f:
+                    try:
+                        entry = json.loads(line)
+                        self.done[entry["key"]] = entry["result"]
+                    except (ValueError, KeyError, TypeError):
+                        continue  # a line torn by a kill: that item runs again
+        self._file: Optional[TextIO] = None
+
+    def add(self, key: str, result: Dict[str, Any]) -> None:
+        if self._file is None:
+            self._file = open(self.path, "a", encoding="utf-8")
+        self._file.write(json.dumps({"key": key, "result": result}) + "\n")
+        self._file.flush()
+        self.done[key] = result
+
+    def close(self) -> None:
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+
+_UNSET = object()
+
+
+def _difference(before: Any, now: Any, where: str = "") -> str:
+    """The first setting in which two specs differ, as `where: X before, Y now`."""
+    if isinstance(before, dict) and isinstance(now, dict):
+        for k in sorted(set(before) | set(now), key=str):
+            b, n = before.get(k, _UNSET), now.get(k, _UNSET)
+            if b != n:
+                return _difference(b, n, f"{where}.{k}" if where else str(k))
+    show = lambda v: "unset" if v is _UNSET or v is None else json.dumps(v)[:60]  # noqa: E731
+    return f"{where or 'settings'}: {show(before)} before, {show(now)} now"
+
+
+class Progress:
+    """A line per finished item (on a terminal: one line updated in place), with rate and ETA."""
+
+    def __init__(self, total: int, stream: TextIO = sys.stderr, quiet: bool = False) -> None:
+        self.total, self.stream, self.quiet = total, stream, quiet
+        self.tty = stream.isatty()
+        self.count = 0
+        self.started = time.perf_counter()
+        self.last = 0.0
+
+    def __call__(self, line: str) -> None:
+        self.count += 1
+        if self.quiet:
+            return
+        now = time.perf_counter()
+        elapsed = now - self.started
+        rate = self.count / elapsed if elapsed > 0 else 0.0
+        left = (self.total - self.count) / rate if rate > 0 else 0.0
+        text = f"[{self.count}/{self.total}] {line}  ({rate:.2f}/s, {left:.0f} s left)"
+        if self.tty:
+            self.stream.write("\r\x1b[K" + text[:200])
+            if self.count == self.total:
+                self.stream.write("\n")
+        elif self.total <= 1000 or now - self.last >= 1.0 or self.count == self.total:
+            self.stream.write(text + "\n")
+            self.last = now
+        self.stream.flush()
+
+    def message(self, text: str) -> None:
+        if not self.quiet:
+            if self.tty and 0 < self.count < self.total:
+                self.stream.write("\n")
+            self.stream.write(text + "\n")
+            self.stream.flush()
+
+
+def run(job: Job, out: os.PathLike | str, ray: Optional[str] = "local", workers: Optional[int] = None,
+        fresh: bool = False, quiet: bool = False, stream: TextIO = sys.stderr) -> Outcome:
+    """Runs ``job`` into folder ``out``: every item not done before, then the job's closing files.
+
+    :param ray: ``"local"`` starts a Ray instance on this machine with ``workers`` CPUs;
+        ``"auto"`` joins the cluster Ray finds (``RAY_ADDRESS``, or one started with
+        ``ray start``); ``"ray://host:10001"`` or ``"host:6379"`` joins that cluster; ``None``
+        or ``"none"`` runs the items in a serial loop in this process (no Ray needed).
+    :param workers: CPUs of a local Ray (default: all); with a cluster, how many items run at
+        once at most (default: the cluster's CPUs).
+    :param fresh: forget what a previous batch in ``out`` did and start over.
+    """
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    items = job.items()
+    keys = [i.key for i in items]
+    if len(set(keys)) != len(keys):
+        raise BatchError("two items of the batch have the same name")
+    journal = Journal(out, job, fresh=fresh)
+    todo = [i for i in items if not (i.key in journal.done and job.done(out, i, journal.done[i.key]))]
+    outcome = Outcome(total=len(items), skipped=len(items) - len(todo))
+    progress = Progress(len(todo), stream=stream, quiet=quiet)
+    if outcome.skipped:
+        progress.message(f"{out}: {outcome.skipped} of {len(items)} items done before, {len(todo)} to go")
+    started = time.perf_counter()
+
+    def finished(item: Item, result: Dict[str, Any]) -> None:
+        if "error" in result:
+            outcome.failed[item.key] = result["error"]
+        else:
+            journal.add(item.key, result)
+            outcome.ran += 1
+        progress(job.describe(item, result))
+
+    try:
+        if ray in (None, "none"):
+            for item in todo:
+                finished(item, run_item(job.kind, job.spec, item.payload, str(out)))
+        else:
+            _run_ray(job, todo, str(out), ray, workers, finished, progress)
+    except KeyboardInterrupt:
+        journal.close()
+        progress.message(
+            f"interrupted: {len(journal.done)} of {len(items)} items done; "
+            "the same command again finishes the rest"
+        )
+        raise
+    journal.close()
+    outcome.seconds = time.perf_counter() - started
+    if outcome.failed:
+        for key, error in outcome.failed.items():
+            progress.message(f"error: {key}: {error}")
+        outcome.summary = (f"{len(outcome.failed)} of {len(items)} items failed; fix them and run the same "
+                           "command again (finished items are kept)")
+    else:
+        outcome.summary = job.finish(out, {k: journal.done[k] for k in keys})
+    if outcome.ran:
+        rate = outcome.ran / outcome.seconds if outcome.seconds > 0 else float("inf")
+        outcome.summary += f"\n{outcome.ran} items in {outcome.seconds:.1f} s ({rate:.2f} items/s)"
+    return outcome
+
+
+def _ray_module():
+    try:
+        import ray
+    except ImportError as e:
+        raise BatchError("Ray is not installed: pip install 'ray>=2.9' (or ./py[batch]), or use --ray none") from e
+    return ray
+
+
+# environment of every worker: one thread per task (Ray gives each task one CPU; asp's own
+# thread pools would otherwise oversubscribe the cores)
+WORKER_ENV = {"RAYON_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+
+
+def _run_ray(job: Job, todo: List[Item], out: str, address: str, workers: Optional[int],
+             finished: Callable[[Item, Dict[str, Any]], None], progress: Progress) -> None:
+    ray = _ray_module()
+    started_here = not ray.is_initialized()
+    if started_here:
+        runtime_env = {"env_vars": dict(WORKER_ENV)}
+        if address == "local":
+            cpus = workers or os.cpu_count() or 1
+            ray.init(num_cpus=cpus, include_dashboard=False, runtime_env=runtime_env, log_to_driver=False,
+                     configure_logging=False)
+        else:
+            ray.init(address=address, runtime_env=runtime_env, log_to_driver=False, configure_logging=False)
+    try:
+        if not todo:
+            return
+        cpus = int(ray.cluster_resources().get("CPU", 1))
+        task = ray.remote(num_cpus=1, max_retries=1)(run_item)
+        spec = ray.put(job.spec)
+        pending: Dict[Any, Item] = {}
+        queue = list(reversed(todo))
+        # a bounded number of items in flight (twice the CPUs that run them): a batch of 100,000
+        # assemblies does not become 100,000 tasks at once, and results are journaled as they come
+        in_flight = 2 * max(1, min(workers, cpus) if workers else cpus)
+        while queue or pending:
+            while queue and len(pending) < in_flight:
+                item = queue.pop()
+                pending[task.remote(job.kind, spec, item.payload, out)] = item
+            ready, _ = ray.wait(list(pending), num_returns=1)
+            for ref in ready:
+                item = pending.pop(ref)
+                try:
+                    result = ray.get(ref)
+                except Exception as e:  # a worker that died (out of memory, a crash)
+                    result = {"error": f"the task failed: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"}
+                finished(item, result)
+    finally:
+        if started_here:
+            ray.shutdown()
