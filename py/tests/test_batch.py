@@ -18,7 +18,7 @@ from conftest import LACK, ROOT, need, without_seconds
 ray = need("ray", "asp.batch on Ray needs ray (pip install 'ray>=2.9')")
 
 from asp.batch import BatchError, BenchJob, CollectJob, GenJob, PlanJob, run  # noqa: E402
-from asp.batch.runner import JOURNAL_DIR, WORKER_ENV  # noqa: E402
+from asp.batch.runner import JOURNAL_DIR, WORKER_ENV, chunk_size  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -48,15 +48,21 @@ def soma_models(tmp_path: Path, count: int = 4, size: int = 3) -> Path:
 def test_gen_on_ray_writes_the_files_of_asp_gen(tmp_path, asp_cli, local_ray):
     for args, job in [
         (["soma", "--size", "3", "--count", "5", "--seed", "11"], GenJob.soma(size=3, count=5, seed=11)),
+        # 70 items on 2 CPUs: tasks of 2 items each (chunk_size)
+        (["soma", "--size", "2", "--count", "70", "--seed", "4"], GenJob.soma(size=2, count=70, seed=4)),
         (["profiles", "--preset", "double-layer", "--count", "2", "--seed", "3"],
          GenJob.profiles("double-layer", count=2, seed=3)),
     ]:
-        cli, batch = tmp_path / f"cli-{args[0]}", tmp_path / f"batch-{args[0]}"
+        cli, batch = tmp_path / f"cli-{args[0]}-{args[2]}", tmp_path / f"batch-{args[0]}-{args[2]}"
         code, _, err = asp_cli("gen", *args, "--out", str(cli), "--quiet")
         assert code == 0, err
         outcome = run(job, batch, quiet=True)
         assert outcome.ok and outcome.ran == job.spec["count"]
         assert files(batch) == files(cli), f"{args[0]}: the batch's files differ from asp gen's"
+
+
+def test_small_items_go_in_chunks():
+    assert [chunk_size(n, 2) for n in (1, 31, 64, 70, 1000, 100_000)] == [1, 1, 2, 2, 31, 64]
 
 
 def test_plans_on_ray_equal_the_serial_loop_and_the_cli(tmp_path, asp_cli, local_ray):

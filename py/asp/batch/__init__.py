@@ -17,7 +17,7 @@ when a batch uses it; ``ray="none"`` runs a serial loop. On a cluster every node
 
 from __future__ import annotations
 
-from .jobs import BenchJob, CollectJob, GenJob, Item, Job, LoadSettings, PlanJob, run_item
+from .jobs import BenchJob, CollectJob, GenJob, Item, Job, LoadSettings, PlanJob, run_chunk, run_item
 from .runner import BatchError, Outcome, run
 
 __all__ = [
@@ -31,5 +31,6 @@ __all__ = [
     "Outcome",
     "PlanJob",
     "run",
+    "run_chunk",
     "run_item",
 ]

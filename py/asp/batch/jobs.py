@@ -336,3 +336,8 @@ def run_item(kind: str, spec: Dict[str, Any], payload: Dict[str, Any], out: str)
         return _RUNNERS[kind](spec, payload, out)
     except AspError as e:
         return {"error": str(e)}
+
+
+def run_chunk(kind: str, spec: Dict[str, Any], payloads: List[Dict[str, Any]], out: str) -> List[Dict[str, Any]]:
+    """:func:`run_item` of several items in turn (one Ray task)."""
+    return [run_item(kind, spec, p, out) for p in payloads]

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, TextIO
 
-from .jobs import Item, Job, run_item
+from .jobs import Item, Job, run_chunk, run_item
 
 JOURNAL_DIR = ".asp-batch"
 
@@ -31,13 +31,15 @@ class BatchError(Exception):
 
 @dataclass
 class Outcome:
-    """What a batch did: items run now, skipped as done before, and failed (with the error)."""
+    """What a batch did: items run now, skipped as done before, and failed (with the error);
+    ``seconds`` of the whole run, of which ``startup_seconds`` starting or joining Ray."""
 
     total: int
     ran: int = 0
     skipped: int = 0
     failed: Dict[str, str] = field(default_factory=dict)
     seconds: float = 0.0
+    startup_seconds: float = 0.0
     summary: str = ""
 
     @property
@@ -189,7 +191,7 @@ def run(job: Job, out: os.PathLike | str, ray: Optional[str] = "local", workers:
             for item in todo:
                 finished(item, run_item(job.kind, job.spec, item.payload, str(out)))
         else:
-            _run_ray(job, todo, str(out), ray, workers, finished, progress)
+            outcome.startup_seconds = _run_ray(job, todo, str(out), ray, workers, finished)
     except KeyboardInterrupt:
         journal.close()
         progress.message(
@@ -207,8 +209,10 @@ def run(job: Job, out: os.PathLike | str, ray: Optional[str] = "local", workers:
     else:
         outcome.summary = job.finish(out, {k: journal.done[k] for k in keys})
     if outcome.ran:
-        rate = outcome.ran / outcome.seconds if outcome.seconds > 0 else float("inf")
-        outcome.summary += f"\n{outcome.ran} items in {outcome.seconds:.1f} s ({rate:.2f} items/s)"
+        work = outcome.seconds - outcome.startup_seconds
+        rate = outcome.ran / work if work > 0 else float("inf")
+        startup = f", after {outcome.startup_seconds:.1f} s starting Ray" if outcome.startup_seconds else ""
+        outcome.summary += f"\n{outcome.ran} items in {work:.1f} s ({rate:.2f} items/s{startup})"
     return outcome
 
 
@@ -220,46 +224,65 @@ def _ray_module():
     return ray
 
 
+def chunk_size(items: int, slots: int) -> int:
+    """Items per Ray task: one while there are few (the slowest item bounds the batch, so spread
+    them), up to 64 when there are many, so that a task's overhead (a few milliseconds) does not
+    swamp items that take one (generating a Soma cube). A kill loses at most the chunks in flight."""
+    return max(1, min(64, items // (16 * slots)))
+
+
 # environment of every worker: one thread per task (Ray gives each task one CPU; asp's own
 # thread pools would otherwise oversubscribe the cores)
 WORKER_ENV = {"RAYON_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 
 
 def _run_ray(job: Job, todo: List[Item], out: str, address: str, workers: Optional[int],
-             finished: Callable[[Item, Dict[str, Any]], None], progress: Progress) -> None:
+             finished: Callable[[Item, Dict[str, Any]], None]) -> float:
+    """Runs the items as Ray tasks; returns the seconds spent starting or joining Ray."""
+    started = time.perf_counter()
     ray = _ray_module()
     started_here = not ray.is_initialized()
     if started_here:
         runtime_env = {"env_vars": dict(WORKER_ENV)}
-        if address == "local":
-            cpus = workers or os.cpu_count() or 1
-            ray.init(num_cpus=cpus, include_dashboard=False, runtime_env=runtime_env, log_to_driver=False,
-                     configure_logging=False)
-        else:
-            ray.init(address=address, runtime_env=runtime_env, log_to_driver=False, configure_logging=False)
+        try:
+            if address == "local":
+                cpus = workers or os.cpu_count() or 1
+                ray.init(num_cpus=cpus, include_dashboard=False, runtime_env=runtime_env, log_to_driver=False,
+                         configure_logging=False)
+            else:
+                ray.init(address=address, runtime_env=runtime_env, log_to_driver=False, configure_logging=False)
+        except Exception as e:  # Ray raises ConnectionError, RuntimeError, ValueError... by case
+            first = str(e).splitlines()[0] if str(e) else type(e).__name__
+            raise BatchError(f"cannot {'start' if address == 'local' else 'join'} Ray ({address}): {first}") from e
+    startup = time.perf_counter() - started
     try:
         if not todo:
-            return
+            return startup
         cpus = int(ray.cluster_resources().get("CPU", 1))
-        task = ray.remote(num_cpus=1, max_retries=1)(run_item)
+        slots = max(1, min(workers, cpus) if workers else cpus)
+        task = ray.remote(num_cpus=1, max_retries=1)(run_chunk)
         spec = ray.put(job.spec)
-        pending: Dict[Any, Item] = {}
-        queue = list(reversed(todo))
-        # a bounded number of items in flight (twice the CPUs that run them): a batch of 100,000
+        size = chunk_size(len(todo), slots)
+        chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
+        chunks.reverse()
+        pending: Dict[Any, List[Item]] = {}
+        # a bounded number of tasks in flight (twice the CPUs that run them): a batch of 100,000
         # assemblies does not become 100,000 tasks at once, and results are journaled as they come
-        in_flight = 2 * max(1, min(workers, cpus) if workers else cpus)
-        while queue or pending:
-            while queue and len(pending) < in_flight:
-                item = queue.pop()
-                pending[task.remote(job.kind, spec, item.payload, out)] = item
+        while chunks or pending:
+            while chunks and len(pending) < 2 * slots:
+                chunk = chunks.pop()
+                pending[task.remote(job.kind, spec, [i.payload for i in chunk], out)] = chunk
             ready, _ = ray.wait(list(pending), num_returns=1)
             for ref in ready:
-                item = pending.pop(ref)
+                chunk = pending.pop(ref)
                 try:
-                    result = ray.get(ref)
+                    results = ray.get(ref)
                 except Exception as e:  # a worker that died (out of memory, a crash)
-                    result = {"error": f"the task failed: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"}
-                finished(item, result)
+                    first = str(e).splitlines()[0] if str(e) else ""
+                    results = [{"error": f"the task failed: {type(e).__name__}: {first}"}] * len(chunk)
+                for item, result in zip(chunk, results):
+                    finished(item, result)
+        return startup
     finally:
         if started_here:
             ray.shutdown()
