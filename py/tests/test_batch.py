@@ -133,7 +133,13 @@ def test_a_bad_model_fails_alone(tmp_path):
     outcome = run(PlanJob([models, broken]), out, ray="none", quiet=True)
     assert outcome.ran == 2 and list(outcome.failed) == ["broken"]
     assert str(broken) in outcome.failed["broken"]
-    assert not (out / "summary.json").exists(), "no summary while an item is missing"
+    summary = json.loads((out / "summary.json").read_text())
+    assert [("error" in p, p.get("status")) for p in summary["plans"]] == [(False, "found")] * 2 + [(True, None)]
+    assert "1 of 3 items failed" in outcome.summary
+    data = tmp_path / "data"
+    collected = run(CollectJob([models, broken], runs=1, max_tests=200), data, ray="none", quiet=True)
+    assert list(collected.failed) == ["broken"] and collected.ran == 2
+    assert not (data / "index.json").exists(), "no data set index while a model is missing"
     broken.unlink()
     env = dict(os.environ)
     cli = subprocess.run([sys.executable, "-m", "asp.batch", "plan", str(tmp_path / "nothing"), "--out", str(out),

@@ -51,6 +51,8 @@ class Job:
     """A batch job: override :meth:`items`, :func:`run_item` dispatch and :meth:`finish`."""
 
     kind: str = ""
+    # whether :meth:`finish` runs when some items failed (their results are ``{"error": ...}``)
+    finishes_with_failures: bool = False
 
     def __init__(self, spec: Dict[str, Any]) -> None:
         self.spec = spec
@@ -63,7 +65,7 @@ class Job:
         return all((out / f).is_file() for f in result.get("files", []))
 
     def describe(self, item: Item, result: Dict[str, Any]) -> str:
-        """One line of progress for a finished item."""
+        """One line of progress for an item that succeeded."""
         return item.key
 
     def finish(self, out: Path, results: Dict[str, Dict[str, Any]]) -> str:
@@ -150,10 +152,11 @@ class LoadSettings:
 
 class PlanJob(Job):
     """Plans every model with the same keywords of :meth:`asp.Assembly.plan`: ``OUT/<name>.json``
-    holds the plan JSON ``asp plan MODEL --json`` prints, and ``OUT/summary.json`` one line per
-    model."""
+    holds the plan JSON ``asp plan MODEL --json`` prints, and ``OUT/summary.json`` one row per
+    model (with ``"error"`` for a model that could not be planned)."""
 
     kind = "plan"
+    finishes_with_failures = True  # the summary lists the models that failed, with the error
 
     def __init__(self, models: Sequence[os.PathLike | str], settings: Optional[Dict[str, Any]] = None,
                  load: Optional[LoadSettings] = None) -> None:
@@ -172,8 +175,6 @@ class PlanJob(Job):
         return [Item(m["name"], m) for m in self.spec["models"]]
 
     def describe(self, item: Item, result: Dict[str, Any]) -> str:
-        if "error" in result:
-            return f"{item.key}: error: {result['error']}"
         return (f"{item.key}: {result['status']}, {result['steps']} steps, "
                 f"{result['removal_tests']} removal tests, {result['seconds']:.2f} s")
 
@@ -183,7 +184,9 @@ class PlanJob(Job):
                    "load": self.spec["load"], "plans": rows}
         _write_atomic(out / "summary.json", json.dumps(summary, indent=2) + "\n")
         found = sum(1 for r in rows if r.get("found"))
-        return f"{found} of {len(rows)} models planned; plans and summary.json in {out}"
+        failed = sum(1 for r in rows if "error" in r)
+        errors = f", {failed} could not be planned (errors in summary.json)" if failed else ""
+        return f"{found} of {len(rows)} models planned{errors}; plans and summary.json in {out}"
 
 
 def _plan(spec: Dict[str, Any], payload: Dict[str, Any], out: str) -> Dict[str, Any]:

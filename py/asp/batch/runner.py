@@ -144,6 +144,10 @@ class Progress:
             self.last = now
         self.stream.flush()
 
+    def restart(self) -> None:
+        """Rates count from now (after Ray has started)."""
+        self.started = time.perf_counter()
+
     def message(self, text: str) -> None:
         if not self.quiet:
             if self.tty and 0 < self.count < self.total:
@@ -181,17 +185,18 @@ def run(job: Job, out: os.PathLike | str, ray: Optional[str] = "local", workers:
     def finished(item: Item, result: Dict[str, Any]) -> None:
         if "error" in result:
             outcome.failed[item.key] = result["error"]
+            progress(f"{item.key}: failed")
         else:
             journal.add(item.key, result)
             outcome.ran += 1
-        progress(job.describe(item, result))
+            progress(job.describe(item, result))
 
     try:
         if ray in (None, "none"):
             for item in todo:
                 finished(item, run_item(job.kind, job.spec, item.payload, str(out)))
         else:
-            outcome.startup_seconds = _run_ray(job, todo, str(out), ray, workers, finished)
+            outcome.startup_seconds = _run_ray(job, todo, str(out), ray, workers, finished, progress.restart)
     except KeyboardInterrupt:
         journal.close()
         progress.message(
@@ -204,10 +209,13 @@ def run(job: Job, out: os.PathLike | str, ray: Optional[str] = "local", workers:
     if outcome.failed:
         for key, error in outcome.failed.items():
             progress.message(f"error: {key}: {error}")
-        outcome.summary = (f"{len(outcome.failed)} of {len(items)} items failed; fix them and run the same "
-                           "command again (finished items are kept)")
-    else:
-        outcome.summary = job.finish(out, {k: journal.done[k] for k in keys})
+    if not outcome.failed or job.finishes_with_failures:
+        results = {k: journal.done[k] if k in journal.done else {"error": outcome.failed[k]} for k in keys}
+        outcome.summary = job.finish(out, results)
+    if outcome.failed:
+        note = (f"{len(outcome.failed)} of {len(items)} items failed; fix them and run the same "
+                "command again (finished items are kept)")
+        outcome.summary = f"{outcome.summary}\n{note}" if outcome.summary else note
     if outcome.ran:
         work = outcome.seconds - outcome.startup_seconds
         rate = outcome.ran / work if work > 0 else float("inf")
@@ -237,7 +245,7 @@ WORKER_ENV = {"RAYON_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 
 
 def _run_ray(job: Job, todo: List[Item], out: str, address: str, workers: Optional[int],
-             finished: Callable[[Item, Dict[str, Any]], None]) -> float:
+             finished: Callable[[Item, Dict[str, Any]], None], ready: Callable[[], None]) -> float:
     """Runs the items as Ray tasks; returns the seconds spent starting or joining Ray."""
     started = time.perf_counter()
     ray = _ray_module()
@@ -255,6 +263,7 @@ def _run_ray(job: Job, todo: List[Item], out: str, address: str, workers: Option
             first = str(e).splitlines()[0] if str(e) else type(e).__name__
             raise BatchError(f"cannot {'start' if address == 'local' else 'join'} Ray ({address}): {first}") from e
     startup = time.perf_counter() - started
+    ready()
     try:
         if not todo:
             return startup
