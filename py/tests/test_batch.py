@@ -182,3 +182,55 @@ def test_killed_half_way_the_same_command_finishes_the_rest(tmp_path, asp_cli):
     code, _, err = asp_cli("gen", "profiles", "--count", str(count), "--seed", "2", "--out", str(cli), "--quiet")
     assert code == 0, err
     assert files(out) == files(cli), "the resumed batch's files differ from asp gen's"
+
+
+def test_a_batch_joins_a_cluster_by_address(tmp_path, asp_cli):
+    """`ray start --head` makes a one-node cluster (2 CPUs) in a process of its own; the batch joins
+    it by the address ray start prints, as it would join a cluster on other machines."""
+    import re
+    import shutil
+    import socket
+    import tempfile
+
+    ray_cli = shutil.which("ray", path=str(Path(sys.executable).parent)) or shutil.which("ray")
+    assert ray_cli, "the ray command comes with the ray package"
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    # Ray's socket paths must stay under 108 bytes: a short folder, not pytest's tmp_path
+    temp = tempfile.mkdtemp(prefix="asp-ray-", dir="/tmp")
+    # a cluster's nodes and drivers share one token (Ray >= 2.59 authenticates by default)
+    env = dict(os.environ, RAY_AUTH_MODE="token", RAY_AUTH_TOKEN=os.urandom(16).hex())
+    head = subprocess.Popen(
+        [ray_cli, "start", "--head", "--block", "--num-cpus", "2", "--port", str(port), "--include-dashboard",
+         "false", "--disable-usage-stats", "--temp-dir", temp],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True, env=env,
+    )
+    try:
+        address, seen = None, []
+        deadline = time.time() + 90
+        while address is None and time.time() < deadline:
+            line = head.stdout.readline()
+            if not line:
+                break
+            seen.append(line)
+            m = re.search(r"ray start --address='([^']+)'", line)
+            address = m.group(1) if m else None
+        assert address, "ray start printed no address:\n" + "".join(seen[-20:])
+        out = tmp_path / "gen"
+        batch = subprocess.run(
+            [sys.executable, "-m", "asp.batch", "gen", "soma", "--size", "3", "--count", "6", "--seed", "5",
+             "--out", str(out), "--ray", address], capture_output=True, text=True, timeout=300, env=env,
+        )
+        assert batch.returncode == 0, batch.stderr
+        cli = tmp_path / "cli"
+        code, _, err = asp_cli("gen", "soma", "--size", "3", "--count", "6", "--seed", "5", "--out", str(cli), "--quiet")
+        assert code == 0, err
+        assert files(out) == files(cli)
+    finally:
+        os.killpg(head.pid, signal.SIGTERM)  # --block: ray start stops the processes it started
+        try:
+            head.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            os.killpg(head.pid, signal.SIGKILL)
+        shutil.rmtree(temp, ignore_errors=True)
