@@ -78,8 +78,22 @@ class Plan:
 
     @property
     def disassembly_sequence(self) -> List[int]:
-        """Part indices in removal order (the branch reached, when not found)."""
+        """Part indices in removal order (when not found: the partial disassembly that got
+        furthest)."""
         return list(self._dict["disassembly_sequence"])
+
+    @property
+    def partial_assembly_sequence(self) -> List[Dict[str, Any]]:
+        """When not found: the parts that did come off, in assembly order onto
+        :attr:`remaining`, entries as in :attr:`assembly_sequence` (empty when found)."""
+        return self.to_dict().get("partial_assembly_sequence", [])
+
+    @property
+    def remaining(self) -> Optional[List[int]]:
+        """When not found: the parts present where the partial disassembly stops (fixed parts
+        included); ``None`` when found."""
+        value = self._dict.get("remaining")
+        return None if value is None else list(value)
 
     @property
     def stats(self) -> Dict[str, Any]:

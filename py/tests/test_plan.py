@@ -54,6 +54,11 @@ def test_no_plan_pump_explains_what_holds_what(root, asp_cli):
         assert entry["name"] in names
         assert entry["reason"] in ("blocked", "unsupported", "dead_end")
     assert any(e["reason"] == "blocked" and e["parts"] for e in explanation)
+    # the partial plan: the parts that came off, onto the stuck core that remains
+    partial = [s["part"] for s in plan.partial_assembly_sequence]
+    assert partial == plan.disassembly_sequence[::-1] and len(partial) == len(a) - 3
+    assert sorted(plan.remaining + partial) == list(range(len(a)))
+    assert {e["part"] for e in explanation} <= set(plan.remaining)
     code, out, err = asp_cli("plan", PUMP, "--unit", "mm", "--up", "z", "--json")
     assert code == 1, err
     assert without_seconds(plan.json) == without_seconds(out)

@@ -149,9 +149,9 @@ pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Resu
     } else {
         writeln!(out, "base: ground plane under the lowest point (up {})", r.up)?;
     }
-    if !r.assembly_sequence.is_empty() {
+    let steps = |out: &mut dyn Write, sequence: &[asp_search::report::AssemblyStep]| -> std::io::Result<()> {
         writeln!(out, "{:>4}  {:<width$}  motion (insertion, {})", "step", "part", r.units)?;
-        for (k, step) in r.assembly_sequence.iter().enumerate() {
+        for (k, step) in sequence.iter().enumerate() {
             let motion = match &step.motion {
                 MotionEntry::Linear { direction: d, distance } => {
                     format!("straight along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
@@ -160,6 +160,19 @@ pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Resu
             };
             writeln!(out, "{:>4}  {:<width$}  {motion}", k + 1, step.name)?;
         }
+        Ok(())
+    };
+    if !r.assembly_sequence.is_empty() {
+        steps(out, &r.assembly_sequence)?;
+    }
+    if !r.partial_assembly_sequence.is_empty() {
+        let remaining = r.remaining.as_ref().map_or(0, Vec::len);
+        writeln!(
+            out,
+            "partial plan: {} parts come off; in assembly order onto the {remaining} parts that stay:",
+            r.partial_assembly_sequence.len()
+        )?;
+        steps(out, &r.partial_assembly_sequence)?;
     }
     if !r.explanation.is_empty() {
         writeln!(out, "stuck with {} parts left; none can leave:", r.explanation.len())?;

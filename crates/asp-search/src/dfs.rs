@@ -102,8 +102,11 @@ struct Search<'p, 'a, 'v> {
     expanded: u64,
     exhausted: bool,
     total: usize,
-    /// The dead-end state with the fewest parts, with its parts' reasons.
-    deepest: Option<(PartSet, Vec<Stuck>)>,
+    /// The dead-end state with the fewest parts, with its parts' reasons and the removals that
+    /// reached it (a `no_plan` result's partial disassembly).
+    deepest: Option<(PartSet, Vec<Stuck>, Vec<Step>)>,
+    /// The longest branch so far (a `budget_exhausted` result's partial disassembly).
+    longest: Vec<Step>,
 }
 
 impl Search<'_, '_, '_> {
@@ -190,9 +193,9 @@ impl Search<'_, '_, '_> {
                 self.cores.push(core);
             }
             self.dead.insert(state.clone());
-            if self.deepest.as_ref().is_none_or(|(s, _)| state.len() < s.len()) {
+            if self.deepest.as_ref().is_none_or(|(s, _, _)| state.len() < s.len()) {
                 reasons.sort_by_key(|s| s.part);
-                self.deepest = Some((state.clone(), reasons));
+                self.deepest = Some((state.clone(), reasons, self.path.clone()));
             }
         }
         false
@@ -203,6 +206,9 @@ impl Search<'_, '_, '_> {
         match outcome {
             Outcome::Removed(motion) => {
                 self.path.push(Step { part, motion });
+                if self.path.len() > self.longest.len() {
+                    self.longest.clone_from(&self.path);
+                }
                 if self.search(&state.without(part)) {
                     return true;
                 }
@@ -280,20 +286,24 @@ impl Dfs {
             exhausted: false,
             total: problem.removable(&problem.start).len(),
             deepest: None,
+            longest: Vec::new(),
         };
         let found = search.search(&problem.start);
-        let status = if found {
-            Status::Found
+        // not found: the removals of the partial disassembly that got furthest (to the deepest
+        // dead end, whose parts the explanation lists, or the longest branch when the budget ran
+        // out), so a failed search still says which parts came off and how
+        let (status, removals) = if found {
+            (Status::Found, std::mem::take(&mut search.path))
         } else if search.exhausted {
-            Status::BudgetExhausted
+            (Status::BudgetExhausted, std::mem::take(&mut search.longest))
         } else {
-            let (state, stuck) = search.deepest.take().unwrap_or_default();
-            Status::NoPlan { stuck, state }
+            let (state, stuck, path) = search.deepest.take().unwrap_or_else(|| (problem.start.clone(), Vec::new(), Vec::new()));
+            (Status::NoPlan { stuck, state }, path)
         };
         let counters = search.counters;
         PlanOutcome {
             status,
-            removals: search.path,
+            removals,
             stats: Stats { counters, seconds: started.elapsed().as_secs_f64(), states_expanded: search.expanded },
         }
     }

@@ -120,7 +120,9 @@ pub struct Stats {
 pub struct PlanOutcome {
     /// How the search ended.
     pub status: Status,
-    /// The removals in disassembly order (complete when `status` is `Found`).
+    /// The removals in disassembly order: the whole sequence when `status` is `Found`; otherwise
+    /// the partial disassembly that got furthest (to the deepest dead end for `NoPlan`, the
+    /// longest branch for `BudgetExhausted`).
     pub removals: Vec<Step>,
     /// The effort spent.
     pub stats: Stats,

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.2";
+pub const FORMAT_VERSION: &str = "1.3";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -32,8 +32,17 @@ pub struct PlanReport {
     pub parts: Vec<PartEntry>,
     /// One entry per non-fixed part, in assembly order (empty unless `found`).
     pub assembly_sequence: Vec<AssemblyStep>,
-    /// Part indices in removal order (the branch reached, when not `found`).
+    /// Part indices in removal order (when not `found`: the partial disassembly that got
+    /// furthest, to the deepest dead end or, when the budget ran out, the longest branch).
     pub disassembly_sequence: Vec<usize>,
+    /// When not `found`: the parts that did come off, in assembly order onto the `remaining`
+    /// parts, with their motions (as `assembly_sequence`). Since format 1.3.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub partial_assembly_sequence: Vec<AssemblyStep>,
+    /// When not `found`: the parts still present where the partial disassembly stops (fixed
+    /// parts included). Since format 1.3.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub remaining: Option<Vec<usize>>,
     /// The effort spent.
     pub stats: StatsEntry,
     /// For `no_plan`: the parts of the deepest dead-end state and what holds each.
@@ -212,16 +221,17 @@ impl PlanReport {
             Status::NoPlan { .. } => "no_plan",
             Status::BudgetExhausted => "budget_exhausted",
         };
-        let assembly_sequence = if outcome.status == Status::Found {
-            outcome
-                .removals
-                .iter()
-                .rev()
-                .map(|s| AssemblyStep { part: s.part, name: name(s.part), motion: insertion(&s.motion, &u) })
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let steps: Vec<AssemblyStep> = outcome
+            .removals
+            .iter()
+            .rev()
+            .map(|s| AssemblyStep { part: s.part, name: name(s.part), motion: insertion(&s.motion, &u) })
+            .collect();
+        let found = outcome.status == Status::Found;
+        let remaining = (!found).then(|| {
+            (0..assembly.parts.len()).filter(|i| !outcome.removals.iter().any(|s| s.part == *i)).collect()
+        });
+        let (assembly_sequence, partial_assembly_sequence) = if found { (steps, Vec::new()) } else { (Vec::new(), steps) };
         let explanation = match &outcome.status {
             Status::NoPlan { stuck, .. } => stuck
                 .iter()
@@ -252,6 +262,8 @@ impl PlanReport {
                 .collect(),
             assembly_sequence,
             disassembly_sequence: outcome.removals.iter().map(|s| s.part).collect(),
+            partial_assembly_sequence,
+            remaining,
             stats: StatsEntry {
                 checker: CHECKER_COLLISION_WORLD.into(),
                 removal_tests: c.removal_tests,

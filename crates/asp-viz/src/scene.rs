@@ -222,9 +222,10 @@ impl Scene {
             .ok_or_else(|| VizError::input(source, format!("unknown unit '{}'", report.units)))?
             .metres;
         let mut order_recorded = true;
-        let steps: Vec<Step> = if report.status == "found" {
-            report
-                .assembly_sequence
+        // plans since format 1.3 carry the partial disassembly of a failed search with its motions
+        let sequence = if report.status == "found" { &report.assembly_sequence } else { &report.partial_assembly_sequence };
+        let steps: Vec<Step> = if report.status == "found" || !sequence.is_empty() {
+            sequence
                 .iter()
                 .map(|s| {
                     let part = assembly.parts.get(s.part).ok_or_else(|| bad(s.part))?;
@@ -235,8 +236,8 @@ impl Scene {
                 })
                 .collect::<Result<_>>()?
         } else {
-            // The explanation lists every movable part of the deepest dead end; with the fixed
-            // parts that is the starting
+            // Older plans (format < 1.3) have no partial sequence. The explanation lists every
+            // movable part of the deepest dead end; with the fixed parts that is the starting
             // scene. `disassembly_sequence` is the branch the search was on last, which leads
             // there only when its complement is that dead end (after a full backtrack it is
             // empty); the other parts follow in index order, and the scene says the order is

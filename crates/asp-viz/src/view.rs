@@ -144,14 +144,21 @@ fn page_data(scene: &Scene) -> Value {
 /// One line about the plan for the page's header.
 fn status_text(scene: &Scene) -> String {
     let n = scene.steps.len();
+    let moving = n > 0 && scene.steps.iter().all(|s| s.motion.is_some());
     match scene.report.status.as_str() {
         "found" => format!("Plan found: {n} steps ({} parts, units {}).", scene.assembly.parts.len(), scene.report.units),
+        "no_plan" if moving => format!(
+            "No plan: the search got stuck with {} parts left (stuck parts in red). Steps: the partial plan, \
+             the other {n} parts in assembly order onto them.",
+            scene.initial.len()
+        ),
         "no_plan" => format!(
             "No plan: the search got stuck with {} parts left (stuck parts in red). Steps: the other {n} parts, {}, \
              appearing in place (no motions are recorded for them).",
             scene.initial.len(),
             if scene.order_recorded { "in the order of the branch reached" } else { "order not recorded" }
         ),
+        other if moving => format!("{}: the partial plan reached ({n} parts).", other.replace('_', " ")),
         other => format!("{}: the partial sequence reached ({n} parts; motions not recorded).", other.replace('_', " ")),
     }
 }

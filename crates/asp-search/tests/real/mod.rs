@@ -1,7 +1,7 @@
 //! Real assemblies (tests/data, licences there): each plans to completion — every step
 //! re-checked by the independent sweep — or ends in `no_plan` with a checkable explanation.
 
-use crate::verify::verify_plan;
+use crate::verify::{verify_plan, verify_removals};
 use asp_geom::io::{load, LoadOptions};
 use asp_geom::math::Axis;
 use asp_geom::{Checker, CheckerConfig, FeasibilityChecker, Units, World, WorldConfig};
@@ -65,6 +65,17 @@ fn ikea_models_plan_and_every_step_rechecks() {
 }
 
 #[test]
+fn a_budget_that_runs_out_keeps_the_longest_branch_it_reached() {
+    let checker = Checker::new(world("pump", Some("mm"), false).unwrap(), CheckerConfig::default());
+    let budget = Budget { max_tests: Some(40), timeout: None };
+    let outcome = Dfs::builder().bookkeeping(true).build().solve(&Problem::full(&checker), &budget);
+    assert_eq!(outcome.status, Status::BudgetExhausted);
+    assert!(!outcome.removals.is_empty(), "some parts came off within 40 tests");
+    let reached = verify_removals(checker.world(), &outcome.removals);
+    assert_eq!(reached.len(), checker.num_parts() - outcome.removals.len());
+}
+
+#[test]
 fn gross_overlaps_are_errors_naming_both_parts() {
     let err = world("ikea/bed_dalselv_0270.glb", None, false).err().expect("gross overlap is an error").to_string();
     assert!(err.contains("'0_part0'") && err.contains("'1_part1'") && err.contains("ignore overlapping"), "{err}");
@@ -97,6 +108,15 @@ fn pump_ends_in_no_plan_with_its_stuck_core_explained_and_the_rest_rechecked() {
             StuckReason::DeadEnd => panic!("{s:?}"),
         }
     }
+    // the result carries the partial disassembly that reached the stuck core: its removals pass
+    // the independent sweep and leave exactly the core (issue 9: a no_plan is not an empty plan)
+    assert_eq!(outcome.removals.len(), checker.num_parts() - 3);
+    assert_eq!(verify_removals(w, &outcome.removals), *state);
+    let report = asp_search::report::PlanReport::new(w.assembly(), &outcome, w.tolerance(), &[]);
+    assert!(report.assembly_sequence.is_empty());
+    let inserted: Vec<usize> = report.partial_assembly_sequence.iter().map(|s| s.part).collect();
+    assert_eq!(inserted, outcome.removals.iter().rev().map(|s| s.part).collect::<Vec<_>>());
+    assert_eq!(report.remaining, Some(state.iter().collect::<Vec<_>>()));
     // every other part comes off that core in a plan the independent sweep re-checks
     let core = left.iter().map(|n| format!("PumpAssembly - {n}")).collect();
     let options = LoadOptions { unit: Units::parse("mm"), up: Some(Axis::Z), fixed: core };

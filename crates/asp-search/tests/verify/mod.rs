@@ -46,10 +46,17 @@ fn penetrates(world: &World, p: usize, pose: &Pose, present: &PartSet, shrunk_ca
 /// and a stable remainder. Panics with the step on failure.
 pub fn verify_plan(world: &World, outcome: &PlanOutcome) {
     assert_eq!(outcome.status, Status::Found, "only found plans are verified");
+    let state = verify_removals(world, &outcome.removals);
+    assert!(state.iter().all(|p| world.fixed().contains(p)), "plan leaves non-fixed parts");
+}
+
+/// Re-checks removals from the full assembly as [`verify_plan`] does (a whole plan or a partial
+/// disassembly) and returns the state they reach.
+pub fn verify_removals(world: &World, removals: &[asp_search::Step]) -> PartSet {
     let n = world.num_parts();
     let mut state = PartSet::full(n);
     let mut cache = HashMap::new();
-    for (k, step) in outcome.removals.iter().enumerate() {
+    for (k, step) in removals.iter().enumerate() {
         let p = step.part;
         assert!(state.contains(p) && !world.fixed().contains(p), "step {k}: part {p} not removable");
         let present = world.with_fixed(&state);
@@ -82,6 +89,6 @@ pub fn verify_plan(world: &World, outcome: &PlanOutcome) {
         state.remove(p);
         assert_eq!(world.contact_stability(&state), Stability::Stable, "step {k}: remainder unstable");
     }
-    assert!(state.iter().all(|p| world.fixed().contains(p)), "plan leaves non-fixed parts");
     let _ = Vec3::ZERO;
+    state
 }

@@ -25,6 +25,9 @@ pub fn stuck_tube() -> Scene {
     let index = |name: &str| report.parts.iter().position(|p| p.name == name).unwrap();
     let (handle, stick, receptacle, cap) = (index("handle"), index("stick"), index("receptacle"), index("cap"));
     report.status = "no_plan".into();
+    // format 1.3: the partial plan is the handle's step (its motion as in the found plan)
+    report.partial_assembly_sequence = report.assembly_sequence.iter().filter(|s| s.part == handle).cloned().collect();
+    report.remaining = Some(vec![stick, receptacle, cap]);
     report.assembly_sequence.clear();
     report.disassembly_sequence = vec![handle];
     report.explanation = vec![Explanation {

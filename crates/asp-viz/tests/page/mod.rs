@@ -51,7 +51,9 @@ fn an_unfinished_plan_shows_its_partial_sequence_and_stuck_parts() {
     let d = data(&html(&scene));
     assert_eq!(d["status"], "no_plan");
     assert_eq!(d["steps"].as_array().unwrap().len(), 1);
-    assert!(d["steps"][0]["motion"].is_null());
+    // the partial plan (format 1.3) records how the part that came off moves
+    assert_eq!(d["steps"][0]["motion"]["kind"], "linear");
+    assert!(d["status_text"].as_str().unwrap().contains("the partial plan"), "{}", d["status_text"]);
     assert_eq!(d["initial"].as_array().unwrap().len(), 3);
     let stick = d["stuck"][0].as_u64().unwrap() as usize;
     assert_eq!(d["parts"][stick]["stuck"], true);
@@ -71,8 +73,10 @@ fn names_cannot_break_out_of_the_data_script() {
 fn a_no_plan_after_a_full_backtrack_starts_from_the_dead_end_its_explanation_describes() {
     // the planner backtracked to the root: the last branch is empty, the explanation names the
     // dead end {stick, cap} (+ the fixed receptacle)
+    // a plan of format < 1.3: no partial sequence
     let mut scene = stuck_tube();
     scene.report.disassembly_sequence.clear();
+    scene.report.partial_assembly_sequence.clear();
     let scene = asp_viz::Scene::new(scene.assembly.clone(), scene.report.clone(), std::path::Path::new("fixture")).unwrap();
     assert_eq!(scene.initial.len(), 3);
     assert_eq!(scene.steps.len(), 1, "the handle");
