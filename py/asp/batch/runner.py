@@ -192,7 +192,7 @@ def run(job: Job, out: os.PathLike | str, ray: Optional[str] = "local", workers:
             progress(job.describe(item, result))
 
     try:
-        if ray in (None, "none"):
+        if ray in (None, "none") or not todo:  # nothing to run: no Ray to start
             for item in todo:
                 finished(item, run_item(job.kind, job.spec, item.payload, str(out)))
         else:
