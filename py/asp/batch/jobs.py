@@ -10,6 +10,7 @@ machine, and resume by skipping the items whose results are recorded.
 
 from __future__ import annotations
 
+import abc
 import json
 import os
 import time
@@ -47,8 +48,9 @@ def _models(paths: Sequence[os.PathLike | str]) -> List[Dict[str, Any]]:
     ]
 
 
-class Job:
-    """A batch job: override :meth:`items`, :func:`run_item` dispatch and :meth:`finish`."""
+class Job(abc.ABC):
+    """A batch job (abstract): each kind defines its items, its :func:`run_item` runner and
+    :meth:`finish`."""
 
     kind: str = ""
     # whether :meth:`finish` runs when some items failed (their results are ``{"error": ...}``)
@@ -57,8 +59,9 @@ class Job:
     def __init__(self, spec: Dict[str, Any]) -> None:
         self.spec = spec
 
+    @abc.abstractmethod
     def items(self) -> List[Item]:
-        raise NotImplementedError
+        """The job's items, in a fixed order."""
 
     def done(self, out: Path, item: Item, result: Dict[str, Any]) -> bool:
         """Whether a journaled item is still done (its output files exist)."""
@@ -68,9 +71,9 @@ class Job:
         """One line of progress for an item that succeeded."""
         return item.key
 
+    @abc.abstractmethod
     def finish(self, out: Path, results: Dict[str, Dict[str, Any]]) -> str:
         """Writes what needs every item (manifest, index, summary); returns the closing line."""
-        raise NotImplementedError
 
     def record(self) -> Dict[str, Any]:
         """The job record of the journal: a resumed batch must have the same one."""
