@@ -93,6 +93,7 @@ impl OptimiseArgs {
                 SupportArg::Below => Support::Below,
                 SupportArg::Contact => Support::ContactGraph,
             },
+            ..OptimiseSettings::default()
         }))
     }
 }

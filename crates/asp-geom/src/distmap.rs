@@ -83,6 +83,17 @@ impl DirMask {
     /// No direction.
     pub const EMPTY: DirMask = DirMask { words: [0; 4] };
 
+    /// The set whose direction `64 k + b` is bit `b` of `words[k]` (the inverse of
+    /// [`DirMask::words`]; e.g. a mask kept in an objective's memory words).
+    pub const fn from_words(words: [u64; 4]) -> DirMask {
+        DirMask { words }
+    }
+
+    /// The set as four words: direction `64 k + b` is bit `b` of word `k`.
+    pub const fn words(&self) -> [u64; 4] {
+        self.words
+    }
+
     /// The directions `0..count`.
     pub fn first(count: usize) -> DirMask {
         let mut m = DirMask::EMPTY;

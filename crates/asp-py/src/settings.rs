@@ -209,6 +209,7 @@ fn optimise_settings(k: &Keywords<'_, '_>) -> Result<Option<OptimiseSettings>, E
         resolution: k.count("resolution")?.unwrap_or(d.resolution),
         d_max: k.positive("d_max")?,
         support,
+        ..d
     }))
 }
 

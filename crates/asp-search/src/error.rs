@@ -33,6 +33,15 @@ pub enum SearchError {
         /// The first step that fails and why.
         reason: String,
     },
+    /// A search plug-in (a rollout or expansion policy, a Q-function, an objective or filter)
+    /// failed, or broke its contract (e.g. chose an action that is not on offer).
+    #[error("{what}: {reason}")]
+    Plugin {
+        /// Which plug-in (e.g. `rollout policy`).
+        what: String,
+        /// What went wrong.
+        reason: String,
+    },
     /// An error of the geometry layer (loading, distance maps).
     #[error(transparent)]
     Geom(#[from] GeomError),
@@ -42,6 +51,11 @@ impl SearchError {
     /// Shorthand for a [`SearchError::Config`].
     pub fn config(reason: impl Into<String>) -> Self {
         SearchError::Config { reason: reason.into() }
+    }
+
+    /// Shorthand for a [`SearchError::Plugin`].
+    pub fn plugin(what: impl Into<String>, reason: impl Into<String>) -> Self {
+        SearchError::Plugin { what: what.into(), reason: reason.into() }
     }
 }
 

@@ -6,12 +6,15 @@
 //! the remaining removals depend only on that state (the memories carry the history the
 //! direction-change objective needs), and adding the same vector to every point keeps dominance,
 //! so the front of a state is the non-dominated union over its feasible removals `a` of
-//! `r(s, a) + front(s \ a)`.
+//! `r(s, a) + front(s \ a)`. States are told apart by their memories' key words
+//! ([`crate::Objective::key_words`]), as in the search; the programme is exact when the key
+//! holds everything the rewards depend on (true of the built-in objectives). Steps are
+//! [`StepKind::Replay`] steps.
 
 use crate::error::{Result, SearchError};
 use crate::hypervolume::ParetoFront;
-use crate::objective::Memory;
 use crate::mdp::Mdp;
+use crate::objective::StepKind;
 use asp_geom::distmap::MapState;
 use asp_geom::PartSet;
 use std::collections::HashMap;
@@ -49,7 +52,8 @@ impl ExactFront {
     }
 }
 
-type Key = (PartSet, Vec<Memory>);
+/// Present parts and the memories' key words.
+type Key = (PartSet, Vec<u64>);
 
 struct Entry {
     /// suffix vectors with (action, child entry, child point)
@@ -67,8 +71,8 @@ struct Dp<'p> {
 }
 
 impl<'p> Dp<'p> {
-    fn solve(&mut self, present: &PartSet, memories: &[Memory]) -> Result<usize> {
-        let key = (present.clone(), memories.to_vec());
+    fn solve(&mut self, present: &PartSet, memory: &[u64]) -> Result<usize> {
+        let key = (present.clone(), self.problem.key_of(memory));
         if let Some(&e) = self.memo.get(&key) {
             return Ok(e);
         }
@@ -88,13 +92,12 @@ impl<'p> Dp<'p> {
             worst.iter_mut().for_each(|w| *w = 0.0);
         } else {
             let mut actions = Vec::new();
-            sim.feasible_actions(&mut actions);
+            let mut counts = problem.filter_counts();
+            problem.feasible_actions(&mut sim, memory, StepKind::Replay, &mut actions, &mut counts);
             for a in actions {
-                let mut mem = memories.to_vec();
+                let mut mem = memory.to_vec();
                 let mut rewards = vec![0.0; m];
-                for (k, o) in self.problem.objectives().iter().enumerate() {
-                    rewards[k] = o.reward(a, &mut sim, &mut mem[k]);
-                }
+                problem.rewards(&mut sim, &mut mem, a, StepKind::Replay, &mut rewards);
                 let child = self.solve(&present.without(a), &mem)?;
                 let c = &self.entries[child];
                 let mut cand = vec![0.0; m];
@@ -139,8 +142,7 @@ impl<'p> Dp<'p> {
 pub fn exact_front(problem: &Mdp, max_states: usize) -> Result<ExactFront> {
     let maps = problem.maps();
     let mut dp = Dp { problem, memo: HashMap::new(), entries: Vec::new(), max_states, spare: Vec::new() };
-    let m = problem.num_objectives();
-    let root = dp.solve(&PartSet::full(maps.num_parts()), &vec![Memory::default(); m])?;
+    let root = dp.solve(&PartSet::full(maps.num_parts()), &problem.initial_memory())?;
     let e = &dp.entries[root];
     let mut solutions: Vec<ExactSolution> = e
         .front
@@ -172,7 +174,7 @@ pub fn enumerate_sequences(problem: &Mdp, limit: usize) -> Result<Vec<ExactSolut
     enumerate(
         problem,
         &PartSet::full(maps.num_parts()),
-        &vec![Memory::default(); m],
+        &problem.initial_memory(),
         &mut seq,
         &mut totals,
         &mut out,
@@ -184,7 +186,7 @@ pub fn enumerate_sequences(problem: &Mdp, limit: usize) -> Result<Vec<ExactSolut
 fn enumerate(
     problem: &Mdp,
     present: &PartSet,
-    memories: &[Memory],
+    memory: &[u64],
     seq: &mut Vec<usize>,
     totals: &mut [f64],
     out: &mut Vec<ExactSolution>,
@@ -200,15 +202,12 @@ fn enumerate(
         return Ok(());
     }
     let mut actions = Vec::new();
-    sim.feasible_actions(&mut actions);
+    let mut counts = problem.filter_counts();
+    problem.feasible_actions(&mut sim, memory, StepKind::Replay, &mut actions, &mut counts);
     for a in actions {
-        let mut mem = memories.to_vec();
-        let rewards: Vec<f64> = problem
-            .objectives()
-            .iter()
-            .enumerate()
-            .map(|(k, o)| o.reward(a, &mut sim, &mut mem[k]))
-            .collect();
+        let mut mem = memory.to_vec();
+        let mut rewards = vec![0.0; problem.num_objectives()];
+        problem.rewards(&mut sim, &mut mem, a, StepKind::Replay, &mut rewards);
         for (t, r) in totals.iter_mut().zip(&rewards) {
             *t += r;
         }

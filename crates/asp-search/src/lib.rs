@@ -20,13 +20,13 @@ pub mod search;
 pub use dfs::Dfs;
 pub use error::{Result, SearchError};
 pub use mcts::Mcts;
-pub use mdp::Mdp;
-pub use objective::{Accessibility, DirectionChanges, Memory, Objective, PathLength};
+pub use mdp::{ActionFilter, FilterCount, Mdp, MdpExtension, ModelContext, Verdict};
+pub use objective::{Accessibility, DirHistory, DirectionChanges, Objective, PathLength, StepContext, StepKind};
 pub use ordering::{Bookkeeping, BuiltinOrder, OrderingFactory, OrderingSource, PartOrdering, WithBookkeeping};
 pub use pareto::ParetoMcts;
-pub use policy::{EpsilonGreedy, Policy, QFunction, RandomPolicy};
+pub use policy::{EpsilonGreedy, Policy, PolicyContext, PolicyWorker, QFunction, QWorker, RandomPolicy};
 pub use problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, Stuck, StuckReason};
-pub use search::{SearchOutcome, SearchStatus, Solution};
+pub use search::{SearchOutcome, SearchStats, SearchStatus, Solution, StopToken};
 
 /// A planner: takes a problem apart within a budget. Every planner runs the same conformance
 /// tests (`tests/conformance`).

@@ -83,8 +83,11 @@ impl Variant for MaxBackup {
                 // global bounds of the whole returns
                 ctx.bounds.normalise(0, ctx.prefix[0] + v).clamp(0.0, 1.0)
             };
-            let score =
-                q_hat + exploration_term(ctx.exploration, parent_visits, tree.edges[e as usize].visits);
+            let visits = tree.edges[e as usize].visits;
+            let mut score = q_hat + exploration_term(ctx.exploration, parent_visits, visits);
+            if ctx.priors.is_some() {
+                score += ctx.prior_bonus(e, parent_visits, visits);
+            }
             if score > best.0 {
                 best = (score, k);
             }

@@ -61,7 +61,10 @@ impl Variant for FrontBackup {
             let visits = tree.edges[e as usize].visits;
             let child = tree.edges[e as usize].child as usize;
             let hv = normalised_hypervolume(tree.values[child].front.as_ref(), tree.reward(e), ctx);
-            let score = hv / visits.max(1) as f64 + exploration_term(ctx.exploration, parent_visits, visits);
+            let mut score = hv / visits.max(1) as f64 + exploration_term(ctx.exploration, parent_visits, visits);
+            if ctx.priors.is_some() {
+                score += ctx.prior_bonus(e, parent_visits, visits);
+            }
             if score > best.0 {
                 best = (score, k);
             }
@@ -119,7 +122,7 @@ mod tests {
             assert!(front.insert(p, || ()));
         }
         let bounds = Bounds { lo: [0.0; MAX_OBJECTIVES], hi: [1.0; MAX_OBJECTIVES] };
-        let ctx = SelectContext { exploration: 1.0, bounds: &bounds, prefix: &[0.0, 0.0] };
+        let ctx = SelectContext { exploration: 1.0, bounds: &bounds, prefix: &[0.0, 0.0], priors: None };
         let hv = normalised_hypervolume(Some(&front), &[0.0, 0.0], &ctx);
         let all = hypervolume_2d(&pts, [NORMALISED_REFERENCE; 2]);
         let first_64 = hypervolume_2d(&pts[..64], [NORMALISED_REFERENCE; 2]);

@@ -6,11 +6,12 @@
 //! that name the setting, not a command-line flag. Every step is also public on its own, so a
 //! caller that plans many times on one model (data collection, benchmarks) builds the world once.
 
-use crate::objective::parse_objectives;
+use crate::mdp::{MdpExtension, ModelContext};
+use crate::objective::resolve_objectives;
 use crate::ordering::{BuiltinOrder, OrderingSource};
 use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step};
 use crate::report::{OptimisationEntry, ParetoEntry, PlanReport, CHECKER_DISTANCE_MAPS};
-use crate::search::{SearchOutcome, SearchStatus, DEFAULT_BUDGET, DEFAULT_EPISODES};
+use crate::search::{SearchOutcome, SearchStatus, StopToken, DEFAULT_BUDGET, DEFAULT_EPISODES};
 use crate::{Dfs, Mcts, Mdp, ParetoMcts, Planner, Result, SearchError};
 use asp_geom::distmap::{DistanceMaps, MapConfig, Support};
 use asp_geom::io::LoadOptions;
@@ -136,6 +137,12 @@ pub struct OptimiseSettings {
     pub d_max: Option<f64>,
     /// The optimiser's gravity check.
     pub support: Support,
+    /// Objectives and feasibility filters beyond the built-in ones (e.g. a robot's); their
+    /// objective names may appear in `objectives`.
+    pub extensions: Vec<Arc<dyn MdpExtension>>,
+    /// Stops the search from another thread (Ctrl-C, a caller's deadline); what was found so
+    /// far is returned, as with `time_limit`.
+    pub stop: Option<StopToken>,
 }
 
 impl Default for OptimiseSettings {
@@ -151,6 +158,8 @@ impl Default for OptimiseSettings {
             resolution: asp_geom::distmap::DEFAULT_RESOLUTION,
             d_max: None,
             support: Support::Below,
+            extensions: Vec::new(),
+            stop: None,
         }
     }
 }
@@ -264,7 +273,7 @@ pub fn plan_assembly(
     progress: Option<&(dyn Fn(&Progress) + Sync)>,
 ) -> Result<PlanResult> {
     if let Some(optimise) = &settings.optimise {
-        return self::optimise(&assembly, settings, optimise);
+        return self::optimise(Arc::new(assembly), settings, optimise);
     }
     let checker = checker(assembly, settings)?;
     let dfs = planner(settings, checker.world())?;
@@ -279,15 +288,15 @@ pub fn plan_assembly(
 
 /// Optimises a sequence of `assembly` on distance maps (MCTS for one objective, Pareto-MCTS
 /// for several).
-pub fn optimise(assembly: &Assembly, settings: &PlanSettings, o: &OptimiseSettings) -> Result<PlanResult> {
-    let objectives = parse_objectives(&o.objectives)?;
-    if objectives.len() > 1 && !o.pareto {
+pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<PlanResult> {
+    crate::objective::check_objective_names(&o.objectives, &o.extensions)?;
+    if o.objectives.split(',').filter(|s| !s.trim().is_empty()).count() > 1 && !o.pareto {
         return Err(SearchError::config(format!(
             "objectives {}: several objectives need a Pareto search (or give one objective)",
             o.objectives
         )));
     }
-    let world = world_config(assembly, settings)?;
+    let world = world_config(&assembly, settings)?;
     let metres = assembly.units.metres;
     let mut config = MapConfig::builder().resolution(o.resolution).support(o.support);
     if let Some(d) = o.d_max {
@@ -301,9 +310,16 @@ pub fn optimise(assembly: &Assembly, settings: &PlanSettings, o: &OptimiseSettin
     }
     let config = config.build()?;
     let started = Instant::now();
-    let maps = Arc::new(DistanceMaps::build(assembly, &config)?);
+    let maps = Arc::new(DistanceMaps::build(&assembly, &config)?);
     let map_seconds = started.elapsed().as_secs_f64();
-    let mdp = Mdp::new(maps.clone(), objectives)?;
+    let model = ModelContext { assembly: &assembly, maps: &maps, seed: settings.seed };
+    let objectives = resolve_objectives(&o.objectives, &o.extensions, &model)?;
+    let mut mdp = Mdp::new(maps.clone(), objectives)?.with_assembly(assembly.clone()).with_seed(settings.seed);
+    for e in &o.extensions {
+        for f in e.filters(&model)? {
+            mdp = mdp.with_filter(f);
+        }
+    }
     let threads = o.threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     macro_rules! configure {
         ($builder:expr) => {{
@@ -315,6 +331,9 @@ pub fn optimise(assembly: &Assembly, settings: &PlanSettings, o: &OptimiseSettin
                 .exploration(o.exploration);
             if let Some(t) = o.time_limit {
                 b = b.time_limit(Duration::from_secs_f64(positive("the time limit", t)?));
+            }
+            if let Some(stop) = &o.stop {
+                b = b.stop_token(stop.clone());
             }
             b.build()?
         }};
@@ -331,7 +350,7 @@ pub fn optimise(assembly: &Assembly, settings: &PlanSettings, o: &OptimiseSettin
             warnings.push(w.clone());
         }
     }
-    let mut report = PlanReport::new(assembly, &plan, maps.tolerance(), &warnings);
+    let mut report = PlanReport::new(&assembly, &plan, maps.tolerance(), &warnings);
     report.stats.checker = CHECKER_DISTANCE_MAPS.into();
     report.pareto_front = o.pareto.then(|| {
         outcome

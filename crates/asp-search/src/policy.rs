@@ -1,11 +1,24 @@
-//! Rollout (default) policies: which feasible removal a simulation takes next (thesis 5.4.2,
-//! "Simulation"). The vanilla search uses [`RandomPolicy`]; [`EpsilonGreedy`] is the guided
-//! policy of 5.4.5 / 6.4.4 over any [`QFunction`]s (the product of their values for several
-//! objectives), so a learned Q-function slots in by implementing that trait.
+//! Rollout and expansion policies: which feasible removal a simulation takes next (thesis 5.4.2,
+//! "Simulation"), which untried removal an expansion adds, and optional priors for the tree
+//! policy.
+//!
+//! A [`Policy`] is the shareable description a search is configured with; every search thread
+//! asks it for its own [`PolicyWorker`] ([`Policy::for_worker`]), which owns whatever scratch it
+//! needs (feature buffers, an inference session) and is never shared between threads. The same
+//! holds for [`QFunction`]s and their [`QWorker`]s, which give the Q-values of every feasible
+//! action of a state in one call.
+//!
+//! The vanilla search uses [`RandomPolicy`]; [`EpsilonGreedy`] is the guided policy of 5.4.5 /
+//! 6.4.4 over any [`QFunction`]s (the product of their values for several objectives).
+//!
+//! A policy that returns an index outside the actions offered, or fails, stops the search with
+//! a [`SearchError::Plugin`] error; it never panics a worker thread.
 
-use crate::objective::Memory;
+use crate::error::{Result, SearchError};
 use crate::mdp::Mdp;
-use asp_geom::distmap::MapState;
+use crate::objective::{StepContext, StepKind};
+use asp_geom::distmap::{DistanceMaps, MapState};
+use asp_geom::PartSet;
 use rand::{RngExt, SeedableRng};
 use std::fmt::Debug;
 use std::sync::Arc;
@@ -21,24 +34,99 @@ pub fn rng_for(seed: u64, stream: u64) -> SearchRng {
     r
 }
 
-/// What a policy may look at: the state (distance maps, present parts, lazily computed minimum
-/// maps), the objectives' memories, and the problem.
+/// What a policy or Q-function may look at: the state (distance maps, present parts, lazily
+/// computed minimum maps and free directions), the objectives' memories (e.g. the direction
+/// history `H`), and the problem (objectives, maps, the assembly). Everything a learned
+/// Q-function needs to build its state graph (thesis 5.4.3, 6.4.3) is reachable from here
+/// without copying maps: part boxes and centres ([`DistanceMaps::part_aabb`]), distance maps
+/// ([`DistanceMaps::map`], [`DistanceMaps::blocked`]), minimum maps ([`MapState::min_map`],
+/// [`MapState::free_mask`]) and the history ([`PolicyContext::memory`]).
 #[derive(Debug)]
 pub struct PolicyContext<'a, 'm> {
     /// The current state.
     pub state: &'a mut MapState<'m>,
-    /// The objectives' memories (e.g. the common directions `H`).
-    pub memories: &'a [Memory],
+    /// Every objective's memory words ([`Mdp::memory_range`]).
+    pub memory: &'a [u64],
     /// The problem (objectives, maps).
     pub problem: &'a Mdp,
 }
 
-/// Chooses one of the feasible `actions` (part indices, never empty) and returns its position
-/// in `actions`. Must draw every random choice from `rng`.
+impl<'m> PolicyContext<'_, 'm> {
+    /// The distance maps.
+    #[inline]
+    pub fn maps(&self) -> &'m DistanceMaps {
+        self.state.maps()
+    }
+
+    /// The parts present.
+    pub fn present(&self) -> PartSet {
+        self.state.present()
+    }
+
+    /// Objective `k`'s memory words.
+    #[inline]
+    pub fn memory(&self, k: usize) -> &[u64] {
+        &self.memory[self.problem.memory_range(k)]
+    }
+}
+
+/// A rollout and expansion policy as a search is configured with it, shared by its threads.
 pub trait Policy: Send + Sync + Debug {
-    /// The index into `actions` of the part to remove next.
-    fn choose(&self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], rng: &mut SearchRng)
-        -> usize;
+    /// The instance search thread `thread` uses (called on that thread, before its first
+    /// episode).
+    fn for_worker(&self, thread: usize) -> Result<Box<dyn PolicyWorker + '_>>;
+}
+
+/// One search thread's policy: owns its scratch, used from that thread only.
+pub trait PolicyWorker {
+    /// The index into `actions` (the feasible removals of `ctx`'s state, never empty, in
+    /// increasing part order) of the part a rollout removes next. Must draw every random choice
+    /// from `rng`.
+    fn choose(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], rng: &mut SearchRng) -> Result<usize>;
+
+    /// The index into `untried` (the removals of `ctx`'s state not yet in the search graph,
+    /// never empty, increasing part order) that an expansion adds. `priors` holds this policy's
+    /// priors of the untried removals when it gives priors ([`PolicyWorker::has_priors`]).
+    /// Default: the largest prior (the first of equals), or a uniformly random one without
+    /// priors (thesis 5.4.2).
+    fn expand(
+        &mut self,
+        _ctx: &mut PolicyContext<'_, '_>,
+        untried: &[usize],
+        priors: Option<&[f64]>,
+        rng: &mut SearchRng,
+    ) -> Result<usize> {
+        Ok(match priors {
+            Some(p) => argmax(p),
+            None => rng.random_range(0..untried.len()),
+        })
+    }
+
+    /// Whether this policy gives priors ([`PolicyWorker::priors`]); asked once per search
+    /// thread. Default false.
+    fn has_priors(&self) -> bool {
+        false
+    }
+
+    /// Priors (non-negative, e.g. a softmax of Q-values) of the feasible `actions` of a state
+    /// the search adds to its graph, written to `out` (as long as `actions`). They order
+    /// expansions and, with [`crate::search::SearchBuilder::prior_weight`], add a PUCT bonus
+    /// `w · P(a) · √N(s) / (1 + N(s, a))` to the tree policy.
+    fn priors(&mut self, _ctx: &mut PolicyContext<'_, '_>, _actions: &[usize], out: &mut [f64]) -> Result<()> {
+        out.fill(0.0);
+        Ok(())
+    }
+}
+
+/// The index of the largest value (the first of equals; 0 for an empty or all-NaN slice).
+pub fn argmax(values: &[f64]) -> usize {
+    let mut best = (f64::NEG_INFINITY, 0);
+    for (k, &v) in values.iter().enumerate() {
+        if v > best.0 {
+            best = (v, k);
+        }
+    }
+    best.1
 }
 
 /// The default policy: a uniformly random feasible removal.
@@ -46,18 +134,46 @@ pub trait Policy: Send + Sync + Debug {
 pub struct RandomPolicy;
 
 impl Policy for RandomPolicy {
-    #[inline]
-    fn choose(&self, _: &mut PolicyContext<'_, '_>, actions: &[usize], rng: &mut SearchRng) -> usize {
-        rng.random_range(0..actions.len())
+    fn for_worker(&self, _thread: usize) -> Result<Box<dyn PolicyWorker + '_>> {
+        Ok(Box::new(RandomPolicy))
     }
 }
 
-/// An estimate of the return of removing `action` in the context's state (a learned
-/// Q-function, or a heuristic). For products over several objectives values should be
-/// positive.
+impl PolicyWorker for RandomPolicy {
+    #[inline]
+    fn choose(&mut self, _: &mut PolicyContext<'_, '_>, actions: &[usize], rng: &mut SearchRng) -> Result<usize> {
+        Ok(rng.random_range(0..actions.len()))
+    }
+}
+
+/// An estimate of the return of each removal in a state (a learned Q-function, or a
+/// heuristic), shared by a search's threads. For products over several objectives values
+/// should be positive.
 pub trait QFunction: Send + Sync + Debug {
-    /// `Q(s, a)`.
-    fn q_value(&self, ctx: &mut PolicyContext<'_, '_>, action: usize) -> f64;
+    /// `Q(s, a)` for every `a` in `actions` (the feasible removals of `ctx`'s state), written
+    /// to `out` (as long as `actions`), in one call.
+    fn q_values(&self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], out: &mut [f64]) -> Result<()>;
+
+    /// The evaluator search thread `thread` uses. Default: this function itself; override it to
+    /// give each thread its own scratch (an inference session, feature buffers).
+    fn for_worker(&self, _thread: usize) -> Result<Box<dyn QWorker + '_>> {
+        Ok(Box::new(Shared(self)))
+    }
+}
+
+/// One search thread's Q-function evaluator.
+pub trait QWorker {
+    /// `Q(s, a)` for every `a` in `actions`, written to `out`.
+    fn q_values(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], out: &mut [f64]) -> Result<()>;
+}
+
+/// A shared Q-function used as a thread's evaluator.
+struct Shared<'q, Q: ?Sized>(&'q Q);
+
+impl<Q: QFunction + ?Sized> QWorker for Shared<'_, Q> {
+    fn q_values(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], out: &mut [f64]) -> Result<()> {
+        self.0.q_values(ctx, actions, out)
+    }
 }
 
 /// The ε-greedy policy of 5.4.5 / 6.4.4: with probability ε a random removal, otherwise the
@@ -70,35 +186,58 @@ pub struct EpsilonGreedy {
 
 impl EpsilonGreedy {
     /// ε-greedy over `q_functions` (at least one); ε in `[0, 1]` (the thesis uses 0.2).
-    pub fn new(epsilon: f64, q_functions: Vec<Arc<dyn QFunction>>) -> crate::Result<Self> {
+    pub fn new(epsilon: f64, q_functions: Vec<Arc<dyn QFunction>>) -> Result<Self> {
         if !(0.0..=1.0).contains(&epsilon) {
-            return Err(crate::SearchError::config(format!("epsilon must be in [0, 1], got {epsilon}")));
+            return Err(SearchError::config(format!("epsilon must be in [0, 1], got {epsilon}")));
         }
         if q_functions.is_empty() {
-            return Err(crate::SearchError::config("the epsilon-greedy policy needs a Q-function"));
+            return Err(SearchError::config("the epsilon-greedy policy needs a Q-function"));
         }
         Ok(EpsilonGreedy { epsilon, q_functions })
+    }
+
+    /// ε.
+    pub fn epsilon(&self) -> f64 {
+        self.epsilon
     }
 }
 
 impl Policy for EpsilonGreedy {
-    fn choose(&self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], rng: &mut SearchRng) -> usize {
-        if rng.random::<f64>() <= self.epsilon {
-            return rng.random_range(0..actions.len());
-        }
-        let mut best = (f64::NEG_INFINITY, 0);
-        for (k, &a) in actions.iter().enumerate() {
-            let v: f64 = self.q_functions.iter().map(|q| q.q_value(ctx, a)).product();
-            if v > best.0 {
-                best = (v, k);
-            }
-        }
-        best.1
+    fn for_worker(&self, thread: usize) -> Result<Box<dyn PolicyWorker + '_>> {
+        let q = self.q_functions.iter().map(|q| q.for_worker(thread)).collect::<Result<Vec<_>>>()?;
+        Ok(Box::new(EpsilonGreedyWorker { epsilon: self.epsilon, q, values: Vec::new(), product: Vec::new() }))
     }
 }
 
-/// A myopic Q-function: the immediate reward of one objective (a one-step look-ahead). Useful
-/// as a baseline guide and to test guided rollouts.
+/// A thread's [`EpsilonGreedy`].
+struct EpsilonGreedyWorker<'q> {
+    epsilon: f64,
+    q: Vec<Box<dyn QWorker + 'q>>,
+    values: Vec<f64>,
+    product: Vec<f64>,
+}
+
+impl PolicyWorker for EpsilonGreedyWorker<'_> {
+    fn choose(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], rng: &mut SearchRng) -> Result<usize> {
+        if rng.random::<f64>() <= self.epsilon {
+            return Ok(rng.random_range(0..actions.len()));
+        }
+        let n = actions.len();
+        self.product.clear();
+        self.product.resize(n, 1.0);
+        self.values.resize(n, 0.0);
+        for q in &mut self.q {
+            q.q_values(ctx, actions, &mut self.values[..n])?;
+            for (p, v) in self.product.iter_mut().zip(&self.values) {
+                *p *= v;
+            }
+        }
+        Ok(argmax(&self.product))
+    }
+}
+
+/// A myopic Q-function: the immediate reward of one objective (a one-step look-ahead, on a
+/// copy of the memory). Useful as a baseline guide and to test guided rollouts.
 #[derive(Clone, Copy, Debug)]
 pub struct ImmediateReward {
     /// The objective's index in the problem.
@@ -106,8 +245,27 @@ pub struct ImmediateReward {
 }
 
 impl QFunction for ImmediateReward {
-    fn q_value(&self, ctx: &mut PolicyContext<'_, '_>, action: usize) -> f64 {
-        let mut memory = ctx.memories[self.objective];
-        ctx.problem.objectives()[self.objective].reward(action, ctx.state, &mut memory)
+    fn q_values(&self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], out: &mut [f64]) -> Result<()> {
+        let objective = &ctx.problem.objectives()[self.objective];
+        let mut memory = ctx.memory(self.objective).to_vec();
+        let original = memory.clone();
+        for (o, &a) in out.iter_mut().zip(actions) {
+            memory.copy_from_slice(&original);
+            let mut step = StepContext::new(ctx.problem, ctx.state, a, StepKind::Simulation);
+            *o = objective.reward(&mut step, &mut memory);
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn argmax_takes_the_first_of_equals() {
+        assert_eq!(argmax(&[1.0, 3.0, 3.0, 2.0]), 1);
+        assert_eq!(argmax(&[]), 0);
+        assert_eq!(argmax(&[f64::NAN, 0.5]), 1);
     }
 }

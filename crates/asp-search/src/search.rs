@@ -5,9 +5,10 @@
 //! # Episodes and steps
 //! An *episode* walks from the root to a complete disassembly. At each *search step* it runs
 //! `budget` *iterations* from the current node — selection by the tree policy, expansion of one
-//! untried removal (chosen at random), a rollout with the default policy until no part can be
-//! removed, and backpropagation along the path to the root — and then moves to the child the
-//! tree policy picks. The next episode starts again at the root.
+//! untried removal (chosen by the policy's [`PolicyWorker::expand`]: at random by default), a
+//! rollout with the rollout policy until no part can be removed, and backpropagation along the
+//! path to the root — and then moves to the child the tree policy picks. The next episode
+//! starts again at the root.
 //!
 //! # Transpositions
 //! Removing A then B leaves the same state as B then A. By default every state (present parts
@@ -28,19 +29,26 @@
 //! Root parallelism: each thread grows its own graph with its own random stream
 //! (`seed`, thread index) and its share of the episodes; the answers are merged in thread order.
 //! The output depends only on the seed, the settings and the thread count (not on timing)
-//! unless a time limit stops the search. `threads = 1` runs on the calling thread.
+//! unless a time limit or a [`StopToken`] stops the search. `threads = 1` runs on the calling
+//! thread.
+//!
+//! # Plug-ins
+//! The rollout and expansion policy ([`Policy`], one [`PolicyWorker`] per thread), the
+//! objectives and the feasibility filters of the [`Mdp`] are the search's plug-ins. One that
+//! fails or breaks its contract (a rollout index outside the actions offered) stops the search
+//! with an error; a panic in one is reported as an error too, not re-raised.
 
 use crate::error::{Result, SearchError};
 use crate::hypervolume::ParetoFront;
-use crate::objective::Memory;
-use crate::policy::{rng_for, Policy, PolicyContext, RandomPolicy, SearchRng};
-use crate::mdp::{Mdp, MAX_OBJECTIVES};
+use crate::mdp::{FilterCount, FilterCounts, Mdp, MAX_OBJECTIVES};
+use crate::objective::StepKind;
+use crate::policy::{rng_for, Policy, PolicyContext, PolicyWorker, RandomPolicy, SearchRng};
 use asp_geom::distmap::MapState;
 use asp_geom::{Motion, PartSet};
-use rand::RngExt;
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::marker::PhantomData;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -68,6 +76,32 @@ pub struct SearchSettings {
     pub(crate) policy: Arc<dyn Policy>,
     pub(crate) reference: Option<Vec<f64>>,
     pub(crate) transpositions: bool,
+    pub(crate) stop: Option<StopToken>,
+    pub(crate) prior_weight: f64,
+}
+
+/// Stops running searches from another thread (Ctrl-C from Python, a caller's deadline): each
+/// search thread finishes its current iteration and the search returns what it has found, as
+/// with a time limit ([`SearchStats::stopped`]). Clones share the token.
+#[derive(Clone, Debug, Default)]
+pub struct StopToken(Arc<AtomicBool>);
+
+impl StopToken {
+    /// A token that has not been stopped.
+    pub fn new() -> Self {
+        StopToken::default()
+    }
+
+    /// Asks every search holding the token to stop.
+    pub fn stop(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether [`StopToken::stop`] was called.
+    #[inline]
+    pub fn is_stopped(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
 }
 
 impl Default for SearchSettings {
@@ -83,6 +117,8 @@ impl Default for SearchSettings {
             policy: Arc::new(RandomPolicy),
             reference: None,
             transpositions: true,
+            stop: None,
+            prior_weight: 0.0,
         }
     }
 }
@@ -119,6 +155,14 @@ impl SearchSettings {
     /// Whether states reached along different paths share one node.
     pub fn transpositions(&self) -> bool {
         self.transpositions
+    }
+    /// The weight of the policy's priors in the tree policy (0: none).
+    pub fn prior_weight(&self) -> f64 {
+        self.prior_weight
+    }
+    /// The policy.
+    pub fn policy(&self) -> &Arc<dyn Policy> {
+        &self.policy
     }
 }
 
@@ -178,9 +222,23 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
         self
     }
 
-    /// The rollout policy (default [`RandomPolicy`]).
+    /// The rollout and expansion policy (default [`RandomPolicy`]).
     pub fn policy(mut self, policy: Arc<dyn Policy>) -> Self {
         self.settings.policy = policy;
+        self
+    }
+
+    /// Stops the search when `token` is stopped (breaks reproducibility, like a time limit).
+    pub fn stop_token(mut self, token: StopToken) -> Self {
+        self.settings.stop = Some(token);
+        self
+    }
+
+    /// The weight `w` of the PUCT bonus `w · P(a) · √N(s) / (1 + N(s, a))` that the policy's
+    /// priors ([`PolicyWorker::priors`]) add to the tree policy's score (default 0: priors only
+    /// order expansions; finite and ≥ 0).
+    pub fn prior_weight(mut self, weight: f64) -> Self {
+        self.settings.prior_weight = weight;
         self
     }
 
@@ -222,6 +280,12 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
         }
         if s.time_limit.is_some_and(|t| t.is_zero()) {
             return Err(SearchError::config("the time limit must be positive"));
+        }
+        if !(s.prior_weight.is_finite() && s.prior_weight >= 0.0) {
+            return Err(SearchError::config(format!(
+                "the prior weight must be finite and >= 0, got {}",
+                s.prior_weight
+            )));
         }
         if let Some(r) = &s.reference {
             if r.iter().any(|v| !v.is_finite()) {
@@ -306,7 +370,7 @@ pub struct TracePoint {
 }
 
 /// What the search did.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SearchStats {
     /// Episodes finished.
     pub episodes: u64,
@@ -332,6 +396,17 @@ pub struct SearchStats {
     pub exhausted: bool,
     /// Threads used.
     pub threads: usize,
+    /// Removals the problem's feasibility filters rejected, by filter and reason (all threads;
+    /// empty without filters).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub filtered: Vec<FilterCount>,
+    /// Whether a time limit or a stop token ended the search early.
+    #[serde(default)]
+    pub stopped: bool,
+    /// Complete sequences the search found that did not replay ([`Mdp::evaluate`]: a filter
+    /// that rejects on replay what a rollout admitted); they are left out of the answer.
+    #[serde(default)]
+    pub replay_failures: u64,
 }
 
 /// The result of a search.
@@ -382,7 +457,7 @@ pub(crate) enum Status {
     Dead,
 }
 
-/// A disassembly state: the parts present and the objectives' memories (kept in
+/// A disassembly state: the parts present and the objectives' memory words (kept in
 /// [`Tree::memory`]). With transpositions every state has one node however it was reached.
 /// What selection reads is here (16 bytes); the node's part sets are in [`Tree::sets`].
 #[derive(Clone, Debug)]
@@ -422,14 +497,27 @@ pub(crate) struct Tree<V> {
     pub values: Vec<V>,
     pub edges: Vec<Edge>,
     rewards: Vec<f64>,
-    memory: Vec<Memory>,
+    /// `w` memory words per node.
+    memory: Vec<u64>,
+    w: usize,
     index: HashMap<u64, u32>,
     pub m: usize,
+    /// With a policy that gives priors: per node, its feasible actions' priors (a range of
+    /// `node_priors`), and per edge its action's prior.
+    prior_spans: Vec<(u32, u32)>,
+    node_priors: Vec<(u16, f32)>,
+    pub edge_priors: Vec<f32>,
 }
 
 impl<V> Tree<V> {
-    fn memory(&self, n: u32) -> &[Memory] {
-        &self.memory[n as usize * self.m..(n as usize + 1) * self.m]
+    fn memory(&self, n: u32) -> &[u64] {
+        &self.memory[n as usize * self.w..(n as usize + 1) * self.w]
+    }
+
+    /// The prior node `n` gave `action` (0 when it gave none).
+    fn prior_of(&self, n: u32, action: usize) -> f32 {
+        let Some(&(from, to)) = self.prior_spans.get(n as usize) else { return 0.0 };
+        self.node_priors[from as usize..to as usize].iter().find(|(a, _)| *a as usize == action).map_or(0.0, |p| p.1)
     }
 
     /// The rewards of edge `e`.
@@ -442,9 +530,9 @@ impl<V> Tree<V> {
         EdgeIter { tree: self, next: self.nodes[n as usize].first_edge }
     }
 
-    /// Whether node `n` holds `present` and `memory`.
-    fn is(&self, n: u32, present: &PartSet, memory: &[Memory]) -> bool {
-        self.sets[n as usize].present == *present && self.memory(n) == memory
+    /// Whether node `n` holds `present` and `memory` (its key words).
+    fn is(&self, n: u32, present: &PartSet, memory: &[u64], problem: &Mdp) -> bool {
+        self.sets[n as usize].present == *present && problem.key_eq(self.memory(n), memory)
     }
 }
 
@@ -465,11 +553,11 @@ impl<V> Iterator for EdgeIter<'_, V> {
     }
 }
 
-/// A hash of a state (present parts and memories), for the transposition index.
-fn state_hash(present: &PartSet, memory: &[Memory]) -> u64 {
+/// A hash of a state (present parts and the memories' key words), for the transposition index.
+fn state_hash(present: &PartSet, memory: &[u64], problem: &Mdp) -> u64 {
     let mut h = std::collections::hash_map::DefaultHasher::new();
     present.hash(&mut h);
-    memory.hash(&mut h);
+    problem.hash_key(memory, &mut h);
     h.finish()
 }
 
@@ -510,6 +598,20 @@ pub(crate) struct SelectContext<'a> {
     pub bounds: &'a Bounds,
     /// The returns collected on the way to the node selection starts from.
     pub prefix: &'a [f64],
+    /// The PUCT weight and the edges' priors, when the policy gives priors and the weight is
+    /// positive.
+    pub priors: Option<(f64, &'a [f32])>,
+}
+
+impl SelectContext<'_> {
+    /// The PUCT bonus of edge `e`: `w · P(e) · √N(parent) / (1 + N(e))` (0 without priors).
+    #[inline]
+    pub fn prior_bonus(&self, e: u32, parent_visits: u32, edge_visits: u32) -> f64 {
+        match self.priors {
+            None => 0.0,
+            Some((w, p)) => w * p[e as usize] as f64 * (parent_visits as f64).sqrt() / (1.0 + edge_visits as f64),
+        }
+    }
 }
 
 /// The variant-specific parts: the node value, its backup and the tree policy.
@@ -544,11 +646,22 @@ struct Worker<'p, V: Variant> {
     settings: &'p SearchSettings,
     m: usize,
     n: usize,
+    /// Memory words per state.
+    w: usize,
     tree: Tree<V::Value>,
     rng: SearchRng,
     sim: MapState<'p>,
+    policy: Box<dyn PolicyWorker + 'p>,
+    /// Whether the policy gives priors.
+    priors: bool,
     actions: Vec<usize>,
     candidates: Vec<u32>,
+    /// Scratch: a node's untried actions and their priors, and the priors of new nodes.
+    untried: Vec<usize>,
+    untried_priors: Vec<f64>,
+    prior_buf: Vec<f64>,
+    /// Scratch: the memory words of the state being simulated.
+    memory: Vec<u64>,
     /// The nodes of the current path from the root, the edges between them, and the returns
     /// collected up to each node (`m` per node).
     path: Vec<u32>,
@@ -559,18 +672,33 @@ struct Worker<'p, V: Variant> {
     archive: ParetoFront<Vec<u16>>,
     archive_changed: bool,
     stats: SearchStats,
+    filtered: FilterCounts,
     deadline: Option<Instant>,
     stopped: bool,
+    /// The first plug-in error; it stops this worker, and through `abort` the others.
+    error: Option<SearchError>,
+    abort: &'p StopToken,
 }
 
 impl<'p, V: Variant> Worker<'p, V> {
-    fn new(problem: &'p Mdp, settings: &'p SearchSettings, thread: usize, start: Instant) -> Self {
+    fn new(
+        problem: &'p Mdp,
+        settings: &'p SearchSettings,
+        thread: usize,
+        start: Instant,
+        abort: &'p StopToken,
+    ) -> Result<Self> {
         let m = problem.num_objectives();
         let maps = problem.maps();
         let n = maps.num_parts();
+        let memory = problem.initial_memory();
+        let w = memory.len();
         let mut sim = MapState::new(maps);
+        let mut filtered = problem.filter_counts();
         let mut actions = Vec::with_capacity(n);
-        sim.feasible_actions(&mut actions);
+        problem.feasible_actions(&mut sim, &memory, StepKind::Expansion, &mut actions, &mut filtered);
+        let policy = settings.policy.for_worker(thread)?;
+        let priors = policy.has_priors();
         let full = PartSet::full(n);
         let complete = sim.is_complete();
         let root = Node {
@@ -597,23 +725,34 @@ impl<'p, V: Variant> Worker<'p, V> {
             values: vec![V::Value::default()],
             edges: Vec::new(),
             rewards: Vec::new(),
-            memory: vec![Memory::default(); m],
+            memory: memory.clone(),
+            w,
             index: HashMap::new(),
             m,
+            prior_spans: Vec::new(),
+            node_priors: Vec::new(),
+            edge_priors: Vec::new(),
         };
         if settings.transpositions {
-            tree.index.insert(state_hash(&tree.sets[0].present, tree.memory(0)), 0);
+            tree.index.insert(state_hash(&tree.sets[0].present, tree.memory(0), problem), 0);
         }
-        Worker {
+        let mut worker = Worker {
             problem,
             settings,
             m,
             n,
+            w,
             tree,
             rng: rng_for(settings.seed, thread as u64),
             sim,
+            policy,
+            priors,
             actions,
             candidates: Vec::with_capacity(n),
+            untried: Vec::with_capacity(n),
+            untried_priors: Vec::with_capacity(n),
+            prior_buf: Vec::with_capacity(n),
+            memory,
             path: Vec::with_capacity(n + 1),
             path_edges: Vec::with_capacity(n),
             path_prefix: Vec::with_capacity((n + 1) * m),
@@ -622,9 +761,30 @@ impl<'p, V: Variant> Worker<'p, V> {
             archive: ParetoFront::new(m),
             archive_changed: false,
             stats: SearchStats::default(),
+            filtered,
             deadline: settings.time_limit.map(|t| start + t),
             stopped: false,
+            error: None,
+            abort,
+        };
+        if worker.priors {
+            worker.record_priors()?;
         }
+        Ok(worker)
+    }
+
+    /// Asks the policy for the priors of `self.actions` in the simulated state (that of the
+    /// node just added) and keeps them for that node.
+    fn record_priors(&mut self) -> Result<()> {
+        let count = self.actions.len();
+        self.prior_buf.clear();
+        self.prior_buf.resize(count, 0.0);
+        let mut ctx = PolicyContext { state: &mut self.sim, memory: &self.memory, problem: self.problem };
+        self.policy.priors(&mut ctx, &self.actions, &mut self.prior_buf)?;
+        let from = self.tree.node_priors.len() as u32;
+        self.tree.node_priors.extend(self.actions.iter().zip(&self.prior_buf).map(|(&a, &p)| (a as u16, p as f32)));
+        self.tree.prior_spans.push((from, self.tree.node_priors.len() as u32));
+        Ok(())
     }
 
     fn root_finished(&self) -> bool {
@@ -651,6 +811,14 @@ impl<'p, V: Variant> Worker<'p, V> {
         self.path_prefix.truncate(len * self.m);
     }
 
+    /// Whether the time limit or the stop token says to stop.
+    #[inline]
+    fn should_stop(&self) -> bool {
+        self.deadline.is_some_and(|d| Instant::now() >= d)
+            || self.settings.stop.as_ref().is_some_and(StopToken::is_stopped)
+            || self.abort.is_stopped()
+    }
+
     /// One episode: search steps from the root down to a complete sequence.
     fn episode(&mut self) {
         self.path.clear();
@@ -668,9 +836,13 @@ impl<'p, V: Variant> Worker<'p, V> {
                 if self.tree.nodes[current as usize].status != Status::Open {
                     break;
                 }
-                self.iterate();
+                if let Err(e) = self.iterate() {
+                    self.error = Some(e);
+                    self.stopped = true;
+                    return;
+                }
                 self.stats.iterations += 1;
-                if self.deadline.is_some_and(|d| Instant::now() >= d) {
+                if self.should_stop() {
                     self.stopped = true;
                     return;
                 }
@@ -679,6 +851,18 @@ impl<'p, V: Variant> Worker<'p, V> {
                 Some(e) => self.push(e),
                 None => break,
             }
+        }
+    }
+
+    /// The tree policy's context at the end of the path.
+    fn select_context(&self) -> SelectContext<'_> {
+        let m = self.m;
+        SelectContext {
+            exploration: self.settings.exploration,
+            bounds: &self.bounds,
+            prefix: &self.path_prefix[self.path_prefix.len() - m..],
+            priors: (self.priors && self.settings.prior_weight > 0.0)
+                .then_some((self.settings.prior_weight, &self.tree.edge_priors[..])),
         }
     }
 
@@ -695,16 +879,14 @@ impl<'p, V: Variant> Worker<'p, V> {
         if self.candidates.is_empty() {
             return None;
         }
-        let m = self.m;
-        let prefix = &self.path_prefix[self.path_prefix.len() - m..];
-        let ctx = SelectContext { exploration: self.settings.exploration, bounds: &self.bounds, prefix };
-        let k = V::select(&self.tree, node, &self.candidates, &ctx);
+        let k = V::select(&self.tree, node, &self.candidates, &self.select_context());
         Some(self.candidates[k])
     }
 
     /// Selection, expansion, rollout and backpropagation from the end of the path.
-    fn iterate(&mut self) {
+    fn iterate(&mut self) -> Result<()> {
         let m = self.m;
+        let w = self.w;
         let base = self.path.len();
         // Selection: descend through fully expanded nodes.
         loop {
@@ -712,7 +894,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             let nd = &self.tree.nodes[node as usize];
             if nd.status != Status::Open {
                 self.truncate(base);
-                return;
+                return Ok(());
             }
             if nd.untried_left != 0 {
                 break;
@@ -727,39 +909,54 @@ impl<'p, V: Variant> Worker<'p, V> {
             if self.candidates.is_empty() {
                 self.refresh_path_status();
                 self.truncate(base);
-                return;
+                return Ok(());
             }
-            let prefix = &self.path_prefix[self.path_prefix.len() - m..];
-            let ctx = SelectContext { exploration: self.settings.exploration, bounds: &self.bounds, prefix };
-            let k = V::select(&self.tree, node, &self.candidates, &ctx);
+            let k = V::select(&self.tree, node, &self.candidates, &self.select_context());
             let e = self.candidates[k];
             self.push(e);
         }
 
-        // Expansion: a random untried removal.
+        // Expansion: an untried removal, chosen by the policy (at random by default).
         let parent = *self.path.last().expect("path");
         let ps = &self.tree.sets[parent as usize];
         self.sim.reset_with_free(&ps.present, &ps.free);
-        let mut memories = [Memory::default(); MAX_OBJECTIVES];
-        memories[..m].copy_from_slice(self.tree.memory(parent));
+        self.memory.copy_from_slice(self.tree.memory(parent));
         let mut ret = [0.0f64; MAX_OBJECTIVES];
         ret[..m].copy_from_slice(&self.path_prefix[self.path_prefix.len() - m..]);
-        let untried = &self.tree.sets[parent as usize].untried;
-        let pick = self.rng.random_range(0..untried.len());
-        let action = untried.iter().nth(pick).expect("pick < len");
+        self.untried.clear();
+        self.untried.extend(self.tree.sets[parent as usize].untried.iter());
+        let untried_priors = if self.priors {
+            self.untried_priors.clear();
+            for &a in &self.untried {
+                self.untried_priors.push(self.tree.prior_of(parent, a) as f64);
+            }
+            Some(&self.untried_priors[..])
+        } else {
+            None
+        };
+        let pick = {
+            let mut ctx = PolicyContext { state: &mut self.sim, memory: &self.memory, problem: self.problem };
+            self.policy.expand(&mut ctx, &self.untried, untried_priors, &mut self.rng)?
+        };
+        let Some(&action) = self.untried.get(pick) else {
+            return Err(SearchError::plugin(
+                "expansion policy",
+                format!("chose untried action {pick} of {}", self.untried.len()),
+            ));
+        };
         let mut rewards = [0.0f64; MAX_OBJECTIVES];
-        self.problem.step(&mut self.sim, &mut memories[..m], action, &mut rewards[..m]);
+        self.problem.step(&mut self.sim, &mut self.memory, action, StepKind::Expansion, &mut rewards[..m]);
         for k in 0..m {
             ret[k] += rewards[k];
         }
         let present = self.sim.present();
         // The child: an existing node with the same state, or a new one.
-        let hash = if self.settings.transpositions { state_hash(&present, &memories[..m]) } else { 0 };
+        let hash = if self.settings.transpositions { state_hash(&present, &self.memory, self.problem) } else { 0 };
         let mut existing = NONE;
         if self.settings.transpositions {
             let mut c = self.tree.index.get(&hash).copied().unwrap_or(NONE);
             while c != NONE {
-                if self.tree.is(c, &present, &memories[..m]) {
+                if self.tree.is(c, &present, &self.memory, self.problem) {
                     existing = c;
                     break;
                 }
@@ -775,7 +972,13 @@ impl<'p, V: Variant> Worker<'p, V> {
                 existing
             } else {
                 new_child = true;
-                self.sim.feasible_actions(&mut self.actions);
+                self.problem.feasible_actions(
+                    &mut self.sim,
+                    &self.memory,
+                    StepKind::Expansion,
+                    &mut self.actions,
+                    &mut self.filtered,
+                );
                 let status = if self.sim.is_complete() {
                     Status::Solved
                 } else if self.actions.is_empty() {
@@ -802,13 +1005,20 @@ impl<'p, V: Variant> Worker<'p, V> {
                     untried: PartSet::from_indices(self.n, self.actions.iter().copied()),
                 });
                 self.tree.values.push(V::Value::default());
-                self.tree.memory.extend_from_slice(&memories[..m]);
+                self.tree.memory.extend_from_slice(&self.memory[..w]);
+                if self.priors {
+                    self.record_priors()?;
+                }
                 id
             };
             let e = self.tree.edges.len() as u32;
             let first = self.tree.nodes[parent as usize].first_edge;
             self.tree.edges.push(Edge { child, next: first, visits: 0, action: action as u16 });
             self.tree.rewards.extend_from_slice(&rewards[..m]);
+            if self.priors {
+                let p = self.tree.prior_of(parent, action);
+                self.tree.edge_priors.push(p);
+            }
             self.tree.nodes[parent as usize].first_edge = e;
             self.push(e);
         }
@@ -820,28 +1030,34 @@ impl<'p, V: Variant> Worker<'p, V> {
             self.sequence.push(action as u16);
         }
 
-        // Rollout with the default policy (from a transposed child too: more evidence).
-        let policy = &*self.settings.policy;
+        // Rollout with the rollout policy (from a transposed child too: more evidence).
         // a new child's feasible removals are in `actions` already
         let mut known = new_child;
         loop {
             if !known {
-                self.sim.feasible_actions(&mut self.actions);
+                self.problem.feasible_actions(
+                    &mut self.sim,
+                    &self.memory,
+                    StepKind::Simulation,
+                    &mut self.actions,
+                    &mut self.filtered,
+                );
             }
             known = false;
             if self.actions.is_empty() {
                 break;
             }
             let k = {
-                let mut ctx = PolicyContext {
-                    state: &mut self.sim,
-                    memories: &memories[..m],
-                    problem: self.problem,
-                };
-                policy.choose(&mut ctx, &self.actions, &mut self.rng)
+                let mut ctx = PolicyContext { state: &mut self.sim, memory: &self.memory, problem: self.problem };
+                self.policy.choose(&mut ctx, &self.actions, &mut self.rng)?
             };
-            let p = self.actions[k];
-            self.problem.step(&mut self.sim, &mut memories[..m], p, &mut rewards[..m]);
+            let Some(&p) = self.actions.get(k) else {
+                return Err(SearchError::plugin(
+                    "rollout policy",
+                    format!("chose action {k} of {}", self.actions.len()),
+                ));
+            };
+            self.problem.step(&mut self.sim, &mut self.memory, p, StepKind::Simulation, &mut rewards[..m]);
             for k in 0..m {
                 ret[k] += rewards[k];
             }
@@ -886,6 +1102,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             self.refresh_path_status();
         }
         self.truncate(base);
+        Ok(())
     }
 
     /// Recomputes the status of the path's nodes from their children, from the end up, while
@@ -947,10 +1164,14 @@ impl<'p, V: Variant> Worker<'p, V> {
         }
     }
 
-    /// Runs `episodes` episodes (or until the time limit or the root is finished).
+    /// Runs `episodes` episodes (or until the time limit, a stop or the root is finished).
     fn run(&mut self, episodes: usize, shared: &Mutex<Shared>, reference: &[f64], start: Instant) {
         for _ in 0..episodes {
             if self.stopped || self.root_finished() {
+                break;
+            }
+            if self.settings.stop.as_ref().is_some_and(StopToken::is_stopped) || self.abort.is_stopped() {
+                self.stopped = true;
                 break;
             }
             let before = self.stats.iterations;
@@ -966,7 +1187,10 @@ impl<'p, V: Variant> Worker<'p, V> {
         self.stats.removal_tests = c.blocked + c.gravity_tests;
         self.stats.failed_collision = c.blocked;
         self.stats.failed_gravity = c.unsupported;
-        if self.settings.transpositions {
+        self.stats.stopped = self.stopped && self.error.is_none();
+        if self.error.is_some() {
+            self.abort.stop();
+        } else if self.settings.transpositions {
             self.read_graph();
         }
     }
@@ -1044,6 +1268,18 @@ fn front_value<P>(front: &ParetoFront<P>, reference: &[f64]) -> f64 {
     }
 }
 
+/// What one worker hands back: its archive, statistics, filter counts and root status.
+type WorkerResult = Result<(ParetoFront<Vec<u16>>, SearchStats, FilterCounts, Status)>;
+
+/// The message of a panic payload.
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "(no message)".into())
+}
+
 /// Runs the search of variant `V` on `problem`.
 pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Result<SearchOutcome> {
     let m = problem.num_objectives();
@@ -1070,33 +1306,48 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Resul
     });
     let threads = settings.threads;
     let share = |t: usize| settings.episodes / threads + usize::from(t < settings.episodes % threads);
-    let results: Vec<(ParetoFront<Vec<u16>>, SearchStats, Status)> = if threads == 1 {
-        let mut w = Worker::<V>::new(problem, settings, 0, start);
-        w.run(share(0), &shared, &reference, start);
-        vec![(w.archive, w.stats, w.tree.nodes[0].status)]
+    let abort = StopToken::new();
+    // One worker's search; a panic in a plug-in becomes an error (and stops the others).
+    let work = |t: usize| -> WorkerResult {
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            let mut w = Worker::<V>::new(problem, settings, t, start, &abort)?;
+            w.run(share(t), &shared, &reference, start);
+            match w.error.take() {
+                Some(e) => Err(e),
+                None => Ok((w.archive, w.stats, w.filtered, w.tree.nodes[0].status)),
+            }
+        }));
+        match outcome {
+            Ok(r) => r,
+            Err(payload) => Err(SearchError::plugin(format!("search thread {t}"), format!("panicked: {}", panic_message(&*payload)))),
+        }
+        .inspect_err(|_| abort.stop())
+    };
+    let results: Vec<WorkerResult> = if threads == 1 {
+        vec![work(0)]
     } else {
         std::thread::scope(|scope| {
-            let handles: Vec<_> = (0..threads)
-                .map(|t| {
-                    let shared = &shared;
-                    let reference = &reference;
-                    scope.spawn(move || {
-                        let mut w = Worker::<V>::new(problem, settings, t, start);
-                        w.run(share(t), shared, reference, start);
-                        (w.archive, w.stats, w.tree.nodes[0].status)
+            let handles: Vec<_> = (0..threads).map(|t| scope.spawn(move || work(t))).collect();
+            handles
+                .into_iter()
+                .enumerate()
+                .map(|(t, h)| {
+                    h.join().unwrap_or_else(|p| {
+                        Err(SearchError::plugin(format!("search thread {t}"), format!("panicked: {}", panic_message(&*p))))
                     })
                 })
-                .collect();
-            handles.into_iter().map(|h| h.join().expect("search threads do not panic")).collect()
+                .collect()
         })
     };
     let seconds = start.elapsed().as_secs_f64();
+    let results = results.into_iter().collect::<Result<Vec<_>>>()?;
 
     // Merge in thread order (deterministic).
     let mut merged: ParetoFront<Vec<u16>> = ParetoFront::new(m);
     let mut stats = SearchStats { threads, seconds, exhausted: false, ..Default::default() };
+    let mut filtered = problem.filter_counts();
     let mut dead = true;
-    for (archive, s, status) in &results {
+    for (archive, s, f, status) in &results {
         for (p, seq) in archive.iter() {
             merged.insert(p, || seq.clone());
         }
@@ -1109,13 +1360,26 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Resul
         stats.failed_gravity += s.failed_gravity;
         stats.tree_nodes += s.tree_nodes;
         stats.exhausted |= s.exhausted;
+        stats.stopped |= s.stopped;
+        filtered.add(f);
         dead &= *status == Status::Dead;
     }
+    stats.filtered = problem.report_filtered(&filtered);
     let mut solutions = Vec::with_capacity(merged.len());
     for (_, seq) in merged.sorted() {
         let sequence: Vec<usize> = seq.iter().map(|&p| p as usize).collect();
-        let (values, motions) = problem.evaluate(&sequence)?;
-        solutions.push(Solution { values, sequence, motions });
+        match problem.evaluate(&sequence) {
+            Ok((values, motions)) => solutions.push(Solution { values, sequence, motions }),
+            // a filter rejected on replay what a rollout admitted: not an answer
+            Err(SearchError::Infeasible { .. }) => stats.replay_failures += 1,
+            Err(e) => return Err(e),
+        }
+    }
+    if stats.replay_failures > 0 {
+        merged = ParetoFront::new(m);
+        for s in &solutions {
+            merged.insert(&s.values, || s.sequence.iter().map(|&p| p as u16).collect());
+        }
     }
     let value = front_value(&merged, &reference);
     let mut shared = shared.into_inner().unwrap_or_else(|e| e.into_inner());

@@ -9,4 +9,5 @@ mod mcts;
 mod objectives;
 mod pareto;
 mod real;
+mod seams;
 mod verify;

@@ -139,3 +139,40 @@ fn bad_objective_flags_are_errors() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("resolution"), "{}", stderr(&o));
 }
+
+/// The optimiser's answers for fixed seeds and thread counts, pinned to the values the search
+/// gave before its plug-in points (objective memory, filters, per-thread policies) were opened:
+/// refactoring the engine must not change a single result. Update the literals only for a
+/// change that is meant to change the search (and say so in the commit).
+#[test]
+fn optimiser_results_for_a_seed_are_pinned() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = asp(&["gen", "soma", "--size", "4", "--seed", "5", "--out", dir.path().to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let cube = dir.path().join("soma4_000.glb");
+    let plan = |args: &[&str]| {
+        let out = dir.path().join("plan.json");
+        let mut all = vec!["plan", cube.to_str().unwrap(), "--threads", "2", "--episodes", "300", "--quiet"];
+        all.extend_from_slice(args);
+        all.extend_from_slice(&["--out", out.to_str().unwrap()]);
+        let o = asp(&all);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        json(&out)
+    };
+    let seq = |v: &serde_json::Value| -> Vec<u64> {
+        v["disassembly_sequence"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect()
+    };
+    let pareto = plan(&["--objective", "access,dirchange", "--pareto", "--seed", "1"]);
+    let opt = &pareto["optimisation"];
+    assert_eq!(opt["hypervolume"].as_f64().unwrap(), 107386.34163125232);
+    assert_eq!(opt["values"].as_array().unwrap()[0].as_f64().unwrap(), 353.59507842361927);
+    assert_eq!(opt["values"].as_array().unwrap()[1].as_f64().unwrap(), 46.0);
+    assert_eq!(pareto["pareto_front"].as_array().unwrap().len(), 12);
+    assert_eq!(seq(&pareto), vec![10, 8, 12, 7, 3, 11, 18, 19, 5, 15, 16, 13, 17, 2, 9, 1, 4, 0, 6, 14]);
+    assert_eq!((opt["iterations"].as_u64(), opt["tree_nodes"].as_u64()), (Some(25860), Some(21517)));
+    let path = plan(&["--objective", "pathlen", "--seed", "2"]);
+    let opt = &path["optimisation"];
+    assert_eq!(opt["values"].as_array().unwrap()[0].as_f64().unwrap(), -1.4999999776482582);
+    assert_eq!(seq(&path), vec![15, 19, 17, 10, 11, 12, 8, 9, 16, 7, 3, 18, 5, 1, 2, 4, 13, 0, 6, 14]);
+    assert_eq!((opt["iterations"].as_u64(), opt["tree_nodes"].as_u64()), (Some(17567), Some(7733)));
+}

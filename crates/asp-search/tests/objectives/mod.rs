@@ -13,7 +13,7 @@ use crate::fixtures::{close, figure_6_2, maps, problem};
 use asp_geom::distmap::MapState;
 use asp_search::exact::{enumerate_sequences, exact_front};
 use asp_search::objective::direction_changes;
-use asp_search::{DirectionChanges, Memory, Objective, SearchError};
+use asp_search::{DirHistory, DirectionChanges, Objective, SearchError, StepContext, StepKind};
 
 #[test]
 fn figure_6_2_by_hand() {
@@ -58,18 +58,22 @@ fn direction_change_resets_h_step_by_step() {
     let up = h.up_index();
     let plus_x = h.nearest(asp_geom::math::Vec3::X);
     let mut state = MapState::new(&maps);
-    let mut memory = Memory::default();
+    let p = problem(&maps, "dirchange");
+    let mut memory = [0u64; DirHistory::WORDS];
     let o = DirectionChanges;
+    let reward = |part: usize, state: &mut MapState<'_>, memory: &mut [u64]| {
+        o.reward(&mut StepContext::new(&p, state, part, StepKind::Simulation), memory)
+    };
     // top: H = {up}, Ĥ = 1
-    assert_eq!(o.reward(1, &mut state, &mut memory), 1.0);
-    assert_eq!(memory.mask.iter().collect::<Vec<_>>(), vec![up]);
+    assert_eq!(reward(1, &mut state, &mut memory), 1.0);
+    assert_eq!(DirHistory::load(&memory).mask.iter().collect::<Vec<_>>(), vec![up]);
     state.remove(1);
     // ball: {+x} ∩ {up} = ∅ → a direction change: Ĥ = 0 and H restarts as {+x}
-    assert_eq!(o.reward(2, &mut state, &mut memory), 0.0);
-    assert_eq!(memory.mask.iter().collect::<Vec<_>>(), vec![plus_x]);
+    assert_eq!(reward(2, &mut state, &mut memory), 0.0);
+    assert_eq!(DirHistory::load(&memory).mask.iter().collect::<Vec<_>>(), vec![plus_x]);
     state.remove(2);
     // base: all nine directions ∩ {+x} = {+x}: Ĥ = 1
-    assert_eq!(o.reward(0, &mut state, &mut memory), 1.0);
+    assert_eq!(reward(0, &mut state, &mut memory), 1.0);
 }
 
 #[test]
