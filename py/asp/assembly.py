@@ -124,10 +124,11 @@ class Assembly:
         stability: str = "contact",
         physics_threshold: float = 0.01,
         path_planner: bool = True,
+        subassemblies: bool = True,
         rrt_iterations: int = 2000,
         rrt_time: float = 5.0,
         max_tests: Optional[int] = None,
-        timeout: Optional[float] = None,
+        timeout: Optional[float] = 60.0,
         objective: Union[str, Sequence[str], None] = None,
         pareto: bool = False,
         episodes: int = 1000,
@@ -163,10 +164,14 @@ class Assembly:
         :param physics_threshold: physics stability: how far (fraction of the diagonal) a part
             may move.
         :param path_planner: try the RRT path planner when no straight line works.
+        :param subassemblies: let groups of parts leave together as one rigid subassembly when
+            no single part can (each planned on its own base; ``--no-subassemblies`` is
+            ``subassemblies=False``).
         :param rrt_iterations: path planner iterations per call.
         :param rrt_time: path planner wall-time cap per call, seconds.
         :param max_tests: stop after this many removal tests (status ``budget_exhausted``).
-        :param timeout: stop after this many seconds.
+        :param timeout: stop after this many seconds (status ``budget_exhausted`` with the
+            best partial plan); ``None`` for no limit.
         :param objective: optimise instead (MCTS on distance maps): ``access``, ``dirchange``,
             ``pathlen``, comma-separated or a list; several need ``pareto=True``.
         :param pareto: Pareto-MCTS over the objectives.
@@ -201,6 +206,7 @@ class Assembly:
             "stability": stability,
             "physics_threshold": physics_threshold,
             "path_planner": path_planner,
+            "subassemblies": subassemblies,
             "rrt_iterations": rrt_iterations,
             "rrt_time": rrt_time,
             "max_tests": max_tests,

@@ -18,7 +18,8 @@ LACK = "tests/data/ikea/table_lack_0825.glb"
 PUMP = "tests/data/pump"
 
 # every wall-time figure of a plan JSON: the one thing two runs of the same plan may differ in
-_SECONDS = re.compile(r'("(?:seconds|map_seconds|search_seconds)": )[-+0-9.eE]+')
+# (`stats.timings` since format 1.4: load, world, search, path_planner)
+_SECONDS = re.compile(r'("(?:seconds|map_seconds|search_seconds|load|world|search|path_planner)": )[-+0-9.eE]+')
 
 
 def need(module: str, install: str):

@@ -100,6 +100,9 @@ pub struct ModelArgs {
     /// Never call the path planner (straight lines only).
     #[arg(long)]
     pub no_path_planner: bool,
+    /// Never let a group of parts leave together as one rigid subassembly (single parts only).
+    #[arg(long)]
+    pub no_subassemblies: bool,
     /// Path planner iterations per call.
     #[arg(long, default_value_t = 2000)]
     pub rrt_iterations: usize,
@@ -112,15 +115,23 @@ pub struct ModelArgs {
 /// Flags of `asp plan`.
 #[derive(Args, Debug)]
 pub struct PlanArgs {
-    /// The model: a .glb/.gltf file, or a folder of .obj/.stl files (one part per file).
-    pub model: PathBuf,
-    /// Also write the plan as JSON to this file (format: docs/plan-format.md).
-    #[arg(long, value_name = "FILE")]
+    /// The models: .glb/.gltf files, or folders of .obj/.stl files (one part per file, the
+    /// folder is one model). Several models are planned one after another in one process.
+    #[arg(required = true, num_args = 1.., value_name = "MODEL")]
+    pub models: Vec<PathBuf>,
+    /// Each MODEL is a folder of models: every .glb/.gltf file in it, and every subfolder of
+    /// .obj/.stl files, is planned on its own.
+    #[arg(long)]
+    pub each: bool,
+    /// Also write the plan as JSON to this file (format: docs/plan-format.md); with several
+    /// models, a folder that gets one NAME.json per model.
+    #[arg(long, value_name = "PATH")]
     pub out: Option<PathBuf>,
-    /// Print the plan JSON on stdout instead of the table.
+    /// Print the plan JSON on stdout instead of the table (with several models, a JSON array).
     #[arg(long)]
     pub json: bool,
-    /// Also write the assembly animated over time as MCAP for Foxglove (docs/pictures.md).
+    /// Also write the assembly animated over time as MCAP for Foxglove (docs/pictures.md; one
+    /// model only).
     #[arg(long, value_name = "FILE")]
     pub mcap: Option<PathBuf>,
     /// Loading and testing.
@@ -142,9 +153,9 @@ pub struct PlanArgs {
     /// Stop after this many removal tests.
     #[arg(long)]
     pub max_tests: Option<u64>,
-    /// Stop after this many seconds.
-    #[arg(long)]
-    pub timeout: Option<f64>,
+    /// Stop after this many seconds with the best partial plan (0: no limit).
+    #[arg(long, default_value_t = asp_search::pipeline::DEFAULT_TIMEOUT)]
+    pub timeout: f64,
     /// No progress bar, no warnings.
     #[arg(long, short)]
     pub quiet: bool,

@@ -5,11 +5,16 @@ use anyhow::{bail, Context};
 use asp_geom::math::Axis;
 use asp_geom::Units;
 use asp_search::pipeline::{self, PlanSettings, StabilitySetting};
-use asp_search::report::{MotionEntry, PlanReport};
+use asp_search::report::{AssemblyStep, MotionEntry, PlanReport};
 use asp_search::Progress;
+use asp_search::StopReason;
+use std::collections::BTreeSet;
 use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Duration;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
+use std::time::{Duration, Instant};
 
 pub(crate) fn positive(name: &str, v: f64) -> anyhow::Result<f64> {
     if v > 0.0 && v.is_finite() {
@@ -46,6 +51,7 @@ pub(crate) fn model_settings(args: &ModelArgs) -> anyhow::Result<PlanSettings> {
             }
         },
         path_planner: !args.no_path_planner,
+        subassemblies: !args.no_subassemblies,
         rrt_iterations: args.rrt_iterations,
         rrt_time: positive("rrt-time", args.rrt_time)?,
         ..PlanSettings::default()
@@ -54,22 +60,186 @@ pub(crate) fn model_settings(args: &ModelArgs) -> anyhow::Result<PlanSettings> {
 
 /// The pipeline's settings of `asp plan`.
 pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
-    let check = |name: &str, v: Option<f64>| v.map(|v| positive(name, v)).transpose();
+    let timeout = match args.timeout {
+        t if t == 0.0 => None,
+        t => Some(positive("timeout", t)?),
+    };
     Ok(PlanSettings {
         order: crate::learn::order_source(args.order, args.onnx.as_deref())?,
         bookkeeping: args.bookkeeping || args.order == OrderArg::Bookkeeping,
         seed: args.seed,
         max_tests: args.max_tests,
-        timeout: check("timeout", args.timeout)?,
+        timeout,
         optimise: args.optimise.settings()?,
         ..model_settings(&args.load)?
     })
 }
 
-/// Runs `asp plan`.
+/// How one model's run ended, worst last: the process exits with the worst.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Verdict {
+    Found,
+    NotFound,
+    Error,
+    Interrupted,
+}
+
+impl Verdict {
+    fn code(self) -> ExitCode {
+        match self {
+            Verdict::Found => ExitCode::SUCCESS,
+            Verdict::NotFound => ExitCode::from(1),
+            Verdict::Error => ExitCode::from(2),
+            Verdict::Interrupted => ExitCode::from(130),
+        }
+    }
+}
+
+/// The Ctrl-C flag, set by the first Ctrl-C (the search then stops and its best result is
+/// printed and written); a second Ctrl-C ends the process at once.
+fn interrupt_flag() -> Arc<AtomicBool> {
+    static FLAG: OnceLock<Arc<AtomicBool>> = OnceLock::new();
+    FLAG.get_or_init(|| {
+        let flag = Arc::new(AtomicBool::new(false));
+        let seen = flag.clone();
+        let installed = ctrlc::set_handler(move || {
+            if seen.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+            eprintln!("interrupted: stopping the search, keeping the best result so far (Ctrl-C again to quit now)");
+        });
+        if let Err(e) = installed {
+            eprintln!("warning: cannot catch Ctrl-C ({e}); it will end the process without output");
+        }
+        flag
+    })
+    .clone()
+}
+
+/// The models to plan: the arguments, or with `--each` the models inside each argument folder.
+fn models(args: &PlanArgs) -> anyhow::Result<Vec<PathBuf>> {
+    if !args.each {
+        return Ok(args.models.clone());
+    }
+    let mut models = Vec::new();
+    for dir in &args.models {
+        let entries = std::fs::read_dir(dir).with_context(|| format!("{}: cannot list the folder (--each)", dir.display()))?;
+        let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+        paths.sort();
+        let ext = |p: &Path| p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        let is_part = |p: &Path| p.is_file() && matches!(ext(p).as_deref(), Some("obj" | "stl"));
+        let before = models.len();
+        for p in &paths {
+            let is_model_file = p.is_file() && matches!(ext(p).as_deref(), Some("glb" | "gltf"));
+            let is_parts_folder = p.is_dir()
+                && std::fs::read_dir(p).map(|d| d.filter_map(|e| e.ok()).any(|e| is_part(&e.path()))).unwrap_or(false);
+            if is_model_file || is_parts_folder {
+                models.push(p.clone());
+            }
+        }
+        if models.len() == before {
+            if paths.iter().any(|p| is_part(p)) {
+                bail!("{}: holds .obj/.stl parts, so it is one model: plan it without --each", dir.display());
+            }
+            bail!("{}: no models in it (--each plans every .glb/.gltf file and every folder of .obj/.stl files)", dir.display());
+        }
+    }
+    Ok(models)
+}
+
+/// Runs `asp plan` on every model: results per model, the exit code of the worst outcome.
 pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
-    let settings = settings(args)?;
-    let assembly = pipeline::load(&args.model, &settings)?;
+    let mut settings = settings(args)?;
+    settings.cancel = Some(interrupt_flag());
+    let models = models(args)?;
+    let many = models.len() > 1;
+    if many && args.mcap.is_some() {
+        bail!("--mcap writes one model's plan: give one model");
+    }
+    if many && args.optimise.trace.is_some() {
+        bail!("--trace writes one model's search: give one model");
+    }
+    let out_dir = match (&args.out, many) {
+        (Some(dir), true) => {
+            std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
+            Some(dir.clone())
+        }
+        _ => None,
+    };
+    let started = Instant::now();
+    let mut names = BTreeSet::new();
+    let mut printed = 0;
+    let mut worst = Verdict::Found;
+    let mut counts = [0usize; 4];
+    let mut stdout = std::io::stdout().lock();
+    if args.json && many {
+        writeln!(stdout, "[")?;
+    }
+    for (k, model) in models.iter().enumerate() {
+        let out = match &out_dir {
+            Some(dir) => Some(dir.join(format!("{}.json", unique_stem(model, &mut names)))),
+            None => args.out.clone(),
+        };
+        let verdict = match plan_one(args, &settings, model, out.as_deref(), &mut stdout, printed > 0) {
+            Ok(v) => {
+                printed += 1;
+                v
+            }
+            Err(e) => {
+                eprintln!("error: {e:#}");
+                Verdict::Error
+            }
+        };
+        counts[verdict as usize] += 1;
+        worst = worst.max(verdict);
+        if verdict == Verdict::Interrupted {
+            if k + 1 < models.len() {
+                eprintln!("interrupted: {} models not planned", models.len() - k - 1);
+            }
+            break;
+        }
+    }
+    if args.json && many {
+        writeln!(stdout, "]")?;
+    }
+    if many && !args.quiet {
+        eprintln!(
+            "{} models in {:.2} s: {} found, {} not found, {} errors{}",
+            models.len(),
+            started.elapsed().as_secs_f64(),
+            counts[Verdict::Found as usize],
+            counts[Verdict::NotFound as usize],
+            counts[Verdict::Error as usize],
+            if worst == Verdict::Interrupted { ", interrupted" } else { "" }
+        );
+    }
+    Ok(worst.code())
+}
+
+/// A file stem for `model`'s plan in an output folder, distinct from the stems given before.
+fn unique_stem(model: &Path, taken: &mut BTreeSet<String>) -> String {
+    let stem = model.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "model".into());
+    let mut name = stem.clone();
+    let mut k = 2;
+    while !taken.insert(name.clone()) {
+        name = format!("{stem}-{k}");
+        k += 1;
+    }
+    name
+}
+
+/// Plans one model: prints its table (or JSON) and writes its files.
+fn plan_one(
+    args: &PlanArgs,
+    settings: &PlanSettings,
+    model: &Path,
+    out: Option<&Path>,
+    stdout: &mut impl Write,
+    separate: bool,
+) -> anyhow::Result<Verdict> {
+    let load_started = Instant::now();
+    let assembly = pipeline::load(model, settings)?;
+    let load_seconds = load_started.elapsed().as_secs_f64();
     let for_mcap = args.mcap.as_ref().map(|_| assembly.clone());
     let bar = progress_bar(args.quiet || settings.optimise.is_some());
     let report_progress = |p: &Progress| {
@@ -79,40 +249,53 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
             bar.set_message(format!("{} tests", p.tests));
         }
     };
-    let result = pipeline::plan_assembly(assembly, &settings, Some(&report_progress));
+    let result = pipeline::plan_assembly(assembly, settings, Some(&report_progress));
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
-    let result = result?;
+    let mut result = result?;
+    if let Some(t) = result.report.stats.timings.as_mut() {
+        t.load = load_seconds;
+    }
     let report = &result.report;
     if !args.quiet {
         for w in &report.warnings {
-            eprintln!("warning: {}: {w}", args.model.display());
+            eprintln!("warning: {}: {w}", model.display());
         }
     }
     if let (Some(path), Some(search)) = (&args.optimise.trace, &result.search) {
-        let file = std::fs::File::create(path).with_context(|| format!("{}: cannot write the trace", path.display()))?;
-        search
-            .write_trace_csv(std::io::BufWriter::new(file))
+        asp_geom::io::write_atomic_with(path, |file| search.write_trace_csv(std::io::BufWriter::new(file)))
             .with_context(|| format!("{}: cannot write the trace", path.display()))?;
     }
     if let (Some(path), Some(assembly)) = (&args.mcap, &for_mcap) {
         asp_viz::mcap::write_plan(path, assembly, report)?;
     }
     let json = report.to_json();
-    if let Some(path) = &args.out {
-        std::fs::write(path, &json).with_context(|| format!("{}: cannot write the plan", path.display()))?;
+    if let Some(path) = out {
+        asp_geom::io::write_atomic(path, json.as_bytes()).with_context(|| format!("{}: cannot write the plan", path.display()))?;
     }
-    let mut stdout = std::io::stdout().lock();
     if args.json {
+        if separate {
+            write!(stdout, ",")?;
+        }
         write!(stdout, "{json}")?;
     } else {
-        write_table(&mut stdout, report)?;
+        if separate {
+            writeln!(stdout)?;
+        }
+        write_table(stdout, report)?;
         if let Some(summary) = &report.optimisation {
-            crate::optimise::write_summary(&mut stdout, summary, report.pareto_front.as_deref())?;
+            crate::optimise::write_summary(stdout, summary, report.pareto_front.as_deref())?;
         }
     }
-    Ok(if result.found() { ExitCode::SUCCESS } else { ExitCode::from(1) })
+    stdout.flush()?;
+    Ok(if result.found() {
+        Verdict::Found
+    } else if report.stats.stopped_by.as_deref() == Some(StopReason::Interrupted.as_str()) {
+        Verdict::Interrupted
+    } else {
+        Verdict::NotFound
+    })
 }
 
 fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
@@ -149,30 +332,17 @@ pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Resu
     } else {
         writeln!(out, "base: ground plane under the lowest point (up {})", r.up)?;
     }
-    let steps = |out: &mut dyn Write, sequence: &[asp_search::report::AssemblyStep]| -> std::io::Result<()> {
-        writeln!(out, "{:>4}  {:<width$}  motion (insertion, {})", "step", "part", r.units)?;
-        for (k, step) in sequence.iter().enumerate() {
-            let motion = match &step.motion {
-                MotionEntry::Linear { direction: d, distance } => {
-                    format!("straight along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
-                }
-                MotionEntry::Path { poses, .. } => format!("path of {} poses", poses.len()),
-            };
-            writeln!(out, "{:>4}  {:<width$}  {motion}", k + 1, step.name)?;
-        }
-        Ok(())
-    };
     if !r.assembly_sequence.is_empty() {
-        steps(out, &r.assembly_sequence)?;
+        write_steps(out, r, &r.assembly_sequence, width, "")?;
     }
     if !r.partial_assembly_sequence.is_empty() {
         let remaining = r.remaining.as_ref().map_or(0, Vec::len);
         writeln!(
             out,
-            "partial plan: {} parts come off; in assembly order onto the {remaining} parts that stay:",
+            "partial plan: {} steps; in assembly order onto the {remaining} parts that stay:",
             r.partial_assembly_sequence.len()
         )?;
-        steps(out, &r.partial_assembly_sequence)?;
+        write_steps(out, r, &r.partial_assembly_sequence, width, "")?;
     }
     if !r.explanation.is_empty() {
         writeln!(out, "stuck with {} parts left; none can leave:", r.explanation.len())?;
@@ -187,7 +357,49 @@ pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Resu
         }
     }
     if r.status == "budget_exhausted" {
-        writeln!(out, "the budget ran out (--max-tests / --timeout) before a plan was found")?;
+        match r.stats.stopped_by.as_deref() {
+            Some("interrupted") => writeln!(out, "interrupted (Ctrl-C) before a plan was found; the best partial plan so far is above")?,
+            _ => writeln!(out, "the budget ran out (--max-tests / --timeout) before a plan was found")?,
+        }
+    }
+    Ok(())
+}
+
+/// Assembly steps as table rows; a subassembly's own steps follow it, indented.
+fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], width: usize, indent: &str) -> std::io::Result<()> {
+    let name = |i: usize| r.parts.get(i).map_or("?", |p| p.name.as_str());
+    let label = |step: &AssemblyStep| match &step.subassembly {
+        None => step.name.clone(),
+        Some(g) => format!("{} + {} more (subassembly)", step.name, g.parts.len() - 1),
+    };
+    let width = sequence.iter().map(|s| label(s).len()).fold(width, usize::max);
+    if indent.is_empty() {
+        writeln!(out, "{:>4}  {:<width$}  motion (insertion, {})", "step", "part", r.units)?;
+    }
+    for (k, step) in sequence.iter().enumerate() {
+        let motion = match &step.motion {
+            MotionEntry::Linear { direction: d, distance } => {
+                format!("straight along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
+            }
+            MotionEntry::Path { poses, .. } => format!("path of {} poses", poses.len()),
+        };
+        writeln!(out, "{indent}{:>4}  {:<width$}  {motion}", k + 1, label(step))?;
+        if let Some(g) = &step.subassembly {
+            let inner = format!("{indent}      ");
+            let members: Vec<&str> = g.parts.iter().map(|&p| name(p)).collect();
+            let how = match g.status.as_str() {
+                "found" => "built on its base in this order:".to_string(),
+                "no_plan" => "cannot be taken apart (it goes in as one unit):".to_string(),
+                "unplanned" => "not planned".to_string(),
+                other => format!("{} before its own plan was found; the parts that come off:", other.replace('_', " ")),
+            };
+            writeln!(out, "{inner}subassembly {} on base {}: {how}", members.join(", "), step.name)?;
+            write_steps(out, r, &g.assembly_sequence, width.saturating_sub(6), &inner)?;
+            for e in &g.explanation {
+                let others: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
+                writeln!(out, "{inner}  {} {} {}", e.name, e.reason.replace('_', " "), others.join(", "))?;
+            }
+        }
     }
     Ok(())
 }

@@ -73,19 +73,13 @@ impl FeasibilityChecker for Checker {
     fn test_removal(&self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome {
         let motion = match kind {
             MotionKind::Linear => self.world.linear_removal(part, state),
-            MotionKind::Path { seed } => {
-                plan_removal_path(&self.world, part, state, &self.config.rrt, seed)
-            }
-        };
-        let outcome = match motion {
-            Err(blockers) => Outcome::Collision { blockers },
-            Ok(motion) => match self.stability(&state.without(part)) {
-                Stability::Stable => Outcome::Removed(motion),
-                Stability::Unstable { floating } => Outcome::Unstable { floating, motion },
+            // two straight moves in turn first (exact and cheap), then random sampling
+            MotionKind::Path { seed } => match self.world.two_step_removal(part, state) {
+                Some(motion) => Ok(motion),
+                None => plan_removal_path(&self.world, part, state, &self.config.rrt, seed),
             },
         };
-        self.counters.record(kind, &outcome);
-        outcome
+        self.finish(kind, motion, &state.without(part))
     }
 
     fn stability(&self, state: &PartSet) -> Stability {
@@ -97,5 +91,163 @@ impl FeasibilityChecker for Checker {
 
     fn counters(&self) -> CounterSnapshot {
         self.counters.snapshot()
+    }
+
+    fn group_candidates(&self, state: &PartSet) -> Vec<PartSet> {
+        group_candidates(&self.world, state, self.world.fixed())
+    }
+
+    fn in_movable_group(&self, part: usize, state: &PartSet) -> bool {
+        in_movable_group(&self.world, part, state, self.world.fixed())
+    }
+
+    fn test_group_removal(&self, group: &PartSet, state: &PartSet) -> Outcome {
+        let motion = self.world.group_removal_among(group, state, &self.world.with_fixed(state));
+        self.finish(MotionKind::Linear, motion, &without(state, group))
+    }
+
+    fn subassembly(&self, group: &PartSet) -> Option<(usize, Box<dyn FeasibilityChecker + '_>)> {
+        let base = subassembly_base(&self.world, group)?;
+        let fixed = PartSet::from_indices(self.world.num_parts() + 1, [base]);
+        Some((base, Box::new(OnBase { world: &self.world, fixed, counters: Counters::default() })))
+    }
+}
+
+impl Checker {
+    /// The outcome of a removal whose motion test gave `motion`: the stability of `rest`, then
+    /// counted.
+    fn finish(&self, kind: MotionKind, motion: std::result::Result<crate::Motion, PartSet>, rest: &PartSet) -> Outcome {
+        let outcome = match motion {
+            Err(blockers) => Outcome::Collision { blockers },
+            Ok(motion) => match self.stability(rest) {
+                Stability::Stable => Outcome::Removed(motion),
+                Stability::Unstable { floating } => Outcome::Unstable { floating, motion },
+            },
+        };
+        self.counters.record(kind, &outcome);
+        outcome
+    }
+}
+
+/// `state` without the parts of `group`.
+fn without(state: &PartSet, group: &PartSet) -> PartSet {
+    let mut rest = state.clone();
+    for p in group.iter() {
+        rest.remove(p);
+    }
+    rest
+}
+
+/// The closures of single parts under blocking, per candidate direction, that hold no fixed part
+/// and at least two parts: smallest first, then by their lowest part, without duplicates.
+fn group_candidates(world: &World, state: &PartSet, fixed: &PartSet) -> Vec<PartSet> {
+    let mut present = state.clone();
+    present.union_with(fixed);
+    let mut found: Vec<PartSet> = Vec::new();
+    for k in 0..world.directions().len() {
+        for p in state.iter().filter(|&p| !fixed.contains(p)) {
+            let closure = world.group_closure(&PartSet::from_indices(world.num_parts() + 1, [p]), k, &present);
+            if closure.len() >= 2 && !closure.intersects(fixed) && !found.contains(&closure) {
+                found.push(closure);
+            }
+        }
+    }
+    found.sort_by_key(|g| (g.len(), g.iter().next()));
+    found
+}
+
+/// Whether the closure of `part` along some candidate direction reaches no fixed part.
+fn in_movable_group(world: &World, part: usize, state: &PartSet, fixed: &PartSet) -> bool {
+    let mut present = state.clone();
+    present.union_with(fixed);
+    let seed = PartSet::from_indices(world.num_parts() + 1, [part]);
+    (0..world.directions().len()).any(|k| !world.group_closure(&seed, k, &present).intersects(fixed))
+}
+
+/// The base of a subassembly planned on its own: its largest part (by the volume of its
+/// bounds; the lowest index among equals), which the others are put onto.
+fn subassembly_base(world: &World, group: &PartSet) -> Option<usize> {
+    let volume = |p: usize| {
+        let b = world.aabb(p);
+        (b.maxs - b.mins).as_dvec3().element_product()
+    };
+    group.iter().filter(|&p| p < world.num_parts()).fold(None, |best: Option<usize>, p| match best {
+        Some(b) if volume(b) >= volume(p) => Some(b),
+        _ => Some(p),
+    })
+}
+
+/// A subassembly taken out of the model and planned on its own base: `fixed` are the only fixed
+/// parts (no virtual ground), straight-line removals and groups only (the path planner searches
+/// the whole model's space), contact-graph stability on the base.
+struct OnBase<'w> {
+    world: &'w World,
+    fixed: PartSet,
+    counters: Counters,
+}
+
+impl OnBase<'_> {
+    fn present(&self, state: &PartSet) -> PartSet {
+        let mut present = state.clone();
+        present.union_with(&self.fixed);
+        present
+    }
+
+    fn finish(&self, motion: std::result::Result<crate::Motion, PartSet>, rest: &PartSet) -> Outcome {
+        let outcome = match motion {
+            Err(blockers) => Outcome::Collision { blockers },
+            Ok(motion) => match self.stability(rest) {
+                Stability::Stable => Outcome::Removed(motion),
+                Stability::Unstable { floating } => Outcome::Unstable { floating, motion },
+            },
+        };
+        self.counters.record(MotionKind::Linear, &outcome);
+        outcome
+    }
+}
+
+impl FeasibilityChecker for OnBase<'_> {
+    fn num_parts(&self) -> usize {
+        self.world.num_parts()
+    }
+
+    fn is_fixed(&self, part: usize) -> bool {
+        self.fixed.contains(part)
+    }
+
+    fn test_removal(&self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome {
+        let motion = match kind {
+            MotionKind::Linear => self.world.linear_removal_among(part, state, &self.present(state)),
+            // no path planner inside a subassembly: a failed test that names no blocker
+            MotionKind::Path { .. } => Err(PartSet::empty(self.world.num_parts() + 1)),
+        };
+        self.finish(motion, &state.without(part))
+    }
+
+    fn stability(&self, state: &PartSet) -> Stability {
+        self.world.contact_stability_among(&self.present(state), &self.fixed)
+    }
+
+    fn counters(&self) -> CounterSnapshot {
+        self.counters.snapshot()
+    }
+
+    fn group_candidates(&self, state: &PartSet) -> Vec<PartSet> {
+        group_candidates(self.world, state, &self.fixed)
+    }
+
+    fn in_movable_group(&self, part: usize, state: &PartSet) -> bool {
+        in_movable_group(self.world, part, state, &self.fixed)
+    }
+
+    fn test_group_removal(&self, group: &PartSet, state: &PartSet) -> Outcome {
+        let motion = self.world.group_removal_among(group, state, &self.present(state));
+        self.finish(motion, &without(state, group))
+    }
+
+    fn subassembly(&self, group: &PartSet) -> Option<(usize, Box<dyn FeasibilityChecker + '_>)> {
+        let base = subassembly_base(self.world, group)?;
+        let fixed = PartSet::from_indices(self.world.num_parts() + 1, [base]);
+        Some((base, Box::new(OnBase { world: self.world, fixed, counters: Counters::default() })))
     }
 }

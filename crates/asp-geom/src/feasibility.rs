@@ -171,4 +171,38 @@ pub trait FeasibilityChecker: Send + Sync {
     fn stability(&self, state: &PartSet) -> Stability;
     /// The counters so far.
     fn counters(&self) -> CounterSnapshot;
+
+    /// Candidate subassemblies of `state`: sets of at least two present, non-fixed parts that can
+    /// translate together along one straight line without colliding with the rest (for each
+    /// candidate direction, the closure of a part under "is blocked by"), smallest first, without
+    /// duplicates. Default: none (a checker that cannot move groups).
+    fn group_candidates(&self, state: &PartSet) -> Vec<PartSet> {
+        let _ = state;
+        Vec::new()
+    }
+
+    /// Whether some rigid group of parts of `state` that contains `part` and no fixed part could
+    /// translate along a candidate direction (a closure under blocking that reaches no fixed
+    /// part). Removing other parts never makes such a closure smaller, so `false` holds in every
+    /// state that contains this one. Default: `false` (a checker that cannot move groups).
+    fn in_movable_group(&self, part: usize, state: &PartSet) -> bool {
+        let _ = (part, state);
+        false
+    }
+
+    /// Tests whether the parts of `group` (present, non-fixed) can leave `state` together as one
+    /// rigid body along a straight line, and whether what remains is stable. Counts the test.
+    /// Default: blocked by nothing nameable (a checker that cannot move groups).
+    fn test_group_removal(&self, group: &PartSet, state: &PartSet) -> Outcome {
+        let _ = state;
+        Outcome::Collision { blockers: PartSet::empty(group.len()) }
+    }
+
+    /// The checker of a subassembly planned on its own: its base part (one of `group`) and a
+    /// checker in which that base is the only fixed part (no virtual ground), so the group's own
+    /// disassembly can be planned. Default: `None` (subassemblies stay unplanned).
+    fn subassembly(&self, group: &PartSet) -> Option<(usize, Box<dyn FeasibilityChecker + '_>)> {
+        let _ = group;
+        None
+    }
 }

@@ -145,3 +145,57 @@ pub fn arch() -> Assembly {
         ],
     )
 }
+
+/// Issue 9's locked core, in 1 cm voxels on the ground (no fixed part): a post whose foot is
+/// caught in a cavity of the base (the shaft leaves through a hole narrower than the foot), a
+/// ring around the shaft between the base and the post's head, and a cap lying on the head.
+/// The cap lifts off; then ring, post and base hold each other in every direction (a locked
+/// core). Together they can leave the ground as one subassembly, which cannot be taken apart.
+/// Parts: 0 base, 1 post, 2 ring, 3 cap.
+pub fn ring_on_locked_post() -> Assembly {
+    let layer = |lo: i32, hi: i32, z: i32| (lo..hi).flat_map(move |x| (lo..hi).map(move |y| [x, y, z]));
+    let foot: Vec<[i32; 3]> = layer(1, 4, 1).collect();
+    let base: Vec<[i32; 3]> = (0..3)
+        .flat_map(|z| layer(0, 5, z))
+        .filter(|c| !foot.contains(c) && *c != [2, 2, 2])
+        .collect();
+    let post: Vec<[i32; 3]> = foot.iter().copied().chain((2..6).map(|z| [2, 2, z])).chain(layer(1, 4, 6)).collect();
+    let ring: Vec<[i32; 3]> = layer(1, 4, 3).filter(|c| *c != [2, 2, 3]).collect();
+    let cap: Vec<[i32; 3]> = layer(1, 4, 7).collect();
+    assembly(
+        "ring_on_locked_post",
+        vec![
+            voxel_part("base", &base, 0.01),
+            voxel_part("post", &post, 0.01),
+            voxel_part("ring", &ring, 0.01),
+            voxel_part("cap", &cap, 0.01),
+        ],
+    )
+}
+
+/// Issue 9's hooked shelf bracket, in 5 mm voxels: a fixed wall with a pocket whose opening
+/// has a lip at its bottom, and a bracket whose hook hangs down behind the lip while its arm
+/// comes out through the opening. No straight line frees it (the hook catches on the lip, the
+/// pocket's roof stops it above); lifted by 10 mm until the hook clears the lip, it slides out.
+/// Parts: 0 wall (fixed), 1 bracket.
+pub fn hooked_bracket() -> Assembly {
+    let cube = |x: std::ops::Range<i32>, y: std::ops::Range<i32>, z: std::ops::Range<i32>| {
+        let mut cells = Vec::new();
+        for i in x {
+            for j in y.clone() {
+                for k in z.clone() {
+                    cells.push([i, j, k]);
+                }
+            }
+        }
+        cells
+    };
+    // pocket: a chamber behind the face (x 2..3, z 2..10) and its opening (x 3..4, z 6..10)
+    let pocket: Vec<[i32; 3]> = [cube(2..3, 2..4, 2..10), cube(3..4, 2..4, 6..10)].concat();
+    let wall: Vec<[i32; 3]> = cube(0..4, 0..6, 0..14).into_iter().filter(|c| !pocket.contains(c)).collect();
+    // the hook (x 2..3, z 4..8) behind the lip (x 3..4, z 2..6), the arm out through the opening
+    let bracket: Vec<[i32; 3]> = [cube(2..3, 2..4, 4..8), cube(3..10, 2..4, 6..8)].concat();
+    let mut wall = voxel_part("wall", &wall, 0.005);
+    wall.fixed = true;
+    assembly("hooked_bracket", vec![wall, voxel_part("bracket", &bracket, 0.005)])
+}

@@ -495,12 +495,20 @@ impl World {
     /// present real parts, plus the contact distance. With no other part left, it clears its own
     /// starting bounds (so the last part is lifted by its size, not by nothing).
     pub fn clearance(&self, p: usize, state: &PartSet, dir: Vec3) -> f32 {
-        let a = &self.geoms[p].aabb;
+        self.clearance_of(&self.geoms[p].aabb, state.iter().filter(|&q| q != p), dir)
+    }
+
+    /// [`World::clearance`] of a group of parts moving together: its bounds clear the bounds of
+    /// the other present real parts.
+    pub fn group_clearance(&self, group: &PartSet, state: &PartSet, dir: Vec3) -> f32 {
+        let bounds = aabb_of(group.iter().flat_map(|q| [self.geoms[q].aabb.mins, self.geoms[q].aabb.maxs]))
+            .expect("a group has parts");
+        self.clearance_of(&bounds, state.iter().filter(|&q| !group.contains(q)), dir)
+    }
+
+    fn clearance_of(&self, a: &Aabb, others: impl Iterator<Item = usize>, dir: Vec3) -> f32 {
         let others = aabb_of(
-            state
-                .iter()
-                .filter(|&q| q != p && q < self.num_parts())
-                .flat_map(|q| [self.geoms[q].aabb.mins, self.geoms[q].aabb.maxs]),
+            others.filter(|&q| q < self.num_parts()).flat_map(|q| [self.geoms[q].aabb.mins, self.geoms[q].aabb.maxs]),
         )
         .unwrap_or(*a);
         let t = (0..3)
@@ -521,15 +529,72 @@ impl World {
     /// travel (ties go to the direction closest to up), or the union of all blockers when every
     /// direction is blocked.
     pub fn linear_removal(&self, p: usize, state: &PartSet) -> std::result::Result<Motion, PartSet> {
-        let present = self.with_fixed(state);
+        self.linear_removal_among(p, state, &self.with_fixed(state))
+    }
+
+    /// [`World::linear_removal`] among an explicit set of `present` parts (the state plus the
+    /// base parts that count as present, e.g. a subassembly on its own base without the ground).
+    pub fn linear_removal_among(&self, p: usize, state: &PartSet, present: &PartSet) -> std::result::Result<Motion, PartSet> {
         let row = self.blocking_row(p);
+        self.best_free_direction(|k| row[k].intersection(present), |dir| self.clearance(p, state, dir))
+    }
+
+    /// The parts of `present` that block the rigid `group` moving along candidate direction `k`:
+    /// straight-line blocking is a property of part pairs, so this is the union of the members'
+    /// blocking rows, minus the group.
+    pub fn group_blockers(&self, group: &PartSet, k: usize, present: &PartSet) -> PartSet {
+        let mut blockers = PartSet::empty(self.geoms.len());
+        for p in group.iter().filter(|&p| p < self.num_parts()) {
+            blockers.union_with(&self.blocking_row(p)[k].intersection(present));
+        }
+        for p in group.iter() {
+            blockers.remove(p);
+        }
+        blockers
+    }
+
+    /// The smallest set of `present` parts that contains `seeds` and can translate along
+    /// candidate direction `k` as one rigid body: `seeds` closed under "is blocked by" (a
+    /// directional blocking graph's closure). It contains a fixed part when the seeds cannot
+    /// leave along `k` without one.
+    pub fn group_closure(&self, seeds: &PartSet, k: usize, present: &PartSet) -> PartSet {
+        let mut group = seeds.clone();
+        let mut frontier: Vec<usize> = seeds.iter().collect();
+        while let Some(p) = frontier.pop() {
+            if p >= self.num_parts() {
+                continue; // the ground never moves: a closure that reaches it is refused anyway
+            }
+            for q in self.blocking_row(p)[k].intersection(present).iter() {
+                if !group.contains(q) {
+                    group.insert(q);
+                    frontier.push(q);
+                }
+            }
+        }
+        group
+    }
+
+    /// The straight-line removal test of a rigid `group` of parts of `state` among the `present`
+    /// parts: the free direction with the shortest travel for the group's bounds to clear the
+    /// rest (ties go to the direction closest to up), or every blocker.
+    pub fn group_removal_among(&self, group: &PartSet, state: &PartSet, present: &PartSet) -> std::result::Result<Motion, PartSet> {
+        self.best_free_direction(|k| self.group_blockers(group, k, present), |dir| self.group_clearance(group, state, dir))
+    }
+
+    /// The free candidate direction (no blockers) with the shortest travel, ties to the one
+    /// closest to up; or the union of every direction's blockers.
+    fn best_free_direction(
+        &self,
+        blockers_along: impl Fn(usize) -> PartSet,
+        travel: impl Fn(Vec3) -> f32,
+    ) -> std::result::Result<Motion, PartSet> {
         let up = self.assembly.up.vector();
         let mut best: Option<(f32, Vec3)> = None;
         let mut blockers = PartSet::empty(self.geoms.len());
         for (k, dir) in self.directions.iter().enumerate() {
-            let b = row[k].intersection(&present);
+            let b = blockers_along(k);
             if b.is_empty() {
-                let d = self.clearance(p, state, *dir);
+                let d = travel(*dir);
                 let better = match best {
                     None => true,
                     Some((bd, bdir)) => {
@@ -549,13 +614,81 @@ impl World {
         }
     }
 
+    /// A removal of `p` from `state` by two straight moves in turn when no single straight line
+    /// is free (a hooked bracket lifts, then slides out): along a candidate direction as far as
+    /// the first contact (less half the tolerance) or half of it, then along another candidate
+    /// direction until its bounds clear the rest. Both moves are tested exactly (box intervals,
+    /// or triangle sweeps of the pair's shapes); the first that works, in direction order, is a
+    /// `Path` of pure translations.
+    pub fn two_step_removal(&self, p: usize, state: &PartSet) -> Option<Motion> {
+        let present = self.with_fixed(state);
+        let others: Vec<usize> = present.iter().filter(|&q| q != p && !self.ignores(p, q)).collect();
+        let row = self.blocking_row(p);
+        let a = self.geoms[p].aabb;
+        let pivot = (a.mins + a.maxs) * 0.5;
+        for (k1, &d1) in self.directions.iter().enumerate() {
+            let blockers = row[k1].intersection(&present);
+            if blockers.is_empty() {
+                continue;
+            }
+            let reach = blockers.iter().filter_map(|q| self.pair_travel(p, q, Vec3::ZERO, d1)).fold(f32::INFINITY, f32::min);
+            if !reach.is_finite() || reach <= 2.0 * self.tolerance {
+                continue;
+            }
+            // just short of the contact (half the tolerance: the part clears what it rose
+            // above by that much, and presses into nothing deeper than the tolerance), or half way
+            for s in [reach - 0.5 * self.tolerance, 0.5 * reach] {
+                let shift = d1 * s;
+                let moved = Aabb::new(a.mins + shift, a.maxs + shift);
+                for &d2 in &self.directions {
+                    if d2.dot(d1).abs() > 0.999 {
+                        continue;
+                    }
+                    let length = self.clearance_of(&moved, state.iter().filter(|&q| q != p), d2);
+                    if others.iter().all(|&q| self.pair_travel(p, q, shift, d2).is_none_or(|t| t > length)) {
+                        let poses = [Vec3::ZERO, shift, shift + d2 * length].map(Pose::from_translation).to_vec();
+                        return Some(Motion::Path { poses, pivot });
+                    }
+                }
+            }
+        }
+        None
+    }
+
+    /// How far `p`, displaced by `from`, travels along unit `dir` before it first penetrates `q`
+    /// deeper than the tolerance (boxes: when they first touch); `None` when never.
+    fn pair_travel(&self, p: usize, q: usize, from: Vec3, dir: Vec3) -> Option<f32> {
+        let (a, b) = (&self.geoms[p].aabb, &self.geoms[q].aabb);
+        let moved = Aabb::new(a.mins + from, a.maxs + from);
+        let (_, t1) = sweep_overlap(&moved, dir, b)?;
+        if let (Some(bp), Some(bq)) = (&self.geoms[p].boxes, &self.geoms[q].boxes) {
+            let (_, amount) = self.pair_erosion(p, q);
+            return bp
+                .iter()
+                .flat_map(|x| bq.iter().map(move |y| (x, y)))
+                .filter_map(|(x, y)| boxes::first_overlap(&Aabb::new(x.mins + from, x.maxs + from), dir, y, amount))
+                .reduce(f32::min);
+        }
+        let (moving, fixed) = self.pair_shapes(p, q);
+        if from == Vec3::ZERO {
+            return sweep::sweep_distance(&moving, dir, &fixed, t1);
+        }
+        // from a displaced start only whether it hits at all matters (the second move)
+        sweep::sweep_hits_at(&moving, &Pose::from_translation(from), dir, &fixed, t1).then_some(0.0)
+    }
+
     /// Contact-graph stability: every present part is linked through contacts to a fixed part.
     pub fn contact_stability(&self, state: &PartSet) -> Stability {
-        let present = self.with_fixed(state);
-        let mut reached = present.intersection(&self.fixed);
+        self.contact_stability_among(&self.with_fixed(state), &self.fixed)
+    }
+
+    /// Contact-graph stability of the `present` parts on the `base` parts among them: every
+    /// present part is linked through contacts to a present base part.
+    pub fn contact_stability_among(&self, present: &PartSet, base: &PartSet) -> Stability {
+        let mut reached = present.intersection(base);
         let mut frontier: Vec<usize> = reached.iter().collect();
         while let Some(i) = frontier.pop() {
-            for j in self.contacts[i].intersection(&present).iter() {
+            for j in self.contacts[i].intersection(present).iter() {
                 if !reached.contains(j) {
                     reached.insert(j);
                     frontier.push(j);

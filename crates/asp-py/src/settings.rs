@@ -39,6 +39,7 @@ pub const PLAN_KEYS: [&str; 26] = [
     "stability",
     "physics_threshold",
     "path_planner",
+    "subassemblies",
     "rrt_iterations",
     "rrt_time",
     "max_tests",
@@ -167,11 +168,13 @@ pub fn plan_settings(dict: &Bound<'_, PyDict>) -> Result<PlanSettings, Error> {
         bookkeeping: k.flag("bookkeeping", defaults.bookkeeping)? || implied_bookkeeping,
         seed: k.value::<u64>("seed", "a non-negative integer")?.unwrap_or(defaults.seed),
         path_planner: k.flag("path_planner", defaults.path_planner)?,
+        subassemblies: k.flag("subassemblies", defaults.subassemblies)?,
         rrt_iterations: k.count("rrt_iterations")?.unwrap_or(defaults.rrt_iterations),
         rrt_time: k.positive("rrt_time")?.unwrap_or(defaults.rrt_time),
         max_tests: k.value::<u64>("max_tests", "a non-negative integer")?,
         timeout: k.positive("timeout")?,
         optimise: optimise_settings(&k)?,
+        cancel: None,
     })
 }
 
@@ -290,6 +293,7 @@ pub fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("stability", "contact")?;
     d.set_item("physics_threshold", DEFAULT_PHYSICS_THRESHOLD)?;
     d.set_item("path_planner", p.path_planner)?;
+    d.set_item("subassemblies", p.subassemblies)?;
     d.set_item("rrt_iterations", p.rrt_iterations)?;
     d.set_item("rrt_time", p.rrt_time)?;
     d.set_item("max_tests", p.max_tests)?;

@@ -258,13 +258,15 @@ pub fn collect_model(item: &ModelItem, out: &Path, settings: &CollectSettings) -
     let world = checker.world();
     let graph = AssemblyGraph::build(world, &settings.graph)?;
     let n = world.num_parts();
-    let budget = Budget { max_tests: settings.max_tests, timeout: settings.timeout.map(Duration::from_secs_f64) };
+    let budget = Budget { max_tests: settings.max_tests, timeout: settings.timeout.map(Duration::from_secs_f64), cancel: None };
     let runs: Vec<(Vec<PartSet>, bool)> = (0..settings.runs)
         .into_par_iter()
         .map(|r| {
+            // the thesis' linear sequences: the labelled states are reached one part at a time
             let dfs = Dfs::builder()
                 .ordering(BuiltinOrder::Shuffled)
                 .path_planner(settings.plan.path_planner)
+                .subassemblies(false)
                 .seed(seed_of(settings.seed, m, r))
                 .build();
             let mut states = Vec::new();

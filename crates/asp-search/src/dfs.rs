@@ -2,15 +2,20 @@
 //! bookkeeping heuristic (seed 3.1.1).
 //!
 //! In each state the parts are tested in the configured order with the fast straight-line test;
-//! the first removal whose remainder is stable is followed. When no part of a state can leave
-//! along a straight line, the slow test (a path planner) is tried for each blocked part. Dead-end
-//! states are remembered so that no state is expanded twice.
+//! the first removal whose remainder is stable is followed. When every single-part removal of a
+//! state fails (or leads to dead ends), groups of parts that can leave together along a straight
+//! line are tried (subassemblies, smallest first; on by default). When no part of a state can
+//! leave along a straight line, the slow test (a path planner) is tried for each blocked part,
+//! except where it failed before with the same blockers. Dead-end states are remembered so that
+//! no state is expanded twice, and so are locked cores: sets of parts that hold each other in
+//! every state that contains them, so the search stops as soon as every branch contains one.
+//! Subassemblies of the result are then planned on their own base, recursively.
 
 use crate::ordering::{state_seed, BuiltinOrder, OrderingFactory, PartOrdering, WithBookkeeping};
-use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, Stuck, StuckReason};
+use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StopReason, Stuck, StuckReason, Subassembly};
 use crate::Planner;
 use asp_geom::{MotionKind, Outcome, PartSet};
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -19,6 +24,7 @@ use std::time::Instant;
 pub struct Dfs {
     ordering: Arc<dyn OrderingFactory>,
     path_planner: bool,
+    subassemblies: bool,
     seed: u64,
 }
 
@@ -28,12 +34,19 @@ pub struct DfsBuilder {
     ordering: Arc<dyn OrderingFactory>,
     bookkeeping: bool,
     no_path_planner: bool,
+    no_subassemblies: bool,
     seed: u64,
 }
 
 impl Default for DfsBuilder {
     fn default() -> Self {
-        DfsBuilder { ordering: Arc::new(BuiltinOrder::Given), bookkeeping: false, no_path_planner: false, seed: 0 }
+        DfsBuilder {
+            ordering: Arc::new(BuiltinOrder::Given),
+            bookkeeping: false,
+            no_path_planner: false,
+            no_subassemblies: false,
+            seed: 0,
+        }
     }
 }
 
@@ -58,6 +71,12 @@ impl DfsBuilder {
         self.no_path_planner = !on;
         self
     }
+    /// Whether groups of parts may leave together as rigid subassemblies (when no single part
+    /// can). Default on.
+    pub fn subassemblies(mut self, on: bool) -> Self {
+        self.no_subassemblies = !on;
+        self
+    }
     /// Seed of every random choice (shuffled and random orderings, path planner). Default 0.
     pub fn seed(mut self, seed: u64) -> Self {
         self.seed = seed;
@@ -67,12 +86,13 @@ impl DfsBuilder {
     pub fn build(self) -> Dfs {
         let ordering: Arc<dyn OrderingFactory> =
             if self.bookkeeping { Arc::new(WithBookkeeping(self.ordering)) } else { self.ordering };
-        Dfs { ordering, path_planner: !self.no_path_planner, seed: self.seed }
+        Dfs { ordering, path_planner: !self.no_path_planner, subassemblies: !self.no_subassemblies, seed: self.seed }
     }
 }
 
 impl Dfs {
-    /// A builder with the defaults: given order, no bookkeeping, path planner on, seed 0.
+    /// A builder with the defaults: given order, no bookkeeping, path planner and subassemblies
+    /// on, seed 0.
     pub fn builder() -> DfsBuilder {
         DfsBuilder::default()
     }
@@ -107,6 +127,13 @@ struct Search<'p, 'a, 'v> {
     deepest: Option<(PartSet, Vec<Stuck>, Vec<Step>)>,
     /// The longest branch so far (a `budget_exhausted` result's partial disassembly).
     longest: Vec<Step>,
+    /// Per part, the straight-line blockers of the states where the path planner failed for it:
+    /// it is not called again while those blockers are all present (more obstacles never help).
+    path_failed: HashMap<usize, Vec<PartSet>>,
+    /// Time spent in the path planner.
+    path_seconds: f64,
+    /// Why the budget ran out.
+    stopped_by: Option<StopReason>,
 }
 
 impl Search<'_, '_, '_> {
@@ -115,10 +142,25 @@ impl Search<'_, '_, '_> {
     }
 
     fn out_of_budget(&mut self) -> bool {
-        if !self.exhausted && self.budget.exhausted(self.tests(), self.started) {
-            self.exhausted = true;
+        if !self.exhausted {
+            if let Some(reason) = self.budget.stop_reason(self.tests(), self.started) {
+                self.exhausted = true;
+                self.stopped_by = Some(reason);
+            }
         }
         self.exhausted
+    }
+
+    fn report_progress(&self) {
+        if let Some(report) = self.problem.progress {
+            let removed = self.path.iter().map(|s| s.group.as_ref().map_or(1, |g| g.parts.len())).sum();
+            report(&Progress { removed, total: self.total, tests: self.tests() });
+        }
+    }
+
+    /// Whether a known locked core lies within `state` (then `state` is a dead end).
+    fn holds_core(&self, state: &PartSet) -> bool {
+        self.cores.iter().any(|c| c.is_subset(state))
     }
 
     fn order(&mut self, state: &PartSet) -> Vec<usize> {
@@ -140,16 +182,14 @@ impl Search<'_, '_, '_> {
         if self.problem.is_goal(state) {
             return true;
         }
-        if self.dead.contains(state) || self.cores.iter().any(|c| c.is_subset(state)) || self.out_of_budget() {
+        if self.dead.contains(state) || self.holds_core(state) || self.out_of_budget() {
             return false;
         }
         self.expanded += 1;
         if let Some(visit) = self.visit.as_mut() {
             visit(state);
         }
-        if let Some(report) = self.problem.progress {
-            report(&Progress { removed: self.path.len(), total: self.total, tests: self.tests() });
-        }
+        self.report_progress();
         let mut reasons: Vec<Stuck> = Vec::new();
         let mut collided: Vec<usize> = Vec::new();
         let mut any_removed = false;
@@ -172,24 +212,79 @@ impl Search<'_, '_, '_> {
             if self.follow(part, state, outcome, &mut reasons) {
                 return true;
             }
+            if self.holds_core(state) {
+                // a branch below found a locked core that this state holds too
+                return self.dead_end(state, reasons);
+            }
+        }
+        if self.config.subassemblies {
+            for group in self.problem.checker.group_candidates(state) {
+                if self.out_of_budget() {
+                    return false;
+                }
+                let outcome = self.problem.checker.test_group_removal(&group, state);
+                self.counters.record(MotionKind::Linear, &outcome);
+                if let Outcome::Removed(motion) = outcome {
+                    any_removed = true;
+                    let mut rest = state.clone();
+                    for p in group.iter() {
+                        rest.remove(p);
+                    }
+                    let part = group.iter().next().expect("a group has parts");
+                    let group = Some(Box::new(Subassembly { parts: group, plan: None }));
+                    if self.descend(Step { part, motion, group }, &rest) {
+                        return true;
+                    }
+                    if self.holds_core(state) {
+                        return self.dead_end(state, reasons);
+                    }
+                }
+            }
         }
         if self.config.path_planner && !any_removed {
             for part in collided {
                 if self.out_of_budget() {
                     return false;
                 }
+                let blockers = match reasons.iter().find(|s| s.part == part).map(|s| &s.reason) {
+                    Some(StuckReason::Blocked(b)) => b.clone(),
+                    _ => PartSet::empty(0),
+                };
+                if self.path_failed.get(&part).is_some_and(|f| f.iter().any(|b| b.is_subset(&blockers))) {
+                    continue; // it failed before among these blockers or fewer: the same answer
+                }
+                // a path planner call is slow: report progress before each (a caller's hook may
+                // stop the search there, e.g. on Ctrl-C)
+                self.report_progress();
                 // seeded by the state and the part, not by the search's history: the same
                 // state gets the same path-planner runs whatever the ordering skipped before
                 let seed = state_seed(self.config.seed, state, part as u64);
+                let started = Instant::now();
                 let outcome = self.test(part, state, MotionKind::Path { seed });
+                self.path_seconds += started.elapsed().as_secs_f64();
+                if let Outcome::Collision { .. } = &outcome {
+                    self.path_failed.entry(part).or_default().push(blockers);
+                }
                 reasons.retain(|s| s.part != part);
                 if self.follow(part, state, outcome, &mut reasons) {
                     return true;
                 }
             }
         }
+        self.dead_end(state, reasons)
+    }
+
+    /// Records `state` as a dead end (unless the budget ran out, which proves nothing): its
+    /// locked core, if any, and the deepest dead end with its reasons. Returns false.
+    fn dead_end(&mut self, state: &PartSet, mut reasons: Vec<Stuck>) -> bool {
         if !self.exhausted {
-            if let Some(core) = locked_core(&reasons, |p| self.problem.checker.is_fixed(p)) {
+            let checker = self.problem.checker;
+            let groups = self.config.subassemblies;
+            let core = locked_core(&reasons, |p| checker.is_fixed(p))
+                // with subassemblies a core is locked only when none of its parts can leave in a
+                // group either (a group closure only grows when parts are added)
+                .filter(|core| !groups || !core.iter().any(|p| checker.in_movable_group(p, state)));
+            if let Some(core) = core {
                 self.cores.push(core);
             }
             self.dead.insert(state.clone());
@@ -201,18 +296,26 @@ impl Search<'_, '_, '_> {
         false
     }
 
+    /// Follows a removal into the state it leaves; true when that led to a full sequence.
+    fn descend(&mut self, step: Step, rest: &PartSet) -> bool {
+        self.path.push(step);
+        if self.path.len() > self.longest.len() {
+            self.longest.clone_from(&self.path);
+        }
+        if self.search(rest) {
+            return true;
+        }
+        self.path.pop();
+        false
+    }
+
     /// Acts on one test's outcome: recurse into the child state, or record why it failed.
     fn follow(&mut self, part: usize, state: &PartSet, outcome: Outcome, reasons: &mut Vec<Stuck>) -> bool {
         match outcome {
             Outcome::Removed(motion) => {
-                self.path.push(Step { part, motion });
-                if self.path.len() > self.longest.len() {
-                    self.longest.clone_from(&self.path);
-                }
-                if self.search(&state.without(part)) {
+                if self.descend(Step::single(part, motion), &state.without(part)) {
                     return true;
                 }
-                self.path.pop();
                 reasons.push(Stuck { part, reason: StuckReason::DeadEnd });
             }
             Outcome::Collision { blockers } => {
@@ -226,23 +329,27 @@ impl Search<'_, '_, '_> {
     }
 }
 
-/// The largest set `C` of parts of a dead state such that each part of `C` was blocked (in
-/// every direction tried) only by parts of `C` and fixed parts. Straight-line blocking is a
-/// property of part pairs, so removing parts outside `C` never frees a part of `C`: every state
-/// containing `C` is a dead end too. (With the path planner in play this is a heuristic: a path
-/// that failed among these parts is taken to fail among more.)
+/// The largest set `C` of parts of a dead state such that each part of `C` either was blocked
+/// (in every direction tried) only by parts of `C` and fixed parts, or could leave but would
+/// leave a part of `C` without support. Straight-line blocking is a property of part pairs, so
+/// removing parts outside `C` never frees a part of `C`; and contact-graph support only shrinks
+/// when parts go, so a part of `C` left floating stays floating. Every state containing `C` is
+/// a dead end too. (With the path planner in play, or physics stability, this is a heuristic: a
+/// path that failed among these parts is taken to fail among more.)
 fn locked_core(reasons: &[Stuck], is_fixed: impl Fn(usize) -> bool) -> Option<PartSet> {
-    let mut core: Vec<(usize, &PartSet)> = reasons
+    let mut core: Vec<(usize, &StuckReason)> = reasons
         .iter()
-        .filter_map(|s| match &s.reason {
-            StuckReason::Blocked(b) => Some((s.part, b)),
-            _ => None,
-        })
+        .filter(|s| matches!(s.reason, StuckReason::Blocked(_) | StuckReason::WouldLeaveUnsupported(_)))
+        .map(|s| (s.part, &s.reason))
         .collect();
     loop {
         let members: Vec<usize> = core.iter().map(|(p, _)| *p).collect();
         let before = core.len();
-        core.retain(|(_, b)| b.iter().all(|q| is_fixed(q) || members.contains(&q)));
+        core.retain(|(_, reason)| match reason {
+            StuckReason::Blocked(b) => b.iter().all(|q| is_fixed(q) || members.contains(&q)),
+            StuckReason::WouldLeaveUnsupported(f) => f.iter().any(|q| members.contains(&q)),
+            StuckReason::DeadEnd => false,
+        });
         if core.len() == before {
             break;
         }
@@ -287,6 +394,9 @@ impl Dfs {
             total: problem.removable(&problem.start).len(),
             deepest: None,
             longest: Vec::new(),
+            path_failed: HashMap::new(),
+            path_seconds: 0.0,
+            stopped_by: None,
         };
         let found = search.search(&problem.start);
         // not found: the removals of the partial disassembly that got furthest (to the deepest
@@ -300,11 +410,47 @@ impl Dfs {
             let (state, stuck, path) = search.deepest.take().unwrap_or_else(|| (problem.start.clone(), Vec::new(), Vec::new()));
             (Status::NoPlan { stuck, state }, path)
         };
-        let counters = search.counters;
-        PlanOutcome {
+        let mut outcome = PlanOutcome {
             status,
             removals,
-            stats: Stats { counters, seconds: started.elapsed().as_secs_f64(), states_expanded: search.expanded },
+            stats: Stats {
+                counters: search.counters,
+                seconds: 0.0,
+                states_expanded: search.expanded,
+                path_planner_seconds: search.path_seconds,
+                stopped_by: search.stopped_by,
+            },
+        };
+        self.plan_subassemblies(problem, budget, started, &mut outcome);
+        outcome.stats.seconds = started.elapsed().as_secs_f64();
+        outcome
+    }
+
+    /// Plans every subassembly of `outcome`'s removals on its own base (recursively: a
+    /// subassembly's plan may hold subassemblies), within what is left of the budget; adds their
+    /// effort to `outcome`'s. The step's part becomes the subassembly's base.
+    fn plan_subassemblies(&self, problem: &Problem, budget: &Budget, started: Instant, outcome: &mut PlanOutcome) {
+        let inner = Dfs { path_planner: false, ..self.clone() };
+        for step in &mut outcome.removals {
+            let Some(group) = step.group.as_mut() else { continue };
+            let Some((base, checker)) = problem.checker.subassembly(&group.parts) else { continue };
+            step.part = base;
+            let stats = &outcome.stats;
+            let left = budget.remaining(stats.counters.removal_tests, started);
+            if left.exhausted(0, Instant::now()) {
+                continue;
+            }
+            let sub = Problem { checker: &*checker, start: group.parts.clone(), progress: problem.progress };
+            let plan = inner.solve(&sub, &left);
+            let (c, s) = (&mut outcome.stats.counters, &plan.stats);
+            c.removal_tests += s.counters.removal_tests;
+            c.failed_collision += s.counters.failed_collision;
+            c.failed_gravity += s.counters.failed_gravity;
+            outcome.stats.states_expanded += s.states_expanded;
+            if plan.status == Status::BudgetExhausted {
+                outcome.stats.stopped_by = outcome.stats.stopped_by.or(s.stopped_by);
+            }
+            group.plan = Some(plan);
         }
     }
 }

@@ -25,7 +25,7 @@ pub use objective::{Accessibility, DirHistory, DirectionChanges, Objective, Path
 pub use ordering::{Bookkeeping, BuiltinOrder, OrderingFactory, OrderingSource, PartOrdering, WithBookkeeping};
 pub use pareto::ParetoMcts;
 pub use policy::{EpsilonGreedy, Policy, PolicyContext, PolicyWorker, QFunction, QWorker, RandomPolicy};
-pub use problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, Stuck, StuckReason};
+pub use problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StopReason, Stuck, StuckReason, Subassembly};
 pub use search::{SearchOutcome, SearchStats, SearchStatus, Solution, StopToken};
 
 /// A planner: takes a problem apart within a budget. Every planner runs the same conformance

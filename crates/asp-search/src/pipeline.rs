@@ -10,7 +10,7 @@ use crate::mdp::{MdpExtension, ModelContext};
 use crate::objective::resolve_objectives;
 use crate::ordering::{BuiltinOrder, OrderingSource};
 use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step};
-use crate::report::{OptimisationEntry, ParetoEntry, PlanReport, CHECKER_DISTANCE_MAPS};
+use crate::report::{OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
 use crate::search::{SearchOutcome, SearchStatus, StopToken, DEFAULT_BUDGET, DEFAULT_EPISODES};
 use crate::{Dfs, Mcts, Mdp, ParetoMcts, Planner, Result, SearchError};
 use asp_geom::distmap::{DistanceMaps, MapConfig, Support};
@@ -20,8 +20,14 @@ use asp_geom::physics::PhysicsConfig;
 use asp_geom::rrt::RrtConfig;
 use asp_geom::{Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, StabilityMode, Units, World, WorldConfig};
 use std::path::Path;
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+/// The default time budget of a feasibility search, seconds: long enough for every real model
+/// the tests know (the slowest answers in a few seconds), short enough that a model that
+/// cannot be answered still gives its best partial plan within a minute.
+pub const DEFAULT_TIMEOUT: f64 = 60.0;
 
 /// How the stability of a state is judged.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -66,16 +72,20 @@ pub struct PlanSettings {
     pub seed: u64,
     /// Fall back to the path planner when no straight line works.
     pub path_planner: bool,
+    /// Let groups of parts leave together as rigid subassemblies when no single part can.
+    pub subassemblies: bool,
     /// Path planner iterations per call.
     pub rrt_iterations: usize,
     /// Path planner wall-time cap per call, seconds.
     pub rrt_time: f64,
     /// Stop after this many removal tests.
     pub max_tests: Option<u64>,
-    /// Stop after this many seconds.
+    /// Stop after this many seconds ([`DEFAULT_TIMEOUT`]; `None`: no limit).
     pub timeout: Option<f64>,
     /// Optimise instead of finding a feasible sequence.
     pub optimise: Option<OptimiseSettings>,
+    /// Set from outside (a Ctrl-C handler) to stop the search with the best result so far.
+    pub cancel: Option<Arc<AtomicBool>>,
 }
 
 impl Default for PlanSettings {
@@ -94,11 +104,13 @@ impl Default for PlanSettings {
             bookkeeping: false,
             seed: 0,
             path_planner: true,
+            subassemblies: true,
             rrt_iterations: RrtConfig::default().max_iterations,
             rrt_time: RrtConfig::default().max_time.as_secs_f64(),
             max_tests: None,
-            timeout: None,
+            timeout: Some(DEFAULT_TIMEOUT),
             optimise: None,
+            cancel: None,
         }
     }
 }
@@ -248,6 +260,7 @@ pub fn planner(settings: &PlanSettings, world: &World) -> Result<Dfs> {
         .ordering_factory(factory)
         .bookkeeping(settings.bookkeeping)
         .path_planner(settings.path_planner)
+        .subassemblies(settings.subassemblies)
         .seed(settings.seed)
         .build())
 }
@@ -257,12 +270,21 @@ pub fn budget(settings: &PlanSettings) -> Result<Budget> {
     Ok(Budget {
         max_tests: settings.max_tests,
         timeout: settings.timeout.map(|t| positive("the timeout", t).map(Duration::from_secs_f64)).transpose()?,
+        cancel: settings.cancel.clone(),
     })
 }
 
-/// Plans the model at `path`: [`load`], then [`plan_assembly`].
+/// Plans the model at `path`: [`load`], then [`plan_assembly`] (the load time in the report's
+/// timings).
 pub fn plan_file(path: &Path, settings: &PlanSettings, progress: Option<&(dyn Fn(&Progress) + Sync)>) -> Result<PlanResult> {
-    plan_assembly(load(path, settings)?, settings, progress)
+    let started = Instant::now();
+    let assembly = load(path, settings)?;
+    let load_seconds = started.elapsed().as_secs_f64();
+    let mut result = plan_assembly(assembly, settings, progress)?;
+    if let Some(t) = result.report.stats.timings.as_mut() {
+        t.load = load_seconds;
+    }
+    Ok(result)
 }
 
 /// Plans `assembly`: a feasible sequence by depth-first AbD, or, with
@@ -275,14 +297,22 @@ pub fn plan_assembly(
     if let Some(optimise) = &settings.optimise {
         return self::optimise(Arc::new(assembly), settings, optimise);
     }
+    let started = Instant::now();
     let checker = checker(assembly, settings)?;
+    let world_seconds = started.elapsed().as_secs_f64();
     let dfs = planner(settings, checker.world())?;
     let budget = budget(settings)?;
     let mut problem = Problem::full(&checker);
     problem.progress = progress;
     let outcome = dfs.solve(&problem, &budget);
     let world = checker.world();
-    let report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
+    let mut report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
+    report.stats.timings = Some(Timings {
+        load: 0.0,
+        world: world_seconds,
+        search: outcome.stats.seconds,
+        path_planner: outcome.stats.path_planner_seconds,
+    });
     Ok(PlanResult { report, status: outcome.status, search: None })
 }
 
@@ -391,14 +421,16 @@ fn adapt(maps: &DistanceMaps, outcome: &SearchOutcome) -> PlanOutcome {
             s.sequence
                 .iter()
                 .zip(&s.motions)
-                .map(|(&part, m)| Step {
-                    part,
-                    motion: match m {
-                        Motion::Linear { direction, distance } => {
-                            Motion::Linear { direction: *direction, distance: distance + margin }
-                        }
-                        other => other.clone(),
-                    },
+                .map(|(&part, m)| {
+                    Step::single(
+                        part,
+                        match m {
+                            Motion::Linear { direction, distance } => {
+                                Motion::Linear { direction: *direction, distance: distance + margin }
+                            }
+                            other => other.clone(),
+                        },
+                    )
                 })
                 .collect()
         })
@@ -420,7 +452,7 @@ fn adapt(maps: &DistanceMaps, outcome: &SearchOutcome) -> PlanOutcome {
                 path_planner_calls: 0,
             },
             seconds: s.seconds,
-            states_expanded: 0,
+            ..Stats::default()
         },
     }
 }

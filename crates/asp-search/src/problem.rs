@@ -1,6 +1,8 @@
 //! What every planner gets (a [`Problem`] and a [`Budget`]) and gives back (a [`PlanOutcome`]).
 
 use asp_geom::{CounterSnapshot, FeasibilityChecker, Motion, PartSet};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// A planning problem: the feasibility checker of an assembly and the state to take apart.
@@ -38,12 +40,60 @@ pub struct Budget {
     pub max_tests: Option<u64>,
     /// The longest wall time.
     pub timeout: Option<Duration>,
+    /// Set from outside (e.g. by a Ctrl-C handler) to stop the search now; it then ends like an
+    /// exhausted budget, with the best result so far.
+    pub cancel: Option<Arc<AtomicBool>>,
+}
+
+/// Why a search stopped before it could finish.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// The wall-time budget ran out.
+    Timeout,
+    /// The removal-test budget ran out.
+    MaxTests,
+    /// It was cancelled ([`Budget::cancel`], e.g. Ctrl-C).
+    Interrupted,
+}
+
+impl StopReason {
+    /// The name in the plan JSON (`timeout`, `max_tests`, `interrupted`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            StopReason::Timeout => "timeout",
+            StopReason::MaxTests => "max_tests",
+            StopReason::Interrupted => "interrupted",
+        }
+    }
 }
 
 impl Budget {
     /// Whether the budget is used up, given the tests run so far and the start time.
     pub fn exhausted(&self, tests: u64, started: Instant) -> bool {
-        self.max_tests.is_some_and(|m| tests >= m) || self.timeout.is_some_and(|t| started.elapsed() >= t)
+        self.stop_reason(tests, started).is_some()
+    }
+
+    /// Why the budget is used up, if it is.
+    pub fn stop_reason(&self, tests: u64, started: Instant) -> Option<StopReason> {
+        if self.cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed)) {
+            Some(StopReason::Interrupted)
+        } else if self.max_tests.is_some_and(|m| tests >= m) {
+            Some(StopReason::MaxTests)
+        } else if self.timeout.is_some_and(|t| started.elapsed() >= t) {
+            Some(StopReason::Timeout)
+        } else {
+            None
+        }
+    }
+
+    /// The budget left after `tests` tests and the time since `started` (for a search that
+    /// continues another's work, e.g. a subassembly's own plan).
+    pub fn remaining(&self, tests: u64, started: Instant) -> Budget {
+        Budget {
+            max_tests: self.max_tests.map(|m| m.saturating_sub(tests)),
+            timeout: self.timeout.map(|t| t.saturating_sub(started.elapsed())),
+            cancel: self.cancel.clone(),
+        }
     }
 }
 
@@ -58,13 +108,43 @@ pub struct Progress {
     pub tests: u64,
 }
 
-/// One removal: which part, along which motion.
+/// One removal: which part (or rigid subassembly), along which motion.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Step {
-    /// The part index.
+    /// The part index (for a subassembly, its base: the part the others are put onto).
     pub part: usize,
     /// Its removal motion (from the assembled pose outward).
     pub motion: Motion,
+    /// When several parts leave together as one rigid subassembly: which, and how the
+    /// subassembly itself comes apart.
+    pub group: Option<Box<Subassembly>>,
+}
+
+impl Step {
+    /// A single part's removal.
+    pub fn single(part: usize, motion: Motion) -> Step {
+        Step { part, motion, group: None }
+    }
+
+    /// The parts that leave in this step (the part, or every part of the subassembly).
+    pub fn parts(&self) -> Vec<usize> {
+        match &self.group {
+            Some(g) => g.parts.iter().collect(),
+            None => vec![self.part],
+        }
+    }
+}
+
+/// A group of parts that leaves as one rigid body (built beforehand as a subassembly).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Subassembly {
+    /// Every part of the subassembly (the step's part, its base, among them).
+    pub parts: PartSet,
+    /// The subassembly's own disassembly on its base (the step's part as the only fixed part):
+    /// `Found` when it can be built part by part; otherwise it cannot be taken apart (a locked
+    /// core: its explanation says what holds what), or was not planned (`None`: the checker
+    /// cannot plan subassemblies, or the budget ran out first).
+    pub plan: Option<PlanOutcome>,
 }
 
 /// Why a part could not leave the state where the search got stuck.
@@ -113,10 +193,14 @@ pub struct Stats {
     pub seconds: f64,
     /// Disassembly states expanded.
     pub states_expanded: u64,
+    /// Wall time spent in path planner calls (part of `seconds`).
+    pub path_planner_seconds: f64,
+    /// Why the search stopped early (with [`Status::BudgetExhausted`]).
+    pub stopped_by: Option<StopReason>,
 }
 
 /// The result of [`crate::Planner::solve`].
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct PlanOutcome {
     /// How the search ended.
     pub status: Status,

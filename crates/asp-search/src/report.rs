@@ -4,14 +4,14 @@
 //! frame; `assembly_sequence` runs in assembly order (the removal order reversed, each motion
 //! reversed into an insertion).
 
-use crate::problem::{PlanOutcome, Status, StuckReason};
+use crate::problem::{PlanOutcome, Status, Step, StuckReason};
 use asp_geom::math::Pose;
 use asp_geom::{Assembly, Motion, PartSet};
 use serde::{Deserialize, Serialize};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.3";
+pub const FORMAT_VERSION: &str = "1.4";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -73,12 +73,33 @@ pub struct PartEntry {
 /// One assembly step.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct AssemblyStep {
-    /// Part index.
+    /// Part index (for a subassembly, its base).
     pub part: usize,
     /// Part name.
     pub name: String,
     /// How it goes in.
     pub motion: MotionEntry,
+    /// When several parts go in together as one rigid subassembly (built beforehand): its parts
+    /// and its own plan. Since format 1.4.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub subassembly: Option<Box<SubassemblyEntry>>,
+}
+
+/// A subassembly: parts that go in together, rigidly, as one step.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct SubassemblyEntry {
+    /// Every part of it, by index (the step's part, its base, among them).
+    pub parts: Vec<usize>,
+    /// How it is built on its base: `found` (its `assembly_sequence` builds it part by part),
+    /// `no_plan` (it cannot be taken apart: a locked core, `explanation` says what holds
+    /// what), `budget_exhausted`, or `unplanned` (not tried).
+    pub status: String,
+    /// Its own steps onto the base, in assembly order (for `no_plan` and `budget_exhausted`
+    /// the parts that do come off, onto the parts that stay); steps may be subassemblies again.
+    pub assembly_sequence: Vec<AssemblyStep>,
+    /// For `no_plan`: the parts that cannot be separated and what holds each.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub explanation: Vec<Explanation>,
 }
 
 /// An insertion motion, ending in the part's assembled pose.
@@ -120,6 +141,26 @@ pub struct StatsEntry {
     pub path_planner_calls: u64,
     /// Wall time in seconds (the only field that differs between identical runs).
     pub seconds: f64,
+    /// Where the wall time went: `load`, `world`, `search` (= `seconds`) and `path_planner`
+    /// (part of `search`), seconds. Since format 1.4.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub timings: Option<Timings>,
+    /// For `budget_exhausted`: `timeout`, `max_tests` or `interrupted` (Ctrl-C). Since 1.4.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stopped_by: Option<String>,
+}
+
+/// Where a run's wall time went, in seconds.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Default)]
+pub struct Timings {
+    /// Reading the model file(s).
+    pub load: f64,
+    /// Building the collision world (meshes, directions, contacts, overlaps).
+    pub world: f64,
+    /// The search, from its start to its answer (removal tests included).
+    pub search: f64,
+    /// Path planner calls (part of `search`).
+    pub path_planner: f64,
 }
 
 /// `stats.checker` of plans tested on the collision world.
@@ -216,36 +257,13 @@ impl PlanReport {
         let u = |m: f32| assembly.units.from_metres(m as f64);
         let name = |i: usize| assembly.parts.get(i).map(|p| p.name.clone()).unwrap_or_else(|| "ground".into());
         let named = |s: &PartSet| s.iter().map(|part| NamedPart { part, name: name(part) }).collect();
-        let status = match &outcome.status {
-            Status::Found => "found",
-            Status::NoPlan { .. } => "no_plan",
-            Status::BudgetExhausted => "budget_exhausted",
-        };
-        let steps: Vec<AssemblyStep> = outcome
-            .removals
-            .iter()
-            .rev()
-            .map(|s| AssemblyStep { part: s.part, name: name(s.part), motion: insertion(&s.motion, &u) })
-            .collect();
+        let status = status_name(&outcome.status);
+        let steps = assembly_steps(&outcome.removals, &name, &u);
         let found = outcome.status == Status::Found;
-        let remaining = (!found).then(|| {
-            (0..assembly.parts.len()).filter(|i| !outcome.removals.iter().any(|s| s.part == *i)).collect()
-        });
+        let removed = removal_order(&outcome.removals);
+        let remaining = (!found).then(|| (0..assembly.parts.len()).filter(|i| !removed.contains(i)).collect());
         let (assembly_sequence, partial_assembly_sequence) = if found { (steps, Vec::new()) } else { (Vec::new(), steps) };
-        let explanation = match &outcome.status {
-            Status::NoPlan { stuck, .. } => stuck
-                .iter()
-                .map(|s| {
-                    let (reason, parts) = match &s.reason {
-                        StuckReason::Blocked(b) => ("blocked", named(b)),
-                        StuckReason::WouldLeaveUnsupported(f) => ("unsupported", named(f)),
-                        StuckReason::DeadEnd => ("dead_end", Vec::new()),
-                    };
-                    Explanation { part: s.part, name: name(s.part), reason: reason.into(), parts }
-                })
-                .collect(),
-            _ => Vec::new(),
-        };
+        let explanation = explain(&outcome.status, &name, &named);
         let c = &outcome.stats.counters;
         PlanReport {
             format_version: FORMAT_VERSION.into(),
@@ -261,7 +279,7 @@ impl PlanReport {
                 .map(|(index, p)| PartEntry { index, name: p.name.clone(), fixed: p.fixed })
                 .collect(),
             assembly_sequence,
-            disassembly_sequence: outcome.removals.iter().map(|s| s.part).collect(),
+            disassembly_sequence: removed,
             partial_assembly_sequence,
             remaining,
             stats: StatsEntry {
@@ -271,12 +289,81 @@ impl PlanReport {
                 failed_gravity: c.failed_gravity,
                 path_planner_calls: c.path_planner_calls,
                 seconds: outcome.stats.seconds,
+                timings: None,
+                stopped_by: outcome.stats.stopped_by.map(|r| r.as_str().to_string()),
             },
             explanation,
             warnings: warnings.to_vec(),
             pareto_front: None,
             optimisation: None,
         }
+    }
+}
+
+/// The removals as assembly steps (reversed, each motion reversed into an insertion), with
+/// their subassemblies' own plans.
+fn assembly_steps(removals: &[Step], name: &dyn Fn(usize) -> String, u: &dyn Fn(f32) -> f64) -> Vec<AssemblyStep> {
+    removals
+        .iter()
+        .rev()
+        .map(|s| AssemblyStep {
+            part: s.part,
+            name: name(s.part),
+            motion: insertion(&s.motion, u),
+            subassembly: s.group.as_ref().map(|g| {
+                let named = |set: &PartSet| set.iter().map(|part| NamedPart { part, name: name(part) }).collect();
+                let (status, assembly_sequence, explanation) = match &g.plan {
+                    None => ("unplanned", Vec::new(), Vec::new()),
+                    Some(plan) => (status_name(&plan.status), assembly_steps(&plan.removals, name, u), explain(&plan.status, name, &named)),
+                };
+                Box::new(SubassemblyEntry { parts: g.parts.iter().collect(), status: status.into(), assembly_sequence, explanation })
+            }),
+        })
+        .collect()
+}
+
+/// The parts in removal order, a subassembly's parts at its step: those its own plan removes
+/// first, in that order, then the ones that stay on its base, the base last.
+pub fn removal_order(removals: &[Step]) -> Vec<usize> {
+    let mut order = Vec::new();
+    for s in removals {
+        match &s.group {
+            None => order.push(s.part),
+            Some(g) => {
+                let inner = g.plan.as_ref().map(|p| removal_order(&p.removals)).unwrap_or_default();
+                let stay = g.parts.iter().filter(|p| !inner.contains(p) && *p != s.part).collect::<Vec<_>>();
+                order.extend(inner);
+                order.extend(stay);
+                order.push(s.part);
+            }
+        }
+    }
+    order
+}
+
+fn status_name(status: &Status) -> &'static str {
+    match status {
+        Status::Found => "found",
+        Status::NoPlan { .. } => "no_plan",
+        Status::BudgetExhausted => "budget_exhausted",
+    }
+}
+
+/// The explanation of a `no_plan` status: what holds each part of the deepest dead end.
+fn explain(status: &Status, name: &dyn Fn(usize) -> String, named: &dyn Fn(&PartSet) -> Vec<NamedPart>) -> Vec<Explanation> {
+    match status {
+        Status::NoPlan { stuck, .. } => stuck
+            .iter()
+            .map(|s| {
+                let (reason, parts) = match &s.reason {
+                    StuckReason::Blocked(b) => ("blocked", named(b)),
+                    StuckReason::WouldLeaveUnsupported(f) => ("unsupported", named(f)),
+                    StuckReason::DeadEnd => ("dead_end", Vec::new()),
+                };
+                Explanation { part: s.part, name: name(s.part), reason: reason.into(), parts }
+            })
+            .collect(),
+        _ => Vec::new(),
     }
 }
 

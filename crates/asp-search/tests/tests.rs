@@ -4,6 +4,7 @@ mod collect;
 mod conformance;
 mod exact;
 mod fixtures;
+mod groups;
 mod hypervolume;
 mod mcts;
 mod objectives;

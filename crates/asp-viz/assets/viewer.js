@@ -92,18 +92,20 @@ const parts = data.parts.map((p, i) => {
   geometry.boundingBox.getCenter(centre);
   return { ...p, index: i, mesh, material, colour, centre };
 });
-const steps = data.steps.map((s) => ({ ...s, motion: prepareMotion(s.motion) }));
+const steps = data.steps.map((s) => ({ ...s, group: s.group || [s.part], motion: prepareMotion(s.motion) }));
 
 // the bounds of the model and of every motion's start: the camera sees all of it
 const bounds = new THREE.Box3();
 for (const p of parts) bounds.union(p.mesh.geometry.boundingBox);
 for (const s of steps) {
   if (!s.motion) continue;
-  const box = parts[s.part].mesh.geometry.boundingBox;
-  for (let k = 0; k <= 8; k++) {
-    const pose = poseAt(s.motion, k / 8);
-    for (const x of [box.min.x, box.max.x]) for (const y of [box.min.y, box.max.y]) for (const z of [box.min.z, box.max.z])
-      bounds.expandByPoint(apply(pose, new THREE.Vector3(x, y, z)));
+  for (const i of s.group) {
+    const box = parts[i].mesh.geometry.boundingBox;
+    for (let k = 0; k <= 8; k++) {
+      const pose = poseAt(s.motion, k / 8);
+      for (const x of [box.min.x, box.max.x]) for (const y of [box.min.y, box.max.y]) for (const z of [box.min.z, box.max.z])
+        bounds.expandByPoint(apply(pose, new THREE.Vector3(x, y, z)));
+    }
   }
 }
 const centre = bounds.getCenter(new THREE.Vector3());
@@ -170,12 +172,16 @@ function apply_state() {
     place(p, poseAt(null, 1));
     p.material.emissive.setRGB(0, 0, 0);
   }
-  for (let k = 0; k < state.shown; k++) parts[steps[k].part].mesh.visible = true;
+  // a step puts in one part, or a whole subassembly (`group`: its parts move together)
+  for (let k = 0; k < state.shown; k++) for (const i of steps[k].group) parts[i].mesh.visible = true;
   const flying = state.flying >= 0 ? steps[state.flying] : null;
   if (flying) {
-    const p = parts[flying.part];
-    place(p, poseAt(flying.motion, flying.motion ? state.t : 1));
-    p.material.emissive.setRGB(0.25, 0.18, 0.0);
+    for (const i of flying.group) {
+      const p = parts[i];
+      p.mesh.visible = true;
+      place(p, poseAt(flying.motion, flying.motion ? state.t : 1));
+      p.material.emissive.setRGB(0.25, 0.18, 0.0);
+    }
   }
   const current = state.flying >= 0 ? state.flying : state.shown - 1;
   showPath(current >= 0 ? steps[current] : null);
@@ -235,7 +241,8 @@ const list = document.getElementById('asp-steps');
 const items = steps.map((s, k) => {
   const li = document.createElement('li');
   li.innerHTML = `<span class="swatch" style="background:${css(parts[s.part].colour)}"></span>`;
-  const how = s.motion ? (s.motion.kind === 'path' ? ' (path)' : '') : '';
+  const how = (s.motion ? (s.motion.kind === 'path' ? ' (path)' : '') : '') +
+    (s.group.length > 1 ? ` + ${s.group.length - 1} parts (subassembly)` : '');
   li.appendChild(document.createTextNode(s.name + how));
   li.addEventListener('click', () => { pause(); goto(k + 1); });
   list.appendChild(li);

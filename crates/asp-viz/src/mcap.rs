@@ -75,7 +75,20 @@ pub fn write_scene(path: &Path, scene: &Scene, options: &McapOptions) -> Result<
     if !(options.step_seconds > 0.0 && options.step_seconds.is_finite() && options.rate > 0.0 && options.rate.is_finite()) {
         return Err(VizError::output(path, "the step time and the rate must be positive"));
     }
-    let file = std::fs::File::create(path).map_err(|e| VizError::io(path, e))?;
+    // written to a temporary file beside `path` and renamed over it at the end: never half a file
+    let mut failed = None;
+    asp_geom::io::write_atomic_with(path, |file| {
+        let file = file.try_clone()?;
+        write_mcap(path, scene, options, file).map_err(|e| {
+            failed = Some(e);
+            std::io::Error::other("mcap")
+        })
+    })
+    .map_err(|e| failed.take().unwrap_or_else(|| VizError::io(path, e)))
+}
+
+/// Writes the MCAP of `scene` into `file` (`path` names it in errors).
+fn write_mcap(path: &Path, scene: &Scene, options: &McapOptions, file: std::fs::File) -> Result<McapSummary> {
     let err = |e: ::mcap::McapError| VizError::output(path, format!("mcap: {e}"));
     let mut writer = ::mcap::WriteOptions::new()
         .compression(Some(::mcap::Compression::Zstd))
@@ -109,9 +122,10 @@ pub fn write_scene(path: &Path, scene: &Scene, options: &McapOptions) -> Result<
     let frames = ((options.step_seconds * 0.8 * options.rate).round() as u64).max(1);
     for (k, step) in scene.steps.iter().enumerate() {
         let start = lead + k as u64 * step_ns;
-        out.put(parts_ch, TOPIC_PARTS, start, &json!({ "deletions": [], "entities": [part_entity(scene, step.part, start)] }))
-            .map_err(err)?;
-        let frame = part_frame(step.part);
+        // a subassembly's parts appear and move together
+        let entities: Vec<Value> = step.parts.iter().map(|&i| part_entity(scene, i, start)).collect();
+        out.put(parts_ch, TOPIC_PARTS, start, &json!({ "deletions": [], "entities": entities })).map_err(err)?;
+        let frames_of: Vec<String> = step.parts.iter().map(|&i| part_frame(i)).collect();
         match &step.motion {
             Some(motion) => {
                 let centre = scene.assembly.parts[step.part].mesh.aabb().map(|b| (b.mins + b.maxs) / 2.0).unwrap_or(Vec3::ZERO);
@@ -121,13 +135,13 @@ pub fn write_scene(path: &Path, scene: &Scene, options: &McapOptions) -> Result<
                 for j in 0..=frames {
                     let t = start + j * (step_ns * 4 / 5) / frames;
                     let pose = motion.pose_at(j as f32 / frames as f32);
-                    out.put(tf_ch, TOPIC_TRANSFORMS, t, &json!({ "transforms": [transform(t, FRAME_MODEL, &frame, &pose)] }))
-                        .map_err(err)?;
+                    let transforms: Vec<Value> = frames_of.iter().map(|f| transform(t, FRAME_MODEL, f, &pose)).collect();
+                    out.put(tf_ch, TOPIC_TRANSFORMS, t, &json!({ "transforms": transforms })).map_err(err)?;
                 }
             }
             None => {
-                out.put(tf_ch, TOPIC_TRANSFORMS, start, &json!({ "transforms": [transform(start, FRAME_MODEL, &frame, &Pose::IDENTITY)] }))
-                    .map_err(err)?;
+                let transforms: Vec<Value> = frames_of.iter().map(|f| transform(start, FRAME_MODEL, f, &Pose::IDENTITY)).collect();
+                out.put(tf_ch, TOPIC_TRANSFORMS, start, &json!({ "transforms": transforms })).map_err(err)?;
             }
         }
     }

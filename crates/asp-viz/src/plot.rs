@@ -34,7 +34,7 @@ macro_rules! render_to {
             }
             crate::render::png_bytes(&pixels, size.0, size.1, out)?
         };
-        std::fs::write(out, bytes).map_err(|e| VizError::io(out, e))?;
+        asp_geom::io::write_atomic(out, &bytes).map_err(|e| VizError::io(out, e))?;
     }};
 }
 

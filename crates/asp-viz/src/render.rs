@@ -153,7 +153,7 @@ pub fn write(path: &Path, scene: &Scene, options: &RenderOptions) -> Result<Stor
     let board = storyboard(scene, options);
     let is_svg = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("svg"));
     let bytes = if is_svg { svg(&board, path)?.into_bytes() } else { png_bytes(&board.pixels, board.width, board.height, path)? };
-    std::fs::write(path, bytes).map_err(|e| VizError::io(path, e))?;
+    asp_geom::io::write_atomic(path, &bytes).map_err(|e| VizError::io(path, e))?;
     Ok(board)
 }
 
@@ -184,7 +184,8 @@ fn panel_specs(scene: &Scene) -> Vec<PanelSpec> {
     for (k, step) in scene.steps.iter().enumerate() {
         let colour = part_colour(step.part);
         let mut parts: Vec<(usize, Rgb, Pose)> = placed.iter().map(|&i| (i, colour_of_placed(i), Pose::IDENTITY)).collect();
-        parts.push((step.part, colour, Pose::IDENTITY));
+        // a subassembly's parts go in together, in the step's colour
+        parts.extend(step.parts.iter().map(|&i| (i, colour, Pose::IDENTITY)));
         let (kind, arrow) = match &step.motion {
             Some(m) => {
                 let centre = scene.assembly.parts[step.part]
@@ -201,7 +202,7 @@ fn panel_specs(scene: &Scene) -> Vec<PanelSpec> {
             None => ("motion not recorded", Vec::new()),
         };
         specs.push(PanelSpec { parts, part: Some(step.part), colour, title: format!("{}. {} ({kind})", k + 1, step.name), arrow });
-        placed.push(step.part);
+        placed.extend(&step.parts);
     }
     specs
 }

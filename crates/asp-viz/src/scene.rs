@@ -169,11 +169,14 @@ fn segment_weight(a: &Pose, b: &Pose, pivot: Vec3, radius: f32) -> f32 {
     travel + turn * radius
 }
 
-/// One step of the pictures: a part going in.
+/// One step of the pictures: a part, or a subassembly, going in.
 #[derive(Clone, Debug)]
 pub struct Step {
-    /// Part index.
+    /// Part index (a subassembly's base).
     pub part: usize,
+    /// Every part that goes in with this motion: `[part]`, or a subassembly's parts (built
+    /// beforehand, moving together).
+    pub parts: Vec<usize>,
     /// Part name.
     pub name: String,
     /// Its insertion motion; `None` for the partial sequence of a `no_plan` or
@@ -232,7 +235,15 @@ impl Scene {
                     let radius = aabb_of(part.mesh.vertices.iter().copied())
                         .map(|b| (b.maxs - b.mins).length() / 2.0)
                         .unwrap_or(0.0);
-                    Ok(Step { part: s.part, name: part.name.clone(), motion: Some(Insertion::from_entry(&s.motion, metres, radius)) })
+                    let parts = s.subassembly.as_ref().map_or_else(|| vec![s.part], |g| g.parts.clone());
+                    if let Some(&p) = parts.iter().find(|&&p| p >= n) {
+                        return Err(bad(p));
+                    }
+                    let name = match &s.subassembly {
+                        None => part.name.clone(),
+                        Some(g) => format!("{} + {} parts (subassembly)", part.name, g.parts.len() - 1),
+                    };
+                    Ok(Step { part: s.part, parts, name, motion: Some(Insertion::from_entry(&s.motion, metres, radius)) })
                 })
                 .collect::<Result<_>>()?
         } else {
@@ -263,12 +274,12 @@ impl Scene {
             }
             let rest: Vec<usize> = (0..n).filter(|i| !core.contains(i) && !order.contains(i)).collect();
             order.extend(rest);
-            order.into_iter().map(|p| Step { part: p, name: assembly.parts[p].name.clone(), motion: None }).collect()
+            order.into_iter().map(|p| Step { part: p, parts: vec![p], name: assembly.parts[p].name.clone(), motion: None }).collect()
         };
         let mut placed = vec![false; n];
-        for s in &steps {
-            if std::mem::replace(&mut placed[s.part], true) {
-                return Err(VizError::input(source, format!("the plan inserts part {} twice", s.part)));
+        for &p in steps.iter().flat_map(|s| &s.parts) {
+            if std::mem::replace(&mut placed[p], true) {
+                return Err(VizError::input(source, format!("the plan inserts part {p} twice")));
             }
         }
         let initial = (0..n).filter(|&i| !placed[i]).collect();
@@ -290,8 +301,8 @@ impl Scene {
             points.push(b.mins);
             points.push(b.maxs);
         }
-        for s in &self.steps {
-            if let (Some(m), Some(b)) = (&s.motion, self.assembly.parts[s.part].mesh.aabb()) {
+        for (s, &p) in self.steps.iter().flat_map(|s| s.parts.iter().map(move |p| (s, p))) {
+            if let (Some(m), Some(b)) = (&s.motion, self.assembly.parts[p].mesh.aabb()) {
                 for k in 0..=8 {
                     let pose = m.pose_at(k as f32 / 8.0);
                     for c in corners(b.mins, b.maxs) {

@@ -36,7 +36,7 @@ pub fn html(scene: &Scene) -> String {
 
 /// Writes the viewer page of `scene` to `path`.
 pub fn write_html(path: &Path, scene: &Scene) -> Result<()> {
-    std::fs::write(path, html(scene)).map_err(|e| VizError::io(path, e))
+    asp_geom::io::write_atomic(path, html(scene).as_bytes()).map_err(|e| VizError::io(path, e))
 }
 
 /// The JSON the page's script reads: meshes in model units (base64 little-endian `f32`
@@ -109,7 +109,7 @@ fn page_data(scene: &Scene) -> Value {
                     "radius": *radius as f64 * per_metre,
                 }),
             };
-            json!({ "part": s.part, "name": s.name, "motion": motion })
+            json!({ "part": s.part, "name": s.name, "motion": motion, "group": s.parts })
         })
         .collect();
     let explanation: Vec<Value> = r

@@ -38,7 +38,7 @@ fn plans_a_fixture_prints_a_table_and_writes_the_json() {
     assert!(table.contains("found"), "{table}");
     assert!(table.contains("stick") && table.contains("handle") && table.contains("cap"), "{table}");
     let plan = json(&out);
-    assert_eq!(plan["format_version"], "1.3");
+    assert_eq!(plan["format_version"], "1.4");
     assert_eq!(plan["stats"]["checker"], "collision_world");
     assert_eq!(plan["status"], "found");
     assert_eq!(plan["up"], "+z");
@@ -58,6 +58,7 @@ fn same_input_and_seed_give_identical_json_apart_from_seconds() {
         assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
         let mut v = json(&out);
         v["stats"]["seconds"] = serde_json::Value::Null;
+        v["stats"]["timings"] = serde_json::Value::Null;
         serde_json::to_string(&v).unwrap()
     };
     assert_eq!(run(1), run(2));
@@ -172,4 +173,77 @@ fn physics_stability_takes_the_keystone_before_a_pillar() {
     assert_eq!(order(&[]), vec![1, 3, 2]);
     // physics: a keystone on one pillar tips over, so it must leave first
     assert_eq!(order(&["--stability", "physics"]), vec![3, 1, 2]);
+}
+
+#[test]
+fn issue_9_ctrl_c_prints_and_writes_the_best_result_so_far() {
+    // cube81 one piece at a time: every piece is blocked, and the path planner is tried on each
+    // of the 81 in turn (many seconds); Ctrl-C stops it between two path planner calls
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("plan.json");
+    let cube = data("cube81");
+    let args = ["plan", &cube, "--unit", "mm", "--up", "z", "--no-subassemblies", "--rrt-time", "0.1", "--out", out.to_str().unwrap()];
+    let child = Command::new(env!("CARGO_BIN_EXE_asp"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("asp runs");
+    // after the world is built and the search has started
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().expect("kill runs");
+    assert!(kill.success());
+    let started = std::time::Instant::now();
+    let o = child.wait_with_output().unwrap();
+    assert!(started.elapsed().as_secs_f64() < 5.0, "it stops soon after Ctrl-C");
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let table = String::from_utf8(o.stdout).unwrap();
+    assert!(table.contains("budget exhausted") && table.contains("interrupted (Ctrl-C)"), "{table}");
+    assert!(stderr(&o).contains("interrupted"), "{}", stderr(&o));
+    let plan = json(&out);
+    assert_eq!(plan["status"], "budget_exhausted");
+    assert_eq!(plan["stats"]["stopped_by"], "interrupted");
+    // (a slow machine may still be building the world at the Ctrl-C: then no call at all)
+    assert!(plan["stats"]["path_planner_calls"].as_u64().unwrap() < 81, "stopped before the state was done");
+    // written atomically: the plan and nothing else
+    let files: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(files, [std::ffi::OsString::from("plan.json")]);
+}
+
+#[test]
+fn issue_9_one_process_plans_many_models_and_exits_with_the_worst_outcome() {
+    let dir = tempfile::tempdir().unwrap();
+    let tube = fixture_file(dir.path(), &fixtures::tube(), "tube.glb");
+    let arch = fixture_file(dir.path(), &fixtures::arch(), "arch.glb");
+    let missing = dir.path().join("missing.glb");
+    let out = dir.path().join("plans");
+    let models = [tube.to_str().unwrap(), arch.to_str().unwrap()];
+    let o = asp(&["plan", models[0], models[1], "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let table = String::from_utf8(o.stdout).unwrap();
+    assert_eq!(table.matches("found in").count(), 2, "{table}");
+    assert!(stderr(&o).contains("2 models in") && stderr(&o).contains("2 found"), "{}", stderr(&o));
+    assert_eq!(json(&out.join("tube.json"))["status"], "found");
+    assert_eq!(json(&out.join("arch.json"))["status"], "found");
+    // a bad model is an error line; the others still plan; the exit code is the worst (2)
+    let o = asp(&["plan", models[0], missing.to_str().unwrap(), models[1], "--json"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("missing.glb"), "{}", stderr(&o));
+    let all: serde_json::Value = serde_json::from_slice(&o.stdout).expect("a JSON array of plans");
+    assert_eq!(all.as_array().unwrap().len(), 2);
+    // --each: every model inside a folder (a .glb file, a folder of STL parts)
+    let models_dir = dir.path().join("models");
+    std::fs::create_dir_all(models_dir.join("pump")).unwrap();
+    std::fs::copy(&tube, models_dir.join("tube.glb")).unwrap();
+    for f in std::fs::read_dir(data("pump")).unwrap() {
+        let f = f.unwrap();
+        std::fs::copy(f.path(), models_dir.join("pump").join(f.file_name())).unwrap();
+    }
+    let o = asp(&["plan", "--each", models_dir.to_str().unwrap(), "--unit", "mm", "--up", "z", "--no-subassemblies", "--no-path-planner", "-q"]);
+    assert_eq!(o.status.code(), Some(1), "the pump has no plan without subassemblies: {}", stderr(&o));
+    let table = String::from_utf8(o.stdout).unwrap();
+    assert!(table.contains("pump: no plan") && table.contains("tube.glb: found"), "{table}");
+    let o = asp(&["plan", "--each", &data("pump")]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("one model"), "{}", stderr(&o));
 }

@@ -1,9 +1,11 @@
 //! Loading assemblies from files (glTF 2.0, folders of OBJ/STL) and writing GLB.
 
+mod atomic;
 mod folder;
 mod glb_write;
 mod gltf_read;
 
+pub use atomic::{write_atomic, write_atomic_with};
 pub use glb_write::write_glb;
 
 use crate::assembly::{Assembly, Units};

@@ -93,7 +93,7 @@ fn bookkeeping_never_runs_more_tests_than_vanilla() {
 #[test]
 fn budget_of_one_test_is_exhausted() {
     let checker = Checker::new(World::new(fixtures::tube(), &WorldConfig::default()).unwrap(), CheckerConfig::default());
-    let o = Dfs::builder().build().solve(&Problem::full(&checker), &Budget { max_tests: Some(1), timeout: None });
+    let o = Dfs::builder().build().solve(&Problem::full(&checker), &Budget { max_tests: Some(1), ..Budget::default() });
     assert_eq!(o.status, Status::BudgetExhausted);
     assert_eq!(o.stats.counters.removal_tests, 1);
 }

@@ -53,41 +53,80 @@ pub fn verify_plan(world: &World, outcome: &PlanOutcome) {
 /// Re-checks removals from the full assembly as [`verify_plan`] does (a whole plan or a partial
 /// disassembly) and returns the state they reach.
 pub fn verify_removals(world: &World, removals: &[asp_search::Step]) -> PartSet {
-    let n = world.num_parts();
-    let mut state = PartSet::full(n);
+    verify_from(world, PartSet::full(world.num_parts()), world.fixed(), removals)
+}
+
+/// Re-checks `removals` from `state` on the `base` parts: each step's parts (one part, or a
+/// rigid subassembly's) swept together against the others, bounds cleared at the end, the rest
+/// stable on the base; a subassembly's own plan re-checked the same way on its base part.
+pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: &[asp_search::Step]) -> PartSet {
     let mut cache = HashMap::new();
     for (k, step) in removals.iter().enumerate() {
-        let p = step.part;
-        assert!(state.contains(p) && !world.fixed().contains(p), "step {k}: part {p} not removable");
-        let present = world.with_fixed(&state);
-        let size = world.aabb(p).maxs - world.aabb(p).mins;
-        let h = (size.min_element() / 4.0).max(world.tolerance());
+        let movers = step.parts();
+        assert!(movers.contains(&step.part), "step {k}: its part is one of its movers");
+        for &p in &movers {
+            assert!(state.contains(p) && !base.contains(p), "step {k}: part {p} not removable");
+        }
+        let mut others = state.clone();
+        others.union_with(base);
+        for &p in &movers {
+            others.remove(p);
+        }
+        let bounds = movers
+            .iter()
+            .map(|&p| *world.aabb(p))
+            .reduce(|a, b| parry3d::bounding_volume::Aabb::new(a.mins.min(b.mins), a.maxs.max(b.maxs)))
+            .unwrap();
+        // steps of a quarter of the thinnest moving part
+        let thinnest = movers.iter().map(|&p| (world.aabb(p).maxs - world.aabb(p).mins).min_element()).fold(f32::INFINITY, f32::min);
+        let h = (thinnest / 4.0).max(world.tolerance());
         let poses: Vec<Pose> = match &step.motion {
             Motion::Linear { direction, distance } => {
                 assert!((direction.length() - 1.0).abs() < 1e-4);
                 let count = ((distance / h).ceil() as usize).clamp(8, 400);
                 (0..=count).map(|i| Pose::from_translation(*direction * (distance * i as f32 / count as f32))).collect()
             }
+            // every segment, at least 20 samples, and at most `h` apart along its pivot's travel
             Motion::Path { poses, pivot } => poses
                 .windows(2)
-                .flat_map(|w| (0..20).map(move |i| interpolate_about(*pivot, &w[0], &w[1], i as f32 / 20.0)))
+                .flat_map(|w| {
+                    let travel = (w[1].transform_point(*pivot) - w[0].transform_point(*pivot)).length();
+                    let count = ((travel / h).ceil() as usize).clamp(20, 400);
+                    (0..count).map(move |i| interpolate_about(*pivot, &w[0], &w[1], i as f32 / count as f32))
+                })
                 .chain(poses.last().copied())
                 .collect(),
         };
         for pose in &poses {
-            if let Some(q) = penetrates(world, p, pose, &present, &mut cache) {
-                panic!("step {k}: part '{}' hits '{}' at {pose:?}", world.name(p), world.name(q));
+            for &p in &movers {
+                if let Some(q) = penetrates(world, p, pose, &others, &mut cache) {
+                    panic!("step {k}: part '{}' hits '{}' at {pose:?}", world.name(p), world.name(q));
+                }
             }
         }
-        // at the end, the part's bounds are clear of the other present real parts' bounds
-        let end = world.aabb(p).transform_by(poses.last().unwrap());
-        for q in state.iter().filter(|&q| q != p) {
+        // at the end, the movers' bounds are clear of the other present real parts' bounds
+        let end = bounds.transform_by(poses.last().unwrap());
+        for q in state.iter().filter(|q| !movers.contains(q)) {
             let b = world.aabb(q);
             let overlap = (0..3).all(|i| end.mins[i] < b.maxs[i] - 1e-6 && b.mins[i] < end.maxs[i] - 1e-6);
-            assert!(!overlap, "step {k}: part '{}' still inside the bounds of '{}'", world.name(p), world.name(q));
+            assert!(!overlap, "step {k}: part '{}' still inside the bounds of '{}'", world.name(step.part), world.name(q));
         }
-        state.remove(p);
-        assert_eq!(world.contact_stability(&state), Stability::Stable, "step {k}: remainder unstable");
+        for &p in &movers {
+            state.remove(p);
+        }
+        let mut present = state.clone();
+        present.union_with(base);
+        assert_eq!(world.contact_stability_among(&present, base), Stability::Stable, "step {k}: remainder unstable");
+        if let Some(plan) = step.group.as_ref().and_then(|g| g.plan.as_ref()) {
+            let group = step.group.as_ref().unwrap();
+            let sub_base = PartSet::from_indices(world.num_parts() + 1, [step.part]);
+            let mut inner = group.parts.clone();
+            inner.remove(step.part);
+            let left = verify_from(world, inner, &sub_base, &plan.removals);
+            if plan.status == Status::Found {
+                assert!(left.is_empty(), "step {k}: its subassembly's plan leaves parts on the base");
+            }
+        }
     }
     let _ = Vec3::ZERO;
     state
