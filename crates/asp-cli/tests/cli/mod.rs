@@ -197,7 +197,7 @@ fn issue_9_ctrl_c_prints_and_writes_the_best_result_so_far() {
     let o = child.wait_with_output().unwrap();
     assert!(started.elapsed().as_secs_f64() < 5.0, "it stops soon after Ctrl-C");
     assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
-    let table = String::from_utf8(o.stdout).unwrap();
+    let table = String::from_utf8(o.stdout.clone()).unwrap();
     assert!(table.contains("budget exhausted") && table.contains("interrupted (Ctrl-C)"), "{table}");
     assert!(stderr(&o).contains("interrupted"), "{}", stderr(&o));
     let plan = json(&out);
@@ -220,7 +220,7 @@ fn issue_9_one_process_plans_many_models_and_exits_with_the_worst_outcome() {
     let models = [tube.to_str().unwrap(), arch.to_str().unwrap()];
     let o = asp(&["plan", models[0], models[1], "--out", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let table = String::from_utf8(o.stdout).unwrap();
+    let table = String::from_utf8(o.stdout.clone()).unwrap();
     assert_eq!(table.matches("found in").count(), 2, "{table}");
     assert!(stderr(&o).contains("2 models in") && stderr(&o).contains("2 found"), "{}", stderr(&o));
     assert_eq!(json(&out.join("tube.json"))["status"], "found");
