@@ -186,8 +186,8 @@ class Assembly:
         :raises ConfigError: a setting is unknown, of the wrong type or out of range.
         :raises LoadError: the model cannot be planned as given (parts overlapping beyond
             repair, ...).
-        :raises KeyboardInterrupt: Ctrl-C during a depth-first search (checked once per state;
-            the optimiser cannot be interrupted, bound it with ``time_limit``).
+        :raises KeyboardInterrupt: Ctrl-C while planning or optimising (checked every 50 ms; a
+            state whose tests take long, such as a path planner call, delays it until it ends).
 
         The GIL is released while planning.
         """

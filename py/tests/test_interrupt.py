@@ -1,4 +1,4 @@
-"""Ctrl-C stops a depth-first search from Python, and planning releases the GIL."""
+"""Ctrl-C stops a depth-first search and an optimiser from Python, and planning releases the GIL."""
 
 from __future__ import annotations
 
@@ -38,6 +38,29 @@ def test_ctrl_c_interrupts_a_search():
     assert word == "interrupted", p.stdout
     # interrupted well before the search would have ended by itself
     assert float(seconds) < 0.3 + max(1.0, 0.5 * full), (seconds, full)
+
+
+# the optimiser on the pump with far more episodes than it can run in the time limit
+OPTIMISING = f"""
+import _thread, threading, time, asp
+a = asp.load({str(ROOT / PUMP)!r}, unit="mm", up="z")
+threading.Timer(1.0, _thread.interrupt_main).start()
+start = time.monotonic()
+try:
+    a.plan(objective="access", episodes=10**9, time_limit=120, threads=1)
+    print("finished", time.monotonic() - start)
+except KeyboardInterrupt:
+    print("interrupted", time.monotonic() - start)
+"""
+
+
+def test_ctrl_c_interrupts_the_optimiser():
+    p = subprocess.run([sys.executable, "-c", OPTIMISING], capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    word, seconds = p.stdout.split()
+    assert word == "interrupted", p.stdout
+    # the optimiser would run its 120 s limit; it stops within an iteration of the signal
+    assert float(seconds) < 1.0 + 10.0, seconds
 
 
 def test_planning_releases_the_gil():

@@ -7,13 +7,12 @@ use asp_geom::Units;
 use asp_search::pipeline::{self, PlanSettings, StabilitySetting};
 use asp_search::report::{AssemblyStep, MotionEntry, PlanReport};
 use asp_search::Progress;
-use asp_search::StopReason;
+use asp_search::{StopReason, StopToken};
 use std::collections::BTreeSet;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, OnceLock};
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 pub(crate) fn positive(name: &str, v: f64) -> anyhow::Result<f64> {
@@ -97,21 +96,22 @@ impl Verdict {
 
 /// The Ctrl-C flag, set by the first Ctrl-C (the search then stops and its best result is
 /// printed and written); a second Ctrl-C ends the process at once.
-fn interrupt_flag() -> Arc<AtomicBool> {
-    static FLAG: OnceLock<Arc<AtomicBool>> = OnceLock::new();
+fn interrupt_flag() -> StopToken {
+    static FLAG: OnceLock<StopToken> = OnceLock::new();
     FLAG.get_or_init(|| {
-        let flag = Arc::new(AtomicBool::new(false));
-        let seen = flag.clone();
+        let token = StopToken::new();
+        let seen = token.clone();
         let installed = ctrlc::set_handler(move || {
-            if seen.swap(true, Ordering::SeqCst) {
+            if seen.is_stopped() {
                 std::process::exit(130);
             }
+            seen.stop();
             eprintln!("interrupted: stopping the search, keeping the best result so far (Ctrl-C again to quit now)");
         });
         if let Err(e) = installed {
             eprintln!("warning: cannot catch Ctrl-C ({e}); it will end the process without output");
         }
-        flag
+        token
     })
     .clone()
 }
@@ -289,10 +289,13 @@ fn plan_one(
         }
     }
     stdout.flush()?;
-    Ok(if result.found() {
-        Verdict::Found
-    } else if report.stats.stopped_by.as_deref() == Some(StopReason::Interrupted.as_str()) {
+    // Ctrl-C during any search (the optimiser's too) ends with 130 after its result is written
+    let interrupted = report.stats.stopped_by.as_deref() == Some(StopReason::Interrupted.as_str())
+        || settings.cancel.as_ref().is_some_and(StopToken::is_stopped);
+    Ok(if interrupted {
         Verdict::Interrupted
+    } else if result.found() {
+        Verdict::Found
     } else {
         Verdict::NotFound
     })

@@ -109,8 +109,8 @@ impl PyAssembly {
     /// Plans with the keyword settings of `asp.Assembly.plan` (a dict; missing keys take the
     /// defaults). Returns `(plan_json, found, trace_csv)`: the plan JSON exactly as
     /// `asp plan --json` prints it, whether a sequence was found, and for optimising runs the
-    /// search trace as CSV (as `--trace` writes it). Releases the GIL; Ctrl-C interrupts a
-    /// depth-first search.
+    /// search trace as CSV (as `--trace` writes it). Releases the GIL; Ctrl-C interrupts the
+    /// search (see [`run`]).
     fn plan(&self, py: Python<'_>, settings: &Bound<'_, PyDict>) -> PyResult<(String, bool, Option<String>)> {
         let settings = settings::plan_settings(settings).map_err(|e| e.into_py(py))?;
         let result = run::plan(py, (*self.inner).clone(), &settings)?;

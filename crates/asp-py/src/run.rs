@@ -1,60 +1,70 @@
 //! Running the planning pipeline from Python: without the GIL, interruptible by Ctrl-C.
 //!
-//! The search runs on the calling thread with the GIL released, so other Python threads keep
-//! running. Python handles a Ctrl-C by setting a flag that only the interpreter looks at; the
-//! depth-first search calls its progress hook once per expanded state, and there, at most every
-//! [`SIGNAL_INTERVAL`], the hook takes the GIL back and asks Python whether a signal is pending.
-//! When one is (`KeyboardInterrupt`, or whatever a custom handler raised), the hook unwinds out of
-//! the search with a private payload (`resume_unwind`: no panic message, no panic hook), the
-//! search's owned state (world, checker, caches) is dropped, and the signal's exception is
-//! raised in Python.
+//! The pipeline runs on a worker thread while the calling thread waits for it with the GIL
+//! released, so other Python threads keep running. Python handles a Ctrl-C by setting a flag that
+//! only the interpreter looks at: every [`SIGNAL_INTERVAL`] the waiting thread takes the GIL back
+//! and asks Python whether a signal is pending. When one is (`KeyboardInterrupt`, or whatever a
+//! custom handler raised), it stops the search through the pipeline's [`StopToken`] (the same
+//! token the CLI's Ctrl-C handler stops), waits for the worker to end, drops its result and raises
+//! the signal's exception. The depth-first search and the optimisers alike look at the token.
 //!
-//! Limits: the optimiser (`objective=`) takes no progress hook, so it cannot be interrupted
-//! (bound it with `time_limit=`); a single state whose tests take long (a path planner call, up
-//! to `rrt_time` seconds; the first test of a part on a large mesh) delays the interrupt until
-//! the next state. Signals are only seen on Python's main thread, as in Python itself.
+//! Limits: a single state whose tests take long (a path planner call, up to `rrt_time` seconds;
+//! the first test of a part on a large mesh) delays the interrupt until it ends. Signals are only
+//! seen on Python's main thread, as in Python itself.
 
 use crate::errors::Error;
 use asp_geom::Assembly;
 use asp_search::pipeline::{self, PlanResult, PlanSettings};
-use asp_search::Progress;
+use asp_search::StopToken;
 use pyo3::prelude::*;
-use std::panic::{self, AssertUnwindSafe};
+use std::panic;
+use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::Mutex;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-/// How often, at most, the search asks Python for pending signals.
+/// How often, at most, the waiting thread asks Python for pending signals.
 pub const SIGNAL_INTERVAL: Duration = Duration::from_millis(50);
 
-/// The unwinding payload of an interrupted search.
-struct Interrupted;
+/// The worker's stack: as the main thread's (deep models recurse in the loaders and the DFS).
+const WORKER_STACK: usize = 8 << 20;
 
-/// Plans `assembly` with the GIL released, stopping early when a Python signal handler raises.
+/// Plans `assembly` on a worker thread with the GIL released, stopping it early when a Python
+/// signal handler raises.
 pub fn plan(py: Python<'_>, assembly: Assembly, settings: &PlanSettings) -> PyResult<PlanResult> {
-    let raised: Mutex<Option<PyErr>> = Mutex::new(None);
-    let last_check = Mutex::new(Instant::now());
-    let hook = |_: &Progress| {
-        {
-            let mut last = last_check.lock().unwrap_or_else(|e| e.into_inner());
-            if last.elapsed() < SIGNAL_INTERVAL {
-                return;
+    let token = StopToken::new();
+    let settings = PlanSettings { cancel: Some(token.clone()), ..settings.clone() };
+    let (done, finished) = mpsc::channel::<()>();
+    // a Receiver is Send but not Sync: the closures that wait without the GIL borrow it
+    let finished = Mutex::new(finished);
+    std::thread::scope(|scope| {
+        let worker = std::thread::Builder::new()
+            .name("asp-plan".into())
+            .stack_size(WORKER_STACK)
+            .spawn_scoped(scope, move || {
+                // the channel closes when this closure ends, normally or by a panic
+                let _done = done;
+                pipeline::plan_assembly(assembly, &settings, None)
+            })
+            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("cannot start the planning thread: {e}")))?;
+        let mut raised: Option<PyErr> = None;
+        loop {
+            match py.detach(|| finished.lock().unwrap_or_else(|e| e.into_inner()).recv_timeout(SIGNAL_INTERVAL)) {
+                Err(RecvTimeoutError::Timeout) => {}
+                Ok(()) | Err(RecvTimeoutError::Disconnected) => break,
             }
-            *last = Instant::now();
+            if raised.is_none() {
+                if let Err(e) = py.check_signals() {
+                    token.stop();
+                    raised = Some(e);
+                }
+            }
         }
-        if let Err(e) = Python::attach(|py| py.check_signals()) {
-            *raised.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
-            panic::resume_unwind(Box::new(Interrupted));
+        let outcome = py.detach(|| worker.join());
+        match (outcome, raised) {
+            // a bug, not bad input: pyo3 turns the panic into a PanicException
+            (Err(payload), _) => panic::resume_unwind(payload),
+            (Ok(_), Some(e)) => Err(e),
+            (Ok(result), None) => result.map_err(|e| Error::from(e).into_py(py)),
         }
-    };
-    let outcome =
-        py.detach(|| panic::catch_unwind(AssertUnwindSafe(|| pipeline::plan_assembly(assembly, settings, Some(&hook)))));
-    match outcome {
-        Ok(result) => result.map_err(|e| Error::from(e).into_py(py)),
-        Err(payload) if payload.is::<Interrupted>() => {
-            let e = raised.into_inner().unwrap_or_else(|e| e.into_inner());
-            Err(e.unwrap_or_else(|| pyo3::exceptions::PyKeyboardInterrupt::new_err("planning interrupted")))
-        }
-        // a bug, not bad input: pyo3 turns the panic into a PanicException
-        Err(payload) => panic::resume_unwind(payload),
-    }
+    })
 }

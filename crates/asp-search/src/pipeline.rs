@@ -20,7 +20,6 @@ use asp_geom::physics::PhysicsConfig;
 use asp_geom::rrt::RrtConfig;
 use asp_geom::{Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, StabilityMode, Units, World, WorldConfig};
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -84,8 +83,10 @@ pub struct PlanSettings {
     pub timeout: Option<f64>,
     /// Optimise instead of finding a feasible sequence.
     pub optimise: Option<OptimiseSettings>,
-    /// Set from outside (a Ctrl-C handler) to stop the search with the best result so far.
-    pub cancel: Option<Arc<AtomicBool>>,
+    /// Stops the search from another thread (a Ctrl-C handler, a Python signal, a caller's
+    /// deadline) with the best result so far: the depth-first search ends `interrupted` with its
+    /// partial plan, the optimiser returns what it has found, as with its time limit.
+    pub cancel: Option<StopToken>,
 }
 
 impl Default for PlanSettings {
@@ -152,9 +153,6 @@ pub struct OptimiseSettings {
     /// Objectives and feasibility filters beyond the built-in ones (e.g. a robot's); their
     /// objective names may appear in `objectives`.
     pub extensions: Vec<Arc<dyn MdpExtension>>,
-    /// Stops the search from another thread (Ctrl-C, a caller's deadline); what was found so
-    /// far is returned, as with `time_limit`.
-    pub stop: Option<StopToken>,
 }
 
 impl Default for OptimiseSettings {
@@ -171,7 +169,6 @@ impl Default for OptimiseSettings {
             d_max: None,
             support: Support::Below,
             extensions: Vec::new(),
-            stop: None,
         }
     }
 }
@@ -362,7 +359,7 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
             if let Some(t) = o.time_limit {
                 b = b.time_limit(Duration::from_secs_f64(positive("the time limit", t)?));
             }
-            if let Some(stop) = &o.stop {
+            if let Some(stop) = &settings.cancel {
                 b = b.stop_token(stop.clone());
             }
             b.build()?

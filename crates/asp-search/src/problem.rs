@@ -1,8 +1,7 @@
 //! What every planner gets (a [`Problem`] and a [`Budget`]) and gives back (a [`PlanOutcome`]).
 
 use asp_geom::{CounterSnapshot, FeasibilityChecker, Motion, PartSet};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use crate::search::StopToken;
 use std::time::{Duration, Instant};
 
 /// A planning problem: the feasibility checker of an assembly and the state to take apart.
@@ -40,9 +39,9 @@ pub struct Budget {
     pub max_tests: Option<u64>,
     /// The longest wall time.
     pub timeout: Option<Duration>,
-    /// Set from outside (e.g. by a Ctrl-C handler) to stop the search now; it then ends like an
-    /// exhausted budget, with the best result so far.
-    pub cancel: Option<Arc<AtomicBool>>,
+    /// Stopped from outside (a Ctrl-C handler, a Python signal, a caller's deadline) to end the
+    /// search now; it then ends like an exhausted budget, with the best result so far.
+    pub cancel: Option<StopToken>,
 }
 
 /// Why a search stopped before it could finish.
@@ -75,7 +74,7 @@ impl Budget {
 
     /// Why the budget is used up, if it is.
     pub fn stop_reason(&self, tests: u64, started: Instant) -> Option<StopReason> {
-        if self.cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed)) {
+        if self.cancel.as_ref().is_some_and(StopToken::is_stopped) {
             Some(StopReason::Interrupted)
         } else if self.max_tests.is_some_and(|m| tests >= m) {
             Some(StopReason::MaxTests)
