@@ -6,7 +6,7 @@
 //! in another state (bitset work on the cached row).
 
 use asp_geom::io::{load, LoadOptions};
-use asp_geom::math::Axis;
+use asp_geom::math::{Axis, Pose};
 use asp_geom::physics::{PhysicsConfig, PhysicsStability};
 use asp_geom::{fixtures, Assembly, PartSet, Units, World, WorldConfig};
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
@@ -28,6 +28,13 @@ fn models() -> Vec<(String, Assembly)> {
 
 fn bench(c: &mut Criterion) {
     for (name, assembly) in models() {
+        c.bench_function(&format!("world_build/{name}"), |b| {
+            b.iter_batched(
+                || assembly.clone(),
+                |a| black_box(World::new(a, &WorldConfig::default()).expect("world").num_parts()),
+                BatchSize::PerIteration,
+            )
+        });
         let world = World::new(assembly.clone(), &WorldConfig::default()).expect("world");
         let n = world.num_parts();
         let full = PartSet::full(n);
@@ -54,6 +61,32 @@ fn bench(c: &mut Criterion) {
                 black_box(world.linear_removal(k % n, &full).is_ok())
             })
         });
+        group.finish();
+        // the sweeps of every part's cold row (real neighbours, t_max the model's size) on one thread, by the simultaneous BVH descent and by the
+        // per-triangle candidate search it replaced (same pairs, same directions)
+        let diag = world.assembly().diagonal();
+        let row_sweeps = |reference: bool| {
+            let mut blocked = 0;
+            for p in 0..n {
+                for q in (0..n).filter(|&q| q != p) {
+                    let (moving, fixed) = world.pair_shapes(p, q);
+                    for &dir in world.directions() {
+                        let hit = if reference {
+                            asp_geom::sweep::sweep_hits_at_reference(&moving, &Pose::IDENTITY, dir, &fixed, diag)
+                        } else {
+                            asp_geom::sweep::sweep_hits(&moving, dir, &fixed, diag)
+                        };
+                        blocked += usize::from(hit);
+                    }
+                }
+            }
+            blocked
+        };
+        assert_eq!(row_sweeps(false), row_sweeps(true), "{name}: the two candidate searches disagree");
+        let mut group = c.benchmark_group(format!("all_rows_serial/{name}"));
+        group.sample_size(10);
+        group.bench_function("bvh_descent", |b| b.iter(|| black_box(row_sweeps(false))));
+        group.bench_function("per_triangle", |b| b.iter(|| black_box(row_sweeps(true))));
         group.finish();
         c.bench_function(&format!("stability/{name}"), |b| b.iter(|| black_box(world.contact_stability(&full))));
         if name == "tube" || name == "table_lack_0825" {

@@ -100,7 +100,77 @@ fn box_path_meets(a: &Aabb, dir: Vec3, b: &Aabb, t_max: f32) -> bool {
 /// When `moving`, placed by `pose` and then translated along unit `dir`, first overlaps `fixed`
 /// (in its own frame) within `t_max`. With `earliest == false` the search stops at any overlap
 /// and returns its time (not necessarily the earliest).
+///
+/// Candidate pairs come from a simultaneous descent of the two BVHs (parry's
+/// [`Bvh::leaf_pairs`](parry3d::partitioning::Bvh::leaf_pairs)): a pair of nodes is opened only
+/// when the moving node's box, swept along `dir`, meets the fixed node's box, so whole subtrees
+/// of both meshes are dropped at once, and each triangle is converted to `f64` once per call.
 fn mesh_sweep(moving: &TriMesh, pose: &Pose, dir: Vec3, fixed: &TriMesh, t_max: f32, earliest: bool) -> Option<f32> {
+    let placed = *pose != Pose::IDENTITY;
+    let place = |aabb: Aabb| if placed { aabb.transform_by(pose) } else { aabb };
+    if !box_path_meets(&place(moving.local_aabb()), dir, &fixed.local_aabb(), t_max) {
+        return None;
+    }
+    let d = dir.as_dvec3();
+    let best = std::cell::Cell::new(None::<f64>);
+    let limit = || best.get().map_or(t_max, |b| b as f32);
+    let mut moving_cache = TriangleCache::new(moving.num_triangles());
+    let mut fixed_cache = TriangleCache::new(fixed.num_triangles());
+    let pairs =
+        moving.bvh().leaf_pairs(fixed.bvh(), |a, b| box_path_meets(&place(a.aabb()), dir, &b.aabb(), limit()));
+    for (i, j) in pairs {
+        let ta = moving_cache.get(i, || triangle(moving, pose, i));
+        let tb = fixed_cache.get(j, || triangle(fixed, &Pose::IDENTITY, j));
+        // leaves of the root level come without the check: test their boxes here
+        if !box_path_meets(&box_of(&ta), dir, &box_of(&tb), limit()) {
+            continue;
+        }
+        if let Some(t) = triangle_sweep(&ta, d, &tb, best.get().unwrap_or(t_max as f64)) {
+            if !earliest {
+                return Some(t as f32);
+            }
+            best.set(Some(best.get().map_or(t, |b| b.min(t))));
+        }
+    }
+    best.get().map(|t| t as f32)
+}
+
+/// Triangles of one mesh in `f64`, each converted (and placed) the first time a pair needs it.
+struct TriangleCache {
+    /// Per triangle of the mesh: 0 when not yet converted, else its position in `triangles` + 1
+    /// (a zeroed allocation: the operating system's zero pages make it free for big meshes).
+    slot: Vec<u32>,
+    triangles: Vec<[DVec3; 3]>,
+}
+
+impl TriangleCache {
+    fn new(count: usize) -> Self {
+        TriangleCache { slot: vec![0; count], triangles: Vec::new() }
+    }
+
+    fn get(&mut self, i: u32, make: impl FnOnce() -> [DVec3; 3]) -> [DVec3; 3] {
+        let k = self.slot[i as usize];
+        if k > 0 {
+            return self.triangles[k as usize - 1];
+        }
+        let t = make();
+        self.triangles.push(t);
+        self.slot[i as usize] = self.triangles.len() as u32;
+        t
+    }
+}
+
+/// The candidate search before [`mesh_sweep`]'s simultaneous descent, kept as the reference
+/// its tests compare against: the moving triangles whose path meets the fixed mesh's box, then
+/// for each one query of the fixed BVH with its swept box.
+fn mesh_sweep_per_triangle(
+    moving: &TriMesh,
+    pose: &Pose,
+    dir: Vec3,
+    fixed: &TriMesh,
+    t_max: f32,
+    earliest: bool,
+) -> Option<f32> {
     // the moving triangles whose path meets the fixed mesh's box, found in the moving mesh's
     // own frame (the box placed there is a little larger, still a safe cull)
     let inverse = pose.inverse();
@@ -108,6 +178,18 @@ fn mesh_sweep(moving: &TriMesh, pose: &Pose, dir: Vec3, fixed: &TriMesh, t_max: 
     let local_dir = inverse.rotation * dir;
     let candidates = moving.bvh().leaves(|n| box_path_meets(&n.aabb(), local_dir, &fixed_box, t_max));
     sweep_triangles(candidates.map(|i| triangle(moving, pose, i)), dir, fixed, t_max, earliest)
+}
+
+/// [`sweep_distance`] by the per-triangle candidate search (the reference of the simultaneous
+/// BVH descent; slower on large meshes in contact).
+pub fn sweep_distance_reference(moving: &TriMesh, dir: Vec3, fixed: &TriMesh, t_max: f32) -> Option<f32> {
+    mesh_sweep_per_triangle(moving, &Pose::IDENTITY, dir, fixed, t_max, true)
+}
+
+/// [`sweep_hits_at`] by the per-triangle candidate search (the reference of the simultaneous
+/// BVH descent).
+pub fn sweep_hits_at_reference(moving: &TriMesh, pose: &Pose, dir: Vec3, fixed: &TriMesh, t_max: f32) -> bool {
+    mesh_sweep_per_triangle(moving, pose, dir, fixed, t_max, false).is_some()
 }
 
 /// [`mesh_sweep`] for moving triangles given one by one: each is swept against the fixed

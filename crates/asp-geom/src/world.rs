@@ -105,6 +105,13 @@ impl Geom {
 
     fn erode(&self, amount: f32) -> TriMesh {
         let (v, t) = eroded_mesh(self.mesh.vertices(), self.mesh.indices(), amount);
+        if v.len() == self.mesh.vertices().len() && t == self.mesh.indices() {
+            // the same triangles with moved vertices (no saddle vertex was split): refit a copy
+            // of the part's BVH and keep its topology instead of building both again
+            let mut shrunk = (*self.mesh).clone();
+            shrunk.set_vertices(&v);
+            return shrunk;
+        }
         TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED)
             .unwrap_or_else(|_| (*self.mesh).clone())
     }
@@ -213,6 +220,7 @@ impl World {
             warnings,
         };
         world.measure_contacts(config.max_overlap_fraction, config.ignore_overlapping)?;
+        world.prepare_pair_shapes();
         Ok(world)
     }
 
@@ -305,6 +313,26 @@ impl World {
             }
         }
         Ok(())
+    }
+
+    /// Builds, in parallel, the shrunk meshes the removal tests will ask for: each part by the
+    /// tolerance, and the part an overlapping pair's tests shrink by the pair's erosion. Built
+    /// here once, the first removal test of a part is the sweeps alone (one erosion of a 25k
+    /// triangle mesh costs several times a whole blocking row).
+    fn prepare_pair_shapes(&self) {
+        let mut wanted: BTreeSet<(usize, u32)> = BTreeSet::new();
+        for (i, g) in self.geoms.iter().enumerate().take(self.num_parts()) {
+            if g.boxes.is_none() {
+                wanted.insert((i, self.tolerance.to_bits()));
+            }
+        }
+        for &(k, extra) in self.overlaps.values() {
+            wanted.insert((k, (self.tolerance + extra).to_bits()));
+        }
+        let wanted: Vec<(usize, u32)> = wanted.into_iter().filter(|&(k, a)| !self.geoms[k].eroded_cached(f32::from_bits(a))).collect();
+        wanted.par_iter().for_each(|&(k, amount)| {
+            self.geoms[k].eroded(f32::from_bits(amount));
+        });
     }
 
     /// The least extra erosion of part `p` (beyond the tolerance, to within a sixteenth) after

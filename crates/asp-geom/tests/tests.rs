@@ -1,6 +1,7 @@
 //! The one integration test binary of asp-geom.
 
 mod distmap;
+mod fuzz;
 mod graph;
 mod loaders;
 mod physics;

@@ -40,9 +40,23 @@ pub(crate) fn load_folder(dir: &Path, options: &LoadOptions) -> Result<Assembly>
     assemble(dir, &files, options)
 }
 
-/// Loads one `.obj` / `.stl` file as a one-part assembly.
-pub(crate) fn load_single_file(file: &Path, options: &LoadOptions) -> Result<Assembly> {
-    assemble(file, &[file.to_path_buf()], options)
+/// One `.obj` / `.stl` file, its bytes in memory, as a one-part assembly.
+pub(crate) fn single_file_from_bytes(file: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Assembly> {
+    let units = options.unit.clone().unwrap_or_else(Units::metres);
+    let mut mesh = mesh_from_bytes(file, bytes)?;
+    mesh.scale(units.metres as f32);
+    Ok(Assembly {
+        parts: vec![Part::new(part_name(file), mesh, false, serde_json::Value::Null)],
+        units,
+        up: options.up.unwrap_or(Axis::Z),
+        source: file.to_path_buf(),
+        warnings: Vec::new(),
+    })
+}
+
+/// A part named after its file's stem.
+fn part_name(file: &Path) -> String {
+    file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
 /// The OBJ and STL files directly inside `dir`, sorted by file name.
@@ -66,8 +80,7 @@ fn assemble(source: &Path, files: &[PathBuf], options: &LoadOptions) -> Result<A
         .map(|file| {
             let mut mesh = read_mesh(file)?;
             mesh.scale(scale);
-            let name = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-            Ok(Part::new(name, mesh, false, serde_json::Value::Null))
+            Ok(Part::new(part_name(file), mesh, false, serde_json::Value::Null))
         })
         .collect::<Result<Vec<Part>>>()?;
     Ok(Assembly {
@@ -81,26 +94,37 @@ fn assemble(source: &Path, files: &[PathBuf], options: &LoadOptions) -> Result<A
 
 /// The mesh of one file, in the file's units.
 fn read_mesh(path: &Path) -> Result<Mesh> {
+    let bytes = std::fs::read(path).map_err(|source| io_error(path, source))?;
+    mesh_from_bytes(path, &bytes)
+}
+
+/// The mesh of one file's bytes (`path` gives the format by its extension and names errors).
+fn mesh_from_bytes(path: &Path, bytes: &[u8]) -> Result<Mesh> {
     match Format::of(path) {
-        Some(Format::Obj) => read_obj(path),
-        Some(Format::Stl) => read_stl(path),
+        Some(Format::Obj) => read_obj(path, bytes),
+        Some(Format::Stl) => read_stl(path, bytes),
         None => Err(GeomError::format(path, "not an .obj or .stl file")),
     }
 }
 
 /// An STL file, ASCII or binary. Identical vertices are shared (STL stores none).
-fn read_stl(path: &Path) -> Result<Mesh> {
-    let mut bytes = std::fs::read(path).map_err(|source| io_error(path, source))?;
+fn read_stl(path: &Path, bytes: &[u8]) -> Result<Mesh> {
+    let mut bytes = bytes.to_vec();
     if is_binary_stl(&bytes) {
         // Many CAD tools start binary headers with "solid", which stl_io takes for ASCII.
         bytes[..5].fill(0);
     }
     let stl = stl_io::read_stl(&mut Cursor::new(bytes)).map_err(|e| {
-        GeomError::format(path, format!("invalid stl file: {}", lowercase_first(&e.to_string())))
+        GeomError::format(path, format!("invalid stl file: {}", one_line(&lowercase_first(&e.to_string()))))
     })?;
     let vertices = stl.vertices.iter().map(|v| Vec3::new(v.0[0], v.0[1], v.0[2])).collect();
     let triangles = stl.faces.iter().map(|f| f.vertices.map(|i| i as u32)).collect();
     Ok(Mesh::new(vertices, triangles))
+}
+
+/// Another library's message on one line (a parser may quote the offending input).
+fn one_line(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// Whether the file size matches a binary STL with the triangle count of its header.
@@ -115,8 +139,10 @@ fn is_binary_stl(bytes: &[u8]) -> bool {
 }
 
 /// An OBJ file, polygons triangulated, all its objects and groups merged; materials are not read.
-fn read_obj(path: &Path) -> Result<Mesh> {
-    let file = std::fs::File::open(path).map_err(|source| io_error(path, source))?;
+fn read_obj(path: &Path, bytes: &[u8]) -> Result<Mesh> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        GeomError::format(path, format!("invalid obj file: not utf-8 text (byte {})", e.valid_up_to()))
+    })?;
     let options = tobj::LoadOptions {
         triangulate: true,
         ignore_points: true,
@@ -124,7 +150,8 @@ fn read_obj(path: &Path) -> Result<Mesh> {
         ..Default::default()
     };
     let no_materials = |_: &Path| Err(tobj::LoadError::GenericFailure);
-    let (models, _) = tobj::load_obj_buf(&mut BufReader::new(file), &options, no_materials)
+    let positions_only = positions_and_faces(text);
+    let (models, _) = tobj::load_obj_buf(&mut BufReader::new(positions_only.as_bytes()), &options, no_materials)
         .map_err(|e| GeomError::format(path, format!("invalid obj file: {e}")))?;
     let mut mesh = Mesh::default();
     for model in &models {
@@ -148,6 +175,45 @@ fn read_obj(path: &Path) -> Result<Mesh> {
     Ok(mesh)
 }
 
+/// The part of an OBJ file asp reads, for tobj: vertex positions (`v x y z`, colours and
+/// weights dropped), faces by their position indices only (`f 1/4/2` → `f 1`), and object and
+/// group names. Texture coordinates, normals, materials and every other statement are left out,
+/// so tobj never indexes them: tobj 4.0.5 multiplies a face's normal and texture indices without
+/// an overflow check ("attempt to multiply with overflow" on `f 1//99999999999999999999`).
+fn positions_and_faces(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        let keyword = words.next();
+        match keyword {
+            Some("v") => {
+                out.push('v');
+                for word in words.take(3) {
+                    out.push(' ');
+                    out.push_str(word);
+                }
+            }
+            Some("f") => {
+                out.push('f');
+                for word in words {
+                    out.push(' ');
+                    out.push_str(word.split('/').next().unwrap_or(word));
+                }
+            }
+            Some(k @ ("o" | "g")) => {
+                out.push_str(k);
+                for word in words {
+                    out.push(' ');
+                    out.push_str(word);
+                }
+            }
+            _ => continue,
+        }
+        out.push('\n');
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -162,6 +228,23 @@ mod tests {
         bytes.push(0);
         assert!(!is_binary_stl(&bytes));
         assert!(!is_binary_stl(b"solid x\nendsolid x\n"));
+    }
+
+    #[test]
+    fn obj_text_keeps_positions_faces_and_names_only() {
+        let text = "# c\nmtllib x.mtl\no a\nv 1 2 3 1 0.5 0.5\nvt 0 1\nvn 0 0 1\nf 1/1/1 2//1 -1/2\ng b\nl 1 2\n";
+        assert_eq!(positions_and_faces(text), "o a\nv 1 2 3\nf 1 2 -1\ng b\n");
+    }
+
+    #[test]
+    fn huge_normal_and_texture_indices_are_errors_not_overflows() {
+        // indices below isize::MAX whose triple (normals) or double (texture coordinates) overflows:
+        // tobj 4.0.5 panics on these in builds with overflow checks
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1//1 2//1 3//7777777777777777777\nf 1/1 2/1 3/9000000000000000000\n";
+        let mesh = read_obj(Path::new("x.obj"), text.as_bytes()).expect("the positions are valid");
+        assert_eq!(mesh.triangles.len(), 2);
+        let bad = "v 0 0 0\nf 1 2 99999999999999999999\n";
+        assert!(read_obj(Path::new("x.obj"), bad.as_bytes()).unwrap_err().to_string().starts_with("x.obj: invalid obj"));
     }
 
     #[test]

@@ -5,7 +5,7 @@
 //! JSON; buffer data is read here with explicit bounds checks, because the crate's accessor
 //! iterators panic on some malformed files.
 
-use super::{io_error, lowercase_first, LoadOptions};
+use super::{lowercase_first, LoadOptions};
 use crate::assembly::{Assembly, Part, Units};
 use crate::error::{GeomError, Result};
 use crate::math::{Axis, Pose, Vec3};
@@ -20,16 +20,19 @@ use serde_json::Value;
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
-/// Inside this module a failure is just its reason; [`load_gltf`] adds the file name.
+/// Inside this module a failure is just its reason; [`read_gltf_bytes`] adds the file name.
 type Res<T> = std::result::Result<T, String>;
 
-/// Loads a `.glb` or `.gltf` file: one part per mesh instance of the default scene.
-pub(crate) fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Assembly> {
-    let bytes = std::fs::read(path).map_err(|source| io_error(path, source))?;
-    read_gltf(path, &bytes, options).map_err(|reason| GeomError::format(path, reason))
+/// Reads a `.glb` or `.gltf` file from its bytes: one part per mesh instance of the default
+/// scene; `external` reads the files its buffer URIs point to.
+pub(crate) fn read_gltf_bytes(path: &Path, bytes: &[u8], options: &LoadOptions, external: &External) -> Result<Assembly> {
+    read_gltf(path, bytes, options, external).map_err(|reason| GeomError::format(path, reason))
 }
 
-fn read_gltf(path: &Path, bytes: &[u8], options: &LoadOptions) -> Res<Assembly> {
+/// Reads an external file a `.gltf` refers to.
+pub(crate) type External<'e> = dyn Fn(&Path) -> std::io::Result<Vec<u8>> + 'e;
+
+fn read_gltf(path: &Path, bytes: &[u8], options: &LoadOptions, external: &External) -> Res<Assembly> {
     let (json, blob) = if bytes.starts_with(b"glTF") {
         split_glb(bytes)?
     } else if has_glb_extension(path) {
@@ -38,7 +41,7 @@ fn read_gltf(path: &Path, bytes: &[u8], options: &LoadOptions) -> Res<Assembly> 
         (bytes, None)
     };
     let document = parse_document(json)?;
-    let buffers = load_buffers(&document, path, blob)?;
+    let buffers = load_buffers(&document, path, blob, external)?;
     let scene = document.default_scene().or_else(|| document.scenes().next());
     let settings = scene.as_ref().map(scene_settings).transpose()?.unwrap_or_default();
     let units = options.unit.clone().or(settings.unit).unwrap_or_else(Units::metres);
@@ -136,11 +139,16 @@ fn describe_validation(errors: &[(gltf::json::Path, gltf::json::validation::Erro
 // Buffers
 
 /// The bytes of every buffer, in document order.
-fn load_buffers<'a>(document: &Document, path: &Path, blob: Option<&'a [u8]>) -> Res<Vec<Cow<'a, [u8]>>> {
+fn load_buffers<'a>(
+    document: &Document,
+    path: &Path,
+    blob: Option<&'a [u8]>,
+    external: &External,
+) -> Res<Vec<Cow<'a, [u8]>>> {
     document
         .buffers()
         .map(|buffer| {
-            let data = buffer_data(&buffer, path, blob)?;
+            let data = buffer_data(&buffer, path, blob, external)?;
             if data.len() < buffer.length() {
                 return Err(format!(
                     "truncated buffer {}: {} bytes, expected {}",
@@ -154,7 +162,12 @@ fn load_buffers<'a>(document: &Document, path: &Path, blob: Option<&'a [u8]>) ->
         .collect()
 }
 
-fn buffer_data<'a>(buffer: &gltf::Buffer, path: &Path, blob: Option<&'a [u8]>) -> Res<Cow<'a, [u8]>> {
+fn buffer_data<'a>(
+    buffer: &gltf::Buffer,
+    path: &Path,
+    blob: Option<&'a [u8]>,
+    external: &External,
+) -> Res<Cow<'a, [u8]>> {
     let index = buffer.index();
     match buffer.source() {
         gltf::buffer::Source::Bin => blob
@@ -168,7 +181,7 @@ fn buffer_data<'a>(buffer: &gltf::Buffer, path: &Path, blob: Option<&'a [u8]>) -
         gltf::buffer::Source::Uri(uri) => {
             let file =
                 external_file(path, uri).ok_or_else(|| format!("buffer {index}: unsupported uri '{uri}'"))?;
-            std::fs::read(&file).map(Cow::Owned).map_err(|e| match e.kind() {
+            external(&file).map(Cow::Owned).map_err(|e| match e.kind() {
                 std::io::ErrorKind::NotFound => {
                     format!("buffer file '{}' is missing", file.display())
                 }

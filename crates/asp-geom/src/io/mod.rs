@@ -28,20 +28,54 @@ pub struct LoadOptions {
 /// Meshes come back in metres, world frame, part names unique; the assembly is validated.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Assembly> {
     let meta = std::fs::metadata(path).map_err(|source| io_error(path, source))?;
-    let mut assembly = if meta.is_dir() {
-        folder::load_folder(path, options)?
-    } else {
-        match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
-            Some("glb") | Some("gltf") => gltf_read::load_gltf(path, options)?,
-            Some("obj") | Some("stl") => folder::load_single_file(path, options)?,
-            _ => {
-                return Err(GeomError::format(
-                    path,
-                    "unknown file type (expected .glb, .gltf, or a folder of .obj/.stl files)",
-                ))
-            }
-        }
+    if meta.is_dir() {
+        let assembly = folder::load_folder(path, options)?;
+        return finish(assembly, options);
+    }
+    check_extension(path)?;
+    let bytes = std::fs::read(path).map_err(|source| io_error(path, source))?;
+    load_bytes(path, &bytes, options)
+}
+
+/// Loads one model file whose bytes are already in memory: `path` names it (its extension picks
+/// the format, every error names it) and locates the external buffers of a `.gltf`, which are
+/// read from disk. The same checks and results as [`load`] on that file.
+pub fn load_bytes(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Assembly> {
+    load_bytes_with(path, bytes, options, &|file| std::fs::read(file))
+}
+
+/// [`load_bytes`] with the external files a `.gltf` refers to (its `.bin` buffers) read by
+/// `external` instead of from disk (given the path the URI resolves to, relative to `path`).
+pub fn load_bytes_with(
+    path: &Path,
+    bytes: &[u8],
+    options: &LoadOptions,
+    external: &dyn Fn(&Path) -> std::io::Result<Vec<u8>>,
+) -> Result<Assembly> {
+    let assembly = match check_extension(path)? {
+        FileKind::Gltf => gltf_read::read_gltf_bytes(path, bytes, options, external)?,
+        FileKind::Mesh => folder::single_file_from_bytes(path, bytes, options)?,
     };
+    finish(assembly, options)
+}
+
+enum FileKind {
+    Gltf,
+    Mesh,
+}
+
+fn check_extension(path: &Path) -> Result<FileKind> {
+    match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
+        Some("glb") | Some("gltf") => Ok(FileKind::Gltf),
+        Some("obj") | Some("stl") => Ok(FileKind::Mesh),
+        _ => Err(GeomError::format(
+            path,
+            "unknown file type (expected .glb, .gltf, or a folder of .obj/.stl files)",
+        )),
+    }
+}
+
+fn finish(mut assembly: Assembly, options: &LoadOptions) -> Result<Assembly> {
     assembly.dedupe_names();
     assembly.set_fixed(&options.fixed)?;
     assembly.validate()?;
