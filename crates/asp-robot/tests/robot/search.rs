@@ -107,7 +107,7 @@ fn the_optimiser_minimises_the_robot_path_and_repeats_itself() {
         episodes: 3,
         budget: 2,
         threads: Some(threads),
-        resolution: 4,
+        resolution: 5,
         extensions: vec![Arc::new(RobotExtension::new(setup.clone()))],
         ..OptimiseSettings::default()
     };
