@@ -245,3 +245,42 @@ fn a_drop_off_inside_a_closed_box_has_no_path() {
         other => panic!("expected no path, got {other:?}"),
     }
 }
+
+/// Per-part planning time on generated profile assemblies (a measurement for
+/// docs/benchmarks.md, not a timed test): every part that can leave the full assembly along a
+/// straight line is planned with k = 1 and with the default k; prints times and outcomes.
+/// `cargo test -p asp-robot --test tests per_part_planning_time -- --ignored --nocapture`
+#[test]
+#[ignore = "a measurement, run by hand"]
+fn per_part_planning_time() {
+    for (name, params) in [("single-layer", asp_gen::ProfileParams::single_layer()), ("double-layer", asp_gen::ProfileParams::double_layer())] {
+        for seed in [1, 2] {
+            let assembly = asp_gen::ProfileAssembly::generate(&params, seed).unwrap().to_assembly("p");
+            let world = World::new(assembly, &WorldConfig::default()).unwrap();
+            let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
+            let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
+            let state = PartSet::full(world.num_parts());
+            let parts: Vec<(usize, Vec3)> = (0..world.num_parts())
+                .filter(|&p| !world.fixed().contains(p))
+                .filter_map(|p| lift_direction(&world, p, &state).map(|d| (p, d)))
+                .collect();
+            for k in [1, RemovalConfig::default().replans] {
+                let started = std::time::Instant::now();
+                let mut ok = 0;
+                let mut reasons = [0; 3];
+                for &(p, d) in &parts {
+                    match planner.plan(p, &state, d, 1, k) {
+                        Ok(_) => ok += 1,
+                        Err(e) => reasons[e.index()] += 1,
+                    }
+                }
+                let t = started.elapsed().as_secs_f64();
+                println!(
+                    "{name} seed {seed} k={k}: {} parts planned in {t:.2} s = {:.1} ms per part; {ok} removable, failures (blocked, no grasp, no path) {reasons:?}",
+                    parts.len(),
+                    1000.0 * t / parts.len().max(1) as f64
+                );
+            }
+        }
+    }
+}
