@@ -66,7 +66,7 @@ pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
     };
     let robot = crate::robot::setup(args)?;
     let extensions: Vec<Arc<dyn asp_search::MdpExtension>> = match &robot {
-        Some(r) => vec![Arc::new(asp_robot::RobotExtension::new(r.clone()))],
+        Some(r) => vec![Arc::new(asp_robot::RobotExtension::new(r.clone())) as Arc<dyn asp_search::MdpExtension>],
         None => Vec::new(),
     };
     let optimise = args.optimise.settings(extensions)?;
@@ -79,7 +79,7 @@ pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
     }
     let checker_extension: Option<Arc<dyn asp_search::pipeline::CheckerExtension>> =
         if optimise.is_none() && (robot.is_some() || grippers > 1) {
-            Some(Arc::new(asp_robot::CellSetup { robot: robot.clone(), grippers }))
+            Some(Arc::new(asp_robot::CellSetup { robot: robot.clone(), grippers }) as Arc<dyn asp_search::pipeline::CheckerExtension>)
         } else {
             None
         };
