@@ -162,6 +162,9 @@ pub struct PlanArgs {
     /// Optimisation (`--objective`): MCTS / Pareto-MCTS on distance maps.
     #[command(flatten)]
     pub optimise: crate::optimise::OptimiseArgs,
+    /// A robot that must carry every removal out (`--robot`, `--robot-base`, `--drop-off`).
+    #[command(flatten)]
+    pub robot: crate::robot::PlanRobotArgs,
 }
 
 /// Parses the process arguments (exits with usage on error).

@@ -3,7 +3,9 @@
 
 use anyhow::{bail, Context};
 use asp_geom::distmap::Support;
-use asp_search::objective::parse_objectives;
+use asp_search::objective::check_objective_names;
+use asp_search::MdpExtension;
+use std::sync::Arc;
 use asp_search::pipeline::OptimiseSettings;
 use asp_search::report::{OptimisationEntry, ParetoEntry};
 use asp_search::search::{DEFAULT_BUDGET, DEFAULT_EPISODES};
@@ -65,10 +67,15 @@ pub struct OptimiseArgs {
 impl OptimiseArgs {
     /// The pipeline's optimiser settings, `None` unless `--objective` was given. Flag values
     /// are checked here so that errors name the flags.
-    pub fn settings(&self) -> anyhow::Result<Option<OptimiseSettings>> {
+    /// `extensions` provide objectives beyond the built-in ones (the robot's `robot-path`).
+    pub fn settings(&self, extensions: Vec<Arc<dyn MdpExtension>>) -> anyhow::Result<Option<OptimiseSettings>> {
         let Some(list) = &self.objective else { return Ok(None) };
-        let objectives = parse_objectives(list).context("--objective")?;
-        if objectives.len() > 1 && !self.pareto {
+        if list.split(',').any(|n| n.trim() == asp_robot::ROBOT_PATH) && extensions.is_empty() {
+            bail!("--objective {list}: robot-path needs a robot (--robot panda or --robot FILE.urdf)");
+        }
+        check_objective_names(list, &extensions).context("--objective")?;
+        let count = list.split(',').filter(|n| !n.trim().is_empty()).count();
+        if count > 1 && !self.pareto {
             bail!("--objective {list}: several objectives need --pareto (or give one objective)");
         }
         if let Some(t) = self.time_limit {
@@ -93,6 +100,7 @@ impl OptimiseArgs {
                 SupportArg::Below => Support::Below,
                 SupportArg::Contact => Support::ContactGraph,
             },
+            extensions,
             ..OptimiseSettings::default()
         }))
     }

@@ -63,13 +63,33 @@ pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
         t if t == 0.0 => None,
         t => Some(positive("timeout", t)?),
     };
+    let robot = crate::robot::setup(args)?;
+    let extensions: Vec<Arc<dyn asp_search::MdpExtension>> = match &robot {
+        Some(r) => vec![Arc::new(asp_robot::RobotExtension::new(r.clone())) as Arc<dyn asp_search::MdpExtension>],
+        None => Vec::new(),
+    };
+    let optimise = args.optimise.settings(extensions)?;
+    let grippers = args.robot.grippers;
+    if grippers == 0 {
+        bail!("--grippers must be at least 1");
+    }
+    if grippers > 1 && optimise.is_some() {
+        bail!("--grippers works with the feasibility search only, not with --objective");
+    }
+    let checker_extension: Option<Arc<dyn asp_search::pipeline::CheckerExtension>> =
+        if optimise.is_none() && (robot.is_some() || grippers > 1) {
+            Some(Arc::new(asp_robot::CellSetup { robot: robot.clone(), grippers }) as Arc<dyn asp_search::pipeline::CheckerExtension>)
+        } else {
+            None
+        };
     Ok(PlanSettings {
         order: crate::learn::order_source(args.order, args.onnx.as_deref())?,
         bookkeeping: args.bookkeeping || args.order == OrderArg::Bookkeeping,
         seed: args.seed,
         max_tests: args.max_tests,
         timeout,
-        optimise: args.optimise.settings()?,
+        optimise,
+        checker_extension,
         ..model_settings(&args.load)?
     })
 }
@@ -347,6 +367,9 @@ pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Resu
         )?;
         write_steps(out, r, &r.partial_assembly_sequence, width, "")?;
     }
+    if let Some(robot) = &r.robot {
+        writeln!(out, "robot {}: total path length {:.3} {}", robot.name, robot.total_path_length, r.units)?;
+    }
     if !r.explanation.is_empty() {
         writeln!(out, "stuck with {} parts left; none can leave:", r.explanation.len())?;
         for e in &r.explanation {
@@ -386,7 +409,15 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
             }
             MotionEntry::Path { poses, .. } => format!("path of {} poses", poses.len()),
         };
-        writeln!(out, "{indent}{:>4}  {:<width$}  {motion}", k + 1, label(step))?;
+        let robot = step.robot.as_ref().map_or(String::new(), |rs| {
+            format!("; robot path {:.3}", rs.path_length)
+        });
+        let robot = if step.held.is_empty() {
+            robot
+        } else {
+            format!("{robot}; holding {}", step.held.iter().map(|&p| name(p)).collect::<Vec<_>>().join(", "))
+        };
+        writeln!(out, "{indent}{:>4}  {:<width$}  {motion}{robot}", k + 1, label(step))?;
         if let Some(g) = &step.subassembly {
             let inner = format!("{indent}      ");
             let members: Vec<&str> = g.parts.iter().map(|&p| name(p)).collect();

@@ -45,6 +45,70 @@ pub struct CheckArgs {
     pub seed: u64,
 }
 
+/// The robot flags of `asp plan`.
+#[derive(Args, Debug, Clone, Default)]
+pub struct PlanRobotArgs {
+    /// Plan for a robot arm: `panda` (the shipped Franka-Panda-like arm) or a URDF file. A part
+    /// counts as removable only when the arm can grasp it, lift it 5 cm along its removal
+    /// direction and carry it to the drop-off without collision (thesis 5.3).
+    #[arg(long, value_name = "panda|FILE.urdf", help_heading = "Robot")]
+    pub robot: Option<String>,
+    /// The robot base's position `X,Y,Z` in model units (default: on the floor, 0.3 m in front of
+    /// the model's -x side, centred on it).
+    #[arg(long, value_name = "X,Y,Z", help_heading = "Robot")]
+    pub robot_base: Option<String>,
+    /// Where the gripper puts removed parts down, `X,Y,Z` in model units (default: 0.5 m to the
+    /// robot's side, 0.4 m above the floor).
+    #[arg(long, value_name = "X,Y,Z", help_heading = "Robot")]
+    pub drop_off: Option<String>,
+    /// `k`: path plans per grasp, the shortest kept (simulation steps of the optimiser plan once).
+    #[arg(long, default_value_t = 4, help_heading = "Robot")]
+    pub replans: usize,
+    /// Grippers in all: up to N-1 parts already in place may be held (by a second gripper or a
+    /// fixture) while the next part goes in, so states that stand only while held are allowed
+    /// (feasibility search only; the plan's steps say which parts are held).
+    #[arg(long, default_value_t = 1, value_name = "N", help_heading = "Robot")]
+    pub grippers: usize,
+}
+
+fn point(flag: &str, s: &str) -> anyhow::Result<[f64; 3]> {
+    let v: Vec<f64> = s.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| {
+        anyhow::anyhow!("--{flag}: '{s}' is not three numbers X,Y,Z")
+    })?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([x, y, z]),
+        _ => anyhow::bail!("--{flag}: '{s}' is not three finite numbers X,Y,Z"),
+    }
+}
+
+/// The robot of `asp plan`'s flags, if any.
+pub fn setup(args: &crate::flags::PlanArgs) -> anyhow::Result<Option<asp_robot::RobotSetup>> {
+    let a = &args.robot;
+    let uses_path = args.optimise.objective.as_deref().is_some_and(|l| l.split(',').any(|n| n.trim() == asp_robot::ROBOT_PATH));
+    let Some(name) = &a.robot else {
+        for (flag, given) in [("robot-base", a.robot_base.is_some()), ("drop-off", a.drop_off.is_some())] {
+            if given {
+                anyhow::bail!("--{flag} needs --robot");
+            }
+        }
+        if uses_path {
+            anyhow::bail!("--objective robot-path needs a robot (--robot panda or --robot FILE.urdf)");
+        }
+        return Ok(None);
+    };
+    let robot = if name == "panda" { Robot::panda() } else { Robot::from_urdf_file(std::path::Path::new(name))? };
+    if a.replans == 0 {
+        anyhow::bail!("--replans must be at least 1");
+    }
+    let to_vec = |p: [f64; 3]| asp_geom::math::Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+    Ok(Some(asp_robot::RobotSetup {
+        robot,
+        base: a.robot_base.as_deref().map(|s| point("robot-base", s)).transpose()?.map(to_vec),
+        drop_off: a.drop_off.as_deref().map(|s| point("drop-off", s)).transpose()?.map(to_vec),
+        config: asp_robot::RemovalConfig { replans: a.replans, ..Default::default() },
+    }))
+}
+
 /// Runs `asp robot`.
 pub fn run(args: &RobotArgs) -> anyhow::Result<ExitCode> {
     match &args.action {

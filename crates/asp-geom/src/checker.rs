@@ -59,6 +59,19 @@ impl Checker {
     pub fn physics(&self) -> Option<&PhysicsStability> {
         self.physics.as_ref()
     }
+
+    /// Whether `state` stands with the `held` parts (present, not fixed) held in place by a
+    /// gripper or a fixture: they count as fixed. Not counted as a removal test.
+    pub fn stability_holding(&self, state: &PartSet, held: &PartSet) -> Stability {
+        match &self.physics {
+            None => {
+                let mut base = self.world.fixed().clone();
+                base.union_with(held);
+                self.world.contact_stability_among(&self.world.with_fixed(state), &base)
+            }
+            Some(physics) => physics.stability_holding(&self.world, state, held),
+        }
+    }
 }
 
 impl FeasibilityChecker for Checker {

@@ -225,9 +225,15 @@ impl PhysicsStability {
     /// Simulates `state` (plus the fixed parts) under gravity and reports the parts that moved
     /// more than the threshold. `world` must be the one this check was built for.
     pub fn stability(&self, world: &World, state: &PartSet) -> Stability {
+        self.stability_holding(world, state, &PartSet::empty(0))
+    }
+
+    /// [`PhysicsStability::stability`] with the `held` parts of `state` held in place (static,
+    /// like fixed parts: by another gripper or a fixture).
+    pub fn stability_holding(&self, world: &World, state: &PartSet, held: &PartSet) -> Stability {
         // a NaN (a blown-up simulation) counts as moved
         let floating = self
-            .displacements(world, state)
+            .displacements_holding(world, state, held)
             .into_iter()
             .filter(|&(_, d)| d.is_nan() || d > self.threshold)
             .map(|(i, _)| i);
@@ -244,12 +250,17 @@ impl PhysicsStability {
     /// the distance from the centre of mass to its farthest bound. Parts that are static (fixed,
     /// or bonded to a fixed part) are left out.
     pub fn displacements(&self, world: &World, state: &PartSet) -> Vec<(usize, f32)> {
+        self.displacements_holding(world, state, &PartSet::empty(0))
+    }
+
+    /// [`PhysicsStability::displacements`] with the `held` parts static too.
+    pub fn displacements_holding(&self, world: &World, state: &PartSet, held: &PartSet) -> Vec<(usize, f32)> {
         let present = world.with_fixed(state);
         let count = self.shapes.len();
         let parts: Vec<usize> = present.iter().filter(|&i| i < count).collect();
         let group = bonded_groups(world, &parts);
         let static_groups: BTreeSet<usize> =
-            parts.iter().filter(|&&i| world.fixed().contains(i)).map(|i| group[i]).collect();
+            parts.iter().filter(|&&i| world.fixed().contains(i) || held.contains(i)).map(|i| group[i]).collect();
         let is_static = |g: usize| static_groups.contains(&g);
         if parts.iter().all(|i| is_static(group[i])) {
             return Vec::new();

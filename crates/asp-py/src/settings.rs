@@ -175,6 +175,7 @@ pub fn plan_settings(dict: &Bound<'_, PyDict>) -> Result<PlanSettings, Error> {
         timeout: k.positive("timeout")?,
         optimise: optimise_settings(&k)?,
         cancel: None,
+        checker_extension: None,
     })
 }
 

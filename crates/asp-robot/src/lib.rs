@@ -1,15 +1,22 @@
 #![doc = include_str!("../README.md")]
 
+pub mod checker;
 pub mod convert;
 pub mod error;
 pub mod grasp;
 pub mod ik;
+pub mod removal;
 pub mod robot;
+pub mod rrt;
+pub mod search;
 pub mod shape;
 
 pub use error::{Result, RobotError};
 pub use grasp::{antipodal_grasps, grasps_from_meta, part_grasps, GraspConfig};
 pub use ik::{IkConfig, IkOutcome, IkSolution};
+pub use removal::{RemovalConfig, RemovalPlanner, RobotCell, RobotFailure, RobotRemoval};
+pub use checker::{HoldingChecker, RobotChecker};
+pub use search::{CellSetup, RobotExtension, RobotSetup, ROBOT_PATH};
 pub use robot::{ChainSpec, Finger, Joint, JointKind, Link, Robot};
 pub use shape::{LinkShape, ShapeKind};
 

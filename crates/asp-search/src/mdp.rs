@@ -117,6 +117,12 @@ pub trait MdpExtension: Send + Sync + Debug {
     fn filters(&self, _model: &ModelContext<'_>) -> Result<Vec<Arc<dyn ActionFilter>>> {
         Ok(Vec::new())
     }
+
+    /// What it adds to the plan of `sequence` (removal order) on this model, e.g. a robot's
+    /// grasps and paths per step; default `None`.
+    fn describe(&self, _model: &ModelContext<'_>, _sequence: &[usize]) -> Result<Option<crate::report::RobotReport>> {
+        Ok(None)
+    }
 }
 
 /// Distance maps plus the objectives to maximise and the filters on the actions.

@@ -87,6 +87,22 @@ pub struct PlanSettings {
     /// deadline) with the best result so far: the depth-first search ends `interrupted` with its
     /// partial plan, the optimiser returns what it has found, as with its time limit.
     pub cancel: Option<StopToken>,
+    /// Wraps the depth-first search's checker (e.g. a robot that must also take each part out).
+    pub checker_extension: Option<Arc<dyn CheckerExtension>>,
+}
+
+/// Decorates the feasibility planner's checker: [`CheckerExtension::solve`] builds its
+/// checker on the collision-world checker, lets the search run on it, and describes the
+/// outcome's steps (a robot's grasps and paths).
+pub trait CheckerExtension: Send + Sync + std::fmt::Debug {
+    /// Builds the decorated checker on `checker`, calls `search` with it, and returns the
+    /// search's outcome with the extension's report (or `None`).
+    fn solve(
+        &self,
+        checker: &Checker,
+        seed: u64,
+        search: &mut dyn FnMut(&dyn asp_geom::FeasibilityChecker) -> PlanOutcome,
+    ) -> Result<(PlanOutcome, Option<crate::report::RobotReport>)>;
 }
 
 impl Default for PlanSettings {
@@ -112,6 +128,7 @@ impl Default for PlanSettings {
             timeout: Some(DEFAULT_TIMEOUT),
             optimise: None,
             cancel: None,
+            checker_extension: None,
         }
     }
 }
@@ -299,11 +316,20 @@ pub fn plan_assembly(
     let world_seconds = started.elapsed().as_secs_f64();
     let dfs = planner(settings, checker.world())?;
     let budget = budget(settings)?;
-    let mut problem = Problem::full(&checker);
-    problem.progress = progress;
-    let outcome = dfs.solve(&problem, &budget);
+    let mut search = |c: &dyn asp_geom::FeasibilityChecker| {
+        let mut problem = Problem::full(c);
+        problem.progress = progress;
+        dfs.solve(&problem, &budget)
+    };
+    let (outcome, robot) = match &settings.checker_extension {
+        Some(e) => e.solve(&checker, settings.seed, &mut search)?,
+        None => (search(&checker as &dyn asp_geom::FeasibilityChecker), None),
+    };
     let world = checker.world();
     let mut report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
+    if let Some(r) = robot {
+        report.attach_robot(r);
+    }
     report.stats.timings = Some(Timings {
         load: 0.0,
         world: world_seconds,
@@ -379,6 +405,14 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
     }
     let mut report = PlanReport::new(&assembly, &plan, maps.tolerance(), &warnings);
     report.stats.checker = CHECKER_DISTANCE_MAPS.into();
+    if let Some(best) = outcome.best() {
+        for e in &o.extensions {
+            if let Some(r) = e.describe(&model, &best.sequence)? {
+                report.attach_robot(r);
+                break;
+            }
+        }
+    }
     report.pareto_front = o.pareto.then(|| {
         outcome
             .solutions

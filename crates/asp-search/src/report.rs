@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.4";
+pub const FORMAT_VERSION: &str = "1.5";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -57,6 +57,79 @@ pub struct PlanReport {
     /// Optimising runs (`--objective`): the objectives, the result and the search's settings.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub optimisation: Option<OptimisationEntry>,
+    /// Plans with a robot (`--robot`): the robot, its base and drop-off, the total path length.
+    /// Since format 1.5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot: Option<RobotEntry>,
+}
+
+/// The robot a plan was made for. Since format 1.5.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RobotEntry {
+    /// The robot's name (the URDF's).
+    pub name: String,
+    /// The URDF file (or `<builtin panda>`).
+    pub source: String,
+    /// The base link's pose `[x, y, z, qx, qy, qz, qw]`, model units.
+    pub base: [f64; 7],
+    /// Where the tool centre puts removed parts down, model units.
+    pub drop_off: [f64; 3],
+    /// The joints' names, in the order of every `joint_trajectory` row.
+    pub joints: Vec<String>,
+    /// The sum of the steps' `path_length`, model units.
+    pub total_path_length: f64,
+}
+
+/// How the robot takes one part out (in disassembly direction: from the grasp in the assembled
+/// pose, lifted along the removal direction, to the drop-off; assembly runs it backwards).
+/// Since format 1.5.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RobotStepEntry {
+    /// The grasp: the tool centre's pose `[x, y, z, qx, qy, qz, qw]` (z the approach, y the
+    /// closing direction), model units.
+    pub grasp: [f64; 7],
+    /// The gripper's opening at the grasp, model units.
+    pub grasp_width: f64,
+    /// The tool centre's positions along the trajectory, model units.
+    pub gripper_path: Vec<[f64; 3]>,
+    /// Joint waypoints (radians / metres, in [`RobotEntry::joints`] order); the joints move
+    /// linearly between consecutive rows.
+    pub joint_trajectory: Vec<Vec<f64>>,
+    /// The tool centre's travel (eq. 5.3), model units.
+    pub path_length: f64,
+}
+
+/// What an extension (a robot, held parts) adds to a plan: the report-level entry and, per
+/// removal of the plan outcome (removal order), the step's robot entry and held parts.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct RobotReport {
+    /// The robot, if any.
+    pub entry: Option<RobotEntry>,
+    /// One per removal, in removal order (`None`: not planned for a robot).
+    pub steps: Vec<Option<RobotStepEntry>>,
+    /// One per removal, in removal order: the parts held in place while the rest stands
+    /// without the removed part (empty: none); may be shorter than the removals.
+    pub held: Vec<Vec<usize>>,
+}
+
+impl PlanReport {
+    /// Attaches a robot's entries: each removal's entry to its assembly step (assembly order is
+    /// the removal order reversed; the partial sequence when no plan was found).
+    pub fn attach_robot(&mut self, robot: RobotReport) {
+        let steps = if self.assembly_sequence.is_empty() { &mut self.partial_assembly_sequence } else { &mut self.assembly_sequence };
+        let n = steps.len();
+        for (k, entry) in robot.steps.into_iter().enumerate() {
+            if k < n {
+                steps[n - 1 - k].robot = entry;
+            }
+        }
+        for (k, held) in robot.held.into_iter().enumerate() {
+            if k < n {
+                steps[n - 1 - k].held = held;
+            }
+        }
+        self.robot = robot.entry;
+    }
 }
 
 /// A part of the model.
@@ -83,6 +156,13 @@ pub struct AssemblyStep {
     /// and its own plan. Since format 1.4.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub subassembly: Option<Box<SubassemblyEntry>>,
+    /// Plans with a robot: how the robot takes this part out. Since format 1.5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot: Option<RobotStepEntry>,    /// With `--grippers N`: the parts (at most N-1, already in place) held by another gripper
+    /// or a fixture while this part goes in, because the state before it stands only so. Since
+    /// format 1.5.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub held: Vec<usize>,
 }
 
 /// A subassembly: parts that go in together, rigidly, as one step.
@@ -296,6 +376,7 @@ impl PlanReport {
             warnings: warnings.to_vec(),
             pareto_front: None,
             optimisation: None,
+            robot: None,
         }
     }
 }
@@ -318,6 +399,8 @@ fn assembly_steps(removals: &[Step], name: &dyn Fn(usize) -> String, u: &dyn Fn(
                 };
                 Box::new(SubassemblyEntry { parts: g.parts.iter().collect(), status: status.into(), assembly_sequence, explanation })
             }),
+            robot: None,
+            held: Vec::new(),
         })
         .collect()
 }

@@ -1,0 +1,231 @@
+//! The depth-first planner's feasibility with a robot: a [`FeasibilityChecker`] decorator that
+//! admits a removal only when the arm can also take the part out ([`RemovalPlanner`]).
+//!
+//! The inner checker answers first (straight lines, stability); a part it lets leave along a
+//! straight line is then planned for the robot, lifted along that line. A robot failure turns
+//! the outcome into a collision whose blockers are the other present, non-fixed parts (any of
+//! them might be what the arm hits, so the search never concludes that removing others cannot
+//! help). Groups (subassemblies) are not offered: the robot carries one part at a time. Path
+//! motions (the SE(3) path planner) are refused: the robot needs a straight lift.
+//!
+//! Every successful plan is kept by state and part, so the plan's steps can be annotated with
+//! the robot's grasp, gripper path and joint trajectory ([`RobotChecker::removal`]); every
+//! failure is counted by reason and the last one per part is kept ([`RobotChecker::failure`]).
+
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+use asp_geom::{Checker, CounterSnapshot, FeasibilityChecker, Motion, MotionKind, Outcome, PartSet, Stability, World};
+
+use crate::removal::{RemovalPlanner, RobotFailure, RobotRemoval};
+
+/// A deterministic seed for the robot's plan of `part` in `state`.
+pub fn step_seed(seed: u64, state: &PartSet, part: usize) -> u64 {
+    let mut h = mix(seed ^ 0x243f_6a88_85a3_08d3);
+    for w in state.words() {
+        h = mix(h ^ w);
+    }
+    mix(h ^ part as u64)
+}
+
+fn mix(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// Robot removability on top of a collision-world checker.
+pub struct RobotChecker<'c> {
+    inner: &'c dyn FeasibilityChecker,
+    planner: RemovalPlanner<&'c World>,
+    seed: u64,
+    replans: usize,
+    plans: Mutex<HashMap<(Vec<u64>, usize), RobotRemoval>>,
+    failures: Mutex<HashMap<usize, RobotFailure>>,
+    counts: [AtomicU64; 3],
+}
+
+impl std::fmt::Debug for RobotChecker<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RobotChecker").field("planner", &self.planner).finish_non_exhaustive()
+    }
+}
+
+impl<'c> RobotChecker<'c> {
+    /// Wraps `inner`; `planner` must plan on the world `inner` tests on. `replans` is `k`.
+    pub fn new(inner: &'c dyn FeasibilityChecker, planner: RemovalPlanner<&'c World>, seed: u64, replans: usize) -> Self {
+        RobotChecker {
+            inner,
+            planner,
+            seed,
+            replans,
+            plans: Mutex::new(HashMap::new()),
+            failures: Mutex::new(HashMap::new()),
+            counts: Default::default(),
+        }
+    }
+
+    /// The robot planner.
+    pub fn planner(&self) -> &RemovalPlanner<&'c World> {
+        &self.planner
+    }
+
+    /// The robot's plan for removing `part` from `state`, when a test admitted it.
+    pub fn removal(&self, part: usize, state: &PartSet) -> Option<RobotRemoval> {
+        self.plans.lock().expect("not poisoned").get(&(state.words().to_vec(), part)).cloned()
+    }
+
+    /// The last robot failure of `part`, if it ever failed.
+    pub fn failure(&self, part: usize) -> Option<RobotFailure> {
+        self.failures.lock().expect("not poisoned").get(&part).cloned()
+    }
+
+    /// Robot failures so far by reason ([`RobotFailure::REASONS`] order).
+    pub fn failure_counts(&self) -> [u64; 3] {
+        [0, 1, 2].map(|i| self.counts[i].load(Ordering::Relaxed))
+    }
+
+    fn refuse(&self, part: usize, state: &PartSet, failure: RobotFailure) -> Outcome {
+        self.counts[failure.index()].fetch_add(1, Ordering::Relaxed);
+        self.failures.lock().expect("not poisoned").insert(part, failure);
+        let mut blockers = state.without(part);
+        for p in state.iter() {
+            if self.inner.is_fixed(p) {
+                blockers.remove(p);
+            }
+        }
+        Outcome::Collision { blockers }
+    }
+}
+
+impl FeasibilityChecker for RobotChecker<'_> {
+    fn num_parts(&self) -> usize {
+        self.inner.num_parts()
+    }
+
+    fn is_fixed(&self, part: usize) -> bool {
+        self.inner.is_fixed(part)
+    }
+
+    fn test_removal(&self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome {
+        let outcome = self.inner.test_removal(part, state, kind);
+        match &outcome {
+            Outcome::Removed(Motion::Linear { direction, .. }) => {
+                let key = (state.words().to_vec(), part);
+                if self.plans.lock().expect("not poisoned").contains_key(&key) {
+                    return outcome;
+                }
+                match self.planner.plan(part, state, *direction, step_seed(self.seed, state, part), self.replans) {
+                    Ok(r) => {
+                        self.plans.lock().expect("not poisoned").insert(key, r);
+                        outcome
+                    }
+                    Err(f) => self.refuse(part, state, f),
+                }
+            }
+            Outcome::Removed(Motion::Path { .. }) => self.refuse(part, state, RobotFailure::Blocked { by: None }),
+            _ => outcome,
+        }
+    }
+
+    fn stability(&self, state: &PartSet) -> Stability {
+        self.inner.stability(state)
+    }
+
+    fn counters(&self) -> CounterSnapshot {
+        self.inner.counters()
+    }
+}
+
+/// Held parts (`--grippers N`): a removal whose remaining state would not stand is admitted
+/// when holding at most `N - 1` of the remaining, non-fixed parts in place (a second gripper or
+/// a fixture) makes it stand. Candidates to hold: the parts that would fall first, then the
+/// other remaining parts in index order; sets of one part, then of two (when `N ≥ 3`, among the
+/// first 12 candidates). The held parts of each admitted removal are kept
+/// ([`HoldingChecker::held`]).
+pub struct HoldingChecker<'c> {
+    inner: &'c Checker,
+    grippers: usize,
+    held: Mutex<HashMap<(Vec<u64>, usize), PartSet>>,
+}
+
+impl std::fmt::Debug for HoldingChecker<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("HoldingChecker").field("grippers", &self.grippers).finish_non_exhaustive()
+    }
+}
+
+impl<'c> HoldingChecker<'c> {
+    /// Wraps `inner` with `grippers` grippers in all (the robot's included).
+    pub fn new(inner: &'c Checker, grippers: usize) -> Self {
+        HoldingChecker { inner, grippers, held: Mutex::new(HashMap::new()) }
+    }
+
+    /// The parts held while the rest of `state` stands without `part` (empty when none).
+    pub fn held(&self, part: usize, state: &PartSet) -> Vec<usize> {
+        self.held.lock().expect("not poisoned").get(&(state.words().to_vec(), part)).map_or_else(Vec::new, |h| h.iter().collect())
+    }
+
+    fn holding(&self, rest: &PartSet, floating: &PartSet) -> Option<PartSet> {
+        let n = self.inner.num_parts();
+        let mut candidates: Vec<usize> = floating.iter().filter(|&p| p < n && rest.contains(p) && !self.inner.is_fixed(p)).collect();
+        for p in rest.iter() {
+            if p < n && !self.inner.is_fixed(p) && !candidates.contains(&p) {
+                candidates.push(p);
+            }
+        }
+        let stands = |held: &PartSet| self.inner.stability_holding(rest, held) == Stability::Stable;
+        for &c in &candidates {
+            let h = PartSet::from_indices(n, [c]);
+            if stands(&h) {
+                return Some(h);
+            }
+        }
+        if self.grippers >= 3 {
+            let first = &candidates[..candidates.len().min(12)];
+            for (i, &a) in first.iter().enumerate() {
+                for &b in &first[i + 1..] {
+                    let h = PartSet::from_indices(n, [a, b]);
+                    if stands(&h) {
+                        return Some(h);
+                    }
+                }
+            }
+        }
+        None
+    }
+}
+
+impl FeasibilityChecker for HoldingChecker<'_> {
+    fn num_parts(&self) -> usize {
+        self.inner.num_parts()
+    }
+
+    fn is_fixed(&self, part: usize) -> bool {
+        self.inner.is_fixed(part)
+    }
+
+    fn test_removal(&self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome {
+        let outcome = self.inner.test_removal(part, state, kind);
+        match outcome {
+            Outcome::Unstable { floating, motion } if self.grippers >= 2 => match self.holding(&state.without(part), &floating) {
+                Some(h) => {
+                    self.held.lock().expect("not poisoned").insert((state.words().to_vec(), part), h);
+                    Outcome::Removed(motion)
+                }
+                None => Outcome::Unstable { floating, motion },
+            },
+            other => other,
+        }
+    }
+
+    fn stability(&self, state: &PartSet) -> Stability {
+        self.inner.stability(state)
+    }
+
+    fn counters(&self) -> CounterSnapshot {
+        self.inner.counters()
+    }
+}

@@ -1,0 +1,296 @@
+//! The robot in the planners, through their seams:
+//! * the depth-first search: [`CellSetup`] is a [`CheckerExtension`] that wraps the checker in
+//!   a [`HoldingChecker`] (`--grippers`) and a [`RobotChecker`] (a removal must also be one the
+//!   robot can carry out);
+//! * the optimiser: [`RobotSetup`] is an [`MdpExtension`] with the filter `robot` (reasons
+//!   `blocked`, `no reachable grasp`, `no path`) and the objective `robot-path` (reward: minus
+//!   the robot's path length in metres, eq. 5.8). Expansion and replay plan `k` times
+//!   ([`RemovalConfig::replans`]) and keep the shortest, simulation plans once (5.4.2). The lift
+//!   direction is the distance maps' straight-line removal direction of the step.
+//!
+//! Both describe their plan's steps for the plan JSON ([`RobotReport`]).
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+use asp_geom::distmap::{DistanceMaps, MapState};
+use asp_geom::math::{Pose, Vec3};
+use asp_geom::{Assembly, Checker, FeasibilityChecker, Motion, PartSet, World, WorldConfig};
+use asp_search::mdp::{ActionFilter, MdpExtension, ModelContext, Verdict};
+use asp_search::objective::{Objective, StepContext, StepKind};
+use asp_search::pipeline::CheckerExtension;
+use asp_search::report::{RobotEntry, RobotReport, RobotStepEntry};
+use asp_search::{Mdp, PathLength, PlanOutcome, SearchError};
+
+use crate::checker::{HoldingChecker, RobotChecker};
+use crate::removal::{RemovalConfig, RemovalPlanner, RobotCell, RobotFailure, RobotRemoval};
+use crate::robot::Robot;
+
+/// The objective name of the robot's path length.
+pub const ROBOT_PATH: &str = "robot-path";
+
+/// A robot, where it stands, and how it plans: what `--robot` sets up.
+#[derive(Clone, Debug)]
+pub struct RobotSetup {
+    /// The robot (its base pose is set per model from `base`).
+    pub robot: Robot,
+    /// The base position in the model's units, model frame (default: [`RobotCell::for_assembly`]).
+    pub base: Option<Vec3>,
+    /// The drop-off point in the model's units, model frame (default: [`RobotCell::for_assembly`]).
+    pub drop_off: Option<Vec3>,
+    /// The removal test's settings (`k` is `replans`).
+    pub config: RemovalConfig,
+}
+
+impl RobotSetup {
+    /// The default panda with default settings.
+    pub fn panda() -> Self {
+        RobotSetup { robot: Robot::panda(), base: None, drop_off: None, config: RemovalConfig::default() }
+    }
+
+    /// The robot cell on `assembly` (the positions converted to metres).
+    pub fn cell(&self, assembly: &Assembly) -> RobotCell {
+        let m = assembly.units.metres as f32;
+        RobotCell::for_assembly(assembly, self.robot.clone(), self.base.map(|b| b * m), self.drop_off.map(|d| d * m))
+    }
+}
+
+/// The report entries of a robot: the cell and one entry per step (`None` where not planned).
+pub fn robot_report(assembly: &Assembly, cell: &RobotCell, steps: Vec<Option<RobotRemoval>>) -> RobotReport {
+    let u = |m: f64| assembly.units.from_metres(m);
+    let v3 = |v: Vec3| [u(v.x as f64), u(v.y as f64), u(v.z as f64)];
+    let pose7 = |p: &Pose| {
+        let t = v3(p.translation);
+        let q = p.rotation;
+        [t[0], t[1], t[2], q.x as f64, q.y as f64, q.z as f64, q.w as f64]
+    };
+    let mut total = 0.0;
+    let steps = steps
+        .into_iter()
+        .map(|s| {
+            s.map(|r| {
+                total += r.length;
+                RobotStepEntry {
+                    grasp: pose7(&Pose::from_parts(r.grasp.position, r.grasp.orientation)),
+                    grasp_width: u(r.grasp.width as f64),
+                    gripper_path: r.gripper_path.iter().map(|p| v3(*p)).collect(),
+                    joint_trajectory: r.joints.clone(),
+                    path_length: u(r.length),
+                }
+            })
+        })
+        .collect();
+    RobotReport {
+        entry: Some(RobotEntry {
+            name: cell.robot.name.clone(),
+            source: cell.robot.source.display().to_string(),
+            base: pose7(&cell.robot.base_pose()),
+            drop_off: v3(cell.drop_off),
+            joints: cell.robot.movable_joints().map(|j| j.name.clone()).collect(),
+            total_path_length: u(total),
+        }),
+        steps,
+        held: Vec::new(),
+    }
+}
+
+/// What the depth-first search gets from `--robot` and `--grippers`: a robot, held parts, or
+/// both (held parts are tested first, the robot on what they admit).
+#[derive(Clone, Debug)]
+pub struct CellSetup {
+    /// The robot, if any.
+    pub robot: Option<RobotSetup>,
+    /// Grippers in all (`--grippers`, default 1: nothing is held).
+    pub grippers: usize,
+}
+
+impl CheckerExtension for CellSetup {
+    fn solve(
+        &self,
+        checker: &Checker,
+        seed: u64,
+        search: &mut dyn FnMut(&dyn FeasibilityChecker) -> PlanOutcome,
+    ) -> asp_search::Result<(PlanOutcome, Option<RobotReport>)> {
+        let world = checker.world();
+        let holding = (self.grippers >= 2).then(|| HoldingChecker::new(checker, self.grippers));
+        let base: &dyn FeasibilityChecker = match &holding {
+            Some(h) => h,
+            None => checker,
+        };
+        let robot = self.robot.as_ref().map(|r| {
+            let cell = r.cell(world.assembly());
+            let planner = RemovalPlanner::new(world, cell.clone(), r.config.clone());
+            (cell, RobotChecker::new(base, planner, seed, r.config.replans))
+        });
+        let outcome = match &robot {
+            Some((_, rc)) => search(rc),
+            None => search(base),
+        };
+        let mut state = PartSet::full(checker.num_parts());
+        let (mut steps, mut held) = (Vec::new(), Vec::new());
+        for s in &outcome.removals {
+            steps.push(robot.as_ref().and_then(|(_, rc)| rc.removal(s.part, &state)));
+            held.push(holding.as_ref().map_or_else(Vec::new, |h| h.held(s.part, &state)));
+            for p in s.parts() {
+                state.remove(p);
+            }
+        }
+        let mut report = match &robot {
+            Some((cell, _)) => robot_report(world.assembly(), cell, steps),
+            None => RobotReport::default(),
+        };
+        report.held = held;
+        Ok((outcome, Some(report)))
+    }
+}
+
+/// The robot on one model for the optimiser: its planner on a collision world of the model and
+/// the plans made so far, by state, part and number of replans.
+#[derive(Debug)]
+pub struct RobotModel {
+    planner: RemovalPlanner<Arc<World>>,
+    replans: usize,
+    assembly: Arc<Assembly>,
+    cache: Mutex<HashMap<(Vec<u64>, usize, usize), Result<RobotRemoval, RobotFailure>>>,
+}
+
+impl RobotModel {
+    /// The robot's plan for `step` (`k` plans for expansion and replay, one for simulation).
+    pub fn plan(&self, step: &mut StepContext<'_, '_>) -> Result<RobotRemoval, RobotFailure> {
+        let replans = if step.kind() == StepKind::Simulation { 1 } else { self.replans.max(1) };
+        let present = step.present();
+        let key = (present.words().to_vec(), step.part(), replans);
+        if let Some(r) = self.cache.lock().expect("not poisoned").get(&key) {
+            return r.clone();
+        }
+        let r = match step.motion() {
+            Some(Motion::Linear { direction, .. }) => self.planner.plan(step.part(), &present, direction, step.seed(), replans),
+            _ => Err(RobotFailure::Blocked { by: None }),
+        };
+        self.cache.lock().expect("not poisoned").insert(key, r.clone());
+        r
+    }
+
+    /// The planner.
+    pub fn planner(&self) -> &RemovalPlanner<Arc<World>> {
+        &self.planner
+    }
+}
+
+/// The optimiser's filter: the robot must be able to take the part out.
+#[derive(Debug)]
+pub struct RobotFilter(pub Arc<RobotModel>);
+
+impl ActionFilter for RobotFilter {
+    fn name(&self) -> &str {
+        "robot"
+    }
+
+    fn reasons(&self) -> Vec<String> {
+        RobotFailure::REASONS.iter().map(|r| r.to_string()).collect()
+    }
+
+    fn check(&self, step: &mut StepContext<'_, '_>, _memory: &[u64]) -> Verdict {
+        match self.0.plan(step) {
+            Ok(_) => Verdict::Feasible,
+            Err(f) => Verdict::Infeasible { reason: f.index() },
+        }
+    }
+}
+
+/// The objective `robot-path`: minus the robot's path length of the removal, metres (eq. 5.8).
+#[derive(Debug)]
+pub struct RobotPath(pub Arc<RobotModel>);
+
+/// A bound on one removal's path length, metres (the robot cannot drive much farther than this
+/// between any two poses of a path).
+const LENGTH_BOUND: f64 = 20.0;
+
+impl Objective for RobotPath {
+    fn name(&self) -> &str {
+        ROBOT_PATH
+    }
+
+    fn reward(&self, step: &mut StepContext<'_, '_>, _memory: &mut [u64]) -> f64 {
+        // the filter admitted the step; without the filter a failing step costs the bound
+        self.0.plan(step).map_or(-LENGTH_BOUND, |r| -r.length)
+    }
+
+    fn worst_total(&self, _maps: &DistanceMaps, removals: usize) -> f64 {
+        -LENGTH_BOUND * removals as f64
+    }
+}
+
+/// The optimiser's extension: one [`RobotModel`] per model, shared by the filter and the
+/// objective.
+#[derive(Debug)]
+pub struct RobotExtension {
+    setup: RobotSetup,
+    model: Mutex<Option<(usize, Arc<RobotModel>)>>,
+}
+
+impl RobotExtension {
+    /// The extension of `setup`.
+    pub fn new(setup: RobotSetup) -> Self {
+        RobotExtension { setup, model: Mutex::new(None) }
+    }
+
+    /// The robot on `model` (built once per assembly).
+    pub fn model(&self, model: &ModelContext<'_>) -> asp_search::Result<Arc<RobotModel>> {
+        let id = Arc::as_ptr(model.assembly) as usize;
+        let mut slot = self.model.lock().expect("not poisoned");
+        if let Some((k, m)) = slot.as_ref() {
+            if *k == id {
+                return Ok(m.clone());
+            }
+        }
+        let config = WorldConfig {
+            tolerance: Some(model.maps.tolerance()),
+            contact_distance: Some(model.maps.contact_distance()),
+            ..WorldConfig::default()
+        };
+        let world = World::new(model.assembly.as_ref().clone(), &config).map_err(SearchError::from)?;
+        let cell = self.setup.cell(model.assembly);
+        let m = Arc::new(RobotModel {
+            planner: RemovalPlanner::new(Arc::new(world), cell, self.setup.config.clone()),
+            replans: self.setup.config.replans,
+            assembly: model.assembly.clone(),
+            cache: Mutex::new(HashMap::new()),
+        });
+        *slot = Some((id, m.clone()));
+        Ok(m)
+    }
+}
+
+impl MdpExtension for RobotExtension {
+    fn objective_names(&self) -> Vec<String> {
+        vec![ROBOT_PATH.into()]
+    }
+
+    fn objective(&self, name: &str, model: &ModelContext<'_>) -> asp_search::Result<Option<Arc<dyn Objective>>> {
+        if name.trim() != ROBOT_PATH {
+            return Ok(None);
+        }
+        Ok(Some(Arc::new(RobotPath(self.model(model)?))))
+    }
+
+    fn filters(&self, model: &ModelContext<'_>) -> asp_search::Result<Vec<Arc<dyn ActionFilter>>> {
+        Ok(vec![Arc::new(RobotFilter(self.model(model)?))])
+    }
+
+    fn describe(&self, model: &ModelContext<'_>, sequence: &[usize]) -> asp_search::Result<Option<RobotReport>> {
+        let robot = self.model(model)?;
+        // the steps' seeds as the search saw them: a problem with the run's seed
+        let mdp = Mdp::new(model.maps.clone(), vec![Arc::new(PathLength) as Arc<dyn Objective>])?
+            .with_assembly(model.assembly.clone())
+            .with_seed(model.seed);
+        let mut state = MapState::new(model.maps);
+        let mut steps = Vec::new();
+        for &p in sequence {
+            let mut ctx = StepContext::new(&mdp, &mut state, p, StepKind::Replay);
+            steps.push(robot.plan(&mut ctx).ok());
+            state.remove(p);
+        }
+        Ok(Some(robot_report(&robot.assembly, robot.planner.cell(), steps)))
+    }
+}

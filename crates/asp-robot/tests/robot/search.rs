@@ -1,0 +1,185 @@
+//! The robot in the planners: the depth-first search with `--robot` and the optimiser with
+//! `--objective robot-path`; every path of every plan re-checked independently; same seed and
+//! thread count, same plan; held parts on the shared beam.
+
+use std::sync::Arc;
+
+use asp_geom::fixtures::{assemble, box_part};
+use asp_geom::math::{Axis, Pose, Rot, Vec3};
+use asp_geom::{Assembly, Grasp, PartSet, World, WorldConfig};
+use asp_robot::{CellSetup, RobotCell, RobotExtension, RobotRemoval, RobotSetup};
+use asp_search::pipeline::{plan_assembly, OptimiseSettings, PlanSettings, StabilitySetting};
+use asp_search::report::PlanReport;
+
+use super::removal::recheck;
+
+/// Four blocks on a fixed plate in front of the robot: two side by side, one on each.
+fn blocks() -> Assembly {
+    let mut plate = box_part("plate", [-0.1, -0.25, -0.02], [0.35, 0.25, 0.0]);
+    plate.fixed = true;
+    assemble(
+        "blocks",
+        vec![
+            plate,
+            box_part("a", [0.1, -0.12, 0.0], [0.14, -0.08, 0.04]),
+            box_part("b", [0.1, 0.08, 0.0], [0.14, 0.12, 0.04]),
+            box_part("a_top", [0.1, -0.12, 0.04], [0.14, -0.08, 0.08]),
+            box_part("b_top", [0.1, 0.08, 0.04], [0.14, 0.12, 0.08]),
+        ],
+        Axis::Z,
+    )
+}
+
+/// Every robot step of `report` re-checked against the parts present before it.
+fn recheck_report(assembly: &Assembly, report: &PlanReport, setup: &RobotSetup) {
+    let world = World::new(assembly.clone(), &WorldConfig::default()).unwrap();
+    let cell: RobotCell = setup.cell(assembly);
+    let robot = report.robot.as_ref().expect("a robot entry");
+    assert_eq!(robot.joints.len(), cell.robot.dof());
+    let mut state = PartSet::full(world.num_parts());
+    let mut total = 0.0;
+    let m = assembly.units.metres;
+    for (k, &part) in report.disassembly_sequence.iter().enumerate() {
+        let step = &report.assembly_sequence[report.assembly_sequence.len() - 1 - k];
+        assert_eq!(step.part, part);
+        let r = step.robot.as_ref().unwrap_or_else(|| panic!("step {k} (part {part}) has no robot path"));
+        let g = r.grasp;
+        let removal = RobotRemoval {
+            grasp: Grasp {
+                position: Vec3::new((g[0] * m) as f32, (g[1] * m) as f32, (g[2] * m) as f32),
+                orientation: Rot::from_xyzw(g[3] as f32, g[4] as f32, g[5] as f32, g[6] as f32),
+                width: (r.grasp_width * m) as f32,
+            },
+            grasp_index: 0,
+            direction: Vec3::Z,
+            joints: r.joint_trajectory.clone(),
+            gripper_path: Vec::new(),
+            length: r.path_length * m,
+            reachable_grasps: 0,
+        };
+        recheck(&world, &cell, part, &state, &removal, 0.003).unwrap_or_else(|e| panic!("step {k} (part {part}): {e}"));
+        // the trajectory starts at the grasp and ends at the drop-off
+        let first: Pose = cell.robot.tool_pose(&r.joint_trajectory[0]);
+        assert!((first.translation - removal.grasp.position).length() < 1e-3);
+        let last = cell.robot.tool_pose(r.joint_trajectory.last().unwrap());
+        assert!((last.translation - cell.drop_off).length() < 1e-3);
+        total += r.path_length;
+        state.remove(part);
+    }
+    assert!((total - robot.total_path_length).abs() < 1e-9);
+}
+
+fn without_times(report: &PlanReport) -> PlanReport {
+    let mut r = report.clone();
+    r.stats.seconds = 0.0;
+    r.stats.timings = None;
+    if let Some(o) = r.optimisation.as_mut() {
+        o.map_seconds = 0.0;
+        o.search_seconds = 0.0;
+    }
+    r
+}
+
+#[test]
+fn depth_first_search_with_the_robot_plans_checked_paths_deterministically() {
+    let setup = RobotSetup::panda();
+    let settings = PlanSettings {
+        checker_extension: Some(Arc::new(CellSetup { robot: Some(setup.clone()), grippers: 1 })),
+        seed: 3,
+        ..PlanSettings::default()
+    };
+    let a = plan_assembly(blocks(), &settings, None).unwrap();
+    assert!(a.found(), "{:?}", a.report.explanation);
+    // the tops come off before what they rest on
+    let order = &a.report.disassembly_sequence;
+    let pos = |p: usize| order.iter().position(|&q| q == p).unwrap();
+    assert!(pos(3) < pos(1) && pos(4) < pos(2), "{order:?}");
+    recheck_report(&blocks(), &a.report, &setup);
+    let b = plan_assembly(blocks(), &settings, None).unwrap();
+    assert_eq!(without_times(&a.report), without_times(&b.report));
+}
+
+#[test]
+fn the_optimiser_minimises_the_robot_path_and_repeats_itself() {
+    let setup = RobotSetup::panda();
+    let optimise = |threads| OptimiseSettings {
+        objectives: "robot-path".into(),
+        episodes: 3,
+        budget: 2,
+        threads: Some(threads),
+        resolution: 5,
+        extensions: vec![Arc::new(RobotExtension::new(setup.clone()))],
+        ..OptimiseSettings::default()
+    };
+    for threads in [1, 2] {
+        let settings = PlanSettings { seed: 5, optimise: Some(optimise(threads)), ..PlanSettings::default() };
+        let a = plan_assembly(blocks(), &settings, None).unwrap();
+        assert!(a.found());
+        let o = a.report.optimisation.as_ref().unwrap();
+        assert_eq!(o.objectives, vec!["robot-path".to_string()]);
+        // the objective is minus the total path length in metres
+        let total = a.report.robot.as_ref().unwrap().total_path_length;
+        assert!((o.values[0] + total).abs() < 1e-6, "{} vs {total}", o.values[0]);
+        recheck_report(&blocks(), &a.report, &setup);
+        let b = plan_assembly(blocks(), &settings, None).unwrap();
+        assert_eq!(without_times(&a.report), without_times(&b.report), "threads {threads}");
+    }
+}
+
+/// A post on a fixed plate carries a bar, the bar a block. Taken in the given order (post
+/// first), the post's removal leaves bar and block unsupported: refused with one gripper,
+/// admitted with two when the bar is held (the block rests on it), and the plan says so.
+#[test]
+fn a_second_gripper_holds_the_bar_while_the_post_goes_in() {
+    let mut plate = box_part("plate", [-0.3, -0.3, -0.02], [0.3, 0.3, 0.0]);
+    plate.fixed = true;
+    let model = || {
+        assemble(
+            "held",
+            vec![
+                plate.clone(),
+                box_part("post", [0.0, -0.02, 0.0], [0.04, 0.02, 0.1]),
+                box_part("bar", [-0.1, -0.02, 0.1], [0.14, 0.02, 0.12]),
+                box_part("block", [0.0, -0.02, 0.12], [0.04, 0.02, 0.16]),
+            ],
+            Axis::Z,
+        )
+    };
+    let one = plan_assembly(model(), &PlanSettings::default(), None).unwrap();
+    assert!(one.found());
+    assert_ne!(one.report.disassembly_sequence[0], 1, "the post cannot go first without holding");
+    assert!(one.report.assembly_sequence.iter().all(|s| s.held.is_empty()));
+    let settings = PlanSettings {
+        checker_extension: Some(Arc::new(CellSetup { robot: None, grippers: 2 })),
+        ..PlanSettings::default()
+    };
+    let two = plan_assembly(model(), &settings, None).unwrap();
+    assert!(two.found());
+    assert_eq!(two.report.disassembly_sequence[0], 1, "{:?}", two.report.disassembly_sequence);
+    let last = two.report.assembly_sequence.last().unwrap();
+    assert_eq!(last.part, 1);
+    assert_eq!(last.held, vec![2], "the bar is held while the post goes in");
+}
+
+/// The shared beam (tests/data/beam) falls apart under physics unless parts are held. Known
+/// to fail with two grippers: after part_0 every other part moves in simulation, and holding
+/// any one of them does not make the rest stand (see the session report).
+#[test]
+#[ignore = "fails: no single held part makes the beam stand under physics"]
+fn the_beam_plans_under_physics_with_two_grippers() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/beam/beam.glb");
+    let base = PlanSettings { stability: StabilitySetting::Physics { threshold: 0.01 }, ..PlanSettings::default() };
+    let held = PlanSettings {
+        checker_extension: Some(Arc::new(CellSetup { robot: None, grippers: 2 })),
+        ..base.clone()
+    };
+    let with = asp_search::pipeline::plan_file(&path, &held, None).unwrap();
+    assert!(with.found(), "{:?}", with.report.explanation);
+    let holding: Vec<_> = with.report.assembly_sequence.iter().filter(|s| !s.held.is_empty()).collect();
+    assert!(!holding.is_empty(), "some step should need a held part");
+    for s in &holding {
+        assert_eq!(s.held.len(), 1);
+        assert!(!s.held.contains(&s.part));
+    }
+    assert!(with.report.robot.is_none());
+}
