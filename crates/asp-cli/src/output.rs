@@ -1,6 +1,6 @@
 //! `asp plan`: load, plan, print the table, write the JSON.
 
-use crate::flags::{ModelArgs, OrderArg, PlanArgs, StabilityArg};
+use crate::flags::{ModelArgs, OrderArg, OverlapsArg, PlanArgs, StabilityArg};
 use anyhow::{bail, Context};
 use asp_geom::math::Axis;
 use asp_geom::Units;
@@ -43,7 +43,15 @@ pub(crate) fn model_settings(args: &ModelArgs) -> anyhow::Result<PlanSettings> {
         contact_distance: check("contact-distance", args.contact_distance)?,
         normals: args.normals,
         sphere_directions: args.sphere_directions,
-        ignore_overlapping: args.ignore_overlapping,
+        overlaps: if args.ignore_overlapping {
+            asp_geom::OverlapPolicy::Lenient
+        } else {
+            match args.overlaps {
+                OverlapsArg::Strict => asp_geom::OverlapPolicy::Strict,
+                OverlapsArg::Lenient => asp_geom::OverlapPolicy::Lenient,
+                OverlapsArg::Error => asp_geom::OverlapPolicy::Error,
+            }
+        },
         stability: match args.stability {
             StabilityArg::Contact => StabilitySetting::Contact,
             StabilityArg::Physics => {
@@ -332,6 +340,13 @@ pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Resu
     } else {
         writeln!(out, "base: ground plane under the lowest point (up {})", r.up)?;
     }
+    if let Some(o) = &r.overlaps {
+        writeln!(out, "overlapping in the input ({} pairs, policy {}):", o.pairs.len(), o.policy)?;
+        for p in &o.pairs {
+            let bound = if p.gross { "more than " } else { "" };
+            writeln!(out, "  {} / {}: {}, {bound}{:.4} deep, {}", p.names[0], p.names[1], p.kind, p.depth, p.handling)?;
+        }
+    }
     if !r.assembly_sequence.is_empty() {
         write_steps(out, r, &r.assembly_sequence, width, "")?;
     }
@@ -382,6 +397,9 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
                 format!("straight along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
             }
             MotionEntry::Path { poses, .. } => format!("path of {} poses", poses.len()),
+            MotionEntry::Screw { direction: d, distance, .. } => {
+                format!("screw along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
+            }
         };
         writeln!(out, "{indent}{:>4}  {:<width$}  {motion}", k + 1, label(step))?;
         if let Some(g) = &step.subassembly {

@@ -3,5 +3,6 @@
 mod distmap;
 mod graph;
 mod loaders;
+mod overlap;
 mod physics;
 mod removal;

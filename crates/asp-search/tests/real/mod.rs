@@ -4,17 +4,17 @@
 use crate::verify::{verify_plan, verify_removals};
 use asp_geom::io::{load, LoadOptions};
 use asp_geom::math::Axis;
-use asp_geom::{Checker, CheckerConfig, FeasibilityChecker, PartSet, Units, World, WorldConfig};
+use asp_geom::{Checker, CheckerConfig, FeasibilityChecker, OverlapPolicy, PartSet, Units, World, WorldConfig};
 use asp_search::{Budget, Dfs, PlanOutcome, Planner, Problem, Status, StuckReason};
 
 fn data(rel: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data").join(rel)
 }
 
-fn world(rel: &str, unit: Option<&str>, ignore_overlapping: bool) -> asp_geom::Result<World> {
+fn world(rel: &str, unit: Option<&str>, overlaps: OverlapPolicy) -> asp_geom::Result<World> {
     let options = LoadOptions { unit: unit.and_then(Units::parse), up: Some(Axis::Z), fixed: vec![] };
     let assembly = load(&data(rel), &options)?;
-    World::new(assembly, &WorldConfig { ignore_overlapping, ..WorldConfig::default() })
+    World::new(assembly, &WorldConfig { overlaps, ..WorldConfig::default() })
 }
 
 fn plan(world: World, planner: &Dfs) -> (Checker, PlanOutcome) {
@@ -23,10 +23,10 @@ fn plan(world: World, planner: &Dfs) -> (Checker, PlanOutcome) {
     (checker, outcome)
 }
 
-fn found_and_verified(rel: &str, ignore_overlapping: bool) -> Vec<String> {
+fn found_and_verified(rel: &str, overlaps: OverlapPolicy) -> Vec<String> {
     let mut orders = Vec::new();
     for planner in [Dfs::builder().build(), Dfs::builder().bookkeeping(true).build()] {
-        let (checker, outcome) = plan(world(rel, None, ignore_overlapping).unwrap(), &planner);
+        let (checker, outcome) = plan(world(rel, None, overlaps).unwrap(), &planner);
         assert_eq!(outcome.status, Status::Found, "{rel}");
         eprintln!("verifying {rel}");
         verify_plan(checker.world(), &outcome);
@@ -38,7 +38,7 @@ fn found_and_verified(rel: &str, ignore_overlapping: bool) -> Vec<String> {
 
 #[test]
 fn beam_plans_caps_then_posts_then_the_beam() {
-    let orders = found_and_verified("beam/beam.glb", false);
+    let orders = found_and_verified("beam/beam.glb", OverlapPolicy::Strict);
     // the pins (part_0, part_1) sit on top of the posts, which stand in the beam's mortises
     for order in orders {
         let pos = |n: &str| order.split(' ').position(|x| x == n).unwrap();
@@ -60,13 +60,13 @@ fn ikea_models_plan_and_every_step_rechecks() {
         "table_hemnes_0541",
         "table_lack_0825",
     ] {
-        found_and_verified(&format!("ikea/{name}.glb"), false);
+        found_and_verified(&format!("ikea/{name}.glb"), OverlapPolicy::Strict);
     }
 }
 
 #[test]
 fn a_budget_that_runs_out_keeps_the_longest_branch_it_reached() {
-    let checker = Checker::new(world("pump", Some("mm"), false).unwrap(), CheckerConfig::default());
+    let checker = Checker::new(world("pump", Some("mm"), OverlapPolicy::Strict).unwrap(), CheckerConfig::default());
     let budget = Budget { max_tests: Some(40), ..Budget::default() };
     let outcome = Dfs::builder().bookkeeping(true).build().solve(&Problem::full(&checker), &budget);
     assert_eq!(outcome.status, Status::BudgetExhausted);
@@ -77,8 +77,8 @@ fn a_budget_that_runs_out_keeps_the_longest_branch_it_reached() {
 
 #[test]
 fn gross_overlaps_are_errors_naming_both_parts() {
-    let err = world("ikea/bed_dalselv_0270.glb", None, false).err().expect("gross overlap is an error").to_string();
-    assert!(err.contains("'0_part0'") && err.contains("'1_part1'") && err.contains("ignore overlapping"), "{err}");
+    let err = world("ikea/bed_dalselv_0270.glb", None, OverlapPolicy::Error).err().expect("gross overlap is an error").to_string();
+    assert!(err.contains("'0_part0'") && err.contains("'1_part1'") && err.contains("overlaps policy"), "{err}");
     assert!(!err.contains("--"), "library errors name settings, not command-line flags: {err}");
 }
 
@@ -92,7 +92,7 @@ fn short_names(world: &World, parts: impl IntoIterator<Item = usize>) -> Vec<Str
 #[test]
 fn pump_without_subassemblies_ends_in_no_plan_with_its_stuck_core_explained_and_the_rest_rechecked() {
     let planner = Dfs::builder().bookkeeping(true).subassemblies(false).build();
-    let (checker, outcome) = plan(world("pump", Some("mm"), false).unwrap(), &planner);
+    let (checker, outcome) = plan(world("pump", Some("mm"), OverlapPolicy::Strict).unwrap(), &planner);
     let Status::NoPlan { stuck, state } = &outcome.status else { panic!("{:?}", outcome.status) };
     let w = checker.world();
     let name = |p: usize| w.name(p).trim_start_matches("PumpAssembly - ").to_string();
