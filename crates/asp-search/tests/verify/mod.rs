@@ -21,8 +21,10 @@ fn shrunk(world: &World, p: usize, amount: f32) -> TriMesh {
 /// Whether part `p` at `pose` penetrates a present part (other than itself) deeper than the
 /// tolerance: surfaces crossing, or one inside the other. Each pair shrinks the part the world
 /// chose for it (the moving part, or for input overlaps the one that separates more easily).
-fn penetrates(world: &World, p: usize, pose: &Pose, present: &PartSet, shrunk_cache: &mut HashMap<(usize, u32), TriMesh>) -> Option<usize> {
-    present.iter().filter(|&q| q != p && !world.ignores(p, q)).find(|&q| {
+/// A screw step's threaded partners are not tested here (their threads are invariant under the
+/// screw motion, which is not a translation); `screw` says whether the step is one.
+fn penetrates(world: &World, p: usize, pose: &Pose, present: &PartSet, shrunk_cache: &mut HashMap<(usize, u32), TriMesh>, screw: bool) -> Option<usize> {
+    present.iter().filter(|&q| q != p && !world.ignores(p, q) && !(screw && world.thread(p, q).is_some())).find(|&q| {
         let (k, amount) = world.pair_erosion(p, q);
         let shrunk_k = shrunk_cache.entry((k, amount.to_bits())).or_insert_with(|| shrunk(world, k, amount)).clone();
         let id = Pose::IDENTITY;
@@ -81,11 +83,16 @@ fn check_strict(world: &World, k: usize, movers: &[usize], others: &PartSet, pos
                 let bb = world.aabb(b);
                 let pad = 2.0 * world.tolerance();
                 let near = |x: Vec3| (0..3).all(|i| x[i] >= bb.mins[i] - pad && x[i] <= bb.maxs[i] + pad);
-                let start: Vec<bool> = pts.iter().map(|&x| near(x) && mesh.contains_local_point(x)).collect();
+                // a sample on the other's surface (within half the tolerance) counts as inside
+                // at the start and outside later: touching is not entering
+                let depth = |x: Vec3| (mesh.project_local_point(x, false).point - x).length();
+                let half = 0.5 * world.tolerance();
+                let start: Vec<bool> =
+                    pts.iter().map(|&x| near(x) && (mesh.contains_local_point(x) || depth(x) <= half)).collect();
                 for pose in &poses[1..] {
                     if let Some(x) = pts.iter().zip(&start).find(|(x, inside)| {
                         let y = place(pose, **x);
-                        !**inside && near(y) && mesh.contains_local_point(y)
+                        !**inside && near(y) && mesh.contains_local_point(y) && depth(y) > half
                     }) {
                         panic!(
                             "step {k}: strict: a sample of '{}' at {:?} enters '{}', which the pair overlaps in the input, at {pose:?}",
@@ -140,7 +147,7 @@ pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: 
         let thinnest = movers.iter().map(|&p| (world.aabb(p).maxs - world.aabb(p).mins).min_element()).fold(f32::INFINITY, f32::min);
         let h = (thinnest / 4.0).max(world.tolerance());
         let poses: Vec<Pose> = match &step.motion {
-            Motion::Linear { direction, distance } => {
+            Motion::Linear { direction, distance } | Motion::Screw { direction, distance, .. } => {
                 assert!((direction.length() - 1.0).abs() < 1e-4);
                 let count = ((distance / h).ceil() as usize).clamp(8, 400);
                 // and steps of the tolerance over the first 20 tolerances (strict overlaps)
@@ -161,10 +168,12 @@ pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: 
                 .chain(poses.last().copied())
                 .collect(),
         };
-        check_strict(world, k, &movers, &others, &poses, &mut samples);
+        if !matches!(step.motion, Motion::Screw { .. }) {
+            check_strict(world, k, &movers, &others, &poses, &mut samples);
+        }
         for pose in &poses {
             for &p in &movers {
-                if let Some(q) = penetrates(world, p, pose, &others, &mut cache) {
+                if let Some(q) = penetrates(world, p, pose, &others, &mut cache, matches!(step.motion, Motion::Screw { .. })) {
                     panic!("step {k}: part '{}' hits '{}' at {pose:?}", world.name(p), world.name(q));
                 }
             }
