@@ -237,3 +237,4 @@ fn issue_9_interlocking_cubes_come_apart_in_halves_and_every_step_rechecks() {
     }
 }
 
+
