@@ -38,7 +38,7 @@ fn plans_a_fixture_prints_a_table_and_writes_the_json() {
     assert!(table.contains("found"), "{table}");
     assert!(table.contains("stick") && table.contains("handle") && table.contains("cap"), "{table}");
     let plan = json(&out);
-    assert_eq!(plan["format_version"], "1.4");
+    assert_eq!(plan["format_version"], "1.5");
     assert_eq!(plan["stats"]["checker"], "collision_world");
     assert_eq!(plan["status"], "found");
     assert_eq!(plan["up"], "+z");
