@@ -120,7 +120,7 @@ class Assembly:
         contact_distance: Optional[float] = None,
         normals: int = 10,
         sphere_directions: int = 0,
-        ignore_overlapping: bool = False,
+        overlaps: str = "strict",
         stability: str = "contact",
         physics_threshold: float = 0.01,
         path_planner: bool = True,
@@ -157,8 +157,11 @@ class Assembly:
             diagonal).
         :param normals: clustered surface-normal directions tried besides the six axes.
         :param sphere_directions: extra removal directions sampled evenly on the sphere.
-        :param ignore_overlapping: ignore collisions between parts that overlap in the input
-            beyond repair (warned) instead of raising :class:`LoadError`.
+        :param overlaps: parts that overlap in the input (press fits, dowels, screws, slop; warned
+            once per pair with the measured depth, listed in the plan's ``overlaps``):
+            ``strict`` (they separate only along motions that enter no new material of each
+            other), ``lenient`` (shrink one of them; ignore pairs no shrinking separates) or
+            ``error`` (raise :class:`LoadError` on pairs no shrinking separates).
         :param stability: ``contact`` (linked through contacts to a base part) or ``physics``
             (rapier3d simulation).
         :param physics_threshold: physics stability: how far (fraction of the diagonal) a part
@@ -202,7 +205,7 @@ class Assembly:
             "contact_distance": contact_distance,
             "normals": normals,
             "sphere_directions": sphere_directions,
-            "ignore_overlapping": ignore_overlapping,
+            "overlaps": overlaps,
             "stability": stability,
             "physics_threshold": physics_threshold,
             "path_planner": path_planner,
@@ -231,7 +234,7 @@ class Assembly:
         *,
         tolerance: Optional[float] = None,
         contact_distance: Optional[float] = None,
-        ignore_overlapping: bool = False,
+        overlaps: str = "strict",
         radius_bins: int = 8,
         degree: int = 8,
         points_per_part: int = 2048,
@@ -242,7 +245,7 @@ class Assembly:
         :param present: the part indices present in the state (default: every part).
         :param tolerance: as in :meth:`plan` (the collision world the contacts come from).
         :param contact_distance: as in :meth:`plan`: parts closer than this are joined by edges.
-        :param ignore_overlapping: as in :meth:`plan`.
+        :param overlaps: as in :meth:`plan`.
         :param radius_bins: radius shells of the shape descriptor.
         :param degree: highest spherical-harmonic degree of the descriptor.
         :param points_per_part: target number of surface samples per part.
@@ -255,7 +258,7 @@ class Assembly:
         settings = {
             "tolerance": tolerance,
             "contact_distance": contact_distance,
-            "ignore_overlapping": ignore_overlapping,
+            "overlaps": overlaps,
             "radius_bins": radius_bins,
             "degree": degree,
             "points_per_part": points_per_part,

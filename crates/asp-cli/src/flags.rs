@@ -49,6 +49,18 @@ pub enum OrderArg {
     Gnn,
 }
 
+/// What to do with parts that overlap in the input (press fits, dowels, screws, slop).
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum OverlapsArg {
+    /// An overlapping pair separates only along motions that enter no new material of each
+    /// other (a dowel leaves along its axis, never sideways).
+    Strict,
+    /// Shrink one part of the pair in their tests; ignore pairs no shrinking separates.
+    Lenient,
+    /// Shrink small overlaps; stop with an error on pairs no shrinking separates.
+    Error,
+}
+
 /// Stability criteria.
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
 pub enum StabilityArg {
@@ -80,9 +92,11 @@ pub struct ModelArgs {
     /// Parts closer than this (model units) are in contact for stability [default: 1e-3 × diagonal].
     #[arg(long)]
     pub contact_distance: Option<f64>,
-    /// Ignore collisions between parts that overlap in the input far beyond the tolerance
-    /// (warned) instead of stopping with an error.
-    #[arg(long)]
+    /// Parts that overlap in the input (warned once per pair with the measured depth).
+    #[arg(long, value_enum, default_value_t = OverlapsArg::Strict)]
+    pub overlaps: OverlapsArg,
+    /// Old spelling of `--overlaps lenient`.
+    #[arg(long, hide = true)]
     pub ignore_overlapping: bool,
     /// Clustered surface-normal directions tried besides the six axes (each with its opposite).
     #[arg(long, default_value_t = 10)]

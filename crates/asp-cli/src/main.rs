@@ -24,7 +24,7 @@ fn main() -> ExitCode {
                 _ => e.downcast_ref::<asp_geom::GeomError>(),
             };
             let hint = match geom {
-                Some(asp_geom::GeomError::GrossOverlap { .. }) => " (--tolerance, --ignore-overlapping)",
+                Some(asp_geom::GeomError::GrossOverlap { .. }) => " (--tolerance, --overlaps strict|lenient)",
                 _ => "",
             };
             eprintln!("error: {e:#}{hint}");

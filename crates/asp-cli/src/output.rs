@@ -1,6 +1,6 @@
 //! `asp plan`: load, plan, print the table, write the JSON.
 
-use crate::flags::{ModelArgs, OrderArg, PlanArgs, StabilityArg};
+use crate::flags::{ModelArgs, OrderArg, OverlapsArg, PlanArgs, StabilityArg};
 use anyhow::{bail, Context};
 use asp_geom::math::Axis;
 use asp_geom::Units;
@@ -42,7 +42,15 @@ pub(crate) fn model_settings(args: &ModelArgs) -> anyhow::Result<PlanSettings> {
         contact_distance: check("contact-distance", args.contact_distance)?,
         normals: args.normals,
         sphere_directions: args.sphere_directions,
-        ignore_overlapping: args.ignore_overlapping,
+        overlaps: if args.ignore_overlapping {
+            asp_geom::OverlapPolicy::Lenient
+        } else {
+            match args.overlaps {
+                OverlapsArg::Strict => asp_geom::OverlapPolicy::Strict,
+                OverlapsArg::Lenient => asp_geom::OverlapPolicy::Lenient,
+                OverlapsArg::Error => asp_geom::OverlapPolicy::Error,
+            }
+        },
         stability: match args.stability {
             StabilityArg::Contact => StabilitySetting::Contact,
             StabilityArg::Physics => {
@@ -355,6 +363,13 @@ pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Resu
     } else {
         writeln!(out, "base: ground plane under the lowest point (up {})", r.up)?;
     }
+    if let Some(o) = &r.overlaps {
+        writeln!(out, "overlapping in the input ({} pairs, policy {}):", o.pairs.len(), o.policy)?;
+        for p in &o.pairs {
+            let bound = if p.gross { "more than " } else { "" };
+            writeln!(out, "  {} / {}: {}, {bound}{:.4} deep, {}", p.names[0], p.names[1], p.kind, p.depth, p.handling)?;
+        }
+    }
     if !r.assembly_sequence.is_empty() {
         write_steps(out, r, &r.assembly_sequence, width, "")?;
     }
@@ -408,6 +423,9 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
                 format!("straight along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
             }
             MotionEntry::Path { poses, .. } => format!("path of {} poses", poses.len()),
+            MotionEntry::Screw { direction: d, distance, .. } => {
+                format!("screw along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
+            }
         };
         let robot = step.robot.as_ref().map_or(String::new(), |rs| {
             format!("; robot path {:.3}", rs.path_length)

@@ -44,6 +44,7 @@ use crate::feasibility::{
     CounterSnapshot, Counters, FeasibilityChecker, Motion, MotionKind, Outcome, Stability,
 };
 use crate::math::{Aabb, Axis, Vec3};
+use crate::overlap::OverlapPolicy;
 use crate::partset::PartSet;
 use crate::world::{World, WorldConfig};
 use parry3d::shape::TriMesh;
@@ -340,6 +341,7 @@ pub struct MapConfig {
     contact_distance: Option<f32>,
     support: Support,
     use_voxels: bool,
+    overlaps: OverlapPolicy,
 }
 
 impl Default for MapConfig {
@@ -351,6 +353,7 @@ impl Default for MapConfig {
             contact_distance: None,
             support: Support::Below,
             use_voxels: true,
+            overlaps: OverlapPolicy::Strict,
         }
     }
 }
@@ -384,6 +387,11 @@ impl MapConfig {
     /// The gravity check.
     pub fn support(&self) -> Support {
         self.support
+    }
+
+    /// How mesh parts that overlap in the input are tested ([`OverlapPolicy`], default strict).
+    pub fn overlaps(&self) -> OverlapPolicy {
+        self.overlaps
     }
 }
 
@@ -423,6 +431,13 @@ impl MapConfigBuilder {
     /// The gravity check (default [`Support::Below`], the thesis' rule).
     pub fn support(mut self, support: Support) -> Self {
         self.config.support = support;
+        self
+    }
+
+    /// How mesh parts that overlap in the input are tested (default [`OverlapPolicy::Strict`]:
+    /// the maps' distance of such a pair is also limited by the strict rule).
+    pub fn overlaps(mut self, policy: OverlapPolicy) -> Self {
+        self.config.overlaps = policy;
         self
     }
 
@@ -650,6 +665,7 @@ impl DistanceMaps {
             let world_config = WorldConfig {
                 tolerance: Some(tolerance.max(f32::MIN_POSITIVE)),
                 contact_distance: Some(contact_distance.max(f32::MIN_POSITIVE)),
+                overlaps: config.overlaps,
                 ..WorldConfig::default()
             };
             let world = World::new(assembly.clone(), &world_config)?;
@@ -719,15 +735,21 @@ impl DistanceMaps {
                                 let (_, erosion) = world.pair_erosion(i, j);
                                 let (moving, fixed) = world.pair_shapes(i, j);
                                 let ignored = world.ignores(i, j);
+                                let strict = world.is_strict_pair(i, j);
                                 for (d, m) in dirs.iter().enumerate() {
-                                    row[d] = if !ignored
-                                        && first_overlap(&aabbs[i], *m, &aabbs[j], 0.0)
-                                            .is_some_and(|t| t < d_max)
-                                    {
+                                    let near = first_overlap(&aabbs[i], *m, &aabbs[j], 0.0).is_some_and(|t| t < d_max);
+                                    let mut v = if !ignored && near {
                                         cast_distance(&moving, &fixed, *m, d_max, erosion)
                                     } else {
                                         d_max
                                     };
+                                    if strict && near && v > 0.0 {
+                                        // an input overlap: no sample may enter new material
+                                        if let Some(t) = world.strict_entry(i, j, Vec3::ZERO, *m, v, false) {
+                                            v = v.min(if t <= erosion { 0.0 } else { t });
+                                        }
+                                    }
+                                    row[d] = v;
                                 }
                             }
                         }

@@ -152,7 +152,7 @@ fn least_squares_offset(normals: &[Vec3], amount: f32) -> (Vec3, bool) {
 
 /// Eigenvalues and unit eigenvectors of a symmetric 3×3 matrix by cyclic Jacobi rotations
 /// (parry's `SymmetricEigen3` returned wrong eigenvectors for `diag(1, 0, 0)`).
-fn symmetric_eigen(m: Mat3) -> ([f32; 3], [Vec3; 3]) {
+pub(crate) fn symmetric_eigen(m: Mat3) -> ([f32; 3], [Vec3; 3]) {
     let mut a = [[0.0f64; 3]; 3];
     for (i, row) in a.iter_mut().enumerate() {
         for (j, x) in row.iter_mut().enumerate() {

@@ -27,6 +27,18 @@ pub enum Motion {
         /// The point of the part that moves straight between waypoints.
         pivot: Vec3,
     },
+    /// A fastener screwed out: the part turns about its symmetry axis (through `axis_point`,
+    /// along unit `direction`) as its thread requires while it travels `distance` along
+    /// `direction`, until its bounds clear the bounds of what remains. Its threaded partners
+    /// were tested outside their thread zone, every other part as for a straight line.
+    Screw {
+        /// A point on the axis (world frame, metres).
+        axis_point: Vec3,
+        /// Unit removal direction, along the axis.
+        direction: Vec3,
+        /// Travel in metres.
+        distance: f32,
+    },
 }
 
 /// The pose a fraction `s` of the way from `a` to `b`: the `pivot`'s image moves linearly, the
@@ -41,7 +53,7 @@ impl Motion {
     /// The distance the part's pivot (or any point, for a straight line) travels, in metres.
     pub fn length(&self) -> f32 {
         match self {
-            Motion::Linear { distance, .. } => *distance,
+            Motion::Linear { distance, .. } | Motion::Screw { distance, .. } => *distance,
             Motion::Path { poses, pivot } => poses
                 .windows(2)
                 .map(|w| (w[1].transform_point(*pivot) - w[0].transform_point(*pivot)).length())

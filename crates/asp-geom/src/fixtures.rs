@@ -199,3 +199,56 @@ pub fn hooked_bracket() -> Assembly {
     wall.fixed = true;
     assembly("hooked_bracket", vec![wall, voxel_part("bracket", &bracket, 0.005)])
 }
+
+/// A closed prism along Z with a regular `sides`-gon of circumradius `radius` around `(x, y)`,
+/// from `z0` to `z1` (a round peg or dowel, faceted), outward wound.
+pub fn prism(x: f32, y: f32, radius: f32, z0: f32, z1: f32, sides: u32) -> Mesh {
+    let mut vertices = Vec::with_capacity(2 * sides as usize + 2);
+    for z in [z0, z1] {
+        for i in 0..sides {
+            let a = std::f32::consts::TAU * i as f32 / sides as f32;
+            vertices.push(Vec3::new(x + radius * a.cos(), y + radius * a.sin(), z));
+        }
+    }
+    vertices.push(Vec3::new(x, y, z0));
+    vertices.push(Vec3::new(x, y, z1));
+    let (bottom, top) = (2 * sides, 2 * sides + 1);
+    let mut triangles = Vec::new();
+    for i in 0..sides {
+        let j = (i + 1) % sides;
+        triangles.push([i, j, sides + j]);
+        triangles.push([i, sides + j, sides + i]);
+        triangles.push([bottom, j, i]);
+        triangles.push([top, sides + i, sides + j]);
+    }
+    let mut m = Mesh::new(vertices, triangles);
+    m.orient_outward();
+    m
+}
+
+/// Issue 9's press fit: a fixed plate (3 × 3 × 1) and a round peg (radius 0.3, 16 facets)
+/// pushed 0.5 deep into it with no modelled hole — an input overlap no shrinking separates.
+/// Physically the peg leaves along its axis (+Z) only; sliding sideways would cut the plate.
+/// Parts: 0 plate (fixed), 1 peg.
+pub fn pressed_peg() -> Assembly {
+    let mut plate = box_part("plate", [0.0, 0.0, 0.0], [3.0, 3.0, 1.0]);
+    plate.fixed = true;
+    assembly("pressed_peg", vec![plate, part("peg", prism(1.5, 1.5, 0.3, 0.5, 2.0, 16), false)])
+}
+
+/// A dowel pressed into two boards: a fixed lower board (3 × 3 × 1), an upper board on it
+/// (3 × 3 × 1) and a round dowel (radius 0.3) from z 0.5 to 1.5, half in each, no holes
+/// modelled. The upper board pulls off the dowel upward (only); the dowel then leaves upward
+/// (only). Parts: 0 lower (fixed), 1 upper, 2 dowel.
+pub fn dowel_in_two_boards() -> Assembly {
+    let mut lower = box_part("lower", [0.0, 0.0, 0.0], [3.0, 3.0, 1.0]);
+    lower.fixed = true;
+    assembly(
+        "dowel_in_two_boards",
+        vec![
+            lower,
+            box_part("upper", [0.0, 0.0, 1.0], [3.0, 3.0, 2.0]),
+            part("dowel", prism(1.5, 1.5, 0.3, 0.5, 1.5, 16), false),
+        ],
+    )
+}

@@ -16,6 +16,8 @@ use crate::error::{GeomError, Result};
 use crate::feasibility::{Motion, Stability};
 use crate::math::{aabb_of, sweep_overlap, Aabb, Pose, Vec3};
 use crate::mesh::{Mesh, Topology};
+use crate::fastener::{self, SymmetryAxis, Thread};
+use crate::overlap::{self, OverlapKind, OverlapNote, OverlapPolicy};
 use crate::partset::PartSet;
 use parry3d::query::{self, ClosestPoints, NonlinearRigidMotion, PointQuery};
 use parry3d::shape::{TriMesh, TriMeshFlags};
@@ -41,11 +43,12 @@ pub struct WorldConfig {
     /// Parts that overlap in the input are warned about and each is shrunk, in tests against the
     /// other, until it no longer crosses the other's surface — up to this fraction of its
     /// thinnest extent (default 0.4: shrinking by half the thickness would make it vanish).
-    /// A pair that does not separate within that is an error, or ignored (next field).
+    /// What a pair that overlaps beyond the tolerance may do is the policy's (next field).
     pub max_overlap_fraction: f32,
-    /// Ignore collisions between parts that overlap beyond `max_overlap_fraction` (warned)
-    /// instead of failing. Default false.
-    pub ignore_overlapping: bool,
+    /// How overlapping pairs are tested ([`OverlapPolicy`]): `Strict` by default (they separate
+    /// only along motions that enter no new material), `Lenient` (shrink, or ignore pairs that
+    /// no shrinking separates), `Error` (such pairs stop planning).
+    pub overlaps: OverlapPolicy,
     /// Test pairs of parts that are known unions of boxes (voxels or boxes in their extras, or a
     /// box-shaped mesh; see [`crate::boxes`]) exactly on their boxes. Default true; false tests
     /// every pair on the meshes.
@@ -61,7 +64,7 @@ impl Default for WorldConfig {
             cluster_angle_deg: 10.0,
             sphere_directions: 0,
             max_overlap_fraction: 0.4,
-            ignore_overlapping: false,
+            overlaps: OverlapPolicy::Strict,
             exact_boxes: true,
         }
     }
@@ -77,6 +80,11 @@ struct Geom {
     /// The part's exact boxes when it is a known union of boxes ([`crate::boxes`]): pairs of
     /// such parts are tested exactly on them instead of on the meshes.
     boxes: Option<Vec<Aabb>>,
+    /// Surface samples moved inward by the tolerance, for the strict overlap test (made the
+    /// first time a strict pair needs them).
+    samples: OnceLock<Vec<Vec3>>,
+    /// The axis of near rotational symmetry (fasteners), made when first needed.
+    axis: OnceLock<Option<SymmetryAxis>>,
 }
 
 impl Geom {
@@ -90,7 +98,7 @@ impl Geom {
         let aabb = m.aabb().ok_or_else(|| GeomError::config("empty mesh"))?;
         let mesh = TriMesh::with_flags(m.vertices, m.triangles, TriMeshFlags::ORIENTED)
             .map_err(|e| GeomError::config(format!("cannot build a collision mesh: {e}")))?;
-        let geom = Geom { mesh: Arc::new(mesh), aabb, eroded: Mutex::new(BTreeMap::new()), closed, boxes: None };
+        let geom = Geom { mesh: Arc::new(mesh), aabb, eroded: Mutex::new(BTreeMap::new()), closed, boxes: None, samples: OnceLock::new(), axis: OnceLock::new() };
         Ok((geom, topology))
     }
 
@@ -151,6 +159,12 @@ pub struct World {
     /// Unordered pair (low, high) → (the part shrunk in their tests, its extra erosion).
     overlaps: BTreeMap<(usize, usize), (usize, f32)>,
     ignored: BTreeSet<(usize, usize)>,
+    /// Ordered pairs (both orders) tested by the strict overlap rule.
+    strict: BTreeSet<(usize, usize)>,
+    notes: Vec<OverlapNote>,
+    policy: OverlapPolicy,
+    /// Threaded contacts (ordered pairs), found when first needed.
+    threads: Mutex<BTreeMap<(usize, usize), Option<Thread>>>,
     fixed: PartSet,
     rows: Vec<OnceLock<Vec<PartSet>>>,
     warnings: Vec<String>,
@@ -215,17 +229,21 @@ impl World {
             contacts: Vec::new(),
             overlaps: BTreeMap::new(),
             ignored: BTreeSet::new(),
+            strict: BTreeSet::new(),
+            notes: Vec::new(),
+            policy: config.overlaps,
+            threads: Mutex::new(BTreeMap::new()),
             fixed,
             rows,
             warnings,
         };
-        world.measure_contacts(config.max_overlap_fraction, config.ignore_overlapping)?;
+        world.measure_contacts(config.max_overlap_fraction, config.overlaps)?;
         world.prepare_pair_shapes();
         Ok(world)
     }
 
     /// Finds contacts (parts within the contact distance) and input overlaps between parts.
-    fn measure_contacts(&mut self, max_overlap_fraction: f32, ignore_overlapping: bool) -> Result<()> {
+    fn measure_contacts(&mut self, max_overlap_fraction: f32, policy: OverlapPolicy) -> Result<()> {
         let count = self.geoms.len();
         let pairs: Vec<(usize, usize)> = (0..count)
             .flat_map(|i| ((i + 1)..count).map(move |j| (i, j)))
@@ -279,38 +297,67 @@ impl World {
                 (Some(x), None) => Some((i, x)),
                 (None, None) => None,
             };
-            match eroder {
-                _ if e_ij == Some(0.0) && e_ji == Some(0.0) => {}
+            let limit = limit_of(i).max(limit_of(j));
+            let (depth, gross) = match eroder {
+                _ if e_ij == Some(0.0) && e_ji == Some(0.0) => continue,
                 Some((k, 0.0)) => {
                     // only the other part, shrunk by the tolerance, still crosses: shrink this one
                     self.overlaps.insert((i, j), (k, 0.0));
+                    continue;
                 }
                 Some((k, extra)) => {
-                    self.warnings.push(format!(
-                        "parts '{a}' and '{b}' overlap by about {} in the input (tolerance {}); their mutual tests shrink '{}' by that much",
-                        len(extra),
-                        len(self.tolerance),
-                        self.name(k)
-                    ));
                     self.overlaps.insert((i, j), (k, extra));
+                    (self.tolerance + extra, false)
                 }
-                None => {
-                    let msg = format!(
-                        "parts '{a}' and '{b}' overlap far beyond the tolerance ({}): shrinking either by {:.0}% of its thickness does not separate them",
-                        len(self.tolerance),
-                        max_overlap_fraction * 100.0
-                    );
-                    if !ignore_overlapping {
-                        return Err(GeomError::GrossOverlap {
-                            path: self.assembly.source.clone(),
-                            reason: format!("{msg}; fix the model, raise the tolerance, or ignore overlapping parts"),
-                        });
+                None => (self.tolerance + limit, true),
+            };
+            let kind = self.overlap_kind(i, j);
+            let what = match kind {
+                OverlapKind::Crossing => "overlap".to_string(),
+                OverlapKind::Nested { inner } => format!("overlap ('{}' lies inside the other)", self.name(inner)),
+                OverlapKind::Coincident => "overlap (they occupy the same space)".to_string(),
+            };
+            let measured = if gross {
+                format!("by more than {} (shrinking either by {:.0}% of its thickness does not separate them)", len(depth), max_overlap_fraction * 100.0)
+            } else {
+                format!("by about {}", len(depth))
+            };
+            let handling = match (policy, gross) {
+                (OverlapPolicy::Error, true) => {
+                    return Err(GeomError::GrossOverlap {
+                        path: self.assembly.source.clone(),
+                        reason: format!(
+                            "parts '{a}' and '{b}' {what} far beyond the tolerance ({}): {measured}; fix the model, raise the tolerance, or plan with the overlaps policy strict or lenient",
+                            len(self.tolerance)
+                        ),
+                    });
+                }
+                (OverlapPolicy::Strict, _) => {
+                    self.strict.insert((i, j));
+                    self.strict.insert((j, i));
+                    if gross {
+                        self.ignored.insert((i, j));
+                        self.ignored.insert((j, i));
                     }
-                    self.warnings.push(format!("{msg}; their collisions with each other are ignored"));
+                    "strict"
+                }
+                (_, false) => "shrunk",
+                (OverlapPolicy::Lenient, true) => {
                     self.ignored.insert((i, j));
                     self.ignored.insert((j, i));
+                    "ignored"
                 }
-            }
+            };
+            let consequence = match handling {
+                "strict" => "they may separate only along motions that enter no new material of each other".to_string(),
+                "ignored" => "their collisions with each other are ignored".to_string(),
+                _ => format!("their mutual tests shrink '{}' by that much", self.name(self.pair_erosion(i, j).0)),
+            };
+            self.warnings.push(format!(
+                "parts '{a}' and '{b}' {what} in the input {measured} (tolerance {}); {consequence}",
+                len(self.tolerance)
+            ));
+            self.notes.push(OverlapNote { parts: (i, j), kind, depth, gross, handling });
         }
         Ok(())
     }
@@ -333,6 +380,28 @@ impl World {
         wanted.par_iter().for_each(|&(k, amount)| {
             self.geoms[k].eroded(f32::from_bits(amount));
         });
+    }
+
+    /// How overlapping parts `i` and `j` lie in each other: coincident (bounds equal to within
+    /// twice the tolerance), nested (one's bounds inside the other's, its surface clear of the
+    /// other's when shrunk by the tolerance, and a vertex inside the other's closed surface), or
+    /// crossing.
+    fn overlap_kind(&self, i: usize, j: usize) -> OverlapKind {
+        let (a, b) = (&self.geoms[i], &self.geoms[j]);
+        let slack = 2.0 * self.tolerance;
+        if (a.aabb.mins - b.aabb.mins).abs().max_element() <= slack && (a.aabb.maxs - b.aabb.maxs).abs().max_element() <= slack {
+            return OverlapKind::Coincident;
+        }
+        for (inner, x, y) in [(i, a, b), (j, b, a)] {
+            if y.closed
+                && nests(&x.aabb, &y.aabb)
+                && contains_point(&y.mesh, x.mesh.vertices()[0])
+                && !sweep::meshes_cross(&x.eroded(self.tolerance), &y.mesh)
+            {
+                return OverlapKind::Nested { inner };
+            }
+        }
+        OverlapKind::Crossing
     }
 
     /// The least extra erosion of part `p` (beyond the tolerance, to within a sixteenth) after
@@ -417,8 +486,79 @@ impl World {
         &self.overlaps
     }
 
-    /// Whether collisions between `p` and `q` are ignored (gross input overlap with
-    /// `ignore_overlapping`).
+    /// Every pair that overlaps in the input beyond the tolerance: how they lie, the measured
+    /// depth and how their tests treat them (one entry per pair, in pair order).
+    pub fn overlap_notes(&self) -> &[OverlapNote] {
+        &self.notes
+    }
+
+    /// The overlap policy this world was built with.
+    pub fn overlap_policy(&self) -> OverlapPolicy {
+        self.policy
+    }
+
+    /// Whether the pair (`p`, `q`) is tested by the strict overlap rule (it overlaps in the input
+    /// and the policy is strict).
+    pub fn is_strict_pair(&self, p: usize, q: usize) -> bool {
+        self.strict.contains(&(p, q))
+    }
+
+    /// Part `p`'s surface samples moved inward by the tolerance (made once).
+    fn strict_samples(&self, p: usize) -> &[Vec3] {
+        self.geoms[p].samples.get_or_init(|| overlap::inward_samples(&self.geoms[p].mesh, STRICT_SAMPLES, self.tolerance))
+    }
+
+    /// The strict overlap rule for a pair that overlaps in the input (see [`crate::overlap`]):
+    /// how far `p`, displaced by `from`, travels along unit `dir` (up to `t_max`) before a surface
+    /// sample of either part (moved inward by the tolerance) enters the other's material; `None`
+    /// when none does, and always `None` for pairs the rule does not apply to. With
+    /// `first_only`, any entry answers (not the earliest).
+    pub fn strict_entry(&self, p: usize, q: usize, from: Vec3, dir: Vec3, t_max: f32, first_only: bool) -> Option<f32> {
+        if !self.is_strict_pair(p, q) {
+            return None;
+        }
+        let (sp, sq) = (self.strict_samples(p), self.strict_samples(q));
+        overlap::strict_entry(sp, &self.geoms[p].mesh, sq, &self.geoms[q].mesh, from, dir, t_max, first_only)
+    }
+
+    /// Part `p`'s axis of near rotational symmetry (a bolt, screw, nut, washer), if any.
+    pub fn symmetry_axis(&self, p: usize) -> Option<SymmetryAxis> {
+        let g = self.geoms.get(p)?;
+        *g.axis.get_or_init(|| if g.closed && p < self.num_parts() { fastener::symmetry_axis(&g.mesh) } else { None })
+    }
+
+    /// The threaded contact of `p` with `q` (see [`crate::fastener`]): only pairs that overlap in
+    /// the input, `p` with a symmetry axis and `q` symmetric about it near the axis.
+    pub fn thread(&self, p: usize, q: usize) -> Option<Thread> {
+        if p >= self.num_parts() || q >= self.num_parts() {
+            return None;
+        }
+        let key = (p.min(q), p.max(q));
+        if !self.overlaps.contains_key(&key) && !self.ignored.contains(&key) {
+            return None;
+        }
+        if let Some(t) = self.threads.lock().unwrap_or_else(|e| e.into_inner()).get(&(p, q)) {
+            return *t;
+        }
+        let t = self
+            .symmetry_axis(p)
+            .and_then(|axis| fastener::threaded_contact(&axis, &self.geoms[p].mesh, &self.geoms[q].mesh, 4.0 * self.tolerance));
+        self.threads.lock().unwrap_or_else(|e| e.into_inner()).insert((p, q), t);
+        t
+    }
+
+    /// The pair test of a threaded pair along its axis: the strict sample rule outside the
+    /// thread zone (samples of either part closer to the axis than the zone's radius are
+    /// exempt: the thread is invariant under the screw motion).
+    fn screw_blocks(&self, p: usize, q: usize, thread: &Thread, dir: Vec3, t_max: f32) -> bool {
+        let outside = |s: &[Vec3]| -> Vec<Vec3> { s.iter().copied().filter(|&x| thread.axis.radial(x) > thread.radius).collect() };
+        let (sp, sq) = (outside(self.strict_samples(p)), outside(self.strict_samples(q)));
+        overlap::strict_entry(&sp, &self.geoms[p].mesh, &sq, &self.geoms[q].mesh, Vec3::ZERO, dir, t_max, true).is_some()
+    }
+
+    /// Whether collisions between `p` and `q` are ignored by the shrunk tests (a pair no
+    /// shrinking separates, under the lenient policy; under the strict one such a pair is tested
+    /// by the strict rule alone).
     pub fn ignores(&self, p: usize, q: usize) -> bool {
         self.ignored.contains(&(p, q))
     }
@@ -478,12 +618,18 @@ impl World {
 
     /// Whether `q` blocks `p` moving along `dir` (unit) from the assembled pose, to infinity.
     pub fn pair_blocks(&self, p: usize, q: usize, dir: Vec3) -> bool {
-        if self.ignores(p, q) {
-            return false;
-        }
         let Some((_, t1)) = sweep_overlap(&self.geoms[p].aabb, dir, &self.geoms[q].aabb) else {
             return false;
         };
+        if let Some(thread) = self.thread(p, q).filter(|t| t.axis.direction.dot(dir).abs() > 0.9999) {
+            return self.screw_blocks(p, q, &thread, dir, t1);
+        }
+        if self.is_strict_pair(p, q) && self.strict_entry(p, q, Vec3::ZERO, dir, t1, true).is_some() {
+            return true;
+        }
+        if self.ignores(p, q) {
+            return false;
+        }
         if let (Some(bp), Some(bq)) = (&self.geoms[p].boxes, &self.geoms[q].boxes) {
             // exact on the boxes, each of `p`'s shrunk by the pair's erosion
             let (_, amount) = self.pair_erosion(p, q);
@@ -564,7 +710,15 @@ impl World {
     /// base parts that count as present, e.g. a subassembly on its own base without the ground).
     pub fn linear_removal_among(&self, p: usize, state: &PartSet, present: &PartSet) -> std::result::Result<Motion, PartSet> {
         let row = self.blocking_row(p);
-        self.best_free_direction(|k| row[k].intersection(present), |dir| self.clearance(p, state, dir))
+        let motion = self.best_free_direction(|k| row[k].intersection(present), |dir| self.clearance(p, state, dir))?;
+        // along the axis of a threaded partner still present, the part screws out
+        if let Motion::Linear { direction, distance } = motion {
+            let partner = present.iter().filter(|&q| q != p).find_map(|q| self.thread(p, q));
+            if let Some(t) = partner.filter(|t| t.axis.direction.dot(direction).abs() > 0.9999) {
+                return Ok(Motion::Screw { axis_point: t.axis.point, direction, distance });
+            }
+        }
+        Ok(motion)
     }
 
     /// The parts of `present` that block the rigid `group` moving along candidate direction `k`:
@@ -673,7 +827,12 @@ impl World {
                         continue;
                     }
                     let length = self.clearance_of(&moved, state.iter().filter(|&q| q != p), d2);
-                    if others.iter().all(|&q| self.pair_travel(p, q, shift, d2).is_none_or(|t| t > length)) {
+                    if others.iter().all(|&q| self.pair_travel(p, q, shift, d2).is_none_or(|t| t > length))
+                        && present.iter().filter(|&q| self.is_strict_pair(p, q)).all(|q| {
+                            self.strict_entry(p, q, Vec3::ZERO, d1, s, true).is_none()
+                                && self.strict_entry(p, q, shift, d2, length, true).is_none()
+                        })
+                    {
                         let poses = [Vec3::ZERO, shift, shift + d2 * length].map(Pose::from_translation).to_vec();
                         return Some(Motion::Path { poses, pivot });
                     }
@@ -749,9 +908,26 @@ impl World {
         let rel = b.rotation * a.rotation.inverse();
         let motion = NonlinearRigidMotion::new(*a, pivot, cb - ca, rel.to_scaled_axis());
         let still = NonlinearRigidMotion::constant_position(Pose::IDENTITY);
-        let hit = present.iter().filter(|&q| q != p && !self.ignores(p, q)).find(|&q| {
+        let hit = present.iter().filter(|&q| q != p).find(|&q| {
             let qb = &self.geoms[q].aabb;
             if !(0..3).all(|k| region.mins[k] < qb.maxs[k] && qb.mins[k] < region.maxs[k]) {
+                return false;
+            }
+            if self.is_strict_pair(p, q) {
+                // a part overlapping `q` in the input may leave it only along straight motions
+                // that enter no new material: rotating edges count as collisions
+                let turned = |r: crate::math::Rot| r.angle_between(crate::math::Rot::IDENTITY) >= 1e-6;
+                if turned(rel) || turned(a.rotation) {
+                    return true;
+                }
+                let shift = cb - ca;
+                let len = shift.length();
+                let dir = shift / len.max(f32::MIN_POSITIVE);
+                if self.strict_entry(p, q, a.translation, dir, len, true).is_some() {
+                    return true;
+                }
+            }
+            if self.ignores(p, q) {
                 return false;
             }
             let (moving, fixed) = self.pair_shapes(p, q);
@@ -802,6 +978,9 @@ impl World {
         hit
     }
 }
+
+/// About how many surface samples per part the strict overlap rule uses (plus every vertex).
+const STRICT_SAMPLES: usize = 4000;
 
 /// `x` rounded to `digits` significant digits, without an exponent (0.000123, 12.3, 1230).
 fn significant(x: f64, digits: i32) -> String {

@@ -4,5 +4,6 @@ mod distmap;
 mod fuzz;
 mod graph;
 mod loaders;
+mod overlap;
 mod physics;
 mod removal;

@@ -11,7 +11,7 @@ use crate::errors::Error;
 use crate::errors::Kind;
 use asp_geom::distmap::Support;
 use asp_geom::math::Axis;
-use asp_geom::{GraphConfig, Units};
+use asp_geom::{GraphConfig, OverlapPolicy, Units};
 use asp_search::pipeline::{OptimiseSettings, PlanSettings, StabilitySetting};
 use asp_search::{BuiltinOrder, OrderingSource};
 use pyo3::conversion::FromPyObjectOwned;
@@ -35,7 +35,7 @@ pub const PLAN_KEYS: [&str; 27] = [
     "contact_distance",
     "normals",
     "sphere_directions",
-    "ignore_overlapping",
+    "overlaps",
     "stability",
     "physics_threshold",
     "path_planner",
@@ -162,7 +162,7 @@ pub fn plan_settings(dict: &Bound<'_, PyDict>) -> Result<PlanSettings, Error> {
         contact_distance: k.positive("contact_distance")?,
         normals: k.count("normals")?.unwrap_or(defaults.normals),
         sphere_directions: k.count("sphere_directions")?.unwrap_or(defaults.sphere_directions),
-        ignore_overlapping: k.flag("ignore_overlapping", defaults.ignore_overlapping)?,
+        overlaps: overlap_policy(&k)?,
         stability,
         order,
         bookkeeping: k.flag("bookkeeping", defaults.bookkeeping)? || implied_bookkeeping,
@@ -219,7 +219,7 @@ fn optimise_settings(k: &Keywords<'_, '_>) -> Result<Option<OptimiseSettings>, E
 
 /// The keywords of [`graph_settings`].
 pub const GRAPH_KEYS: [&str; 6] =
-    ["tolerance", "contact_distance", "ignore_overlapping", "radius_bins", "degree", "points_per_part"];
+    ["tolerance", "contact_distance", "overlaps", "radius_bins", "degree", "points_per_part"];
 
 /// What the graph of a model depends on: the collision world's contact settings and the feature
 /// parameters (also the key of the graph cache of an assembly handle).
@@ -238,7 +238,7 @@ impl GraphSettings {
         self.config == other.config
             && w.0.tolerance == w.1.tolerance
             && w.0.contact_distance == w.1.contact_distance
-            && w.0.ignore_overlapping == w.1.ignore_overlapping
+            && w.0.overlaps == w.1.overlaps
     }
 }
 
@@ -256,10 +256,19 @@ pub fn graph_settings(dict: &Bound<'_, PyDict>) -> Result<GraphSettings, Error> 
     let world = PlanSettings {
         tolerance: k.positive("tolerance")?,
         contact_distance: k.positive("contact_distance")?,
-        ignore_overlapping: k.flag("ignore_overlapping", false)?,
+        overlaps: overlap_policy(&k)?,
         ..PlanSettings::default()
     };
     Ok(GraphSettings { world, config })
+}
+
+/// The `overlaps` keyword: `strict` (the default), `lenient` or `error`.
+fn overlap_policy(k: &Keywords<'_, '_>) -> Result<OverlapPolicy, Error> {
+    match k.string("overlaps")? {
+        None => Ok(OverlapPolicy::default()),
+        Some(name) => OverlapPolicy::parse(&name)
+            .ok_or_else(|| Error::config(format!("overlaps: unknown policy '{name}' (use strict, lenient or error)"))),
+    }
 }
 
 fn reject_unknown(dict: &Bound<'_, PyDict>, known: &[&str]) -> Result<(), Error> {
@@ -290,7 +299,7 @@ pub fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("contact_distance", p.contact_distance)?;
     d.set_item("normals", p.normals)?;
     d.set_item("sphere_directions", p.sphere_directions)?;
-    d.set_item("ignore_overlapping", p.ignore_overlapping)?;
+    d.set_item("overlaps", p.overlaps.name())?;
     d.set_item("stability", "contact")?;
     d.set_item("physics_threshold", DEFAULT_PHYSICS_THRESHOLD)?;
     d.set_item("path_planner", p.path_planner)?;

@@ -18,7 +18,7 @@ use asp_geom::io::LoadOptions;
 use asp_geom::math::Axis;
 use asp_geom::physics::PhysicsConfig;
 use asp_geom::rrt::RrtConfig;
-use asp_geom::{Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, StabilityMode, Units, World, WorldConfig};
+use asp_geom::{Assembly, Checker, OverlapPolicy, CheckerConfig, CounterSnapshot, Motion, StabilityMode, Units, World, WorldConfig};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -59,8 +59,9 @@ pub struct PlanSettings {
     pub normals: usize,
     /// Extra removal directions sampled evenly on the sphere.
     pub sphere_directions: usize,
-    /// Ignore collisions between parts that overlap in the input beyond repair.
-    pub ignore_overlapping: bool,
+    /// How parts that overlap in the input are tested (default strict: they separate only
+    /// along motions that enter no new material of each other).
+    pub overlaps: OverlapPolicy,
     /// The stability criterion.
     pub stability: StabilitySetting,
     /// The part ordering of the depth-first search.
@@ -115,7 +116,7 @@ impl Default for PlanSettings {
             contact_distance: None,
             normals: WorldConfig::default().normal_clusters,
             sphere_directions: 0,
-            ignore_overlapping: false,
+            overlaps: OverlapPolicy::Strict,
             stability: StabilitySetting::Contact,
             order: Arc::new(BuiltinOrder::Given),
             bookkeeping: false,
@@ -233,7 +234,7 @@ pub fn world_config(assembly: &Assembly, settings: &PlanSettings) -> Result<Worl
         contact_distance: to_m("the contact distance", settings.contact_distance)?,
         normal_clusters: settings.normals,
         sphere_directions: settings.sphere_directions,
-        ignore_overlapping: settings.ignore_overlapping,
+        overlaps: settings.overlaps,
         ..WorldConfig::default()
     })
 }
@@ -330,6 +331,7 @@ pub fn plan_assembly(
     if let Some(r) = robot {
         report.attach_robot(r);
     }
+    report.overlaps = crate::report::OverlapsEntry::of(world);
     report.stats.timings = Some(Timings {
         load: 0.0,
         world: world_seconds,
@@ -351,7 +353,7 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
     }
     let world = world_config(&assembly, settings)?;
     let metres = assembly.units.metres;
-    let mut config = MapConfig::builder().resolution(o.resolution).support(o.support);
+    let mut config = MapConfig::builder().resolution(o.resolution).support(o.support).overlaps(settings.overlaps);
     if let Some(d) = o.d_max {
         config = config.d_max((positive("d_max", d)? * metres) as f32);
     }

@@ -48,6 +48,10 @@ pub struct PlanReport {
     /// For `no_plan`: the parts of the deepest dead-end state and what holds each.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub explanation: Vec<Explanation>,
+    /// Pairs of parts that overlap in the input beyond the tolerance, and how their tests
+    /// treated them (feasibility planning; absent when no pair overlaps). Since format 1.5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overlaps: Option<OverlapsEntry>,
     /// Non-fatal problems found in the model, one line each.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
@@ -132,6 +136,63 @@ impl PlanReport {
     }
 }
 
+/// The input overlaps of a plan (format 1.5).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct OverlapsEntry {
+    /// The overlap policy: `strict`, `lenient` or `error`.
+    pub policy: String,
+    /// One entry per overlapping pair.
+    pub pairs: Vec<OverlapPair>,
+}
+
+/// One pair of parts that overlap in the input.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct OverlapPair {
+    /// The two part indices (low, high).
+    pub parts: [usize; 2],
+    /// Their names.
+    pub names: [String; 2],
+    /// `crossing`, `nested` or `coincident`.
+    pub kind: String,
+    /// For `nested`: the part that lies inside the other.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inner: Option<usize>,
+    /// The measured depth in model units (for `gross` pairs a lower bound).
+    pub depth: f64,
+    /// No shrinking of either part up to 40 % of its thickness separates them.
+    pub gross: bool,
+    /// `strict` (they separate only along motions that enter no new material), `shrunk` or
+    /// `ignored`.
+    pub handling: String,
+}
+
+impl OverlapsEntry {
+    /// The overlaps `world` measured; `None` when no pair overlaps.
+    pub fn of(world: &asp_geom::World) -> Option<OverlapsEntry> {
+        let notes = world.overlap_notes();
+        if notes.is_empty() {
+            return None;
+        }
+        let units = &world.assembly().units;
+        let pairs = notes
+            .iter()
+            .map(|n| OverlapPair {
+                parts: [n.parts.0, n.parts.1],
+                names: [world.name(n.parts.0).to_string(), world.name(n.parts.1).to_string()],
+                kind: n.kind.name().into(),
+                inner: match n.kind {
+                    asp_geom::overlap::OverlapKind::Nested { inner } => Some(inner),
+                    _ => None,
+                },
+                depth: units.from_metres(n.depth as f64),
+                gross: n.gross,
+                handling: n.handling.into(),
+            })
+            .collect();
+        Some(OverlapsEntry { policy: world.overlap_policy().name().into(), pairs })
+    }
+}
+
 /// A part of the model.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct PartEntry {
@@ -201,6 +262,16 @@ pub enum MotionEntry {
         poses: Vec<[f64; 7]>,
         /// The point that moves straight between waypoints, model frame.
         pivot: [f64; 3],
+    },
+    /// Screw in along `direction` (unit, the part's symmetry axis through `axis_point`) by
+    /// `distance`, turning about the axis as the thread requires (format 1.5).
+    Screw {
+        /// Unit insertion direction.
+        direction: [f64; 3],
+        /// Travel in model units.
+        distance: f64,
+        /// A point on the axis, model frame.
+        axis_point: [f64; 3],
     },
 }
 
@@ -373,6 +444,7 @@ impl PlanReport {
                 stopped_by: outcome.stats.stopped_by.map(|r| r.as_str().to_string()),
             },
             explanation,
+            overlaps: None,
             warnings: warnings.to_vec(),
             pareto_front: None,
             optimisation: None,
@@ -458,6 +530,11 @@ fn insertion(motion: &Motion, u: &dyn Fn(f32) -> f64) -> MotionEntry {
         Motion::Linear { direction, distance } => {
             MotionEntry::Linear { direction: v3(-*direction, &unit), distance: u(*distance) }
         }
+        Motion::Screw { axis_point, direction, distance } => MotionEntry::Screw {
+            direction: v3(-*direction, &unit),
+            distance: u(*distance),
+            axis_point: v3(*axis_point, u),
+        },
         Motion::Path { poses, pivot } => MotionEntry::Path {
             poses: poses
                 .iter()

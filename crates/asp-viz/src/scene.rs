@@ -102,7 +102,8 @@ impl Insertion {
     pub fn from_entry(entry: &MotionEntry, metres_per_unit: f64, radius: f32) -> Insertion {
         let m = |v: f64| (v * metres_per_unit) as f32;
         match entry {
-            MotionEntry::Linear { direction, distance } => {
+            // a screw's turn about its own axis is not drawn: the part is nearly symmetric about it
+            MotionEntry::Linear { direction, distance } | MotionEntry::Screw { direction, distance, .. } => {
                 let d = Vec3::new(direction[0] as f32, direction[1] as f32, direction[2] as f32);
                 Insertion::Linear { direction: d.normalize_or_zero(), distance: m(*distance) }
             }

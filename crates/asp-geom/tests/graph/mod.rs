@@ -454,7 +454,7 @@ fn every_shipped_model_has_finite_consistent_features() {
         models.push((p.display().to_string(), load(&p, &z_up()).expect("ikea model")));
     }
     // bed_dalselv has grossly overlapping boards
-    let lenient = WorldConfig { ignore_overlapping: true, ..WorldConfig::default() };
+    let lenient = WorldConfig { overlaps: asp_geom::OverlapPolicy::Lenient, ..WorldConfig::default() };
     for (name, a) in models {
         let w = world(a, &lenient);
         let started = std::time::Instant::now();

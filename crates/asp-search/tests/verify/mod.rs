@@ -21,8 +21,10 @@ fn shrunk(world: &World, p: usize, amount: f32) -> TriMesh {
 /// Whether part `p` at `pose` penetrates a present part (other than itself) deeper than the
 /// tolerance: surfaces crossing, or one inside the other. Each pair shrinks the part the world
 /// chose for it (the moving part, or for input overlaps the one that separates more easily).
-fn penetrates(world: &World, p: usize, pose: &Pose, present: &PartSet, shrunk_cache: &mut HashMap<(usize, u32), TriMesh>) -> Option<usize> {
-    present.iter().filter(|&q| q != p && !world.ignores(p, q)).find(|&q| {
+/// A screw step's threaded partners are not tested here (their threads are invariant under the
+/// screw motion, which is not a translation); `screw` says whether the step is one.
+fn penetrates(world: &World, p: usize, pose: &Pose, present: &PartSet, shrunk_cache: &mut HashMap<(usize, u32), TriMesh>, screw: bool) -> Option<usize> {
+    present.iter().filter(|&q| q != p && !world.ignores(p, q) && !(screw && world.thread(p, q).is_some())).find(|&q| {
         let (k, amount) = world.pair_erosion(p, q);
         let shrunk_k = shrunk_cache.entry((k, amount.to_bits())).or_insert_with(|| shrunk(world, k, amount)).clone();
         let id = Pose::IDENTITY;
@@ -40,6 +42,69 @@ fn penetrates(world: &World, p: usize, pose: &Pose, present: &PartSet, shrunk_ca
             || (closed_raw && nests(&bs, &br) && raw.contains_point(&raw_pose, shrunk_pose.transform_point(shrunk_k.vertices()[0])))
             || (world.is_closed(k) && nests(&br, &bs) && shrunk_k.contains_point(&shrunk_pose, raw_pose.transform_point(raw.vertices()[0])))
     })
+}
+
+/// Each triangle's centroid and each vertex of part `p`, moved inward by the tolerance (vertices
+/// along the mean of their faces' normals): the strict check's samples, made here rather than by
+/// the planner's sampler.
+fn inner_points(world: &World, p: usize) -> Vec<Vec3> {
+    let m = world.mesh(p);
+    let (v, t) = (m.vertices(), m.indices());
+    let depth = world.tolerance();
+    let mut normals = vec![Vec3::ZERO; v.len()];
+    let mut out = Vec::with_capacity(t.len() + v.len());
+    for tri in t {
+        let [a, b, c] = tri.map(|i| v[i as usize]);
+        let n = (b - a).cross(c - a);
+        for &i in tri {
+            normals[i as usize] += n;
+        }
+        if let Some(u) = n.try_normalize() {
+            out.push((a + b + c) / 3.0 - u * depth);
+        }
+    }
+    out.extend(v.iter().zip(&normals).filter_map(|(x, n)| n.try_normalize().map(|u| *x - u * depth)));
+    out
+}
+
+/// The strict overlap rule, re-checked by point containment at the sampled poses (the replay's
+/// rule): for each pair of a mover and a present part that overlap in the input under the
+/// strict policy, no sample of either (moved inward by the tolerance) that is outside the other
+/// at the start is inside it at a later pose.
+fn check_strict(world: &World, k: usize, movers: &[usize], others: &PartSet, poses: &[Pose], samples: &mut HashMap<usize, Vec<Vec3>>) {
+    for &p in movers {
+        for q in others.iter().filter(|&q| world.is_strict_pair(p, q)) {
+            for (a, b, sign) in [(p, q, 1.0f32), (q, p, -1.0)] {
+                let pts = samples.entry(a).or_insert_with(|| inner_points(world, a)).clone();
+                // `a`'s samples in the frame of `b`: the mover's moved by the pose, the other's
+                // by its inverse
+                let place = |pose: &Pose, x: Vec3| if sign > 0.0 { pose.transform_point(x) } else { pose.inverse_transform_point(x) };
+                let mesh = world.mesh(b);
+                let bb = world.aabb(b);
+                let pad = 2.0 * world.tolerance();
+                let near = |x: Vec3| (0..3).all(|i| x[i] >= bb.mins[i] - pad && x[i] <= bb.maxs[i] + pad);
+                // a sample on the other's surface (within half the tolerance) counts as inside
+                // at the start and outside later: touching is not entering
+                let depth = |x: Vec3| (mesh.project_local_point(x, false).point - x).length();
+                let half = 0.5 * world.tolerance();
+                let start: Vec<bool> =
+                    pts.iter().map(|&x| near(x) && (mesh.contains_local_point(x) || depth(x) <= half)).collect();
+                for pose in &poses[1..] {
+                    if let Some(x) = pts.iter().zip(&start).find(|(x, inside)| {
+                        let y = place(pose, **x);
+                        !**inside && near(y) && mesh.contains_local_point(y) && depth(y) > half
+                    }) {
+                        panic!(
+                            "step {k}: strict: a sample of '{}' at {:?} enters '{}', which the pair overlaps in the input, at {pose:?}",
+                            world.name(a),
+                            x.0,
+                            world.name(b)
+                        );
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Re-checks every removal of a found plan: collision-free sweep, bounds cleared at the end,
@@ -61,6 +126,7 @@ pub fn verify_removals(world: &World, removals: &[asp_search::Step]) -> PartSet 
 /// stable on the base; a subassembly's own plan re-checked the same way on its base part.
 pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: &[asp_search::Step]) -> PartSet {
     let mut cache = HashMap::new();
+    let mut samples = HashMap::new();
     for (k, step) in removals.iter().enumerate() {
         let movers = step.parts();
         assert!(movers.contains(&step.part), "step {k}: its part is one of its movers");
@@ -81,10 +147,15 @@ pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: 
         let thinnest = movers.iter().map(|&p| (world.aabb(p).maxs - world.aabb(p).mins).min_element()).fold(f32::INFINITY, f32::min);
         let h = (thinnest / 4.0).max(world.tolerance());
         let poses: Vec<Pose> = match &step.motion {
-            Motion::Linear { direction, distance } => {
+            Motion::Linear { direction, distance } | Motion::Screw { direction, distance, .. } => {
                 assert!((direction.length() - 1.0).abs() < 1e-4);
                 let count = ((distance / h).ceil() as usize).clamp(8, 400);
-                (0..=count).map(|i| Pose::from_translation(*direction * (distance * i as f32 / count as f32))).collect()
+                // and steps of the tolerance over the first 20 tolerances (strict overlaps)
+                let tol = world.tolerance();
+                let first = (1..=20).map(|i| i as f32 * tol).filter(|&t| t < *distance);
+                let mut ts: Vec<f32> = (0..=count).map(|i| distance * i as f32 / count as f32).chain(first).collect();
+                ts.sort_by(f32::total_cmp);
+                ts.into_iter().map(|t| Pose::from_translation(*direction * t)).collect()
             }
             // every segment, at least 20 samples, and at most `h` apart along its pivot's travel
             Motion::Path { poses, pivot } => poses
@@ -97,9 +168,12 @@ pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: 
                 .chain(poses.last().copied())
                 .collect(),
         };
+        if !matches!(step.motion, Motion::Screw { .. }) {
+            check_strict(world, k, &movers, &others, &poses, &mut samples);
+        }
         for pose in &poses {
             for &p in &movers {
-                if let Some(q) = penetrates(world, p, pose, &others, &mut cache) {
+                if let Some(q) = penetrates(world, p, pose, &others, &mut cache, matches!(step.motion, Motion::Screw { .. })) {
                     panic!("step {k}: part '{}' hits '{}' at {pose:?}", world.name(p), world.name(q));
                 }
             }

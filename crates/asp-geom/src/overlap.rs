@@ -1,0 +1,225 @@
+//! Parts that overlap in the input: the policy, and the *strict* per-pair motion test.
+//!
+//! Real CAD overlaps on purpose (press fits, dowels pushed into boards without modelled holes,
+//! screws in tapped holes drawn at their major diameter) and by accident (modelling slop). Such a
+//! pair may separate only along motions that cut into no material it did not already overlap: a
+//! dowel leaves along its axis, never sideways.
+//!
+//! The strict test samples both surfaces ([`crate::graph::sample`]: sub-triangle centroids plus
+//! the vertices), moves every sample inward by the tolerance (so touching and sliding never
+//! count, as in the shrink-then-sweep test), and follows each sample along the relative motion
+//! as a ray: the moving part's samples along `d` against the other's mesh, the other's samples
+//! along `-d` against the moving part's mesh. A sample *enters* material when its ray crosses a
+//! face of the other part from outside, i.e. a face whose outward normal points against the
+//! ray (parry's ray cast with back faces culled); leaving through a back face is always allowed.
+//! So a sample that starts inside the other part may leave it, and one that starts outside may
+//! never get in — continuously along the segment, with no time steps. A sample that leaves and
+//! later enters again is refused too (stricter than "inside at the start may stay inside").
+//!
+//! The test is a sampling of the surfaces, so it is used *together with* the exact (shrunk)
+//! sweep of the pair, never instead of it: a strict pair is blocked when either blocks.
+
+use crate::graph::sample::sample_triangles;
+use crate::math::{Aabb, Vec3};
+use parry3d::query::{Ray, RayCullingMode};
+use parry3d::shape::TriMesh;
+
+/// What asp does with parts that overlap in the input beyond the tolerance.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OverlapPolicy {
+    /// The default: an overlapping pair may separate only along motions that enter no new
+    /// material of the other part (the strict test above, on top of the shrunk sweep); pairs
+    /// that no shrinking separates are tested by the strict rule alone. Never an error.
+    #[default]
+    Strict,
+    /// Shrink one part of the pair in their mutual tests; pairs that no shrinking separates
+    /// ignore each other's collisions (a pressed-in dowel may slide sideways: physically wrong).
+    Lenient,
+    /// Shrink small overlaps; a pair that no shrinking separates stops planning with an error.
+    Error,
+}
+
+impl OverlapPolicy {
+    /// Every policy's name, as the CLI and Python spell them.
+    pub const NAMES: [&'static str; 3] = ["strict", "lenient", "error"];
+
+    /// The policy named `s` (`strict`, `lenient`, `error`).
+    pub fn parse(s: &str) -> Option<OverlapPolicy> {
+        match s {
+            "strict" => Some(OverlapPolicy::Strict),
+            "lenient" => Some(OverlapPolicy::Lenient),
+            "error" => Some(OverlapPolicy::Error),
+            _ => None,
+        }
+    }
+
+    /// The policy's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            OverlapPolicy::Strict => "strict",
+            OverlapPolicy::Lenient => "lenient",
+            OverlapPolicy::Error => "error",
+        }
+    }
+}
+
+/// How two overlapping parts lie in each other.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OverlapKind {
+    /// Their surfaces cross.
+    Crossing,
+    /// The first part lies wholly inside the second (its index).
+    Nested {
+        /// The part inside.
+        inner: usize,
+    },
+    /// The two parts occupy the same space (their bounds agree to within the tolerance and
+    /// each holds the other's surface).
+    Coincident,
+}
+
+impl OverlapKind {
+    /// `crossing`, `nested` or `coincident`.
+    pub fn name(self) -> &'static str {
+        match self {
+            OverlapKind::Crossing => "crossing",
+            OverlapKind::Nested { .. } => "nested",
+            OverlapKind::Coincident => "coincident",
+        }
+    }
+}
+
+/// One pair of parts that overlap in the input beyond the tolerance, as measured and handled.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OverlapNote {
+    /// The pair (low index, high index).
+    pub parts: (usize, usize),
+    /// How they lie in each other.
+    pub kind: OverlapKind,
+    /// The measured depth in metres: the least shrinking of one part (tolerance included) after
+    /// which they no longer cross; for pairs no shrinking separates, the largest shrinking tried
+    /// (a lower bound, `gross` is true).
+    pub depth: f32,
+    /// No shrinking up to the limit separates them.
+    pub gross: bool,
+    /// How their mutual tests treat them: `strict`, `shrunk` (lenient or error policy, small
+    /// overlap) or `ignored` (lenient policy, gross overlap).
+    pub handling: &'static str,
+}
+
+/// A part's surface samples moved inward by `depth` along their outward normals: the
+/// sub-triangle centroids of about `target` area-weighted points, and every vertex (moved along
+/// the area-weighted mean of its faces' normals).
+pub fn inward_samples(mesh: &TriMesh, target: usize, depth: f32) -> Vec<Vec3> {
+    let (vertices, triangles) = (mesh.vertices(), mesh.indices());
+    let sample = sample_triangles(vertices, triangles, target);
+    let mut out: Vec<Vec3> = sample.points.iter().zip(&sample.normals).map(|(p, n)| *p - *n * depth).collect();
+    let mut normals = vec![Vec3::ZERO; vertices.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        let n = (b - a).cross(c - a); // twice the area, outward for an oriented mesh
+        for i in t {
+            normals[*i as usize] += n;
+        }
+    }
+    out.extend(vertices.iter().zip(&normals).filter_map(|(v, n)| {
+        let n = n.normalize_or_zero();
+        (n != Vec3::ZERO).then(|| *v - n * depth)
+    }));
+    out
+}
+
+/// Whether point `s`, moved along unit `dir` for `t` in `[0, t_max]`, can meet box `b` widened
+/// by `pad` (a cull: true when unsure).
+fn path_meets(s: Vec3, dir: Vec3, t_max: f32, b: &Aabb, pad: f32) -> bool {
+    let (mut t0, mut t1) = (0.0f32, t_max);
+    for k in 0..3 {
+        let (lo, hi) = (b.mins[k] - pad, b.maxs[k] + pad);
+        if dir[k].abs() < 1e-12 {
+            if s[k] < lo || s[k] > hi {
+                return false;
+            }
+            continue;
+        }
+        let (a, c) = ((lo - s[k]) / dir[k], (hi - s[k]) / dir[k]);
+        t0 = t0.max(a.min(c));
+        t1 = t1.min(a.max(c));
+        if t0 > t1 {
+            return false;
+        }
+    }
+    true
+}
+
+/// The earliest travel `t` in `[0, t_max]` at which one of `samples`, displaced by `from` and
+/// moved along unit `dir`, enters `other` (crosses one of its faces from outside), or `None`.
+/// With `first_only`, any entry is returned as soon as it is found (not the earliest).
+pub fn first_entry(samples: &[Vec3], from: Vec3, dir: Vec3, t_max: f32, other: &TriMesh, first_only: bool) -> Option<f32> {
+    let bounds = other.local_aabb();
+    let pad = 1e-5 * (bounds.maxs - bounds.mins).length();
+    let mut best: Option<f32> = None;
+    for &s in samples {
+        let s = s + from;
+        let limit = best.unwrap_or(t_max);
+        if !path_meets(s, dir, limit, &bounds, pad) {
+            continue;
+        }
+        let ray = Ray::new(s, dir);
+        if let Some(hit) = other.cast_local_ray_with_culling(&ray, limit, RayCullingMode::IgnoreBackfaces) {
+            if first_only {
+                return Some(hit.time_of_impact);
+            }
+            best = Some(best.map_or(hit.time_of_impact, |b: f32| b.min(hit.time_of_impact)));
+        }
+    }
+    best
+}
+
+/// The strict test of one pair: how far the moving part (samples `moving`, mesh `moving_mesh`),
+/// displaced by `from`, travels along unit `dir` (up to `t_max`) before a sample of either part
+/// enters the other's material; `None` when no sample does. With `first_only` any entry ends
+/// the search (a yes/no answer).
+pub fn strict_entry(
+    moving: &[Vec3],
+    moving_mesh: &TriMesh,
+    still: &[Vec3],
+    still_mesh: &TriMesh,
+    from: Vec3,
+    dir: Vec3,
+    t_max: f32,
+    first_only: bool,
+) -> Option<f32> {
+    let a = first_entry(moving, from, dir, t_max, still_mesh, first_only);
+    if first_only && a.is_some() {
+        return a;
+    }
+    // the still part's samples seen from the moving part: displaced by -from, moving along -dir
+    let b = first_entry(still, -from, -dir, a.unwrap_or(t_max), moving_mesh, first_only);
+    match (a, b) {
+        (Some(x), Some(y)) => Some(x.min(y)),
+        (x, y) => x.or(y),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn policies_round_trip_their_names() {
+        for name in OverlapPolicy::NAMES {
+            assert_eq!(OverlapPolicy::parse(name).unwrap().name(), name);
+        }
+        assert_eq!(OverlapPolicy::parse("ignore"), None);
+        assert_eq!(OverlapPolicy::default(), OverlapPolicy::Strict);
+    }
+
+    #[test]
+    fn a_point_path_misses_a_box_beside_it() {
+        let b = Aabb::new(Vec3::ZERO, Vec3::ONE);
+        assert!(path_meets(Vec3::new(-1.0, 0.5, 0.5), Vec3::X, 2.0, &b, 0.0));
+        assert!(!path_meets(Vec3::new(-1.0, 0.5, 0.5), Vec3::X, 0.5, &b, 0.0));
+        assert!(!path_meets(Vec3::new(-1.0, 2.0, 0.5), Vec3::X, 5.0, &b, 0.0));
+        assert!(!path_meets(Vec3::new(-1.0, 0.5, 0.5), -Vec3::X, 5.0, &b, 0.0));
+    }
+}

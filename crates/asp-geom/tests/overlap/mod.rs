@@ -1,0 +1,113 @@
+//! Input overlaps (issue 9 item 1): press fits are data, not errors, and under the default
+//! strict policy an overlapping pair separates only along motions that enter no new material.
+
+use asp_geom::math::Vec3;
+use asp_geom::overlap::OverlapKind;
+use asp_geom::{fixtures, Checker, CheckerConfig, FeasibilityChecker, Motion, MotionKind, Outcome, OverlapPolicy, PartSet, World, WorldConfig};
+
+fn world(a: asp_geom::Assembly, overlaps: OverlapPolicy) -> asp_geom::Result<World> {
+    World::new(a, &WorldConfig { overlaps, ..WorldConfig::default() })
+}
+
+/// The axis directions along which `part` is free in `state`.
+fn free_axes(w: &World, part: usize, state: &PartSet) -> Vec<&'static str> {
+    let names = ["+x", "-x", "+y", "-y", "+z", "-z"];
+    let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+    let row = w.blocking_row(part);
+    let present = w.with_fixed(state);
+    axes.iter()
+        .zip(names)
+        .filter(|(a, _)| {
+            let k = w.directions().iter().position(|d| d.dot(**a) > 0.9999).unwrap();
+            !row[k].intersects(&present)
+        })
+        .map(|(_, n)| n)
+        .collect()
+}
+
+/// Every candidate direction along which `part` is free in `state`.
+fn free_directions(w: &World, part: usize, state: &PartSet) -> Vec<Vec3> {
+    let row = w.blocking_row(part);
+    let present = w.with_fixed(state);
+    w.directions().iter().enumerate().filter(|(k, _)| !row[*k].intersects(&present)).map(|(_, d)| *d).collect()
+}
+
+#[test]
+fn a_pressed_peg_leaves_along_its_axis_only() {
+    let w = world(fixtures::pressed_peg(), OverlapPolicy::Strict).expect("strict never stops on overlaps");
+    let all = PartSet::full(2);
+    assert_eq!(free_axes(&w, 1, &all), vec!["+z"]);
+    // not only the axes: every free candidate direction is the axis
+    let free = free_directions(&w, 1, &all);
+    assert!(!free.is_empty() && free.iter().all(|d| d.dot(Vec3::Z) > 0.9999), "{free:?}");
+    match w.linear_removal(1, &all).unwrap() {
+        Motion::Linear { direction, .. } => assert!(direction.dot(Vec3::Z) > 0.9999),
+        m => panic!("{m:?}"),
+    }
+    // the pair is reported: gross (no shrinking separates them), handled strictly, warned once
+    let notes = w.overlap_notes();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert_eq!((notes[0].parts, notes[0].gross, notes[0].handling), ((0, 1), true, "strict"));
+    assert_eq!(notes[0].kind, OverlapKind::Crossing);
+    let warned: Vec<&String> = w.warnings().iter().filter(|s| s.contains("'plate' and 'peg'")).collect();
+    assert_eq!(warned.len(), 1, "{:?}", w.warnings());
+    assert!(warned[0].contains("by more than") && warned[0].contains("no new material"), "{}", warned[0]);
+}
+
+#[test]
+fn the_lenient_policy_lets_the_peg_slide_sideways_and_error_stops() {
+    // what strict fixes: ignoring the pair frees every direction but down into the plate's
+    // other side... and sideways
+    let w = world(fixtures::pressed_peg(), OverlapPolicy::Lenient).unwrap();
+    let free = free_axes(&w, 1, &PartSet::full(2));
+    assert!(free.contains(&"+x") && free.contains(&"+z"), "{free:?}");
+    assert_eq!(w.overlap_notes()[0].handling, "ignored");
+    let err = world(fixtures::pressed_peg(), OverlapPolicy::Error).err().expect("error policy").to_string();
+    assert!(err.contains("'plate' and 'peg'") && err.contains("overlaps policy"), "{err}");
+}
+
+#[test]
+fn a_dowel_in_two_boards_comes_out_after_the_upper_board_both_upward() {
+    let w = world(fixtures::dowel_in_two_boards(), OverlapPolicy::Strict).unwrap();
+    let all = PartSet::full(3);
+    // the dowel is held by both boards; the upper board pulls off it upward only
+    assert_eq!(free_axes(&w, 2, &all), Vec::<&str>::new());
+    assert_eq!(free_axes(&w, 1, &all), vec!["+z"]);
+    assert_eq!(free_axes(&w, 2, &all.without(1)), vec!["+z"]);
+    let pairs: Vec<(usize, usize)> = w.overlap_notes().iter().map(|n| n.parts).collect();
+    assert_eq!(pairs, vec![(0, 2), (1, 2)]);
+    // and the checker (every place a removal is tested goes through the blocking rows)
+    let checker = Checker::new(w, CheckerConfig::default());
+    assert!(matches!(checker.test_removal(2, &all, MotionKind::Linear), Outcome::Collision { .. }));
+    match checker.test_removal(1, &all, MotionKind::Linear) {
+        Outcome::Removed(Motion::Linear { direction, .. }) => assert!(direction.dot(Vec3::Z) > 0.9999),
+        o => panic!("{o:?}"),
+    }
+}
+
+#[test]
+fn a_nested_part_is_reported_and_held() {
+    // a small box wholly inside a bigger one (a duplicated inner body)
+    let mut outer = fixtures::box_part("outer", [0.0, 0.0, 0.0], [2.0, 2.0, 2.0]);
+    outer.fixed = true;
+    let inner = fixtures::box_part("inner", [0.5, 0.5, 0.5], [1.5, 1.5, 1.5]);
+    let w = world(fixtures::assemble("nested", vec![outer, inner], asp_geom::math::Axis::Z), OverlapPolicy::Strict).unwrap();
+    let notes = w.overlap_notes();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert_eq!(notes[0].kind, OverlapKind::Nested { inner: 1 });
+    assert!(w.warnings().iter().any(|s| s.contains("'inner' lies inside the other")), "{:?}", w.warnings());
+    assert!(free_directions(&w, 1, &PartSet::full(2)).is_empty(), "embedded in solid material, it cannot leave");
+}
+
+#[test]
+fn coincident_parts_are_reported_and_separate() {
+    let mut a = fixtures::box_part("a", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    a.fixed = true;
+    let b = fixtures::box_part("b", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
+    let w = world(fixtures::assemble("coincident", vec![a, b], asp_geom::math::Axis::Z), OverlapPolicy::Strict).unwrap();
+    let notes = w.overlap_notes();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert_eq!(notes[0].kind, OverlapKind::Coincident);
+    // a copy moving out of its twin enters no material the pair did not already share
+    assert_eq!(free_axes(&w, 1, &PartSet::full(2)).len(), 6);
+}
