@@ -26,7 +26,7 @@ pub const DEFAULT_PHYSICS_THRESHOLD: f64 = 0.01;
 pub const ORDER_NAMES: [&str; 5] = ["given", "shuffled", "random", "bookkeeping", "gnn"];
 
 /// The keywords of [`plan_settings`], in the order of `asp.Assembly.plan`'s signature.
-pub const PLAN_KEYS: [&str; 26] = [
+pub const PLAN_KEYS: [&str; 27] = [
     "order",
     "model",
     "bookkeeping",
