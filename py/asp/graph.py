@@ -26,7 +26,7 @@ class Graph:
     edge_index: np.ndarray
     #: float32 ``[e, edge_dim]``: edge attributes (model input ``edge_attr``).
     edge_attr: np.ndarray
-    #: The feature set and its parameters (``asp-graph/1 radius_bins=8 degree=8 points=2048``).
+    #: The feature set and its parameters (``asp-graph/2 radius_bins=8 degree=8 points=2048``).
     features: str
 
     @property

@@ -22,8 +22,8 @@ def test_full_graph_shapes_and_dtypes(lack):
     assert g.edge_index.dtype == np.int64 and g.edge_index.shape == (2, g.num_edges)
     assert g.edge_attr.dtype == np.float32 and g.edge_attr.shape == (g.num_edges, g.edge_dim)
     # defaults: 8 radius bins x degrees 0..8 = 72 descriptor floats; node +2, edge 2*72+2
-    assert (g.node_dim, g.edge_dim) == (74, 146)
-    assert g.features == "asp-graph/1 radius_bins=8 degree=8 points=2048"
+    assert (g.node_dim, g.edge_dim) == (74, 152)
+    assert g.features == "asp-graph/2 radius_bins=8 degree=8 points=2048"
     assert g.num_edges > 0 and g.num_edges % 2 == 0, "contacts give edges in both directions"
     assert np.isfinite(g.x).all() and np.isfinite(g.edge_attr).all()
     assert g.x.flags.writeable and g.x.flags.c_contiguous
@@ -53,10 +53,10 @@ def test_state_graph_is_the_induced_subgraph(lack):
 
 def test_empty_state_and_feature_parameters(lack):
     g = lack.graph(present=[])
-    assert g.x.shape == (0, 74) and g.edge_index.shape == (2, 0) and g.edge_attr.shape == (0, 146)
+    assert g.x.shape == (0, 74) and g.edge_index.shape == (2, 0) and g.edge_attr.shape == (0, 152)
     small = lack.graph(radius_bins=2, degree=3, points_per_part=256)
-    assert small.node_dim == 2 * 4 + 2 and small.edge_dim == 2 * (2 * 4) + 2
-    assert small.features == "asp-graph/1 radius_bins=2 degree=3 points=256"
+    assert small.node_dim == 2 * 4 + 2 and small.edge_dim == 2 * (2 * 4) + 6 + 2
+    assert small.features == "asp-graph/2 radius_bins=2 degree=3 points=256"
 
 
 def test_graph_is_deterministic_and_cached(lack):

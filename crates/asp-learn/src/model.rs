@@ -538,9 +538,9 @@ mod tests {
     #[test]
     fn the_fixture_passes_every_check() {
         let m = RemovabilityModel::from_proto(&proto(), "random_gnn.onnx").unwrap();
-        assert_eq!((m.node_dim(), m.edge_dim()), (74, 146));
+        assert_eq!((m.node_dim(), m.edge_dim()), (74, 152));
         assert!(m.symbols.is_some(), "n and e should be plain symbols");
-        m.check_features("asp-graph/1 radius_bins=8 degree=8 points=2048", 74, 146).unwrap();
+        m.check_features("asp-graph/2 radius_bins=8 degree=8 points=2048", 74, 152).unwrap();
     }
 
     #[test]
@@ -585,7 +585,7 @@ mod tests {
         assert_eq!(error_of(&p), "models/x.onnx: input 'x' has a fixed size 5 on axis 0; n must be dynamic");
         let mut p = proto();
         input_dims(&mut p, "edge_attr")[1].value = Some(dimension::Value::DimValue(140));
-        assert_eq!(error_of(&p), "models/x.onnx: input 'edge_attr' has 140 features, its asp.edge_dim says 146");
+        assert_eq!(error_of(&p), "models/x.onnx: input 'edge_attr' has 140 features, its asp.edge_dim says 152");
     }
 
     #[test]

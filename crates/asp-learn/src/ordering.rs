@@ -169,20 +169,32 @@ impl GnnSource {
     /// The model shipped with asp (`models/removability.onnx`, embedded in the binary; trained by
     /// `scripts/train-removability`), for graphs with the default features.
     pub fn shipped() -> Result<Self> {
-        let config = GraphConfig::default();
         let model = RemovabilityModel::from_bytes(SHIPPED_MODEL, "models/removability.onnx (shipped)")?;
+        let config = with_version_of(GraphConfig::default(), &model);
         Self::new(Arc::new(model), config)
     }
 
-    /// Load the model at `path` for graphs computed with `config`.
+    /// Load the model at `path` for graphs computed with `config`; whether edges carry contact
+    /// directions (`asp-graph/2`) or not (`asp-graph/1`) follows the model, so models trained on
+    /// either feature set keep working.
     pub fn load(path: impl AsRef<std::path::Path>, config: GraphConfig) -> Result<Self> {
-        let model = RemovabilityModel::load(path, &config.features(), config.node_dim(), config.edge_dim())?;
+        let model = RemovabilityModel::open(path)?;
+        let config = with_version_of(config, &model);
+        model.check_features(&config.features(), config.node_dim(), config.edge_dim())?;
         Ok(GnnSource { model: Arc::new(model), config })
     }
 
     /// The model.
     pub fn model(&self) -> &Arc<RemovabilityModel> {
         &self.model
+    }
+}
+
+/// `config` with the feature version (contact directions or not) of the model's features string.
+fn with_version_of(config: GraphConfig, model: &RemovabilityModel) -> GraphConfig {
+    match GraphConfig::from_features(model.features()) {
+        Some(m) => GraphConfig { contact_directions: m.contact_directions, ..config },
+        None => config,
     }
 }
 

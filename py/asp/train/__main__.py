@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 from ..data import DataError
-from .export import ExportError, export_onnx
+from .export import ExportError, export_onnx, write_parity_cases
 from .trainer import AssemblyData, TrainConfig, evaluate, load_assemblies, train
 
 
@@ -44,6 +44,11 @@ def _parser() -> argparse.ArgumentParser:
         "--parity-tolerance", type=float, default=1e-5,
         help="largest ONNX/PyTorch difference the export check accepts (default 1e-5)",
     )
+    r.add_argument(
+        "--parity-cases", type=Path, metavar="FILE",
+        help="also write a few input graphs with the PyTorch outputs as JSON (for parity tests in other runtimes)",
+    )
+    r.add_argument("--pos-weight", type=float, default=1.0, help="weight of the removable class in the loss (default 1)")
     g = r.add_mutually_exclusive_group()
     g.add_argument("--holdout", nargs="+", metavar="NAME", default=[], help="assemblies to evaluate on, not train on")
     g.add_argument("--leave-one-out", type=Path, metavar="OUT_DIR", help="one model per assembly, trained on the others")
@@ -70,12 +75,16 @@ def _fit_and_export(
     config = TrainConfig(
         epochs=args.epochs, lr=args.lr, batch=args.batch, seed=args.seed,
         width=args.width, layers=args.layers, seconds=args.seconds, threads=args.threads,
+        pos_weight=args.pos_weight,
     )
     names = ", ".join(a.name for a in train_set)
     _log(f"training on {sum(len(a.states) for a in train_set)} states of {len(train_set)} assemblies ({names})")
     model, summary = train(train_set, node_dim, edge_dim, config, log=_log)
     parity = export_onnx(model, out, features, aggregation=args.aggregation, tolerance=args.parity_tolerance)
     _log(f"wrote {out} (ONNX matches PyTorch to {parity:.2g})")
+    if getattr(args, "parity_cases", None) is not None:
+        write_parity_cases(model, args.parity_cases, features)
+        _log(f"wrote {args.parity_cases}")
     train_acc = {a.name: evaluate(model, a) for a in train_set}
     held = {a.name: evaluate(model, a) for a in test_set}
     for name, r in held.items():
@@ -97,6 +106,7 @@ def _fit_and_export(
         "layers": args.layers,
         "width": args.width,
         "aggregation": args.aggregation,
+        "pos_weight": args.pos_weight,
         "final_loss": summary["loss"],
         "train_seconds": summary["seconds"],
         "onnx_parity_max_abs_diff": parity,

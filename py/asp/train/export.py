@@ -25,7 +25,10 @@ import torch
 
 from .gnn import RemovabilityGNN
 
-__all__ = ["OPSET", "INPUT_NAMES", "OUTPUT_NAME", "ExportError", "export_onnx", "parity_check", "run_onnx", "random_graph"]
+__all__ = [
+    "OPSET", "INPUT_NAMES", "OUTPUT_NAME", "ExportError", "export_onnx", "parity_check", "run_onnx", "random_graph",
+    "write_parity_cases",
+]
 
 #: The ONNX opset of exported models.
 OPSET = 17
@@ -35,6 +38,9 @@ INPUT_NAMES = ("x", "edge_index", "edge_attr")
 OUTPUT_NAME = "removability"
 #: ``(n, e)`` of the graphs the exporter checks parity on.
 PARITY_SIZES = ((7, 0), (53, 212), (131, 610))
+#: ``(n, e)`` of the cases :func:`write_parity_cases` writes (sizes never used in training batches
+#: as such; small, so the file stays small).
+CASE_SIZES = ((3, 0), (9, 24), (19, 60))
 
 
 class ExportError(RuntimeError):
@@ -190,3 +196,40 @@ def export_onnx(
     if not check:
         return None
     return parity_check(model, path, tolerance=tolerance)
+
+
+def _f32(v: float) -> float:
+    # shortest decimal that reads back as the same float32
+    return float(np.format_float_positional(np.float32(v), unique=True, trim="-"))
+
+
+def write_parity_cases(model: RemovabilityGNN, path: os.PathLike | str, features: str, seed: int = 4242) -> None:
+    """Write graphs drawn like the model's training inputs (:data:`CASE_SIZES`) with the PyTorch
+    outputs, as JSON (``features``, ``node_dim``, ``edge_dim``, ``cases`` of ``n``, ``e``, ``x``,
+    ``edge_index``, ``edge_attr``, ``removability``), so another runtime (asp-learn's tests on the
+    shipped model) can check its parity on the same inputs."""
+    import json
+
+    rng = np.random.default_rng(seed)
+    model = model.eval()
+    cases = []
+    for n, e in CASE_SIZES:
+        x, edge_index, edge_attr = random_graph(n, e, model.node_dim, model.edge_dim, rng)
+        x, edge_attr = _like_training(model, x, edge_attr, rng)
+        # the inputs as written (shortest decimals) are the inputs PyTorch sees
+        x = np.vectorize(_f32)(x).astype(np.float32) if x.size else x
+        edge_attr = np.vectorize(_f32)(edge_attr).astype(np.float32) if edge_attr.size else edge_attr
+        with torch.no_grad():
+            y = model(torch.from_numpy(x), torch.from_numpy(edge_index), torch.from_numpy(edge_attr)).numpy()
+        cases.append({
+            "n": n, "e": int(edge_index.shape[1]),
+            "x": [_f32(v) for v in x.reshape(-1)],
+            "edge_index": [int(v) for v in edge_index.reshape(-1)],
+            "edge_attr": [_f32(v) for v in edge_attr.reshape(-1)],
+            "removability": [_f32(v) for v in y],
+        })
+    doc = {
+        "about": "inputs drawn like the training data and PyTorch outputs of the model; written by asp.train",
+        "features": features, "node_dim": model.node_dim, "edge_dim": model.edge_dim, "cases": cases,
+    }
+    Path(path).write_text(json.dumps(doc, separators=(",", ":")) + "\n")

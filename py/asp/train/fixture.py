@@ -7,8 +7,8 @@ Run from the repository root (seeded; same output on every run with the same tor
 Writes into the folder:
 
 * ``random_gnn.onnx``: a 3-layer, 64-wide :class:`~asp.train.gnn.RemovabilityGNN` with
-  ``node_dim`` 74, ``edge_dim`` 146 and the features string
-  ``asp-graph/1 radius_bins=8 degree=8 points=2048``, briefly trained on random graphs with a
+  ``node_dim`` 74, ``edge_dim`` 152 and the features string
+  ``asp-graph/2 radius_bins=8 degree=8 points=2048``, briefly trained on random graphs with a
   label rule (so its weights and normalisation are not the initial ones), exported with the
   ``scatter`` aggregation;
 * ``random_gnn_dense.onnx``: the same weights exported with the ``dense`` aggregation;
@@ -30,9 +30,9 @@ import torch
 from .export import export_onnx, random_graph
 from .gnn import RemovabilityGNN
 
-FEATURES = "asp-graph/1 radius_bins=8 degree=8 points=2048"
+FEATURES = "asp-graph/2 radius_bins=8 degree=8 points=2048"
 NODE_DIM = 74
-EDGE_DIM = 146
+EDGE_DIM = 152
 SEED = 7
 #: ``(n, e)`` of the parity cases.
 CASE_SIZES = ((1, 0), (6, 0), (9, 20), (23, 64), (40, 160))

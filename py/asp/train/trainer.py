@@ -42,6 +42,8 @@ class TrainConfig:
     """Stop after this many seconds of training (checked after every batch)."""
     threads: int = 1
     """PyTorch CPU threads (results are reproducible for one thread count)."""
+    pos_weight: float = 1.0
+    """Weight of the removable class (label 1) in the loss; above 1 when removable parts are rare."""
 
 
 @dataclass(frozen=True)
@@ -168,6 +170,7 @@ def train(
     edges = np.concatenate([np.asarray(a.assembly.edge_attr) for a in assemblies])
     model.fit_normalisation(torch.from_numpy(nodes), torch.from_numpy(edges))
     optimiser = torch.optim.Adam(model.parameters(), lr=config.lr)
+    pos_weight = torch.tensor(config.pos_weight, dtype=torch.float32)
     rng = np.random.default_rng(config.seed)
     start = time.monotonic()
     epochs_run = 0
@@ -180,7 +183,9 @@ def train(
         for b in range(0, len(order), config.batch):
             batch = make_batch(items[k] for k in order[b : b + config.batch])
             logits = model.logits(batch.x, batch.edge_index, batch.edge_attr)
-            loss = torch.nn.functional.binary_cross_entropy_with_logits(logits[batch.mask], batch.labels[batch.mask])
+            loss = torch.nn.functional.binary_cross_entropy_with_logits(
+                logits[batch.mask], batch.labels[batch.mask], pos_weight=pos_weight
+            )
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()

@@ -22,8 +22,12 @@ use std::ops::Range;
 /// surface sample), `fixed` (1 for a base part), `on_base` (1 when the part touches a fixed part
 /// or the ground).
 ///
-/// **Edge `s → t`** (`edge_dim = 2D + 2` floats): `h(Q_t^s)`, `h(Q_s^t)` (eq. 3.12 with `i = t`,
-/// `j = s`: the contact region on the target, then on the source), `above = up · unit(c_s − c_t)`
+/// **Edge `s → t`** (`edge_dim = 2D + 8` floats; `2D + 2` without contact directions): `h(Q_t^s)`, `h(Q_s^t)` (eq. 3.12 with `i = t`,
+/// `j = s`: the contact region on the target, then on the source), the six **contact
+/// directions** of `Q_t^s` (the area-weighted means of `max(0, ±n·u1)`, `max(0, ±n·u2)` in the
+/// order `+u1, +u2, −u1, −u2`, then `max(0, ±n·up)`, `+up, −up`, with `n` the target's outward
+/// normal: the share of the contact that faces each way, i.e. the directions in which the source
+/// blocks the target; `u1, u2` the model's [`horizontal_frame`]), `above = up · unit(c_s − c_t)`
 /// (`c` the area-weighted surface centroids) and `normal_up`, the area-weighted mean of `up · n`
 /// over `Q_t^s` (outward normals: +1 the target is a floor under the source, −1 a ceiling, 0 a
 /// wall or no region). `Q_i^j` is the sample points of part `i` closer than the world's contact
@@ -48,7 +52,12 @@ struct PairFeatures {
     h: [Vec<f32>; 2],
     /// `normal_up` over `Q_i^j` and over `Q_j^i`.
     normal_up: [f32; 2],
+    /// The contact directions of `Q_i^j` and of `Q_j^i`.
+    directions: [[f32; DIRECTION_BINS]; 2],
 }
+
+/// Floats of an edge's contact directions (`+u1, +u2, −u1, −u2, +up, −up`).
+pub const DIRECTION_BINS: usize = 6;
 
 impl AssemblyGraph {
     /// The graph of the assembled model of `world`: samples and descriptors per part (in
@@ -57,7 +66,6 @@ impl AssemblyGraph {
     pub fn build(world: &World, config: &GraphConfig) -> Result<AssemblyGraph> {
         config.validate()?;
         let n = world.num_parts();
-        let d = config.descriptor_dim();
         let eps = world.contact_distance();
         let up = world.assembly().up.vector();
         let samples: Vec<SurfaceSample> = (0..n)
@@ -68,6 +76,7 @@ impl AssemblyGraph {
             })
             .collect();
         let centroids: Vec<Vec3> = samples.iter().map(|s| s.centroid().unwrap_or(Vec3::ZERO)).collect();
+        let frame = horizontal_frame(&samples, up);
         let part_h: Vec<Vec<f32>> = samples
             .par_iter()
             .map_init(Vec::new, |scratch, s| region_descriptor(s, None, config, scratch))
@@ -87,6 +96,10 @@ impl AssemblyGraph {
                         region_descriptor(&samples[j], Some(&q_ji), config, &mut scratch),
                     ],
                     normal_up: [normal_up(&samples[i], &q_ij, up), normal_up(&samples[j], &q_ji, up)],
+                    directions: [
+                        contact_directions(&samples[i], &q_ij, frame, up),
+                        contact_directions(&samples[j], &q_ji, frame, up),
+                    ],
                 }
             })
             .collect();
@@ -107,12 +120,15 @@ impl AssemblyGraph {
                 let (on_t, on_s) = if s < t { (1, 0) } else { (0, 1) };
                 edge_attr.extend_from_slice(&f.h[on_t]);
                 edge_attr.extend_from_slice(&f.h[on_s]);
+                if config.contact_directions {
+                    edge_attr.extend_from_slice(&f.directions[on_t]);
+                }
                 edge_attr.push(up.dot((centroids[s] - centroids[t]).normalize_or_zero()));
                 edge_attr.push(f.normal_up[on_t]);
                 edges.push((s, t));
             }
         }
-        debug_assert_eq!(edge_attr.len(), edges.len() * (2 * d + 2));
+        debug_assert_eq!(edge_attr.len(), edges.len() * config.edge_dim());
         Self::from_parts(config, nodes, edges, edge_attr)
     }
 
@@ -277,5 +293,78 @@ fn normal_up(sample: &SurfaceSample, region: &[u32], up: Vec3) -> f32 {
         (sum / total) as f32
     } else {
         0.0
+    }
+}
+
+/// The model's horizontal frame `(u1, u2)` (with `up`, right-handed), or `None` when the model
+/// has no dominant horizontal directions.
+///
+/// Over every sample point of every part, with `(a, b)` the horizontal part of its normal in a
+/// fixed basis `(e1, e2)` of the plane normal to `up`, `c = Σ w (a + ib)⁴`; `u1` is at angle
+/// `arg(c) / 4` from `e1`. Faces at right angles reinforce each other, so for a model of
+/// axis-aligned boxes `u1` is one of its horizontal axes. Turning the model about `up` by `ψ`
+/// turns `c` by `4ψ`, so the frame turns with the model up to a quarter turn: the contact
+/// directions of a turned model are those of the original with `+u1, +u2, −u1, −u2` shifted
+/// cyclically. When `|c|` is below a tenth of `Σ w |(a, b)|⁴` (round or irregular models) the
+/// frame is undefined and the horizontal directions are spread evenly (see
+/// [`contact_directions`]).
+pub fn horizontal_frame(samples: &[SurfaceSample], up: Vec3) -> Option<(Vec3, Vec3)> {
+    let up = up.normalize_or_zero();
+    // a basis that depends only on the up axis: the world axis after up's largest component
+    let e1 = {
+        let mut v = Vec3::ZERO;
+        v[(up.abs().max_position() + 1) % 3] = 1.0;
+        (v - up * up.dot(v)).normalize_or_zero()
+    };
+    let e2 = up.cross(e1);
+    let (mut re, mut im, mut total) = (0.0f64, 0.0f64, 0.0f64);
+    for s in samples {
+        for (n, &w) in s.normals.iter().zip(&s.weights) {
+            let (a, b, w) = (n.dot(e1) as f64, n.dot(e2) as f64, w as f64);
+            let (a2, b2) = (a * a - b * b, 2.0 * a * b); // (a + ib)²
+            re += w * (a2 * a2 - b2 * b2);
+            im += w * 2.0 * a2 * b2;
+            total += w * (a * a + b * b) * (a * a + b * b);
+        }
+    }
+    if total <= 0.0 || (re * re + im * im).sqrt() < 0.1 * total {
+        return None;
+    }
+    let alpha = (im.atan2(re) / 4.0) as f32;
+    let u1 = e1 * alpha.cos() + e2 * alpha.sin();
+    Some((u1, up.cross(u1)))
+}
+
+/// The contact directions of `region` of `sample` (zeros when empty): per point the positive
+/// parts of `n·u1`, `n·u2`, `−n·u1`, `−n·u2`, `n·up`, `−n·up`, averaged with the area weights.
+/// Without a frame, each horizontal entry is a quarter of the mean horizontal length of `n`.
+pub fn contact_directions(sample: &SurfaceSample, region: &[u32], frame: Option<(Vec3, Vec3)>, up: Vec3) -> [f32; DIRECTION_BINS] {
+    let mut sum = [0.0f64; DIRECTION_BINS];
+    let mut total = 0.0f64;
+    for &k in region {
+        let (n, w) = (sample.normals[k as usize], sample.weights[k as usize] as f64);
+        total += w;
+        let v = up.dot(n);
+        match frame {
+            Some((u1, u2)) => {
+                let (a, b) = (u1.dot(n), u2.dot(n));
+                for (slot, c) in [a, b, -a, -b].into_iter().enumerate() {
+                    sum[slot] += w * c.max(0.0) as f64;
+                }
+            }
+            None => {
+                let h = (n - up * v).length() as f64 / 4.0;
+                for slot in sum.iter_mut().take(4) {
+                    *slot += w * h;
+                }
+            }
+        }
+        sum[4] += w * v.max(0.0) as f64;
+        sum[5] += w * (-v).max(0.0) as f64;
+    }
+    if total > 0.0 {
+        sum.map(|v| (v / total) as f32)
+    } else {
+        [0.0; DIRECTION_BINS]
     }
 }

@@ -20,11 +20,14 @@ pub struct GraphConfig {
     /// Target number of surface sample points per part (every triangle with area gets at least
     /// one, so a finely meshed part may get more). Default 2048.
     pub points_per_part: usize,
+    /// Whether edges carry the six contact directions (feature set `asp-graph/2`; without them
+    /// `asp-graph/1`, the features of models trained before). Default true.
+    pub contact_directions: bool,
 }
 
 impl Default for GraphConfig {
     fn default() -> Self {
-        GraphConfig { radius_bins: 8, degree: 8, points_per_part: 2048 }
+        GraphConfig { radius_bins: 8, degree: 8, points_per_part: 2048, contact_directions: true }
     }
 }
 
@@ -58,13 +61,41 @@ impl GraphConfig {
     }
 
     /// The name of the feature set with its parameters, e.g.
-    /// `asp-graph/1 radius_bins=8 degree=8 points=2048`. Models record it; asp refuses a model
+    /// `asp-graph/2 radius_bins=8 degree=8 points=2048`. Models record it; asp refuses a model
     /// whose string differs from the features it computes.
     pub fn features(&self) -> String {
         format!(
-            "asp-graph/1 radius_bins={} degree={} points={}",
-            self.radius_bins, self.degree, self.points_per_part
+            "asp-graph/{} radius_bins={} degree={} points={}",
+            if self.contact_directions { 2 } else { 1 },
+            self.radius_bins,
+            self.degree,
+            self.points_per_part
         )
+    }
+
+    /// The configuration a features string names (`asp-graph/1` or `/2` with its three
+    /// parameters), or `None` when it names no valid configuration.
+    pub fn from_features(features: &str) -> Option<GraphConfig> {
+        let mut words = features.split_whitespace();
+        let contact_directions = match words.next()? {
+            "asp-graph/1" => false,
+            "asp-graph/2" => true,
+            _ => return None,
+        };
+        let mut config = GraphConfig { contact_directions, ..GraphConfig::default() };
+        let mut seen = 0;
+        for w in words {
+            let (key, value) = w.split_once('=')?;
+            let value: usize = value.parse().ok()?;
+            match key {
+                "radius_bins" => config.radius_bins = value,
+                "degree" => config.degree = value,
+                "points" => config.points_per_part = value,
+                _ => return None,
+            }
+            seen += 1;
+        }
+        (seen == 3 && config.validate().is_ok() && config.features() == features).then_some(config)
     }
 
     /// Length `D` of one descriptor: `radius_bins × (degree + 1)` (72 by default).
@@ -77,9 +108,11 @@ impl GraphConfig {
         self.descriptor_dim() + 2
     }
 
-    /// Length of an edge's attributes: `2D + 2` (two descriptors, `above`, `normal_up`).
+    /// Length of an edge's attributes: `2D + 8` (two descriptors, six contact directions,
+    /// `above`, `normal_up`), `2D + 2` without contact directions.
     pub fn edge_dim(&self) -> usize {
-        2 * self.descriptor_dim() + 2
+        let directions = if self.contact_directions { super::build::DIRECTION_BINS } else { 0 };
+        2 * self.descriptor_dim() + directions + 2
     }
 }
 
@@ -122,11 +155,20 @@ mod tests {
     #[test]
     fn defaults_name_the_contract_features() {
         let c = GraphConfig::default();
-        assert_eq!(c.features(), "asp-graph/1 radius_bins=8 degree=8 points=2048");
-        assert_eq!((c.descriptor_dim(), c.node_dim(), c.edge_dim()), (72, 74, 146));
+        assert_eq!(c.features(), "asp-graph/2 radius_bins=8 degree=8 points=2048");
+        assert_eq!((c.descriptor_dim(), c.node_dim(), c.edge_dim()), (72, 74, 152));
         let c = GraphConfig::builder().radius_bins(4).degree(3).points_per_part(100).build().unwrap();
-        assert_eq!(c.features(), "asp-graph/1 radius_bins=4 degree=3 points=100");
-        assert_eq!((c.descriptor_dim(), c.node_dim(), c.edge_dim()), (16, 18, 34));
+        assert_eq!(c.features(), "asp-graph/2 radius_bins=4 degree=3 points=100");
+        assert_eq!((c.descriptor_dim(), c.node_dim(), c.edge_dim()), (16, 18, 40));
+        let old = GraphConfig { contact_directions: false, ..GraphConfig::default() };
+        assert_eq!(old.features(), "asp-graph/1 radius_bins=8 degree=8 points=2048");
+        assert_eq!(old.edge_dim(), 146);
+        for config in [c, old, GraphConfig::default()] {
+            assert_eq!(GraphConfig::from_features(&config.features()), Some(config));
+        }
+        for bad in ["asp-graph/3 radius_bins=8 degree=8 points=2048", "asp-graph/2 radius_bins=8 degree=8", "asp-graph/2 radius_bins=0 degree=8 points=2048", "tiny/1"] {
+            assert_eq!(GraphConfig::from_features(bad), None, "{bad}");
+        }
     }
 
     #[test]

@@ -168,19 +168,23 @@ fn graph(w: &World) -> AssemblyGraph {
 fn stacked_boxes_have_the_expected_edges_and_gravity_attributes() {
     let w = world(fixtures::stacked_boxes(), &WorldConfig::default());
     let g = graph(&w);
-    assert_eq!(g.features(), "asp-graph/1 radius_bins=8 degree=8 points=2048");
-    assert_eq!((g.num_parts(), g.node_dim(), g.edge_dim()), (3, 74, 146));
+    assert_eq!(g.features(), "asp-graph/2 radius_bins=8 degree=8 points=2048");
+    assert_eq!((g.num_parts(), g.node_dim(), g.edge_dim()), (3, 74, 152));
     // base 0, lower 1, top 2: sorted by (source, target)
     assert_eq!(g.edges(), &[(0, 1), (1, 0), (1, 2), (2, 1)]);
     let d = 72;
-    let above = |k: usize| g.edge_attr(k)[2 * d];
-    let normal_up = |k: usize| g.edge_attr(k)[2 * d + 1];
+    let above = |k: usize| g.edge_attr(k)[2 * d + 6];
+    let normal_up = |k: usize| g.edge_attr(k)[2 * d + 7];
+    let directions = |k: usize| &g.edge_attr(k)[2 * d..2 * d + 6];
     // 0 → 1: the base is below the lower box, whose contact region is its bottom (a ceiling)
     assert_eq!((above(0), normal_up(0)), (-1.0, -1.0));
     // 1 → 0: the lower box is above the base, which receives it on its top face (a floor)
     assert_eq!((above(1), normal_up(1)), (1.0, 1.0));
     assert_eq!((above(2), normal_up(2)), (-1.0, -1.0));
     assert_eq!((above(3), normal_up(3)), (1.0, 1.0));
+    // contact directions (+u1, +u2, -u1, -u2, +up, -up): a ceiling faces down, a floor up
+    assert_eq!(directions(0), &[0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+    assert_eq!(directions(1), &[0.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
     // fixed, on_base
     let flags = |i: usize| (g.node_attr(i)[d], g.node_attr(i)[d + 1]);
     assert_eq!(flags(0), (1.0, 0.0));
@@ -201,7 +205,7 @@ fn stacked_boxes_have_the_expected_edges_and_gravity_attributes() {
     assert!(relative_gap(&g.node_attr(1)[..d], &h01[..d]) > 0.02);
     // flat accessors agree with the rows
     assert_eq!(&g.nodes_flat()[74..148], g.node_attr(1));
-    assert_eq!(&g.edge_attr_flat()[146 * 3..], g.edge_attr(3));
+    assert_eq!(&g.edge_attr_flat()[152 * 3..], g.edge_attr(3));
 }
 
 /// Distance from `p` to the surface of the box `[lo, hi]`, for `p` outside or on it.
@@ -246,15 +250,21 @@ fn edge_attributes_follow_the_contract_order_computed_naively() {
     // edge 0 → 1: [h(Q_1^0), h(Q_0^1), up · unit(c_0 − c_1), normal_up over Q_1^0]
     let e = g.edge_attr(0);
     assert!(close(&e[..72], &h10) && close(&e[72..144], &h01));
-    assert!((e[144] - (c[0] - c[1]).normalize().z).abs() < 1e-6 && e[144] < -0.5);
-    assert!((e[145] - up10).abs() < 1e-5, "{} vs {up10}", e[145]);
+    assert!((e[150] - (c[0] - c[1]).normalize().z).abs() < 1e-6 && e[150] < -0.5);
+    assert!((e[151] - up10).abs() < 1e-5, "{} vs {up10}", e[151]);
     // its bottom faces down, its side bands sideways
-    assert!(e[145] < -0.2 && e[145] > -0.6, "the small box's region: {}", e[145]);
+    assert!(e[151] < -0.2 && e[151] > -0.6, "the small box's region: {}", e[151]);
+    // the contact directions: the bottom's share faces -up, the side bands' shares face the four
+    // horizontal ways (the frame of boxes is their axes), and the shares sum to one
+    assert!((e[149] - (-up10)).abs() < 1e-5 && e[148] == 0.0, "{:?}", &e[144..150]);
+    assert!(e[144..148].iter().all(|v| *v > 0.02), "{:?}", &e[144..150]);
+    assert!((e[144..150].iter().sum::<f32>() - 1.0).abs() < 1e-5, "{:?}", &e[144..150]);
     // edge 1 → 0: [h(Q_0^1), h(Q_1^0), up · unit(c_1 − c_0), normal_up over Q_0^1]
     let e = g.edge_attr(1);
     assert!(close(&e[..72], &h01) && close(&e[72..144], &h10));
-    assert!((e[144] - (c[1] - c[0]).normalize().z).abs() < 1e-6 && e[144] > 0.5);
-    assert!((e[145] - up01).abs() < 1e-5 && e[145] > 0.99, "the big box's region is a floor: {}", e[145]);
+    assert!((e[150] - (c[1] - c[0]).normalize().z).abs() < 1e-6 && e[150] > 0.5);
+    assert!((e[151] - up01).abs() < 1e-5 && e[151] > 0.99, "the big box's region is a floor: {}", e[151]);
+    assert!((e[148] - up01).abs() < 1e-5, "{:?}", &e[144..150]);
     // node attributes are the whole part's descriptor, fixed and on_base
     for (i, s) in samples.iter().enumerate() {
         assert!(close(&g.node_attr(i)[..72], &sh_descriptor(&s.points, &s.weights, &config)));
@@ -279,12 +289,23 @@ fn without_a_fixed_part_the_ground_is_the_base_but_no_node() {
     assert_eq!(&g.node_attr(1)[72..], &[0.0, 0.0]);
 }
 
-/// Every attribute of `g` and `h` within `tol` (absolute: every entry is in [-1, 1]).
+/// Every attribute of `g` and `h` within `tol` (absolute: every entry is in [-1, 1]), except
+/// that the horizontal contact directions (`+u1, +u2, -u1, -u2`) of `h` may be those of `g`
+/// turned by the same number of quarter turns on every edge: the model's horizontal frame turns
+/// with the model only up to a quarter turn (`asp_geom::graph::horizontal_frame`).
 fn assert_same_graph(g: &AssemblyGraph, h: &AssemblyGraph, tol: f32, what: &str) {
     assert_eq!(g.edges(), h.edges(), "{what}: edges");
     let gap = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0f32, f32::max);
     let nodes = gap(g.nodes_flat(), h.nodes_flat());
-    let edges = gap(g.edge_attr_flat(), h.edge_attr_flat());
+    let d = 2 * g.config().descriptor_dim();
+    let turned = |k: usize, q: usize| -> Vec<f32> {
+        let mut e = g.edge_attr(k).to_vec();
+        e[d..d + 4].rotate_right(q);
+        e
+    };
+    let edges = (0..4)
+        .map(|q| (0..g.num_edges()).map(|k| gap(&turned(k, q), h.edge_attr(k))).fold(0.0f32, f32::max))
+        .fold(f32::INFINITY, f32::min);
     assert!(nodes < tol && edges < tol, "{what}: node gap {nodes}, edge gap {edges}");
 }
 
@@ -351,7 +372,7 @@ fn a_real_model_keeps_its_part_features_when_moved_with_its_up_axis() {
             match h.edges().binary_search(e) {
                 Ok(j) => {
                     let (ga, ha) = (g.edge_attr(k), h.edge_attr(j));
-                    assert!((ga[144] - ha[144]).abs() < 1e-4, "pump edge {e:?}: above {} vs {}", ga[144], ha[144]);
+                    assert!((ga[150] - ha[150]).abs() < 1e-4, "pump edge {e:?}: above {} vs {}", ga[150], ha[150]);
                 }
                 Err(_) => differ += 1,
             }
@@ -464,7 +485,7 @@ fn every_shipped_model_has_finite_consistent_features() {
         assert_eq!(graph(&w), g, "{name}: two builds differ");
         let n = g.num_parts();
         assert_eq!(g.nodes_flat().len(), n * 74);
-        assert_eq!(g.edge_attr_flat().len(), g.num_edges() * 146);
+        assert_eq!(g.edge_attr_flat().len(), g.num_edges() * 152);
         assert!(g.nodes_flat().iter().chain(g.edge_attr_flat()).all(|v| v.is_finite() && (-1.0 - 1e-5..=1.0 + 1e-5).contains(v)), "{name}");
         // edges are the world's contacts between real parts, both ways, sorted
         let expect: Vec<(usize, usize)> =
@@ -489,10 +510,10 @@ fn bad_configuration_is_an_error() {
     let e = AssemblyGraph::build(&w, &bad).unwrap_err().to_string();
     assert!(e.contains("degree"), "{e}");
     let c = GraphConfig::default();
-    assert!(AssemblyGraph::from_parts(&c, vec![0.0; 74 * 2], vec![(1, 0), (0, 1)], vec![0.0; 146 * 2]).is_err());
-    assert!(AssemblyGraph::from_parts(&c, vec![0.0; 74 * 2], vec![(0, 2)], vec![0.0; 146]).is_err());
+    assert!(AssemblyGraph::from_parts(&c, vec![0.0; 74 * 2], vec![(1, 0), (0, 1)], vec![0.0; 152 * 2]).is_err());
+    assert!(AssemblyGraph::from_parts(&c, vec![0.0; 74 * 2], vec![(0, 2)], vec![0.0; 152]).is_err());
     assert!(AssemblyGraph::from_parts(&c, vec![0.0; 75], vec![], vec![]).is_err());
-    let g = AssemblyGraph::from_parts(&c, vec![0.5; 74 * 2], vec![(0, 1), (1, 0)], vec![0.25; 146 * 2]).unwrap();
+    let g = AssemblyGraph::from_parts(&c, vec![0.5; 74 * 2], vec![(0, 1), (1, 0)], vec![0.25; 152 * 2]).unwrap();
     assert_eq!(g.edges_from(1), 1..2);
     assert_eq!(g.edges_from(5), 0..0);
 }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use asp_learn::{LearnError, RemovabilityModel, ShapePolicy};
 use serde::Deserialize;
 
-const FEATURES: &str = "asp-graph/1 radius_bins=8 degree=8 points=2048";
+const FEATURES: &str = "asp-graph/2 radius_bins=8 degree=8 points=2048";
 
 fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
@@ -30,7 +30,11 @@ struct Case {
 }
 
 fn cases() -> Cases {
-    let text = std::fs::read_to_string(fixture("random_gnn_cases.json")).expect("cases fixture");
+    cases_of("random_gnn_cases.json")
+}
+
+fn cases_of(file: &str) -> Cases {
+    let text = std::fs::read_to_string(fixture(file)).expect("cases fixture");
     serde_json::from_str(&text).expect("cases parse")
 }
 
@@ -58,17 +62,17 @@ fn graph(n: usize, e: usize, seed: u64) -> (Vec<f32>, Vec<i64>, Vec<f32>) {
         dst.push(b as i64);
     }
     src.extend(dst);
-    let attr = (0..e * 146).map(|_| (next() % 1000) as f32 / 500.0 - 0.3).collect();
+    let attr = (0..e * 152).map(|_| (next() % 1000) as f32 / 500.0 - 0.3).collect();
     (x, src, attr)
 }
 
 #[test]
 fn matches_pytorch_on_the_fixture_cases() {
     let c = cases();
-    assert_eq!((c.features.as_str(), c.node_dim, c.edge_dim), (FEATURES, 74, 146));
+    assert_eq!((c.features.as_str(), c.node_dim, c.edge_dim), (FEATURES, 74, 152));
     for file in ["random_gnn.onnx", "random_gnn_dense.onnx"] {
         for policy in [ShapePolicy::Buckets, ShapePolicy::Symbolic] {
-            let model = RemovabilityModel::load(fixture(file), FEATURES, 74, 146).unwrap().with_policy(policy);
+            let model = RemovabilityModel::load(fixture(file), FEATURES, 74, 152).unwrap().with_policy(policy);
             let mut worst = 0.0f32;
             for case in &c.cases {
                 let got = model.score(&case.x, case.n, &case.edge_index, case.e, &case.edge_attr).unwrap();
@@ -81,9 +85,28 @@ fn matches_pytorch_on_the_fixture_cases() {
 }
 
 #[test]
+fn the_shipped_model_matches_pytorch() {
+    // shipped_cases.json: graphs drawn like the training data with the trained model's PyTorch
+    // outputs, written by `python -m asp.train removability ... --parity-cases` in
+    // scripts/train-removability together with models/removability.onnx
+    let c = cases_of("shipped_cases.json");
+    for policy in [ShapePolicy::Buckets, ShapePolicy::Symbolic] {
+        let model = RemovabilityModel::from_bytes(asp_learn::SHIPPED_MODEL, "shipped").unwrap().with_policy(policy);
+        model.check_features(&c.features, c.node_dim, c.edge_dim).expect("the cases belong to the shipped model");
+        let mut worst = 0.0f32;
+        for case in &c.cases {
+            let got = model.score(&case.x, case.n, &case.edge_index, case.e, &case.edge_attr).unwrap();
+            worst = worst.max(max_diff(&got, &case.removability));
+        }
+        assert!(worst <= 1e-5, "shipped {policy:?}: max abs diff {worst}");
+        println!("shipped {policy:?}: max abs diff to PyTorch {worst:.2e}");
+    }
+}
+
+#[test]
 fn padding_does_not_change_real_outputs() {
-    let padded = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 146).unwrap();
-    let exact = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 146).unwrap().with_policy(ShapePolicy::Symbolic);
+    let padded = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 152).unwrap();
+    let exact = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 152).unwrap().with_policy(ShapePolicy::Symbolic);
     // sizes on, just below and just above bucket boundaries
     for (k, (n, e)) in [(2, 1), (7, 8), (8, 8), (9, 13), (40, 160), (47, 191), (48, 192), (100, 500)].into_iter().enumerate() {
         let (x, ei, ea) = graph(n, e, k as u64 + 1);
@@ -98,9 +121,9 @@ fn padding_does_not_change_real_outputs() {
 
 #[test]
 fn graphs_without_edges_work() {
-    let model = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 146).unwrap();
+    let model = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 152).unwrap();
     for policy in [ShapePolicy::Buckets, ShapePolicy::Symbolic] {
-        let model = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 146).unwrap().with_policy(policy);
+        let model = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 152).unwrap().with_policy(policy);
         let (x, _, _) = graph(5, 0, 3);
         let all = model.score(&x, 5, &[], 0, &[]).unwrap();
         assert_eq!(all.len(), 5);
@@ -114,7 +137,7 @@ fn graphs_without_edges_work() {
 
 #[test]
 fn scores_from_several_threads() {
-    let model = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 146).unwrap();
+    let model = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 152).unwrap();
     let (x, ei, ea) = graph(30, 90, 11);
     let expected = model.score(&x, 30, &ei, 90, &ea).unwrap();
     std::thread::scope(|s| {
@@ -130,14 +153,14 @@ fn scores_from_several_threads() {
 
 #[test]
 fn wrong_features_or_dimensions_are_refused() {
-    let err = RemovabilityModel::load(fixture("random_gnn.onnx"), "asp-graph/1 radius_bins=8 degree=8 points=1024", 74, 146).unwrap_err();
+    let err = RemovabilityModel::load(fixture("random_gnn.onnx"), "asp-graph/2 radius_bins=8 degree=8 points=1024", 74, 152).unwrap_err();
     let path = fixture("random_gnn.onnx").display().to_string();
     assert_eq!(
         err.to_string(),
-        format!("{path}: trained on features '{FEATURES}', asp computes 'asp-graph/1 radius_bins=8 degree=8 points=1024'")
+        format!("{path}: trained on features '{FEATURES}', asp computes 'asp-graph/2 radius_bins=8 degree=8 points=1024'")
     );
     let tiny = fixture("tiny_gnn.onnx");
-    let err = RemovabilityModel::load(&tiny, FEATURES, 74, 146).unwrap_err();
+    let err = RemovabilityModel::load(&tiny, FEATURES, 74, 152).unwrap_err();
     assert_eq!(err.to_string(), format!("{}: input 'x' has 6 features, the graph has 74", tiny.display()));
     let err = RemovabilityModel::load(&tiny, "tiny/1", 6, 7).unwrap_err();
     assert_eq!(err.to_string(), format!("{}: input 'edge_attr' has 5 features, the graph has 7", tiny.display()));
@@ -157,7 +180,7 @@ fn missing_and_broken_files_are_refused() {
 
 #[test]
 fn inconsistent_inputs_are_errors_not_panics() {
-    let model = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 146).unwrap();
+    let model = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 152).unwrap();
     let (x, ei, ea) = graph(4, 3, 5);
     let msg = |r: Result<Vec<f32>, LearnError>| r.unwrap_err().to_string();
     assert!(msg(model.score(&x[1..], 4, &ei, 3, &ea)).contains("bad input: x has 295 floats, expected n × node_dim = 4 × 74"));

@@ -78,7 +78,7 @@ fn a_dfs_with_the_learned_ordering_finds_plans() {
 fn other_features_are_refused() {
     let config = GraphConfig::builder().points_per_part(1024).build().unwrap();
     let err = GnnSource::new(model(), config.clone()).unwrap_err().to_string();
-    assert!(err.ends_with("trained on features 'asp-graph/1 radius_bins=8 degree=8 points=2048', asp computes 'asp-graph/1 radius_bins=8 degree=8 points=1024'"), "{err}");
+    assert!(err.ends_with("trained on features 'asp-graph/2 radius_bins=8 degree=8 points=2048', asp computes 'asp-graph/2 radius_bins=8 degree=8 points=1024'"), "{err}");
     let world = World::new(fixtures::stacked_boxes(), &WorldConfig::default()).unwrap();
     let graph = Arc::new(AssemblyGraph::build(&world, &config).unwrap());
     assert!(GnnFactory::new(graph, model()).is_err());

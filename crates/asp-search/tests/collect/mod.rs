@@ -33,7 +33,7 @@ fn data_set_files_labels_and_reproducibility() {
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("index.json")).unwrap()).unwrap();
     assert_eq!(json["format"], "asp-removability");
     assert_eq!(json["version"], 1);
-    assert_eq!(json["features"], "asp-graph/1 radius_bins=8 degree=8 points=2048");
+    assert_eq!(json["features"], "asp-graph/2 radius_bins=8 degree=8 points=2048");
     let (node_dim, edge_dim) = (json["node_dim"].as_u64().unwrap() as usize, json["edge_dim"].as_u64().unwrap() as usize);
     for (entry, path) in json["assemblies"].as_array().unwrap().iter().zip(&models) {
         let folder = out.join(entry["dir"].as_str().unwrap());
