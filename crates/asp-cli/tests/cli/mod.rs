@@ -114,7 +114,7 @@ fn bad_input_is_one_line_naming_the_file() {
 }
 
 #[test]
-fn parts_overlapping_far_beyond_the_tolerance_are_an_error_naming_them() {
+fn parts_overlapping_far_beyond_the_tolerance_leave_along_the_overlap_or_are_an_error_when_asked() {
     let dir = tempfile::tempdir().unwrap();
     let mut a = fixtures::stacked_boxes();
     // push the top box half-way into the lower one
@@ -122,9 +122,26 @@ fn parts_overlapping_far_beyond_the_tolerance_are_an_error_naming_them() {
         v.z -= 0.5;
     }
     let model = fixture_file(dir.path(), &a, "overlap.glb");
-    let o = asp(&["plan", model.to_str().unwrap()]);
+    let o = asp(&["plan", model.to_str().unwrap(), "--overlaps", "error"]);
     assert_error(&o, "overlap");
     assert!(stderr(&o).contains("'lower'") && stderr(&o).contains("'top'"), "{}", stderr(&o));
+    // the default (strict) plans it, warns naming the pair, and the top leaves straight up
+    // (out of the material it already overlaps), never sideways through the lower box
+    let o = asp(&["plan", model.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("warning") && err.contains("'lower' and 'top' overlap"), "{err}");
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let top_index = plan["parts"].as_array().unwrap().iter().find(|p| p["name"] == "top").expect("a part 'top'")["index"].clone();
+    let top = plan["assembly_sequence"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["part"] == top_index)
+        .expect("the top box is in the plan");
+    let d = &top["motion"]["direction"];
+    let (x, y, z) = (d[0].as_f64().unwrap(), d[1].as_f64().unwrap(), d[2].as_f64().unwrap());
+    assert!(x.abs() < 1e-6 && y.abs() < 1e-6 && z.abs() > 0.99, "top moves along z only: {d}");
 }
 
 #[test]
