@@ -44,8 +44,10 @@ def test_optimised_plan_json_is_the_clis(root, asp_cli):
 
 def test_no_plan_pump_explains_what_holds_what(root, asp_cli):
     a = asp.load(PUMP, unit="mm", up="z")
-    # single parts only: body, back lid and the screw through both hold each other (with
-    # subassemblies, the default, they leave the ground as one subassembly and the pump plans)
+    # single parts only: body, back lid, the two large screws through both, and the shaft and
+    # ring pressed into the body (which, under the strict overlap rule, may leave only along
+    # their axis) hold each other (with subassemblies, the default, they leave the ground as one
+    # subassembly and the pump plans; the Rust tests assert the same core)
     assert a.plan().found
     plan = a.plan(subassemblies=False)
     assert plan.status == "no_plan" and not plan.found
@@ -59,8 +61,10 @@ def test_no_plan_pump_explains_what_holds_what(root, asp_cli):
     assert any(e["reason"] == "blocked" and e["parts"] for e in explanation)
     # the partial plan: the parts that came off, onto the stuck core that remains
     partial = [s["part"] for s in plan.partial_assembly_sequence]
-    assert partial == plan.disassembly_sequence[::-1] and len(partial) == len(a) - 3
+    assert partial == plan.disassembly_sequence[::-1] and len(partial) == len(a) - 6
     assert sorted(plan.remaining + partial) == list(range(len(a)))
+    core = sorted(a.parts[i].name.removeprefix("PumpAssembly - ") for i in plan.remaining)
+    assert core == ["BackLid2-1", "LargeScrew1-1", "LargeScrew2-1", "Pump-1", "Ring-1", "Shaft-1"]
     assert {e["part"] for e in explanation} <= set(plan.remaining)
     code, out, err = asp_cli("plan", PUMP, "--unit", "mm", "--up", "z", "--json", "--no-subassemblies")
     assert code == 1, err

@@ -1,28 +1,13 @@
 //! Input overlaps (issue 9 item 1): press fits are data, not errors, and under the default
 //! strict policy an overlapping pair separates only along motions that enter no new material.
 
+use crate::removal::free_axes;
 use asp_geom::math::Vec3;
 use asp_geom::overlap::OverlapKind;
 use asp_geom::{fixtures, Checker, CheckerConfig, FeasibilityChecker, Motion, MotionKind, Outcome, OverlapPolicy, PartSet, World, WorldConfig};
 
 fn world(a: asp_geom::Assembly, overlaps: OverlapPolicy) -> asp_geom::Result<World> {
     World::new(a, &WorldConfig { overlaps, ..WorldConfig::default() })
-}
-
-/// The axis directions along which `part` is free in `state`.
-fn free_axes(w: &World, part: usize, state: &PartSet) -> Vec<&'static str> {
-    let names = ["+x", "-x", "+y", "-y", "+z", "-z"];
-    let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
-    let row = w.blocking_row(part);
-    let present = w.with_fixed(state);
-    axes.iter()
-        .zip(names)
-        .filter(|(a, _)| {
-            let k = w.directions().iter().position(|d| d.dot(**a) > 0.9999).unwrap();
-            !row[k].intersects(&present)
-        })
-        .map(|(_, n)| n)
-        .collect()
 }
 
 /// Every candidate direction along which `part` is free in `state`.

@@ -9,8 +9,8 @@ fn world(a: asp_geom::Assembly) -> World {
     World::new(a, &WorldConfig::default()).expect("fixture builds")
 }
 
-/// The axis directions along which `part` is free in `state`.
-fn free_axes(w: &World, part: usize, state: &PartSet) -> Vec<&'static str> {
+/// The axis directions along which `part` is free in `state` (also used by the overlap tests).
+pub(crate) fn free_axes(w: &World, part: usize, state: &PartSet) -> Vec<&'static str> {
     let names = ["+x", "-x", "+y", "-y", "+z", "-z"];
     let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
     let row = w.blocking_row(part);
