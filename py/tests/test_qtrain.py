@@ -476,3 +476,26 @@ def test_cli_reports_bad_input_in_one_line(tmp_path, capsys):
     assert main(["q", str(root), "--objective", "bonus", "--out", str(tmp_path / "q.onnx")]) == 2
     last = capsys.readouterr().err.strip().splitlines()[-1]
     assert last == f"error: {root / 'a' / 'transitions.jsonl'}:2: 'action' 99 is not one of 'actions'"
+
+
+def test_a_data_set_larger_than_the_buffer_streams_through_it(tmp_path):
+    # 120 training transitions through a buffer of 30: 16 / 8 = 2 new ones per step, round robin
+    # over the assemblies, files restarted at their end; a bad line far into a file is still found
+    _torch()
+    from asp.train.q import QConfig, open_q_assemblies, train_q
+
+    root, _ = bonus_dataset(tmp_path, episodes=8)
+    assemblies, _, node_dim, edge_dim = open_q_assemblies([str(root)], "bonus")
+    train_set = [a for a in assemblies if a.name != "held5"]
+    config = QConfig(steps=60, batch=16, buffer=30, layers=1, width=8)
+    _, summary = train_q(train_set, node_dim, edge_dim, config, FakeGraphs())
+    assert summary["transitions"] == 120 and summary["buffer"] == 30
+    assert summary["transitions_read"] == 30 + 2 * 60  # past the end of every file: they restarted
+    path = root / "a6" / "transitions.jsonl"
+    lines = path.read_text().splitlines()
+    bad = json.loads(lines[19])
+    bad["rewards"] = [1.0]
+    lines[19] = json.dumps(bad)
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(DataError, match=re.escape(f"{path}:20: 'rewards' must be a list of 2 numbers")):
+        train_q(train_set, node_dim, edge_dim, config, FakeGraphs())
