@@ -8,6 +8,7 @@
 
 use crate::mdp::{MdpExtension, ModelContext};
 use crate::objective::resolve_objectives;
+use crate::policy::Policy;
 use crate::ordering::{BuiltinOrder, OrderingSource};
 use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step};
 use crate::report::{OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
@@ -171,6 +172,9 @@ pub struct OptimiseSettings {
     /// Objectives and feasibility filters beyond the built-in ones (e.g. a robot's); their
     /// objective names may appear in `objectives`.
     pub extensions: Vec<Arc<dyn MdpExtension>>,
+    /// The rollout and expansion policy (default: uniformly random; e.g. ε-greedy over learned
+    /// Q-functions, which asp-learn builds).
+    pub policy: Option<Arc<dyn Policy>>,
 }
 
 impl Default for OptimiseSettings {
@@ -187,6 +191,7 @@ impl Default for OptimiseSettings {
             d_max: None,
             support: Support::Below,
             extensions: Vec::new(),
+            policy: None,
         }
     }
 }
@@ -341,9 +346,21 @@ pub fn plan_assembly(
     Ok(PlanResult { report, status: outcome.status, search: None })
 }
 
-/// Optimises a sequence of `assembly` on distance maps (MCTS for one objective, Pareto-MCTS
-/// for several).
-pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<PlanResult> {
+/// The optimiser's problem on one model: the distance maps, the objectives and the extensions'
+/// filters, as [`optimise`] builds them.
+#[derive(Clone, Debug)]
+pub struct OptimiserProblem {
+    /// The problem (it holds the maps and the assembly).
+    pub mdp: Mdp,
+    /// Seconds spent building the distance maps.
+    pub map_seconds: f64,
+}
+
+/// Builds the optimiser's problem of `assembly`: distance maps with the settings' resolution,
+/// cap, gravity check, tolerance, contact distance and overlap policy, the objectives by name
+/// (built-in or from the extensions), the extensions' filters, and `settings.seed` as the
+/// problem's seed. Several objectives need `o.pareto`.
+pub fn optimiser_problem(assembly: &Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<OptimiserProblem> {
     crate::objective::check_objective_names(&o.objectives, &o.extensions)?;
     if o.objectives.split(',').filter(|s| !s.trim().is_empty()).count() > 1 && !o.pareto {
         return Err(SearchError::config(format!(
@@ -351,7 +368,7 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
             o.objectives
         )));
     }
-    let world = world_config(&assembly, settings)?;
+    let world = world_config(assembly, settings)?;
     let metres = assembly.units.metres;
     let mut config = MapConfig::builder().resolution(o.resolution).support(o.support).overlaps(settings.overlaps);
     if let Some(d) = o.d_max {
@@ -367,7 +384,7 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
     let started = Instant::now();
     let maps = Arc::new(DistanceMaps::build(&assembly, &config)?);
     let map_seconds = started.elapsed().as_secs_f64();
-    let model = ModelContext { assembly: &assembly, maps: &maps, seed: settings.seed };
+    let model = ModelContext { assembly, maps: &maps, seed: settings.seed };
     let objectives = resolve_objectives(&o.objectives, &o.extensions, &model)?;
     let mut mdp = Mdp::new(maps.clone(), objectives)?.with_assembly(assembly.clone()).with_seed(settings.seed);
     for e in &o.extensions {
@@ -375,6 +392,15 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
             mdp = mdp.with_filter(f);
         }
     }
+    Ok(OptimiserProblem { mdp, map_seconds })
+}
+
+/// Optimises a sequence of `assembly` on distance maps (MCTS for one objective, Pareto-MCTS
+/// for several).
+pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<PlanResult> {
+    let OptimiserProblem { mdp, map_seconds } = optimiser_problem(&assembly, settings, o)?;
+    let maps = mdp.maps_arc().clone();
+    let model = ModelContext { assembly: &assembly, maps: &maps, seed: settings.seed };
     let threads = o.threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     macro_rules! configure {
         ($builder:expr) => {{
@@ -389,6 +415,9 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
             }
             if let Some(stop) = &settings.cancel {
                 b = b.stop_token(stop.clone());
+            }
+            if let Some(policy) = &o.policy {
+                b = b.policy(policy.clone());
             }
             b.build()?
         }};
