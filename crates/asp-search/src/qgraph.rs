@@ -71,6 +71,13 @@ pub fn direction_history(problem: &Mdp, memory: &[u64]) -> Option<DirMask> {
     h.active.then_some(h.mask)
 }
 
+/// The order of neighbours: the centre distance in units of `1e-5 ×` the model's diagonal,
+/// rounded, so that parts at equal distances (voxel models) tie at every scale and ties go by
+/// part index.
+pub fn neighbour_key(a: Vec3, b: Vec3, diagonal: f32) -> u64 {
+    (f64::from(a.distance(b)) / f64::from(diagonal) * 1e5).round() as u64
+}
+
 /// One state's graph in the layout of a Q model's inputs.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct QGraph {
@@ -147,11 +154,7 @@ impl QGraphBuilder {
         let nearest = (0..n)
             .map(|i| {
                 let mut others: Vec<u16> = (0..n).filter(|&j| j != i).map(|j| j as u16).collect();
-                others.sort_by(|&a, &b| {
-                    let da = centres[i].distance_squared(centres[a as usize]);
-                    let db = centres[i].distance_squared(centres[b as usize]);
-                    da.total_cmp(&db).then(a.cmp(&b))
-                });
+                others.sort_by_key(|&j| (neighbour_key(centres[i], centres[j as usize], diagonal), j));
                 others
             })
             .collect();

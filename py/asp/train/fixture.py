@@ -15,7 +15,11 @@ Writes into the folder:
 * ``random_gnn_cases.json``: input graphs (one without edges, one with a node without incoming
   edges) with PyTorch's outputs, inputs written as shortest float32 decimals;
 * ``tiny_gnn.onnx``: a 1-layer, 8-wide model with ``node_dim`` 6, ``edge_dim`` 5 and features
-  ``tiny/1``, for the tests that a model of other dimensions is refused.
+  ``tiny/1``, for the tests that a model of other dimensions is refused;
+* ``random_q_access.onnx``, ``random_q_dirchange.onnx``: :class:`~asp.train.q.QNetwork` Q models
+  (3 layers, 32 wide, features ``asp-q/1 directions=25 neighbours=8``, for maps of resolution 5)
+  briefly fitted to a random target on synthetic state graphs, so their values differ between
+  parts; ``--only q`` writes just these two.
 """
 
 from __future__ import annotations
@@ -108,12 +112,57 @@ def write_fixtures(out: Path) -> None:
     print(f"wrote fixtures to {out} (parity: scatter {diff:.2g}, dense {diff_dense:.2g})")
 
 
+Q_FEATURES = "asp-q/1 directions=25 neighbours=8"
+
+
+def write_q_fixtures(out: Path) -> None:
+    """Write the two Q-model fixtures into ``out``."""
+    from .q import QNetwork, export_q, synthetic_q_graph
+
+    out.mkdir(parents=True, exist_ok=True)
+    torch.set_num_threads(1)
+    directions, neighbours = 25, 8
+    node_dim, edge_dim = 28 + 2 * directions, 5 + 2 * directions
+    for k, objective in enumerate(("access", "dirchange")):
+        torch.manual_seed(SEED + 10 + k)
+        rng = np.random.default_rng(SEED + 10 + k)
+        graphs = []
+        for _ in range(12):
+            parts = int(rng.integers(4, 20))
+            lo = rng.uniform(0.0, 1.0, size=(parts, 3))
+            boxes = np.stack([lo, lo + rng.uniform(0.05, 0.4, size=(parts, 3))], axis=1)
+            present = np.arange(parts)
+            actions = present[rng.uniform(size=parts) < 0.5]
+            history = np.flatnonzero(rng.uniform(size=directions) < 0.3)
+            graphs.append(synthetic_q_graph(boxes, present, actions, history, directions, neighbours, rng=rng))
+        model = QNetwork(node_dim, edge_dim, width=32, layers=3)
+        model.fit_normalisation(
+            torch.from_numpy(np.concatenate([g.x for g in graphs])), torch.from_numpy(np.concatenate([g.edge_attr for g in graphs]))
+        )
+        opt = torch.optim.Adam(model.parameters(), lr=3e-3)
+        for step in range(40):
+            g = graphs[step % len(graphs)]
+            # a learnable target: the share of free directions of each node
+            target = torch.from_numpy(g.x[:, 28 + directions :].mean(axis=1).astype(np.float32))
+            q = model(torch.from_numpy(g.x), torch.from_numpy(g.edge_index), torch.from_numpy(g.edge_attr))
+            loss = torch.nn.functional.mse_loss(q, target)
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+        model.eval()
+        diff = export_q(model, out / f"random_q_{objective}.onnx", Q_FEATURES, objective)
+        print(f"wrote {out / f'random_q_{objective}.onnx'} (parity {diff:.2g})")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Command line: ``python -m asp.train.fixture OUT_DIR``."""
     parser = argparse.ArgumentParser(prog="python -m asp.train.fixture", description=__doc__.split("\n\n")[0])
     parser.add_argument("out", type=Path, help="folder to write the fixtures into")
+    parser.add_argument("--only", choices=["q"], help="write only the Q-model fixtures")
     args = parser.parse_args(argv)
-    write_fixtures(args.out)
+    if args.only != "q":
+        write_fixtures(args.out)
+    write_q_fixtures(args.out)
     return 0
 
 
