@@ -341,9 +341,21 @@ pub fn plan_assembly(
     Ok(PlanResult { report, status: outcome.status, search: None })
 }
 
-/// Optimises a sequence of `assembly` on distance maps (MCTS for one objective, Pareto-MCTS
-/// for several).
-pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<PlanResult> {
+/// The optimiser's problem on one model: the distance maps, the objectives and the extensions'
+/// filters, as [`optimise`] builds them.
+#[derive(Clone, Debug)]
+pub struct OptimiserProblem {
+    /// The problem (it holds the maps and the assembly).
+    pub mdp: Mdp,
+    /// Seconds spent building the distance maps.
+    pub map_seconds: f64,
+}
+
+/// Builds the optimiser's problem of `assembly`: distance maps with the settings' resolution,
+/// cap, gravity check, tolerance, contact distance and overlap policy, the objectives by name
+/// (built-in or from the extensions), the extensions' filters, and `settings.seed` as the
+/// problem's seed. Several objectives need `o.pareto`.
+pub fn optimiser_problem(assembly: &Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<OptimiserProblem> {
     crate::objective::check_objective_names(&o.objectives, &o.extensions)?;
     if o.objectives.split(',').filter(|s| !s.trim().is_empty()).count() > 1 && !o.pareto {
         return Err(SearchError::config(format!(
@@ -351,7 +363,7 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
             o.objectives
         )));
     }
-    let world = world_config(&assembly, settings)?;
+    let world = world_config(assembly, settings)?;
     let metres = assembly.units.metres;
     let mut config = MapConfig::builder().resolution(o.resolution).support(o.support).overlaps(settings.overlaps);
     if let Some(d) = o.d_max {
@@ -367,7 +379,7 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
     let started = Instant::now();
     let maps = Arc::new(DistanceMaps::build(&assembly, &config)?);
     let map_seconds = started.elapsed().as_secs_f64();
-    let model = ModelContext { assembly: &assembly, maps: &maps, seed: settings.seed };
+    let model = ModelContext { assembly, maps: &maps, seed: settings.seed };
     let objectives = resolve_objectives(&o.objectives, &o.extensions, &model)?;
     let mut mdp = Mdp::new(maps.clone(), objectives)?.with_assembly(assembly.clone()).with_seed(settings.seed);
     for e in &o.extensions {
@@ -375,6 +387,15 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
             mdp = mdp.with_filter(f);
         }
     }
+    Ok(OptimiserProblem { mdp, map_seconds })
+}
+
+/// Optimises a sequence of `assembly` on distance maps (MCTS for one objective, Pareto-MCTS
+/// for several).
+pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<PlanResult> {
+    let OptimiserProblem { mdp, map_seconds } = optimiser_problem(&assembly, settings, o)?;
+    let maps = mdp.maps_arc().clone();
+    let model = ModelContext { assembly: &assembly, maps: &maps, seed: settings.seed };
     let threads = o.threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     macro_rules! configure {
         ($builder:expr) => {{

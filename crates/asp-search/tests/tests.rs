@@ -11,4 +11,5 @@ mod objectives;
 mod pareto;
 mod real;
 mod seams;
+mod transitions;
 mod verify;
