@@ -128,6 +128,68 @@ fn every_transition_replays_on_a_3x3x3_soma_cube() {
     assert_eq!(&again.transitions, ts);
 }
 
+/// Rejects removals of one part in rollouts only: the kinds' feasible sets differ.
+#[derive(Debug)]
+struct NotInRollouts(usize);
+
+impl asp_search::ActionFilter for NotInRollouts {
+    fn name(&self) -> &str {
+        "not-in-rollouts"
+    }
+    fn reasons(&self) -> Vec<String> {
+        vec!["rollout".into()]
+    }
+    fn check(&self, step: &mut asp_search::StepContext<'_, '_>, _memory: &[u64]) -> asp_search::Verdict {
+        if step.kind() == StepKind::Simulation && step.part() == self.0 {
+            asp_search::Verdict::Infeasible { reason: 0 }
+        } else {
+            asp_search::Verdict::Feasible
+        }
+    }
+}
+
+/// The feasible removals of `present` with `memory` for steps of `kind`.
+fn actions_of(p: &Mdp, present: &PartSet, memory: &[u64], kind: StepKind) -> Vec<usize> {
+    let mut state = MapState::new(p.maps());
+    state.reset(present);
+    let mut out = Vec::new();
+    p.feasible_actions(&mut state, memory, kind, &mut out, &mut p.filter_counts());
+    out
+}
+
+#[test]
+fn with_a_filter_each_step_records_the_actions_of_its_kind() {
+    let cube = soma(3, 2);
+    let maps = maps(&cube, 5);
+    let plain = problem(&maps, "access,dirchange");
+    let first = plain.feasible_in(&PartSet::full(maps.num_parts()), &plain.initial_memory());
+    let p = plain.with_filter(std::sync::Arc::new(NotInRollouts(first[0])));
+    // a small node cap: expansions beyond it (no node added) are recorded too
+    let out = ParetoMcts::builder().episodes(40).seed(5).max_nodes(60).record_transitions(true).build().unwrap().solve(&p).unwrap();
+    let ts = &out.transitions;
+    let (mut kinds_differ, mut from_new_node) = (0, 0);
+    for (k, t) in ts.iter().enumerate() {
+        let first_rollout_step = t.kind == StepKind::Simulation && k > 0 && ts[k - 1].kind == StepKind::Expansion;
+        if first_rollout_step && t.actions == ts[k - 1].next_actions {
+            // from a node just added: the node's set, computed at its expansion
+            from_new_node += 1;
+            let mut t = t.clone();
+            t.actions = actions_of(&p, &t.present, &t.memory, StepKind::Simulation);
+            if t.actions.contains(&t.action) {
+                replay(&p, &t);
+            }
+        } else {
+            replay(&p, t);
+        }
+        let mut next = t.present.clone();
+        next.remove(t.action);
+        let other = if t.kind == StepKind::Expansion { StepKind::Simulation } else { StepKind::Expansion };
+        kinds_differ += usize::from(actions_of(&p, &next, &t.next_memory, other) != t.next_actions);
+    }
+    assert!(from_new_node > 0 && kinds_differ > 0, "{from_new_node} rollouts from new nodes, {kinds_differ} steps where the kinds differ");
+    assert!(ts.iter().filter(|t| t.kind == StepKind::Simulation).count() > 0);
+}
+
 #[test]
 fn threads_record_in_thread_order_with_their_own_episode_numbers() {
     let cube = soma(4, 5);
