@@ -4,6 +4,8 @@
 * :mod:`asp.train.trainer`: supervised training on ``asp-removability`` data sets (thesis 3.6.2);
 * :mod:`asp.train.export`: ONNX export as docs/learning.md specifies, with a parity check;
 * :mod:`asp.train.fixture`: the ONNX fixtures of the Rust crate ``asp-learn``.
+* :mod:`asp.train.q`: Q-functions by deep Q-learning on ``asp-transitions`` data sets (thesis 5.4.4,
+  6.4.4), exported as Q models (imported on demand; ``python -m asp.train q``).
 
 Command line: ``python -m asp.train removability DATA_DIR... --out model.onnx`` (see ``--help``).
 """

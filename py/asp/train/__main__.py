@@ -5,6 +5,11 @@ JSON summary beside it (``model.onnx.json``: features, dimensions, epochs, seed,
 accuracy). ``--holdout NAME...`` keeps assemblies out of training and reports their accuracy;
 ``--leave-one-out OUT_DIR`` trains one model per assembly on all the others
 (``OUT_DIR/<name>.onnx``) and reports each on its own assembly (the thesis' five-fold protocol).
+
+``python -m asp.train q DATA_DIR... --objective NAME --out q.onnx [options]`` learns the Q-function of
+one objective by deep Q-learning on ``asp-transitions`` data sets (:mod:`asp.train.q`) and writes the
+ONNX Q model plus ``q.onnx.json`` (settings, loss curve, ranking quality per held-out assembly).
+
 Exit status 0 on success, 2 on bad input.
 """
 
@@ -52,7 +57,39 @@ def _parser() -> argparse.ArgumentParser:
     g = r.add_mutually_exclusive_group()
     g.add_argument("--holdout", nargs="+", metavar="NAME", default=[], help="assemblies to evaluate on, not train on")
     g.add_argument("--leave-one-out", type=Path, metavar="OUT_DIR", help="one model per assembly, trained on the others")
+    _q_parser(sub)
     return p
+
+
+def _q_parser(sub) -> None:
+    q = sub.add_parser("q", help="learn the Q-function of one objective by deep Q-learning (thesis 5.4.4, 6.4.4)")
+    q.add_argument("data", nargs="+", metavar="DATA_DIR", help="asp-transitions data set folders")
+    q.add_argument("--objective", required=True, metavar="NAME", help="the objective of the data sets to learn")
+    q.add_argument("--out", type=Path, required=True, help="the ONNX Q model to write (its summary goes to OUT.json)")
+    q.add_argument("--steps", type=int, default=2000, help="gradient steps (default 2000)")
+    q.add_argument("--seconds", type=float, help="stop training after this many seconds")
+    q.add_argument("--batch", type=int, default=128, help="transitions per step (default 128)")
+    q.add_argument("--buffer", type=int, default=10_000, help="replay buffer capacity (default 10000)")
+    q.add_argument("--target-sync", type=int, default=100, help="steps between target network syncs (default 100)")
+    q.add_argument("--loss", choices=["huber", "mse"], default="huber", help="regression loss (default huber)")
+    q.add_argument("--lr", type=float, default=1e-3, help="Adam learning rate (default 1e-3)")
+    q.add_argument("--seed", type=int, default=0, help="seed of weights and sampling (default 0)")
+    q.add_argument("--layers", type=int, default=3, help="GNN layers (default 3)")
+    q.add_argument("--width", type=int, default=64, help="hidden width (default 64)")
+    q.add_argument("--threads", type=int, default=1, help="PyTorch CPU threads (default 1)")
+    q.add_argument("--holdout", nargs="+", metavar="NAME", default=[], help="assemblies to evaluate on, not train on")
+    q.add_argument(
+        "--eval-states", type=int, default=2000,
+        help="states per assembly scored for the ranking quality (default 2000)",
+    )
+    q.add_argument(
+        "--aggregation", choices=["scatter", "dense"], default="dense",
+        help="aggregation ops in the ONNX file (default dense)",
+    )
+    q.add_argument(
+        "--parity-tolerance", type=float, default=1e-5,
+        help="largest ONNX/PyTorch difference the export check accepts (default 1e-5)",
+    )
 
 
 def _log(message: str) -> None:
@@ -153,17 +190,71 @@ def _removability(args: argparse.Namespace) -> int:
     return 0
 
 
+def _q(args: argparse.Namespace) -> int:
+    from .q import QConfig, config_dict, export_q, open_q_assemblies, ranking_quality, train_q, BindingGraphs
+
+    assemblies, features, node_dim, edge_dim = open_q_assemblies(args.data, args.objective)
+    by_name = {a.name: a for a in assemblies}
+    unknown = [n for n in args.holdout if n not in by_name]
+    if unknown:
+        raise DataError(f"--holdout names no assembly '{unknown[0]}' (known: {', '.join(by_name)})")
+    test_set = [by_name[n] for n in args.holdout]
+    train_set = [a for a in assemblies if a.name not in args.holdout]
+    if not train_set:
+        raise DataError("--holdout leaves no assembly to train on")
+    config = QConfig(
+        steps=args.steps, seconds=args.seconds, batch=args.batch, buffer=args.buffer, lr=args.lr,
+        seed=args.seed, layers=args.layers, width=args.width, threads=args.threads,
+        target_sync=args.target_sync, loss=args.loss,
+    )
+    graphs = BindingGraphs(features, node_dim, edge_dim)
+    transitions = sum(a.assembly.num_transitions for a in train_set)
+    _log(f"learning Q of '{args.objective}' from {transitions} transitions of {len(train_set)} assemblies "
+         f"({', '.join(a.name for a in train_set)})")
+    model, summary = train_q(train_set, node_dim, edge_dim, config, graphs, log=_log)
+    parity = export_q(model, args.out, features, args.objective, aggregation=args.aggregation, tolerance=args.parity_tolerance)
+    _log(f"wrote {args.out} (ONNX matches PyTorch to {parity:.2g}, padded graphs included)")
+    train_rank = {a.name: ranking_quality(model, a, graphs, max_states=args.eval_states) for a in train_set}
+    held = {a.name: ranking_quality(model, a, graphs, max_states=args.eval_states) for a in test_set}
+    for name, r in held.items():
+        if r["accuracy"] is None:
+            print(f"{name}: no state with two observed actions to rank")
+        else:
+            print(f"{name}: argmax-Q is the best observed action in {r['accuracy']:.4f} of {r['scored']} states "
+                  f"(chance {r['chance']:.4f}, mean regret {r['regret']:.4g})")
+    doc = {
+        "kind": "q",
+        "objective": args.objective,
+        "features": features,
+        "node_dim": node_dim,
+        "edge_dim": edge_dim,
+        "data": [str(d) for d in args.data],
+        "settings": config_dict(config),
+        "aggregation": args.aggregation,
+        "training": summary,
+        "onnx_parity_max_abs_diff": parity,
+        "train_assemblies": [a.name for a in train_set],
+        "train_ranking": train_rank,
+        "holdout_ranking": held,
+    }
+    Path(str(args.out) + ".json").write_text(json.dumps(doc, indent=2) + "\n")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     args = _parser().parse_args(argv)
-    for flag in ("epochs", "batch", "layers", "width", "threads"):
-        if getattr(args, flag) < 1:
-            print(f"error: --{flag} must be at least 1", file=sys.stderr)
+    for flag in ("epochs", "batch", "layers", "width", "threads", "steps", "buffer", "target_sync", "eval_states"):
+        value = getattr(args, flag, None)
+        if value is not None and value < 1:
+            print(f"error: --{flag.replace('_', '-')} must be at least 1", file=sys.stderr)
             return 2
     if args.seconds is not None and args.seconds <= 0:
         print("error: --seconds must be positive", file=sys.stderr)
         return 2
     try:
+        if args.command == "q":
+            return _q(args)
         return _removability(args)
     except (DataError, ExportError) as err:
         print(f"error: {err}", file=sys.stderr)

@@ -18,6 +18,7 @@ import copy
 import os
 import warnings
 from pathlib import Path
+from typing import Iterable
 
 import numpy as np
 import onnx
@@ -26,8 +27,8 @@ import torch
 from .gnn import RemovabilityGNN
 
 __all__ = [
-    "OPSET", "INPUT_NAMES", "OUTPUT_NAME", "ExportError", "export_onnx", "parity_check", "run_onnx", "random_graph",
-    "write_parity_cases",
+    "OPSET", "INPUT_NAMES", "OUTPUT_NAME", "ExportError", "export_onnx", "pad_graph", "parity_check", "run_onnx",
+    "random_graph", "write_parity_cases",
 ]
 
 #: The ONNX opset of exported models.
@@ -112,28 +113,62 @@ def _like_training(model: RemovabilityGNN, x: np.ndarray, edge_attr: np.ndarray,
     return x, edge_attr
 
 
-def parity_check(
-    model: RemovabilityGNN, path: os.PathLike | str, seed: int = 12345, tolerance: float = 1e-5
-) -> float:
-    """Compare the ONNX file with the PyTorch model on :data:`PARITY_SIZES` graphs.
+def pad_graph(x: np.ndarray, edge_index: np.ndarray, edge_attr: np.ndarray, nodes: int, edges: int):
+    """The graph as asp-learn pads it to a size bucket: ``nodes`` zero rows appended to ``x`` and
+    ``edges`` self-loop edges with zero attributes on the first padding node (so ``nodes >= 1``
+    when ``edges > 0``). A model's outputs for the real nodes must not change."""
+    if edges and not nodes:
+        raise ValueError("padding edges need a padding node")
+    n = x.shape[0]
+    x = np.concatenate([x, np.zeros((nodes, x.shape[1]), dtype=x.dtype)])
+    loops = np.full((2, edges), n, dtype=np.int64)
+    edge_index = np.concatenate([edge_index, loops], axis=1)
+    edge_attr = np.concatenate([edge_attr, np.zeros((edges, edge_attr.shape[1]), dtype=edge_attr.dtype)])
+    return x, edge_index, edge_attr
 
+
+def parity_check(
+    model: RemovabilityGNN,
+    path: os.PathLike | str,
+    seed: int = 12345,
+    tolerance: float = 1e-5,
+    graphs: Iterable[tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None,
+    padding: tuple[int, int] | None = None,
+) -> float:
+    """Compare the ONNX file with the PyTorch model on ``graphs`` (default: random graphs of
+    :data:`PARITY_SIZES` drawn like a removability model's training data).
+
+    With ``padding = (nodes, edges)``, each graph is also run in ONNX padded by :func:`pad_graph`,
+    and its real nodes' outputs must match PyTorch's on the unpadded graph to the same tolerance.
     Returns the largest absolute difference; raises :class:`ExportError` above ``tolerance``.
     """
-    rng = np.random.default_rng(seed)
-    worst = 0.0
     model = model.eval()
-    for n, e in PARITY_SIZES:
-        x, edge_index, edge_attr = random_graph(n, e, model.node_dim, model.edge_dim, rng)
-        x, edge_attr = _like_training(model, x, edge_attr, rng)
+    if graphs is None:
+        rng = np.random.default_rng(seed)
+        graphs = []
+        for n, e in PARITY_SIZES:
+            x, edge_index, edge_attr = random_graph(n, e, model.node_dim, model.edge_dim, rng)
+            x, edge_attr = _like_training(model, x, edge_attr, rng)
+            graphs.append((x, edge_index, edge_attr))
+    worst = 0.0
+    for x, edge_index, edge_attr in graphs:
+        n, e = x.shape[0], edge_index.shape[1]
         with torch.no_grad():
             expected = model(torch.from_numpy(x), torch.from_numpy(edge_index), torch.from_numpy(edge_attr)).numpy()
-        got = run_onnx(path, x, edge_index, edge_attr)
-        if got.shape != expected.shape:
-            raise ExportError(f"{path}: output shape {list(got.shape)} for n={n}, expected {list(expected.shape)}")
-        diff = float(np.max(np.abs(got.astype(np.float64) - expected))) if n else 0.0
-        if not np.isfinite(got).all() or diff > tolerance:
-            raise ExportError(f"{path}: ONNX and PyTorch differ by {diff:.3g} on a graph with n={n}, e={e} (tolerance {tolerance:g})")
-        worst = max(worst, diff)
+        runs = [("", (x, edge_index, edge_attr))]
+        if padding is not None:
+            runs.append((f" padded by {padding[0]} nodes and {padding[1]} self loops", pad_graph(x, edge_index, edge_attr, *padding)))
+        for what, inputs in runs:
+            got = run_onnx(path, *inputs)
+            if got.shape != (inputs[0].shape[0],):
+                raise ExportError(f"{path}: output shape {list(got.shape)} for n={inputs[0].shape[0]}, expected [{inputs[0].shape[0]}]")
+            got = got[:n]
+            diff = float(np.max(np.abs(got.astype(np.float64) - expected))) if n else 0.0
+            if not np.isfinite(got).all() or diff > tolerance:
+                raise ExportError(
+                    f"{path}: ONNX and PyTorch differ by {diff:.3g} on a graph with n={n}, e={e}{what} (tolerance {tolerance:g})"
+                )
+            worst = max(worst, diff)
     return worst
 
 
@@ -145,8 +180,15 @@ def export_onnx(
     check: bool = True,
     tolerance: float = 1e-5,
     extra_metadata: dict[str, str] | None = None,
+    *,
+    kind: str = "removability",
+    output_name: str = OUTPUT_NAME,
+    parity_graphs: Iterable[tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None,
+    padding: tuple[int, int] | None = None,
 ) -> float | None:
-    """Write ``model`` to ``path`` as a removability ONNX model and check it.
+    """Write ``model`` to ``path`` as an ONNX model of ``kind`` (metadata ``asp.kind``) whose
+    output is ``output_name``, and check it (:func:`parity_check` with ``parity_graphs`` and
+    ``padding``). A removability model by default; :mod:`asp.train.q` writes Q models with it.
 
     ``aggregation`` picks the exported implementation (default: the model's); the model itself is
     not modified. Returns the parity check's largest difference (``None`` with ``check=False``).
@@ -169,18 +211,18 @@ def export_onnx(
             dynamo=False,
             opset_version=OPSET,
             input_names=list(INPUT_NAMES),
-            output_names=[OUTPUT_NAME],
+            output_names=[output_name],
             dynamic_axes={
                 "x": {0: "n"},
                 "edge_index": {1: "e"},
                 "edge_attr": {0: "e"},
-                OUTPUT_NAME: {0: "n"},
+                output_name: {0: "n"},
             },
             do_constant_folding=True,
         )
     proto = onnx.load(str(path))
     metadata = {
-        "asp.kind": "removability",
+        "asp.kind": kind,
         "asp.features": features,
         "asp.node_dim": str(model.node_dim),
         "asp.edge_dim": str(model.edge_dim),
@@ -195,7 +237,7 @@ def export_onnx(
     onnx.save(proto, str(path))
     if not check:
         return None
-    return parity_check(model, path, tolerance=tolerance)
+    return parity_check(model, path, tolerance=tolerance, graphs=parity_graphs, padding=padding)
 
 
 def _f32(v: float) -> float:

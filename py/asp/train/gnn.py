@@ -167,8 +167,9 @@ class RemovabilityGNN(nn.Module):
         return numerator / torch.clamp(denominator, min=1.0)
 
     # -- forward -------------------------------------------------------------------------------
-    def logits(self, x: Tensor, edge_index: Tensor, edge_attr: Tensor) -> Tensor:
-        """Pre-sigmoid removability ``[n]``."""
+    def embed(self, x: Tensor, edge_index: Tensor, edge_attr: Tensor) -> Tensor:
+        """The node embeddings ``[n, width]`` after the last layer (before the head); the
+        Q-function of :mod:`asp.train.q` builds on them."""
         x = (self._log1p(x, self.node_log_mask) - self.node_mean) / self.node_std
         a_e = (self._log1p(edge_attr, self.edge_log_mask) - self.edge_mean) / self.edge_std
         h = self.node_encoder(x)
@@ -189,7 +190,11 @@ class RemovabilityGNN(nn.Module):
             a_e = self.phi_e(h_t + a_e + h.index_select(0, source))
             m = torch.relu(h_t + a_e) + EPS
             h = self.phi_n(h + self._aggregate(m, target, onehot, inv_count, n, self.temperature[layer]))
-        return self.head(h).squeeze(1)
+        return h
+
+    def logits(self, x: Tensor, edge_index: Tensor, edge_attr: Tensor) -> Tensor:
+        """Pre-sigmoid removability ``[n]``."""
+        return self.head(self.embed(x, edge_index, edge_attr)).squeeze(1)
 
     def forward(self, x: Tensor, edge_index: Tensor, edge_attr: Tensor) -> Tensor:
         """Removability ``[n]`` in (0, 1)."""
