@@ -17,6 +17,7 @@ from asp._asp import PLAN_FORMAT_VERSION, __version__
 from asp.assembly import Assembly, Part, load, plan
 from asp.errors import AspError, ConfigError, LoadError
 from asp.graph import Graph
+from asp.qgraphs import QGraphs
 from asp.result import ORDERS, Plan
 
 __all__ = [
@@ -29,6 +30,7 @@ __all__ = [
     "PLAN_FORMAT_VERSION",
     "Part",
     "Plan",
+    "QGraphs",
     "__version__",
     "load",
     "plan",

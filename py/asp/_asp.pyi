@@ -35,6 +35,22 @@ class Assembly:
     ) -> Tuple[bytearray, bytearray, bytearray, bytearray, int, int, str]:
         """``(nodes int64, x float32, edge_index int64, edge_attr float32, node_dim, edge_dim, features)``,
         the arrays as little-endian bytes."""
+    def q_graphs(self, settings: Dict[str, Any]) -> QGraphs: ...
+
+class QGraphs:
+    features: str
+    node_dim: int
+    edge_dim: int
+    directions: int
+    num_parts: int
+    removable: int
+    objectives: List[str]
+    reward_ranges: List[Optional[Tuple[float, float]]]
+    def feasible_actions(self, present: Sequence[int]) -> List[int]: ...
+    def graph(
+        self, present: Sequence[int], actions: Sequence[int] = ..., history: Sequence[int] = ...
+    ) -> Tuple[bytearray, bytearray, bytearray, bytearray, int, int, str]:
+        """Like ``Assembly.graph``; the context node's part index is -1."""
 
 # the items of asp.batch (crates/asp-py/src/batch.rs): JSON strings in and out
 def profile_preset(name: str) -> str: ...

@@ -10,6 +10,7 @@ from typing import Any, Iterable, Optional, Sequence, Tuple, Union
 
 from asp import _asp
 from asp.graph import Graph
+from asp.qgraphs import QGraphs
 from asp.result import Plan
 
 __all__ = ["Assembly", "Part", "load", "plan"]
@@ -139,6 +140,8 @@ class Assembly:
         resolution: int = 9,
         d_max: Optional[float] = None,
         support: str = "below",
+        q: Union[str, Sequence[str], None] = None,
+        epsilon: float = 0.2,
     ) -> Plan:
         """Plans an assembly sequence: the pipeline of ``asp plan``, with the same settings under
         the flags' names (``--max-tests`` is ``max_tests``, ``--no-path-planner`` is
@@ -186,6 +189,11 @@ class Assembly:
         :param resolution: distance map resolution N_M (odd, 3 to 15).
         :param d_max: distance map cap, model units (default the diagonal).
         :param support: the optimiser's gravity check, ``below`` or ``contact``.
+        :param q: learned Q-functions (ONNX files of ``python -m asp.train q``), one per objective
+            in ``objective``'s order (a comma-separated string or a list): rollouts take the
+            removal with the largest Q-value (the product for several objectives) instead of a
+            random one, except with probability ``epsilon`` (thesis 5.4.5, 6.4.4).
+        :param epsilon: probability of a random removal in a rollout guided by ``q``.
         :raises ConfigError: a setting is unknown, of the wrong type or out of range.
         :raises LoadError: the model cannot be planned as given (parts overlapping beyond
             repair, ...).
@@ -224,6 +232,8 @@ class Assembly:
             "resolution": resolution,
             "d_max": d_max,
             "support": support,
+            "q": q if q is None or isinstance(q, str) else ",".join(os.fspath(m) for m in q),
+            "epsilon": epsilon,
         }
         json, found, trace = self._native.plan(settings)
         return Plan(json, found, trace)
@@ -264,6 +274,45 @@ class Assembly:
             "points_per_part": points_per_part,
         }
         return Graph._from_native(self._native.graph(parts, settings))
+
+
+    def q_graphs(
+        self,
+        *,
+        objective: Union[str, Sequence[str]],
+        resolution: int = 9,
+        d_max: Optional[float] = None,
+        support: str = "below",
+        tolerance: Optional[float] = None,
+        contact_distance: Optional[float] = None,
+        overlaps: str = "strict",
+        neighbours: int = 8,
+    ) -> "QGraphs":
+        """The distance maps and optimisation problem of this model (as :meth:`plan` with
+        ``objective`` builds them), as a :class:`QGraphs` that gives the graph of any optimiser
+        state in the layout of a Q model's inputs (``docs/learning.md``, features ``asp-q/1``).
+
+        :param objective: the objectives (a comma-separated string or a list), as in :meth:`plan`.
+        :param resolution: distance map resolution (``resolution²`` directions).
+        :param d_max: cap of the distance maps, model units (default: the model's diagonal).
+        :param support: the optimiser's gravity check, ``below`` or ``contact``.
+        :param tolerance: as in :meth:`plan`.
+        :param contact_distance: as in :meth:`plan`.
+        :param overlaps: as in :meth:`plan`.
+        :param neighbours: nearest parts each part node gets an edge from (``K``).
+        :raises ConfigError: an unknown objective or a bad value.
+        """
+        settings = {
+            "objective": objective if isinstance(objective, str) else list(objective),
+            "resolution": resolution,
+            "d_max": d_max,
+            "support": support,
+            "tolerance": tolerance,
+            "contact_distance": contact_distance,
+            "overlaps": overlaps,
+            "neighbours": neighbours,
+        }
+        return QGraphs(self._native.q_graphs(settings))
 
 
 def plan(

@@ -136,6 +136,9 @@ pub struct BenchArgs {
 pub enum BenchKind {
     /// Time and removal tests of feasible planning under several orderings (thesis Table 3.1).
     Feasible(FeasibleArgs),
+    /// The optimiser's hypervolume (or best value) over wall time, vanilla against guided by
+    /// learned Q-functions (thesis Fig. 6.6 / 6.7).
+    Mcts(crate::bench_mcts::MctsArgs),
 }
 
 /// Flags of `asp bench feasible`.
@@ -296,7 +299,10 @@ fn methods(args: &FeasibleArgs, name: &str) -> anyhow::Result<Vec<Method>> {
 
 /// Runs `asp bench`.
 pub fn bench(args: &BenchArgs) -> anyhow::Result<std::process::ExitCode> {
-    let BenchKind::Feasible(a) = &args.kind;
+    let a = match &args.kind {
+        BenchKind::Feasible(a) => a,
+        BenchKind::Mcts(a) => return crate::bench_mcts::run(a),
+    };
     if a.orderings == 0 {
         bail!("--orderings must be at least 1");
     }

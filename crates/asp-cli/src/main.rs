@@ -2,6 +2,7 @@
 //!
 //! The binary is thin: it parses flags, calls the library crates, and formats output.
 
+mod bench_mcts;
 mod flags;
 mod gen;
 mod learn;

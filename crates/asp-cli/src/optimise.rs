@@ -62,6 +62,15 @@ pub struct OptimiseArgs {
     /// The gravity check of the optimiser.
     #[arg(long, value_enum, default_value_t = SupportArg::Below, help_heading = "Optimisation")]
     pub support: SupportArg,
+    /// Learned Q-functions (ONNX, `python -m asp.train q`), one per objective in the order of
+    /// `--objective` (comma-separated): rollouts take the removal with the largest Q-value
+    /// (the product of the values for several objectives) instead of a random one, except with
+    /// probability `--epsilon` (thesis 5.4.5, 6.4.4).
+    #[arg(long, value_name = "MODELS", help_heading = "Optimisation")]
+    pub q: Option<String>,
+    /// The probability of a random removal in a rollout guided by `--q`.
+    #[arg(long, default_value_t = 0.2, help_heading = "Optimisation")]
+    pub epsilon: f64,
 }
 
 impl OptimiseArgs {
@@ -86,6 +95,18 @@ impl OptimiseArgs {
         if let Some(d) = self.d_max {
             crate::output::positive("d-max", d)?;
         }
+        let policy = match &self.q {
+            None => None,
+            Some(models) => {
+                if !(0.0..=1.0).contains(&self.epsilon) {
+                    bail!("--epsilon must be in [0, 1], got {}", self.epsilon);
+                }
+                let paths: Vec<&str> = models.split(',').map(str::trim).filter(|p| !p.is_empty()).collect();
+                let objectives: Vec<&str> = list.split(',').map(str::trim).filter(|n| !n.is_empty()).collect();
+                let directions = self.resolution * self.resolution;
+                Some(asp_learn::epsilon_greedy(&paths, &objectives, self.epsilon, directions).context("--q")?)
+            }
+        };
         Ok(Some(OptimiseSettings {
             objectives: list.clone(),
             pareto: self.pareto,
@@ -101,6 +122,7 @@ impl OptimiseArgs {
                 SupportArg::Contact => Support::ContactGraph,
             },
             extensions,
+            policy,
             ..OptimiseSettings::default()
         }))
     }

@@ -3,7 +3,9 @@
 pub mod error;
 pub mod model;
 pub mod ordering;
+pub mod qfunction;
 
 pub use error::{LearnError, Result};
-pub use model::{RemovabilityModel, ShapePolicy};
+pub use model::{GraphModel, ModelKind, RemovabilityModel, ShapePolicy};
 pub use ordering::{GnnFactory, GnnOrdering, GnnSource, SHIPPED_MODEL};
+pub use qfunction::{epsilon_greedy, OnnxQ};

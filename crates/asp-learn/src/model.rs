@@ -1,9 +1,11 @@
-//! Removability models: ONNX files of the contract in docs/learning.md, run with tract.
+//! Graph models: ONNX files of the contracts in docs/learning.md, run with tract.
 //!
 //! A model takes one state graph (`x [n, node_dim]`, `edge_index [2, e]`, `edge_attr
-//! [e, edge_dim]`) and returns one removability in (0, 1) per node. Loading checks every part of
-//! the contract (input and output names, element types, ranks, dimensions, the `asp.kind` and
-//! `asp.features` metadata) and runs the model once, so a file that loads also runs.
+//! [e, edge_dim]`) and returns one value per node: a removability in (0, 1)
+//! ([`ModelKind::Removability`], output `removability`) or the Q-value of removing the node's
+//! part ([`ModelKind::Q`], output `q`). Loading checks every part of the contract (input and
+//! output names, element types, ranks, dimensions, the `asp.kind` and `asp.features` metadata)
+//! and runs the model once, so a file that loads also runs.
 //!
 //! tract runs a plan with symbolic `n` and `e` several times slower than a plan whose shapes are
 //! known. [`ShapePolicy::Buckets`] (the default) therefore pads every graph up to a bucket of
@@ -25,8 +27,35 @@ use crate::error::{one_line, LearnError, Result};
 pub const KIND: &str = "removability";
 /// The input names, in contract order.
 pub const INPUTS: [&str; 3] = ["x", "edge_index", "edge_attr"];
-/// The output name.
+/// The output name of a removability model.
 pub const OUTPUT: &str = "removability";
+
+/// What a graph model computes per node.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelKind {
+    /// The removability of each part (output `removability`, in (0, 1)).
+    Removability,
+    /// The Q-value of removing each part (output `q`).
+    Q,
+}
+
+impl ModelKind {
+    /// The `asp.kind` metadata value.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Removability => KIND,
+            ModelKind::Q => "q",
+        }
+    }
+
+    /// The output's name.
+    pub fn output(self) -> &'static str {
+        match self {
+            ModelKind::Removability => OUTPUT,
+            ModelKind::Q => "q",
+        }
+    }
+}
 
 /// Graphs larger than this (nodes) run on the symbolic plan instead of a padded bucket.
 const MAX_BUCKET_NODES: usize = 4096;
@@ -68,9 +97,10 @@ impl Pooled {
     }
 }
 
-/// A loaded removability model (thread-safe: plans are shared, every call has its own state).
-pub struct RemovabilityModel {
+/// A loaded graph model (thread-safe: plans are shared, every call has its own state).
+pub struct GraphModel {
     path: String,
+    kind: ModelKind,
     metadata: BTreeMap<String, String>,
     features: String,
     node_dim: usize,
@@ -86,10 +116,14 @@ pub struct RemovabilityModel {
     buckets: Mutex<HashMap<(usize, usize), Arc<Pooled>>>,
 }
 
-impl std::fmt::Debug for RemovabilityModel {
+/// A removability model (the graph model of `--order gnn`).
+pub type RemovabilityModel = GraphModel;
+
+impl std::fmt::Debug for GraphModel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("RemovabilityModel")
+        f.debug_struct("GraphModel")
             .field("path", &self.path)
+            .field("kind", &self.kind)
             .field("features", &self.features)
             .field("node_dim", &self.node_dim)
             .field("edge_dim", &self.edge_dim)
@@ -98,42 +132,54 @@ impl std::fmt::Debug for RemovabilityModel {
     }
 }
 
-impl RemovabilityModel {
-    /// Load a model and check it against the features asp computes: the `asp.features` string
-    /// and the node and edge attribute widths of the graph.
+impl GraphModel {
+    /// Load a removability model and check it against the features asp computes: the
+    /// `asp.features` string and the node and edge attribute widths of the graph.
     pub fn load(path: impl AsRef<Path>, features: &str, node_dim: usize, edge_dim: usize) -> Result<Self> {
         let model = Self::open(path)?;
         model.check_features(features, node_dim, edge_dim)?;
         Ok(model)
     }
 
-    /// Load a model, checking the contract's names, types, ranks and metadata but not which
-    /// features it was trained on (see [`check_features`](Self::check_features)).
+    /// Load a removability model, checking the contract's names, types, ranks and metadata but
+    /// not which features it was trained on (see [`check_features`](Self::check_features)).
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
+        Self::open_kind(path, ModelKind::Removability)
+    }
+
+    /// Load a model of `kind` (see [`open`](Self::open)).
+    pub fn open_kind(path: impl AsRef<Path>, kind: ModelKind) -> Result<Self> {
         let path = path.as_ref();
         let label = path.display().to_string();
         let bytes = std::fs::read(path).map_err(|e| LearnError::Read { path: label.clone(), reason: format!("cannot read: {e}") })?;
-        Self::from_bytes(&bytes, &label)
+        Self::from_bytes_kind(&bytes, &label, kind)
     }
 
-    /// Load a model from the bytes of an ONNX file; `label` names it in errors.
+    /// Load a removability model from the bytes of an ONNX file; `label` names it in errors.
     pub fn from_bytes(bytes: &[u8], label: &str) -> Result<Self> {
+        Self::from_bytes_kind(bytes, label, ModelKind::Removability)
+    }
+
+    /// Load a model of `kind` from the bytes of an ONNX file; `label` names it in errors.
+    pub fn from_bytes_kind(bytes: &[u8], label: &str, kind: ModelKind) -> Result<Self> {
         let proto = onnx()
             .proto_model_for_read(&mut &bytes[..])
             .map_err(|e| LearnError::Read { path: label.to_string(), reason: format!("not an ONNX model: {}", one_line(&e)) })?;
-        Self::from_proto(&proto, label)
+        Self::from_proto(&proto, label, kind)
     }
 
-    fn from_proto(proto: &pb::ModelProto, label: &str) -> Result<Self> {
+    fn from_proto(proto: &pb::ModelProto, label: &str, expected: ModelKind) -> Result<Self> {
         let mismatch = |m: String| LearnError::Mismatch { path: label.to_string(), mismatch: m };
         let metadata: BTreeMap<String, String> =
             proto.metadata_props.iter().map(|p| (p.key.clone(), p.value.clone())).collect();
         let meta = |key: &str| {
-            metadata.get(key).ok_or_else(|| mismatch(format!("no metadata property '{key}' (not an asp removability model)")))
+            metadata
+                .get(key)
+                .ok_or_else(|| mismatch(format!("no metadata property '{key}' (not an asp {} model)", expected.name())))
         };
         let kind = meta("asp.kind")?;
-        if kind != KIND {
-            return Err(mismatch(format!("asp.kind is '{kind}', expected '{KIND}'")));
+        if kind != expected.name() {
+            return Err(mismatch(format!("asp.kind is '{kind}', expected '{}'", expected.name())));
         }
         let features = meta("asp.features")?.clone();
         let meta_dim = |key: &str| -> Result<usize> {
@@ -143,7 +189,7 @@ impl RemovabilityModel {
         let node_dim = meta_dim("asp.node_dim")?;
         let edge_dim = meta_dim("asp.edge_dim")?;
         let graph = proto.graph.as_ref().ok_or_else(|| mismatch("has no graph".into()))?;
-        check_signature(graph, node_dim, edge_dim).map_err(mismatch)?;
+        check_signature(graph, node_dim, edge_dim, expected.output()).map_err(mismatch)?;
 
         let read = |e: TractError| LearnError::Read { path: label.to_string(), reason: one_line(&e) };
         let inference = onnx().model_for_proto_model(proto).map_err(read)?;
@@ -167,8 +213,9 @@ impl RemovabilityModel {
             (Some(n), Some(e), Some(e2)) if e == e2 && n != e => Some((n, e)),
             _ => None,
         };
-        let model = RemovabilityModel {
+        let model = GraphModel {
             path: label.to_string(),
+            kind: expected,
             metadata,
             features,
             node_dim,
@@ -209,6 +256,11 @@ impl RemovabilityModel {
             return mismatch(format!("trained on features '{}', asp computes '{features}'", self.features));
         }
         Ok(())
+    }
+
+    /// What the model computes.
+    pub fn kind(&self) -> ModelKind {
+        self.kind
     }
 
     /// The file the model came from (as given).
@@ -296,7 +348,7 @@ impl RemovabilityModel {
         if view.len() != np {
             return Err(LearnError::Inference {
                 path: self.path.clone(),
-                reason: format!("output '{OUTPUT}' has {} values for {np} nodes", view.len()),
+                reason: format!("output '{}' has {} values for {np} nodes", self.kind.output(), view.len()),
             });
         }
         Ok(view.iter().take(n).copied().collect())
@@ -375,7 +427,7 @@ fn padded_sizes(n: usize, e: usize) -> Option<(usize, usize)> {
 }
 
 /// Check the graph's inputs and outputs against the contract (names, types, ranks, widths).
-fn check_signature(graph: &pb::GraphProto, node_dim: usize, edge_dim: usize) -> std::result::Result<(), String> {
+fn check_signature(graph: &pb::GraphProto, node_dim: usize, edge_dim: usize, output: &str) -> std::result::Result<(), String> {
     let initialisers: std::collections::HashSet<&str> = graph.initializer.iter().map(|t| t.name.as_str()).collect();
     let inputs: Vec<&pb::ValueInfoProto> = graph.input.iter().filter(|i| !initialisers.contains(i.name.as_str())).collect();
     let names: Vec<&str> = inputs.iter().map(|i| i.name.as_str()).collect();
@@ -420,15 +472,15 @@ fn check_signature(graph: &pb::GraphProto, node_dim: usize, edge_dim: usize) -> 
         }
     }
     let outputs: Vec<&str> = graph.output.iter().map(|o| o.name.as_str()).collect();
-    if outputs != [OUTPUT] {
+    if outputs != [output] {
         return Err(format!(
-            "outputs are {}, expected '{OUTPUT}'",
+            "outputs are {}, expected '{output}'",
             outputs.iter().map(|n| format!("'{n}'")).collect::<Vec<_>>().join(", ")
         ));
     }
-    let out = tensor_type("output", graph.output.first(), OUTPUT)?;
-    expect_type("output 'removability'", out.0, FLOAT)?;
-    expect_rank("output 'removability'", &out.1, 1, "[n]")?;
+    let out = tensor_type("output", graph.output.first(), output)?;
+    expect_type(&format!("output '{output}'"), out.0, FLOAT)?;
+    expect_rank(&format!("output '{output}'"), &out.1, 1, "[n]")?;
     Ok(())
 }
 
@@ -505,7 +557,7 @@ mod tests {
     }
 
     fn error_of(proto: &pb::ModelProto) -> String {
-        RemovabilityModel::from_proto(proto, "models/x.onnx").expect_err("must be refused").to_string()
+        RemovabilityModel::from_proto(proto, "models/x.onnx", ModelKind::Removability).expect_err("must be refused").to_string()
     }
 
     fn set_meta(proto: &mut pb::ModelProto, key: &str, value: Option<&str>) {
@@ -537,7 +589,7 @@ mod tests {
 
     #[test]
     fn the_fixture_passes_every_check() {
-        let m = RemovabilityModel::from_proto(&proto(), "random_gnn.onnx").unwrap();
+        let m = RemovabilityModel::from_proto(&proto(), "random_gnn.onnx", ModelKind::Removability).unwrap();
         assert_eq!((m.node_dim(), m.edge_dim()), (74, 152));
         assert!(m.symbols.is_some(), "n and e should be plain symbols");
         m.check_features("asp-graph/2 radius_bins=8 degree=8 points=2048", 74, 152).unwrap();

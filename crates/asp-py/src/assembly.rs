@@ -2,6 +2,7 @@
 //! `asp._asp.load`.
 
 use crate::errors::Error;
+use crate::qgraphs::PyQGraphs;
 use crate::settings::GraphSettings;
 use crate::{run, settings};
 use asp_geom::{AssemblyGraph, PartSet, World};
@@ -14,7 +15,7 @@ use std::sync::{Arc, Mutex};
 /// What `Assembly.graph` returns: the part indices (int64), `x` (float32), `edge_index` (int64)
 /// and `edge_attr` (float32) as little-endian bytes, `node_dim`, `edge_dim` and the features
 /// string; `asp.Graph` views the bytes as numpy arrays.
-type GraphBuffers<'py> =
+pub type GraphBuffers<'py> =
     (Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, usize, usize, String);
 
 /// A loaded model: its parts in file order, units, up axis and the load's warnings. Immutable;
@@ -162,6 +163,12 @@ impl PyAssembly {
             graph.edge_dim,
             features,
         ))
+    }
+
+    /// The distance maps and MDP of this model for the keywords of `asp.Assembly.q_graphs`
+    /// (a dict), as a handle that gives the `asp-q/1` graph of any state (built without the GIL).
+    fn q_graphs(&self, py: Python<'_>, settings: &Bound<'_, PyDict>) -> PyResult<PyQGraphs> {
+        PyQGraphs::build(py, self.inner.clone(), settings)
     }
 
     fn __repr__(&self) -> String {

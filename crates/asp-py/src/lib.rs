@@ -5,6 +5,7 @@
 //!
 //! - [`assembly`]: `load` and the `Assembly` handle (owns its data);
 //! - [`settings`]: Python keywords into [`asp_search::pipeline::PlanSettings`], order names;
+//! - [`qgraphs`]: the `asp-q/1` graphs of optimiser states (`Assembly.q_graphs`);
 //! - [`run`]: the pipeline with the GIL released, interruptible by Ctrl-C;
 //! - [`batch`]: the items of `asp.batch` (generation, collection, benchmarks), JSON in and out;
 //! - [`errors`]: asp's errors as `asp.errors` exceptions.
@@ -12,6 +13,7 @@
 pub mod assembly;
 pub mod batch;
 pub mod errors;
+pub mod qgraphs;
 pub mod run;
 pub mod settings;
 
@@ -40,6 +42,7 @@ fn asp_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(order_names, m)?)?;
     m.add_class::<assembly::PyAssembly>()?;
+    m.add_class::<qgraphs::PyQGraphs>()?;
     m.add_function(wrap_pyfunction!(batch::profile_preset, m)?)?;
     m.add_function(wrap_pyfunction!(batch::generator_canonical, m)?)?;
     m.add_function(wrap_pyfunction!(batch::gen_item, m)?)?;

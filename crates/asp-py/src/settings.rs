@@ -19,6 +19,10 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use std::sync::Arc;
 
+/// The probability of a random removal in a rollout guided by Q-functions when none is given
+/// (the CLI's `--epsilon`, the thesis' 0.2).
+pub const DEFAULT_EPSILON: f64 = 0.2;
+
 /// The physics stability threshold when none is given (the CLI's `--physics-threshold`).
 pub const DEFAULT_PHYSICS_THRESHOLD: f64 = 0.01;
 
@@ -26,7 +30,7 @@ pub const DEFAULT_PHYSICS_THRESHOLD: f64 = 0.01;
 pub const ORDER_NAMES: [&str; 5] = ["given", "shuffled", "random", "bookkeeping", "gnn"];
 
 /// The keywords of [`plan_settings`], in the order of `asp.Assembly.plan`'s signature.
-pub const PLAN_KEYS: [&str; 27] = [
+pub const PLAN_KEYS: [&str; 29] = [
     "order",
     "model",
     "bookkeeping",
@@ -54,6 +58,8 @@ pub const PLAN_KEYS: [&str; 27] = [
     "resolution",
     "d_max",
     "support",
+    "q",
+    "epsilon",
 ];
 
 /// The ordering source `order=name` stands for, and whether the name implies bookkeeping
@@ -202,6 +208,19 @@ fn optimise_settings(k: &Keywords<'_, '_>) -> Result<Option<OptimiseSettings>, E
         Some("contact") => Support::ContactGraph,
         Some(other) => return Err(Error::config(format!("support: unknown gravity check '{other}' (use below or contact)"))),
     };
+    let resolution = k.count("resolution")?.unwrap_or(d.resolution);
+    let epsilon = k.number("epsilon")?.unwrap_or(DEFAULT_EPSILON);
+    if !(0.0..=1.0).contains(&epsilon) {
+        return Err(Error::config(format!("epsilon must be in [0, 1], got {epsilon}")));
+    }
+    let policy = match k.string("q")? {
+        None => None,
+        Some(models) => {
+            let paths: Vec<&str> = models.split(',').map(str::trim).filter(|p| !p.is_empty()).collect();
+            let names: Vec<&str> = objectives.split(',').map(str::trim).filter(|n| !n.is_empty()).collect();
+            Some(asp_learn::epsilon_greedy(&paths, &names, epsilon, resolution * resolution).map_err(|e| Error::config(format!("q: {e}")))?)
+        }
+    };
     Ok(Some(OptimiseSettings {
         objectives,
         pareto: k.flag("pareto", d.pareto)?,
@@ -210,9 +229,10 @@ fn optimise_settings(k: &Keywords<'_, '_>) -> Result<Option<OptimiseSettings>, E
         threads: k.count("threads")?,
         time_limit: k.positive("time_limit")?,
         exploration: k.number("exploration")?.unwrap_or(d.exploration),
-        resolution: k.count("resolution")?.unwrap_or(d.resolution),
+        resolution,
         d_max: k.positive("d_max")?,
         support,
+        policy,
         ..d
     }))
 }
@@ -260,6 +280,32 @@ pub fn graph_settings(dict: &Bound<'_, PyDict>) -> Result<GraphSettings, Error> 
         ..PlanSettings::default()
     };
     Ok(GraphSettings { world, config })
+}
+
+/// The keywords of [`q_graph_settings`].
+pub const Q_GRAPH_KEYS: [&str; 8] =
+    ["objective", "resolution", "d_max", "support", "tolerance", "contact_distance", "overlaps", "neighbours"];
+
+/// The settings of `asp.Assembly.q_graphs`' keywords: the world's (tolerance, contact distance,
+/// overlaps), the optimiser's that shape the maps and the MDP (objective, resolution, `d_max`,
+/// support), and the neighbours per part node (default 8).
+pub fn q_graph_settings(dict: &Bound<'_, PyDict>) -> Result<(PlanSettings, OptimiseSettings, usize), Error> {
+    reject_unknown(dict, &Q_GRAPH_KEYS)?;
+    let k = Keywords { dict };
+    let neighbours = k.count("neighbours")?.unwrap_or(asp_search::qgraph::DEFAULT_NEIGHBOURS);
+    if neighbours == 0 {
+        return Err(Error::config("neighbours must be at least 1"));
+    }
+    let mut optimise = optimise_settings(&k)?.ok_or_else(|| Error::config("objective: no objective given"))?;
+    optimise.pareto = optimise.objectives.split(',').filter(|n| !n.trim().is_empty()).count() > 1;
+    asp_search::objective::check_objective_names(&optimise.objectives, &[]).map_err(Error::from)?;
+    let plan = PlanSettings {
+        tolerance: k.positive("tolerance")?,
+        contact_distance: k.positive("contact_distance")?,
+        overlaps: overlap_policy(&k)?,
+        ..PlanSettings::default()
+    };
+    Ok((plan, optimise, neighbours))
 }
 
 /// The `overlaps` keyword: `strict` (the default), `lenient` or `error`.
@@ -318,6 +364,8 @@ pub fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("resolution", o.resolution)?;
     d.set_item("d_max", o.d_max)?;
     d.set_item("support", "below")?;
+    d.set_item("q", py.None())?;
+    d.set_item("epsilon", DEFAULT_EPSILON)?;
     let g = GraphConfig::default();
     d.set_item("radius_bins", g.radius_bins)?;
     d.set_item("degree", g.degree)?;

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 pub mod bench;
+pub mod bench_mcts;
 pub mod collect;
 pub mod collect_q;
 pub mod dfs;
@@ -15,6 +16,7 @@ pub mod pareto;
 pub mod pipeline;
 pub mod policy;
 pub mod problem;
+pub mod qgraph;
 pub mod report;
 pub mod search;
 

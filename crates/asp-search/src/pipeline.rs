@@ -8,6 +8,7 @@
 
 use crate::mdp::{MdpExtension, ModelContext};
 use crate::objective::resolve_objectives;
+use crate::policy::Policy;
 use crate::ordering::{BuiltinOrder, OrderingSource};
 use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step};
 use crate::report::{OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
@@ -171,6 +172,9 @@ pub struct OptimiseSettings {
     /// Objectives and feasibility filters beyond the built-in ones (e.g. a robot's); their
     /// objective names may appear in `objectives`.
     pub extensions: Vec<Arc<dyn MdpExtension>>,
+    /// The rollout and expansion policy (default: uniformly random; e.g. ε-greedy over learned
+    /// Q-functions, which asp-learn builds).
+    pub policy: Option<Arc<dyn Policy>>,
 }
 
 impl Default for OptimiseSettings {
@@ -187,6 +191,7 @@ impl Default for OptimiseSettings {
             d_max: None,
             support: Support::Below,
             extensions: Vec::new(),
+            policy: None,
         }
     }
 }
@@ -410,6 +415,9 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
             }
             if let Some(stop) = &settings.cancel {
                 b = b.stop_token(stop.clone());
+            }
+            if let Some(policy) = &o.policy {
+                b = b.policy(policy.clone());
             }
             b.build()?
         }};

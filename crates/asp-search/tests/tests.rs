@@ -9,6 +9,7 @@ mod hypervolume;
 mod mcts;
 mod objectives;
 mod pareto;
+mod qgraph;
 mod real;
 mod seams;
 mod transitions;

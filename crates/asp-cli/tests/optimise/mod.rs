@@ -247,3 +247,26 @@ fn collect_transitions_writes_the_documented_data_set() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("--objective") && stderr(&o).contains("speed"), "{}", stderr(&o));
 }
+
+#[test]
+fn q_models_are_checked_before_the_search() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = jenga(dir.path());
+    let m = model.to_str().unwrap();
+    let removability = concat!(env!("CARGO_MANIFEST_DIR"), "/../asp-learn/tests/data/random_gnn.onnx");
+    // a removability model is not a Q model
+    let o = asp(&["plan", m, "--objective", "access", "--q", removability]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert!(err.contains("--q") && err.contains("random_gnn.onnx") && err.contains("asp.kind is 'removability', expected 'q'"), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    // one model per objective
+    let o = asp(&["plan", m, "--objective", "access,dirchange", "--pareto", "--q", removability]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("1 Q models for 2 objectives"), "{}", stderr(&o));
+    // a missing file, and epsilon out of range
+    let o = asp(&["plan", m, "--objective", "access", "--q", "no/such.onnx"]);
+    assert!(stderr(&o).contains("no/such.onnx: cannot read"), "{}", stderr(&o));
+    let o = asp(&["plan", m, "--objective", "access", "--q", removability, "--epsilon", "1.5"]);
+    assert!(stderr(&o).contains("--epsilon must be in [0, 1], got 1.5"), "{}", stderr(&o));
+}
