@@ -13,11 +13,12 @@
 
 use crate::collect::{self, io_error, ModelItem};
 use crate::mdp::Mdp;
-use crate::objective::{DirHistory, StepKind};
+use crate::objective::StepKind;
 use crate::pipeline::{self, OptimiseSettings, PlanSettings};
+use crate::qgraph::{direction_history, QGraphConfig};
 use crate::search::{Transition, DEFAULT_RECORD_LIMIT};
 use crate::{Mcts, ParetoMcts, Result, SearchError};
-use asp_geom::distmap::{DirMask, Support};
+use asp_geom::distmap::Support;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -138,35 +139,6 @@ pub struct TransitionsIndex {
     pub episodes: usize,
     /// The models.
     pub assemblies: Vec<TransitionsModel>,
-}
-
-/// The state graph's parameters (`asp-q/1`, docs/learning.md).
-// TODO(qgraph): replace by asp_search::qgraph::QGraphConfig when it is on main.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct QGraphConfig {
-    directions: usize,
-    neighbours: usize,
-}
-
-impl QGraphConfig {
-    fn features(&self) -> String {
-        format!("asp-q/1 directions={} neighbours={}", self.directions, self.neighbours)
-    }
-    fn node_dim(&self) -> usize {
-        28 + 2 * self.directions
-    }
-    fn edge_dim(&self) -> usize {
-        5 + 2 * self.directions
-    }
-}
-
-/// `H` of the `dirchange` objective in `memory`, or `None` before the first removal or without
-/// that objective.
-// TODO(qgraph): replace by asp_search::qgraph::direction_history when it is on main.
-fn direction_history(problem: &Mdp, memory: &[u64]) -> Option<DirMask> {
-    let k = problem.objectives().iter().position(|o| o.name() == "dirchange")?;
-    let h = DirHistory::load(&memory[problem.memory_range(k)]);
-    h.active.then_some(h.mask)
 }
 
 /// One line of `transitions.jsonl`.
@@ -310,7 +282,7 @@ fn collect_one(item: &ModelItem, out: &Path, settings: &TransitionSettings) -> R
     std::fs::create_dir_all(&folder).map_err(|e| io_error(&folder, e))?;
     write_lines(&folder.join("transitions.jsonl"), &problem, &outcome.transitions)?;
     let model = std::fs::canonicalize(&item.path).map_err(|e| io_error(&item.path, e))?;
-    let graph = QGraphConfig { directions: maps.num_directions(), neighbours: 8 };
+    let graph = QGraphConfig::for_maps(maps);
     let entry = TransitionsModel {
         name: item.name.clone(),
         dir: item.dir.clone(),
