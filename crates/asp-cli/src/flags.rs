@@ -19,7 +19,8 @@ pub enum Command {
     Plan(PlanArgs),
     /// Generate training assemblies (Soma cubes, aluminium profile assemblies).
     Gen(crate::gen::GenArgs),
-    /// Collect training data from planning runs (`removability`: labelled states, docs/learning.md).
+    /// Collect training data from planning runs (`removability`: labelled states; `transitions`:
+    /// MCTS transitions for Q-functions; docs/learning.md).
     Collect(crate::learn::CollectArgs),
     /// Benchmarks (`feasible`: the thesis' Table 3.1 for a folder of models).
     Bench(crate::learn::BenchArgs),

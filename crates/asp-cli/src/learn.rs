@@ -1,10 +1,16 @@
-//! `asp collect removability` and `asp bench feasible`, and the `--order` flag's orderings
-//! (learned guidance, thesis chapter 3).
+//! `asp collect removability`, `asp collect transitions` and `asp bench feasible`, and the
+//! `--order` flag's orderings (learned guidance, thesis chapters 3, 5 and 6).
 
 use crate::flags::{ModelArgs, OrderArg};
 use anyhow::{bail, Context};
 use asp_search::bench::{self, BenchRow, Method};
+use crate::optimise::SupportArg;
+use asp_geom::distmap::Support;
 use asp_search::collect::{self, CollectSettings};
+use asp_search::collect_q::{self, TransitionSettings, TransitionsModel};
+use asp_search::objective::check_objective_names;
+use asp_search::pipeline::OptimiseSettings;
+use indicatif::{ProgressBar, ProgressStyle};
 use asp_search::{BuiltinOrder, OrderingSource};
 use clap::{Args, Subcommand};
 use std::io::{IsTerminal, Write};
@@ -46,6 +52,47 @@ pub enum CollectKind {
     /// Labelled states from vanilla DFS runs (thesis 3.6.1), the removability model's training
     /// data (format: docs/learning.md).
     Removability(RemovabilityArgs),
+    /// Transitions (s, a, r, s') recorded by MCTS / Pareto-MCTS on distance maps (thesis 5.5.2,
+    /// 6.5.1), the Q-functions' training data (format: docs/learning.md).
+    Transitions(TransitionsArgs),
+}
+
+/// Flags of `asp collect transitions`.
+#[derive(Args, Debug)]
+pub struct TransitionsArgs {
+    /// Models: .glb/.gltf files, folders of them (each file a model), or folders of OBJ/STL parts.
+    #[arg(required = true)]
+    pub models: Vec<PathBuf>,
+    /// The data set folder to write.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// The objectives (comma-separated: access, dirchange, pathlen); several run Pareto-MCTS.
+    #[arg(long, value_name = "LIST")]
+    pub objective: String,
+    /// MCTS episodes per model (one search per model, one thread).
+    #[arg(long, default_value_t = asp_search::collect_q::DEFAULT_EPISODES)]
+    pub episodes: usize,
+    /// Search budget: MCTS iterations per step of an episode (the thesis uses 5).
+    #[arg(long, default_value_t = asp_search::search::DEFAULT_BUDGET)]
+    pub budget: usize,
+    /// Base seed (the search of model m uses a seed derived from it and m).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Distance map resolution N_M (odd, 3 to 15): N_M × N_M directions on the half sphere.
+    #[arg(long, default_value_t = asp_geom::distmap::DEFAULT_RESOLUTION)]
+    pub resolution: usize,
+    /// Cap d_max of the distance maps, model units [default: the model's diagonal].
+    #[arg(long)]
+    pub d_max: Option<f64>,
+    /// The gravity check of the optimiser.
+    #[arg(long, value_enum, default_value_t = SupportArg::Below)]
+    pub support: SupportArg,
+    /// The most transitions recorded per model (its search goes on without recording beyond it).
+    #[arg(long, default_value_t = asp_search::search::DEFAULT_RECORD_LIMIT)]
+    pub max_transitions: usize,
+    /// Loading and testing.
+    #[command(flatten)]
+    pub load: ModelArgs,
 }
 
 /// Flags of `asp collect removability`.
@@ -130,7 +177,10 @@ pub struct FeasibleArgs {
 
 /// Runs `asp collect`.
 pub fn collect(args: &CollectArgs) -> anyhow::Result<std::process::ExitCode> {
-    let CollectKind::Removability(a) = &args.kind;
+    let a = match &args.kind {
+        CollectKind::Removability(a) => a,
+        CollectKind::Transitions(a) => return transitions(a),
+    };
     let settings = CollectSettings {
         runs: a.runs,
         seed: a.seed,
@@ -162,6 +212,73 @@ pub fn collect(args: &CollectArgs) -> anyhow::Result<std::process::ExitCode> {
         a.out.display(),
         index.assemblies.len(),
         states,
+        index.features,
+        index.node_dim,
+        index.edge_dim
+    );
+    Ok(std::process::ExitCode::SUCCESS)
+}
+
+/// Runs `asp collect transitions`.
+fn transitions(a: &TransitionsArgs) -> anyhow::Result<std::process::ExitCode> {
+    check_objective_names(&a.objective, &[]).context("--objective")?;
+    if a.episodes == 0 {
+        bail!("--episodes must be at least 1");
+    }
+    if a.budget == 0 {
+        bail!("--budget must be at least 1");
+    }
+    if a.max_transitions == 0 {
+        bail!("--max-transitions must be at least 1");
+    }
+    if let Some(d) = a.d_max {
+        crate::output::positive("d-max", d)?;
+    }
+    let settings = TransitionSettings {
+        seed: a.seed,
+        plan: crate::output::model_settings(&a.load)?,
+        optimise: OptimiseSettings {
+            objectives: a.objective.clone(),
+            episodes: a.episodes,
+            budget: a.budget,
+            resolution: a.resolution,
+            d_max: a.d_max,
+            support: match a.support {
+                SupportArg::Below => Support::Below,
+                SupportArg::Contact => Support::ContactGraph,
+            },
+            ..OptimiseSettings::default()
+        },
+        limit: a.max_transitions,
+    };
+    let models = collect::model_paths(&a.models)?;
+    let bar = if std::io::stderr().is_terminal() {
+        let style = ProgressStyle::with_template("{bar:30} {pos}/{len} models {elapsed} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar());
+        ProgressBar::new(models.len() as u64).with_style(style)
+    } else {
+        ProgressBar::hidden()
+    };
+    let progress = |m: &TransitionsModel| {
+        bar.set_message(format!("{}: {} transitions", m.name, m.transitions));
+        bar.inc(1);
+    };
+    let index = collect_q::collect_transitions(&models, &a.out, &settings, &progress);
+    bar.finish_and_clear();
+    let index = index?;
+    let transitions: usize = index.assemblies.iter().map(|m| m.transitions).sum();
+    for m in index.assemblies.iter().filter(|m| m.capped) {
+        eprintln!(
+            "warning: {}: recording stopped at --max-transitions {} before the search ended",
+            m.model, a.max_transitions
+        );
+    }
+    println!(
+        "{}: {} models, {} transitions ({}), features {} ({} node, {} edge attributes)",
+        a.out.display(),
+        index.assemblies.len(),
+        transitions,
+        index.objectives.join(", "),
         index.features,
         index.node_dim,
         index.edge_dim

@@ -147,7 +147,7 @@ pub fn model_paths(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
     Ok(out)
 }
 
-fn io_error(path: &Path, e: std::io::Error) -> SearchError {
+pub(crate) fn io_error(path: &Path, e: std::io::Error) -> SearchError {
     SearchError::Geom(asp_geom::GeomError::Io { path: path.to_path_buf(), source: e })
 }
 
@@ -174,7 +174,8 @@ pub fn unique_names(models: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
-fn seed_of(base: u64, model: usize, run: usize) -> u64 {
+/// The seed of run `run` of the model at position `model` in a collection with base seed `base`.
+pub(crate) fn seed_of(base: u64, model: usize, run: usize) -> u64 {
     crate::ordering::state_seed(base, &PartSet::empty(0), ((model as u64) << 32) | run as u64)
 }
 
@@ -239,9 +240,15 @@ pub fn write_index(out: &Path, settings: &CollectSettings, assemblies: Vec<Colle
         runs: settings.runs,
         assemblies,
     };
-    let json = serde_json::to_string_pretty(&index).expect("the index serialises");
-    write_atomic(&out.join("index.json"), format!("{json}\n").as_bytes())?;
+    write_json(&out.join("index.json"), &index)?;
     Ok(index)
+}
+
+/// Writes `value` as pretty JSON with a final newline to `path` ([`write_atomic`]): a data set's
+/// `index.json`.
+pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
+    let json = serde_json::to_string_pretty(value).expect("the index serialises");
+    write_atomic(path, format!("{json}\n").as_bytes())
 }
 
 /// Collects the states of one model into `out/<item.dir>/` (the folder is created): its graph
@@ -348,14 +355,20 @@ pub fn npy_f32(data: &[f32], rows: usize, cols: usize) -> Vec<u8> {
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so a
 /// reader never sees half a file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic_with(path, |w| w.write_all(bytes))
+}
+
+/// Like [`write_atomic`], with the contents streamed by `write` (buffered).
+pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<()> {
     let tmp = path.with_extension(format!("{}.tmp", path.extension().and_then(|e| e.to_str()).unwrap_or("")));
-    let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
+    let run = || -> std::io::Result<()> {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+        write(&mut f)?;
+        let f = f.into_inner().map_err(|e| e.into_error())?;
         f.sync_all()?;
         std::fs::rename(&tmp, path)
     };
-    write().map_err(|e| io_error(path, e))
+    run().map_err(|e| io_error(path, e))
 }
 
 #[cfg(test)]

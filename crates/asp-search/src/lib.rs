@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod bench_mcts;
 pub mod collect;
+pub mod collect_q;
 pub mod dfs;
 pub mod error;
 pub mod exact;
@@ -28,7 +29,7 @@ pub use ordering::{Bookkeeping, BuiltinOrder, OrderingFactory, OrderingSource, P
 pub use pareto::ParetoMcts;
 pub use policy::{EpsilonGreedy, Policy, PolicyContext, PolicyWorker, QFunction, QWorker, RandomPolicy};
 pub use problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StopReason, Stuck, StuckReason, Subassembly};
-pub use search::{SearchOutcome, SearchStats, SearchStatus, Solution, StopToken};
+pub use search::{SearchOutcome, SearchStats, SearchStatus, Solution, StopToken, Transition};
 
 /// A planner: takes a problem apart within a budget. Every planner runs the same conformance
 /// tests (`tests/conformance`).

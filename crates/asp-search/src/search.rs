@@ -32,6 +32,17 @@
 //! unless a time limit or a [`StopToken`] stops the search. `threads = 1` runs on the calling
 //! thread.
 //!
+//! # Recording transitions
+//! With [`SearchBuilder::record_transitions`] every removal step the search simulates — at an
+//! expansion or in a rollout — is kept as a [`Transition`] `(s, a, r, s')` for learning
+//! Q-functions offline (thesis 5.5.2, 6.5.1). Selection walks edges that were recorded when
+//! they were expanded, so expansions and rollouts cover every distinct step. Recording computes
+//! the feasible actions of each step's states (with the step's [`StepKind`]) and nothing else
+//! that the search reads: the search takes the same steps with or without it. Only
+//! [`SearchStats`]' test counters also count the tests recording runs. The outcome holds the
+//! transitions per thread in order, threads in order, up to
+//! [`SearchBuilder::record_transitions_limit`] (split among the threads).
+//!
 //! # Plug-ins
 //! The rollout and expansion policy ([`Policy`], one [`PolicyWorker`] per thread), the
 //! objectives and the feasibility filters of the [`Mdp`] are the search's plug-ins. One that
@@ -61,6 +72,8 @@ pub const DEFAULT_EPISODES: usize = 1000;
 pub const DEFAULT_EXPLORATION: f64 = std::f64::consts::FRAC_1_SQRT_2;
 /// Default cap on tree nodes per thread; beyond it iterations roll out without expanding.
 pub const DEFAULT_MAX_NODES: usize = 1_000_000;
+/// Default cap on recorded transitions ([`SearchBuilder::record_transitions_limit`]).
+pub const DEFAULT_RECORD_LIMIT: usize = 1_000_000;
 
 /// Settings of a tree search. Build with [`crate::Mcts::builder`] or
 /// [`crate::ParetoMcts::builder`].
@@ -78,6 +91,8 @@ pub struct SearchSettings {
     pub(crate) transpositions: bool,
     pub(crate) stop: Option<StopToken>,
     pub(crate) prior_weight: f64,
+    pub(crate) record: bool,
+    pub(crate) record_limit: usize,
 }
 
 /// Stops running searches from another thread (Ctrl-C from Python, a caller's deadline): each
@@ -119,6 +134,8 @@ impl Default for SearchSettings {
             transpositions: true,
             stop: None,
             prior_weight: 0.0,
+            record: false,
+            record_limit: DEFAULT_RECORD_LIMIT,
         }
     }
 }
@@ -163,6 +180,14 @@ impl SearchSettings {
     /// The policy.
     pub fn policy(&self) -> &Arc<dyn Policy> {
         &self.policy
+    }
+    /// Whether the search records its transitions.
+    pub fn records_transitions(&self) -> bool {
+        self.record
+    }
+    /// The cap on recorded transitions (all threads).
+    pub fn record_transitions_limit(&self) -> usize {
+        self.record_limit
     }
 }
 
@@ -257,6 +282,23 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
         self
     }
 
+    /// Records every removal step the search simulates (expansions and rollout steps) as a
+    /// [`Transition`] in [`SearchOutcome::transitions`] (default false). The search's answers
+    /// are the same either way; recording costs the feasible actions of each step's states and
+    /// memory.
+    pub fn record_transitions(mut self, yes: bool) -> Self {
+        self.settings.record = yes;
+        self
+    }
+
+    /// The most transitions recorded (default 1,000,000, ≥ 1), split among the threads like the
+    /// episodes; a thread that reaches its share stops recording and the outcome says so
+    /// ([`SearchOutcome::transitions_capped`]).
+    pub fn record_transitions_limit(mut self, limit: usize) -> Self {
+        self.settings.record_limit = limit;
+        self
+    }
+
     /// Checks the settings.
     pub fn build(self) -> Result<K> {
         let s = &self.settings;
@@ -277,6 +319,9 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
         }
         if s.max_nodes == 0 {
             return Err(SearchError::config("max_nodes must be at least 1"));
+        }
+        if s.record_limit == 0 {
+            return Err(SearchError::config("the transitions limit must be at least 1"));
         }
         if s.time_limit.is_some_and(|t| t.is_zero()) {
             return Err(SearchError::config("the time limit must be positive"));
@@ -427,6 +472,99 @@ pub struct SearchOutcome {
     pub stats: SearchStats,
     /// Quality over episodes and seconds (a row whenever it changed, and a last row).
     pub trace: Vec<TracePoint>,
+    /// The recorded transitions ([`SearchBuilder::record_transitions`]; empty without it): each
+    /// thread's in the order it took them, threads in order.
+    pub transitions: Vec<Transition>,
+    /// Whether a thread reached its share of [`SearchBuilder::record_transitions_limit`] and
+    /// stopped recording (the search went on).
+    pub transitions_capped: bool,
+}
+
+/// One removal step the search simulated: from state `s` (`present` with the objectives'
+/// `memory`) the part `action` left, earning `rewards`, and led to `s'` (`present` without
+/// `action`, with `next_memory`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transition {
+    /// The episode (numbered over all threads: thread `t`'s episodes follow those of the
+    /// threads before it).
+    pub episode: u64,
+    /// [`StepKind::Expansion`] (the step became an edge of the search graph, or would have
+    /// below the node cap) or [`StepKind::Simulation`] (a rollout step).
+    pub kind: StepKind,
+    /// The parts of `s`.
+    pub present: PartSet,
+    /// The memory words of `s` ([`Mdp::memory_range`] per objective).
+    pub memory: Vec<u64>,
+    /// The feasible removals of `s` that the step chose from (increasing part order), computed
+    /// with the step's kind — except for a rollout's first step from a node just added, which
+    /// chooses from the node's feasible set, computed for the expansion.
+    pub actions: Vec<usize>,
+    /// The part removed.
+    pub action: usize,
+    /// The raw reward of each objective (in the problem's order).
+    pub rewards: Vec<f64>,
+    /// The memory words of `s'`.
+    pub next_memory: Vec<u64>,
+    /// The feasible removals of `s'` with the step's kind (empty: the episode ends there).
+    pub next_actions: Vec<usize>,
+    /// Whether `s'` holds fixed parts only (every removable part is gone).
+    pub complete: bool,
+}
+
+/// A worker's recording: the transitions so far, the step being recorded (until the feasible
+/// actions of its `s'` are known) and scratch.
+struct Recorder {
+    transitions: Vec<Transition>,
+    limit: usize,
+    capped: bool,
+    /// The current episode's number.
+    episode: u64,
+    pending: Option<Transition>,
+    actions: Vec<usize>,
+    counts: FilterCounts,
+}
+
+impl Recorder {
+    /// Whether there is room for another transition (sets `capped` when there is not).
+    fn active(&mut self) -> bool {
+        if self.transitions.len() >= self.limit {
+            self.capped = true;
+        }
+        !self.capped
+    }
+
+    /// Starts recording a step from `s` (before it is taken).
+    fn begin(&mut self, kind: StepKind, present: PartSet, memory: &[u64], actions: &[usize], action: usize) {
+        self.pending = Some(Transition {
+            episode: self.episode,
+            kind,
+            present,
+            memory: memory.to_vec(),
+            actions: actions.to_vec(),
+            action,
+            rewards: Vec::new(),
+            next_memory: Vec::new(),
+            next_actions: Vec::new(),
+            complete: false,
+        });
+    }
+
+    /// The step's outcome, once taken.
+    fn taken(&mut self, rewards: &[f64], next_memory: &[u64], complete: bool) {
+        if let Some(t) = &mut self.pending {
+            t.rewards = rewards.to_vec();
+            t.next_memory = next_memory.to_vec();
+            t.complete = complete;
+        }
+    }
+
+    /// Completes the pending step with the feasible actions of its `s'`.
+    fn finish(&mut self, next_actions: &[usize]) {
+        if let Some(mut t) = self.pending.take() {
+            t.next_actions = next_actions.to_vec();
+            self.transitions.push(t);
+        }
+    }
 }
 
 impl SearchOutcome {
@@ -678,6 +816,8 @@ struct Worker<'p, V: Variant> {
     /// The first plug-in error; it stops this worker, and through `abort` the others.
     error: Option<SearchError>,
     abort: &'p StopToken,
+    /// The recording, when the settings ask for it.
+    record: Option<Recorder>,
 }
 
 impl<'p, V: Variant> Worker<'p, V> {
@@ -687,6 +827,7 @@ impl<'p, V: Variant> Worker<'p, V> {
         thread: usize,
         start: Instant,
         abort: &'p StopToken,
+        first_episode: u64,
     ) -> Result<Self> {
         let m = problem.num_objectives();
         let maps = problem.maps();
@@ -766,6 +907,15 @@ impl<'p, V: Variant> Worker<'p, V> {
             stopped: false,
             error: None,
             abort,
+            record: settings.record.then(|| Recorder {
+                transitions: Vec::new(),
+                limit: share_of(settings.record_limit, settings.threads, thread),
+                capped: false,
+                episode: first_episode,
+                pending: None,
+                actions: Vec::with_capacity(n),
+                counts: problem.filter_counts(),
+            }),
         };
         if worker.priors {
             worker.record_priors()?;
@@ -944,10 +1094,21 @@ impl<'p, V: Variant> Worker<'p, V> {
                 format!("chose untried action {pick} of {}", self.untried.len()),
             ));
         };
+        if let Some(rec) = &mut self.record {
+            if rec.active() {
+                let mut actions = std::mem::take(&mut rec.actions);
+                self.problem.feasible_actions(&mut self.sim, &self.memory, StepKind::Expansion, &mut actions, &mut rec.counts);
+                rec.begin(StepKind::Expansion, self.sim.present(), &self.memory, &actions, action);
+                rec.actions = actions;
+            }
+        }
         let mut rewards = [0.0f64; MAX_OBJECTIVES];
         self.problem.step(&mut self.sim, &mut self.memory, action, StepKind::Expansion, &mut rewards[..m]);
         for k in 0..m {
             ret[k] += rewards[k];
+        }
+        if let Some(rec) = &mut self.record {
+            rec.taken(&rewards[..m], &self.memory, self.sim.is_complete());
         }
         let present = self.sim.present();
         // The child: an existing node with the same state, or a new one.
@@ -1023,6 +1184,18 @@ impl<'p, V: Variant> Worker<'p, V> {
             self.push(e);
         }
 
+        // The recorded step's s': a new child's feasible actions are in `actions` (the rollout
+        // completes the record), the rollout computes them for simulation otherwise, which is
+        // the same set unless filters tell the kinds apart.
+        if !new_child && !self.problem.filters().is_empty() {
+            if let Some(rec) = self.record.as_mut().filter(|r| r.pending.is_some()) {
+                let mut actions = std::mem::take(&mut rec.actions);
+                self.problem.feasible_actions(&mut self.sim, &self.memory, StepKind::Expansion, &mut actions, &mut rec.counts);
+                rec.finish(&actions);
+                rec.actions = actions;
+            }
+        }
+
         // The sequence so far: the path's removals (and the unexpanded action).
         self.sequence.clear();
         self.sequence.extend(self.path_edges.iter().map(|&e| self.tree.edges[e as usize].action));
@@ -1044,6 +1217,9 @@ impl<'p, V: Variant> Worker<'p, V> {
                 );
             }
             known = false;
+            if let Some(rec) = &mut self.record {
+                rec.finish(&self.actions);
+            }
             if self.actions.is_empty() {
                 break;
             }
@@ -1057,7 +1233,15 @@ impl<'p, V: Variant> Worker<'p, V> {
                     format!("chose action {k} of {}", self.actions.len()),
                 ));
             };
+            if let Some(rec) = &mut self.record {
+                if rec.active() {
+                    rec.begin(StepKind::Simulation, self.sim.present(), &self.memory, &self.actions, p);
+                }
+            }
             self.problem.step(&mut self.sim, &mut self.memory, p, StepKind::Simulation, &mut rewards[..m]);
+            if let Some(rec) = &mut self.record {
+                rec.taken(&rewards[..m], &self.memory, self.sim.is_complete());
+            }
             for k in 0..m {
                 ret[k] += rewards[k];
             }
@@ -1176,6 +1360,9 @@ impl<'p, V: Variant> Worker<'p, V> {
             }
             let before = self.stats.iterations;
             self.episode();
+            if let Some(rec) = &mut self.record {
+                rec.episode += 1;
+            }
             if !self.stopped {
                 self.stats.episodes += 1;
             }
@@ -1268,8 +1455,14 @@ fn front_value<P>(front: &ParetoFront<P>, reference: &[f64]) -> f64 {
     }
 }
 
-/// What one worker hands back: its archive, statistics, filter counts and root status.
-type WorkerResult = Result<(ParetoFront<Vec<u16>>, SearchStats, FilterCounts, Status)>;
+/// What one worker hands back: its archive, statistics, filter counts, root status and
+/// recording.
+type WorkerResult = Result<(ParetoFront<Vec<u16>>, SearchStats, FilterCounts, Status, Option<Recorder>)>;
+
+/// Thread `t`'s share of `total` episodes (or transitions) over `threads` threads.
+fn share_of(total: usize, threads: usize, t: usize) -> usize {
+    total / threads + usize::from(t < total % threads)
+}
 
 /// The message of a panic payload.
 fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
@@ -1305,16 +1498,17 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Resul
         last_value: None,
     });
     let threads = settings.threads;
-    let share = |t: usize| settings.episodes / threads + usize::from(t < settings.episodes % threads);
+    let share = |t: usize| share_of(settings.episodes, threads, t);
     let abort = StopToken::new();
     // One worker's search; a panic in a plug-in becomes an error (and stops the others).
     let work = |t: usize| -> WorkerResult {
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            let mut w = Worker::<V>::new(problem, settings, t, start, &abort)?;
+            let first_episode = (0..t).map(share).sum::<usize>() as u64;
+            let mut w = Worker::<V>::new(problem, settings, t, start, &abort, first_episode)?;
             w.run(share(t), &shared, &reference, start);
             match w.error.take() {
                 Some(e) => Err(e),
-                None => Ok((w.archive, w.stats, w.filtered, w.tree.nodes[0].status)),
+                None => Ok((w.archive, w.stats, w.filtered, w.tree.nodes[0].status, w.record.take())),
             }
         }));
         match outcome {
@@ -1347,7 +1541,9 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Resul
     let mut stats = SearchStats { threads, seconds, exhausted: false, ..Default::default() };
     let mut filtered = problem.filter_counts();
     let mut dead = true;
-    for (archive, s, f, status) in &results {
+    let mut transitions = Vec::new();
+    let mut transitions_capped = false;
+    for (archive, s, f, status, _) in &results {
         for (p, seq) in archive.iter() {
             merged.insert(p, || seq.clone());
         }
@@ -1365,6 +1561,12 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Resul
         dead &= *status == Status::Dead;
     }
     stats.filtered = problem.report_filtered(&filtered);
+    for (.., record) in results {
+        if let Some(r) = record {
+            transitions.extend(r.transitions);
+            transitions_capped |= r.capped;
+        }
+    }
     let mut solutions = Vec::with_capacity(merged.len());
     for (_, seq) in merged.sorted() {
         let sequence: Vec<usize> = seq.iter().map(|&p| p as usize).collect();
@@ -1406,5 +1608,7 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Resul
         value: if merged.is_empty() { 0.0 } else { value },
         stats,
         trace: shared.trace,
+        transitions,
+        transitions_capped,
     })
 }

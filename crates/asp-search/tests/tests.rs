@@ -12,4 +12,5 @@ mod pareto;
 mod qgraph;
 mod real;
 mod seams;
+mod transitions;
 mod verify;

@@ -177,6 +177,77 @@ fn optimiser_results_for_a_seed_are_pinned() {
     assert_eq!((opt["iterations"].as_u64(), opt["tree_nodes"].as_u64()), (Some(17567), Some(7733)));
 }
 
+/// `asp collect transitions`: a generated cube's transitions as docs/learning.md describes them
+/// (format, version, one line per counted transition), reproducible, and errors naming the file
+/// or the flag.
+#[test]
+fn collect_transitions_writes_the_documented_data_set() {
+    let dir = tempfile::tempdir().unwrap();
+    let models = dir.path().join("cubes");
+    let o = asp(&["gen", "soma", "--size", "3", "--count", "2", "--seed", "4", "--out", models.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let collect = |out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "collect", "transitions", models.to_str().unwrap(), "--objective", "access,dirchange", "--episodes", "15",
+            "--seed", "2", "--resolution", "5", "--out", out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        asp(&args)
+    };
+    let out = dir.path().join("q");
+    let o = collect(&out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let stdout = String::from_utf8(o.stdout).unwrap();
+    assert!(stdout.contains("2 models") && stdout.contains("asp-q/1 directions=25 neighbours=8"), "{stdout}");
+    let index = json(&out.join("index.json"));
+    assert_eq!(index["format"], "asp-transitions");
+    assert_eq!(index["version"], 1);
+    assert_eq!(index["objectives"], serde_json::json!(["access", "dirchange"]));
+    assert_eq!((index["node_dim"].as_u64(), index["edge_dim"].as_u64()), (Some(78), Some(55)));
+    assert_eq!(index["episodes"], 15);
+    let entries = index["assemblies"].as_array().unwrap();
+    assert_eq!(entries.len(), 2);
+    let mut total = 0;
+    for e in entries {
+        assert!(Path::new(e["model"].as_str().unwrap()).is_absolute());
+        assert_eq!(e["maps"]["objective"], "access,dirchange");
+        assert_eq!(e["maps"]["resolution"], 5);
+        assert_eq!(e["reward_ranges"].as_array().unwrap().len(), 2);
+        let text = std::fs::read_to_string(out.join(e["dir"].as_str().unwrap()).join("transitions.jsonl")).unwrap();
+        let lines: Vec<serde_json::Value> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+        assert_eq!(lines.len() as u64, e["transitions"].as_u64().unwrap());
+        assert!(!lines.is_empty());
+        let parts = e["parts"].as_u64().unwrap();
+        for l in &lines {
+            let action = l["action"].as_u64().unwrap();
+            assert!(action < parts && l["actions"].as_array().unwrap().iter().any(|a| a.as_u64() == Some(action)));
+            // s' = present without the action: every next action is one of its parts
+            let present = l["present"].as_array().unwrap();
+            assert!(l["next_actions"].as_array().unwrap().iter().all(|p| present.contains(p) && p.as_u64() != Some(action)));
+            assert_eq!(l["rewards"].as_array().unwrap().len(), 2);
+            assert!(l["kind"] == "expansion" || l["kind"] == "simulation");
+        }
+        total += lines.len();
+    }
+    assert!(stdout.contains(&format!("{total} transitions")), "{stdout}");
+    // the same seed, the same bytes
+    let again = dir.path().join("again");
+    assert_eq!(collect(&again, &[]).status.code(), Some(0));
+    for e in entries {
+        let file = |root: &Path| std::fs::read(root.join(e["dir"].as_str().unwrap()).join("transitions.jsonl")).unwrap();
+        assert_eq!(file(&out), file(&again));
+    }
+    // one-line errors naming the file or the flag
+    let missing = dir.path().join("missing.glb");
+    let o = asp(&["collect", "transitions", missing.to_str().unwrap(), "--objective", "access", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("missing.glb") && stderr(&o).trim().lines().count() == 1, "{}", stderr(&o));
+    let bad = dir.path().join("bad");
+    let o = asp(&["collect", "transitions", models.to_str().unwrap(), "--objective", "access,speed", "--out", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--objective") && stderr(&o).contains("speed"), "{}", stderr(&o));
+}
+
 #[test]
 fn q_models_are_checked_before_the_search() {
     let dir = tempfile::tempdir().unwrap();
