@@ -82,6 +82,24 @@ def _str_field(path: Path, obj: dict, key: str, where: str = "") -> str:
     return value
 
 
+def read_index(path: Path, fmt: str, version: int) -> tuple[dict, str, int, int]:
+    """A data set's ``index.json``, checked to be an object of format ``fmt`` and ``version``,
+    with its ``features``, ``node_dim`` and ``edge_dim``."""
+    index = _read_json(path)
+    if not isinstance(index, dict):
+        raise _fail(path, "must be a JSON object")
+    got = index.get("format")
+    if got != fmt:
+        raise _fail(path, f"format is {json.dumps(got)}, expected \"{fmt}\"")
+    v = index.get("version")
+    if v != version:
+        raise _fail(path, f"{fmt} version {json.dumps(v)} is not supported (this reader knows {version})")
+    features = _str_field(path, index, "features")
+    node_dim = _int_field(path, index, "node_dim", minimum=1)
+    edge_dim = _int_field(path, index, "edge_dim", minimum=1)
+    return index, features, node_dim, edge_dim
+
+
 def _load_array(path: Path, rows: int, cols: int, what: str) -> np.ndarray:
     try:
         array = np.load(path, mmap_mode="r", allow_pickle=False)
@@ -285,18 +303,7 @@ class RemovabilityDataset:
         """Open and validate a data set folder (index, graphs, array shapes; states stream later)."""
         root = Path(root)
         index_path = root / "index.json"
-        index = _read_json(index_path)
-        if not isinstance(index, dict):
-            raise _fail(index_path, "must be a JSON object")
-        fmt = index.get("format")
-        if fmt != FORMAT:
-            raise _fail(index_path, f"format is {json.dumps(fmt)}, expected \"{FORMAT}\"")
-        version = index.get("version")
-        if version != VERSION:
-            raise _fail(index_path, f"{FORMAT} version {json.dumps(version)} is not supported (this reader knows {VERSION})")
-        features = _str_field(index_path, index, "features")
-        node_dim = _int_field(index_path, index, "node_dim", minimum=1)
-        edge_dim = _int_field(index_path, index, "edge_dim", minimum=1)
+        index, features, node_dim, edge_dim = read_index(index_path, FORMAT, VERSION)
         seed = index.get("seed") if isinstance(index.get("seed"), int) else None
         runs = index.get("runs") if isinstance(index.get("runs"), int) else None
         entries = index.get("assemblies")

@@ -32,7 +32,7 @@ from typing import Iterator
 
 import numpy as np
 
-from .data import DataError, _fail, _int_field, _read_json, _str_field
+from .data import DataError, _fail, _int_field, _str_field, read_index
 
 __all__ = [
     "FORMAT",
@@ -276,18 +276,7 @@ class TransitionDataset:
         """Open and validate a data set folder (its index; the transitions are read when streamed)."""
         root = Path(root)
         path = root / "index.json"
-        index = _read_json(path)
-        if not isinstance(index, dict):
-            raise _fail(path, "must be a JSON object")
-        fmt = index.get("format")
-        if fmt != FORMAT:
-            raise _fail(path, f"format is {json.dumps(fmt)}, expected \"{FORMAT}\"")
-        version = index.get("version")
-        if version != VERSION:
-            raise _fail(path, f"{FORMAT} version {json.dumps(version)} is not supported (this reader knows {VERSION})")
-        features = _str_field(path, index, "features")
-        node_dim = _int_field(path, index, "node_dim", minimum=1)
-        edge_dim = _int_field(path, index, "edge_dim", minimum=1)
+        index, features, node_dim, edge_dim = read_index(path, FORMAT, VERSION)
         objectives = index.get("objectives")
         if (
             not isinstance(objectives, list)
