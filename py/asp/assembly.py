@@ -142,6 +142,7 @@ class Assembly:
         support: str = "below",
         q: Union[str, Sequence[str], None] = None,
         epsilon: float = 0.2,
+        q_use: str = "rollouts",
     ) -> Plan:
         """Plans an assembly sequence: the pipeline of ``asp plan``, with the same settings under
         the flags' names (``--max-tests`` is ``max_tests``, ``--no-path-planner`` is
@@ -193,7 +194,10 @@ class Assembly:
             in ``objective``'s order (a comma-separated string or a list): rollouts take the
             removal with the largest Q-value (the product for several objectives) instead of a
             random one, except with probability ``epsilon`` (thesis 5.4.5, 6.4.4).
-        :param epsilon: probability of a random removal in a rollout guided by ``q``.
+        :param epsilon: probability of a random removal in a rollout (or expansion) guided by ``q``.
+        :param q_use: where ``q`` guides: ``rollouts`` (the thesis: one evaluation per rollout
+            step), ``expansions`` (the Q-values of every state the search adds order its
+            expansions, rollouts stay random: one evaluation per node) or ``both``.
         :raises ConfigError: a setting is unknown, of the wrong type or out of range.
         :raises LoadError: the model cannot be planned as given (parts overlapping beyond
             repair, ...).
@@ -234,6 +238,7 @@ class Assembly:
             "support": support,
             "q": q if q is None or isinstance(q, str) else ",".join(os.fspath(m) for m in q),
             "epsilon": epsilon,
+            "q_use": q_use,
         }
         json, found, trace = self._native.plan(settings)
         return Plan(json, found, trace)

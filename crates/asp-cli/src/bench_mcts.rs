@@ -22,8 +22,9 @@ pub struct MctsArgs {
     /// Objectives, comma-separated (several run Pareto-MCTS).
     #[arg(long, value_name = "LIST")]
     pub objective: String,
-    /// Settings, comma-separated: `vanilla` (random rollouts) and `pretrained` (ε-greedy
-    /// rollouts on the `--q` models).
+    /// Settings, comma-separated: `vanilla` (random rollouts), `pretrained` (ε-greedy
+    /// rollouts on the `--q` models), `pretrained-expansions` (the `--q` models order the
+    /// expansions, rollouts stay random) and `pretrained-both`.
     #[arg(long, value_name = "LIST", default_value = "vanilla,pretrained")]
     pub settings: String,
     /// Q models (ONNX), one per objective in `--objective`'s order, for `pretrained`.
@@ -95,14 +96,19 @@ pub fn run(a: &MctsArgs) -> anyhow::Result<std::process::ExitCode> {
     for name in a.settings.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         settings.push(match name {
             "vanilla" => MctsSetting::vanilla(),
-            "pretrained" => {
-                let Some(models) = &a.q else { bail!("--settings {}: pretrained needs --q MODELS", a.settings) };
+            "pretrained" | "pretrained-expansions" | "pretrained-both" => {
+                let Some(models) = &a.q else { bail!("--settings {}: {name} needs --q MODELS", a.settings) };
+                let uses = match name {
+                    "pretrained" => asp_search::QUse::Rollouts,
+                    "pretrained-expansions" => asp_search::QUse::Expansions,
+                    _ => asp_search::QUse::Both,
+                };
                 let paths: Vec<&str> = models.split(',').map(str::trim).filter(|p| !p.is_empty()).collect();
-                let policy = asp_learn::epsilon_greedy(&paths, &objectives, a.epsilon, a.resolution * a.resolution).context("--q")?;
-                MctsSetting { name: "pretrained".into(), policy }
+                let policy = asp_learn::epsilon_greedy(&paths, &objectives, a.epsilon, a.resolution * a.resolution, uses).context("--q")?;
+                MctsSetting { name: name.into(), policy }
             }
             other => bail!(
-                "--settings: unknown setting '{other}' (vanilla, pretrained; the settings that train during the search run from Python)"
+                "--settings: unknown setting '{other}' (vanilla, pretrained, pretrained-expansions, pretrained-both; the settings that train during the search run from Python)"
             ),
         });
     }

@@ -68,9 +68,35 @@ pub struct OptimiseArgs {
     /// probability `--epsilon` (thesis 5.4.5, 6.4.4).
     #[arg(long, value_name = "MODELS", help_heading = "Optimisation")]
     pub q: Option<String>,
-    /// The probability of a random removal in a rollout guided by `--q`.
+    /// The probability of a random removal in a rollout (or expansion) guided by `--q`.
     #[arg(long, default_value_t = 0.2, help_heading = "Optimisation")]
     pub epsilon: f64,
+    /// Where `--q` guides: `rollouts` (thesis: one evaluation per rollout step), `expansions`
+    /// (the Q-values of each state the search adds order its expansions; rollouts stay random:
+    /// one evaluation per node) or `both`.
+    #[arg(long, value_enum, default_value_t = QUseArg::Rollouts, help_heading = "Optimisation")]
+    pub q_use: QUseArg,
+}
+
+/// `--q-use`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum QUseArg {
+    /// ε-greedy rollouts.
+    Rollouts,
+    /// Q-ordered expansions, random rollouts.
+    Expansions,
+    /// Both.
+    Both,
+}
+
+impl From<QUseArg> for asp_search::QUse {
+    fn from(a: QUseArg) -> Self {
+        match a {
+            QUseArg::Rollouts => asp_search::QUse::Rollouts,
+            QUseArg::Expansions => asp_search::QUse::Expansions,
+            QUseArg::Both => asp_search::QUse::Both,
+        }
+    }
 }
 
 impl OptimiseArgs {
@@ -104,7 +130,7 @@ impl OptimiseArgs {
                 let paths: Vec<&str> = models.split(',').map(str::trim).filter(|p| !p.is_empty()).collect();
                 let objectives: Vec<&str> = list.split(',').map(str::trim).filter(|n| !n.is_empty()).collect();
                 let directions = self.resolution * self.resolution;
-                Some(asp_learn::epsilon_greedy(&paths, &objectives, self.epsilon, directions).context("--q")?)
+                Some(asp_learn::epsilon_greedy(&paths, &objectives, self.epsilon, directions, self.q_use.into()).context("--q")?)
             }
         };
         Ok(Some(OptimiseSettings {

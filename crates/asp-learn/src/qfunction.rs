@@ -9,7 +9,7 @@
 
 use crate::error::{LearnError, Result};
 use crate::model::{GraphModel, ModelKind};
-use asp_search::policy::{EpsilonGreedy, Policy, PolicyContext, QFunction, QWorker};
+use asp_search::policy::{EpsilonGreedy, Policy, PolicyContext, QFunction, QUse, QWorker};
 use asp_search::qgraph::{self, QGraph, QGraphBuilder, QGraphConfig};
 use asp_search::SearchError;
 use std::path::Path;
@@ -145,8 +145,8 @@ impl QWorker for OnnxQWorker<'_> {
 
 /// The ε-greedy rollout policy (thesis 5.4.5, 6.4.4) over the Q models at `paths`, one per
 /// objective in `objectives`' order (each model's `asp.objective` must be that objective), for
-/// maps with `directions` directions.
-pub fn epsilon_greedy(paths: &[impl AsRef<Path>], objectives: &[&str], epsilon: f64, directions: usize) -> Result<Arc<dyn Policy>> {
+/// maps with `directions` directions, evaluated where `uses` says (rollouts, expansions or both).
+pub fn epsilon_greedy(paths: &[impl AsRef<Path>], objectives: &[&str], epsilon: f64, directions: usize, uses: QUse) -> Result<Arc<dyn Policy>> {
     let label = |p: &dyn AsRef<Path>| p.as_ref().display().to_string();
     if paths.len() != objectives.len() {
         let names = paths.iter().map(|p| label(p)).collect::<Vec<_>>().join(",");
@@ -167,7 +167,7 @@ pub fn epsilon_greedy(paths: &[impl AsRef<Path>], objectives: &[&str], epsilon: 
         qs.push(Arc::new(q));
     }
     let policy = EpsilonGreedy::new(epsilon, qs).map_err(|e| LearnError::Input { path: "epsilon".into(), reason: e.to_string() })?;
-    Ok(Arc::new(policy))
+    Ok(Arc::new(policy.using(uses)))
 }
 
 #[cfg(test)]

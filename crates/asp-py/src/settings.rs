@@ -30,7 +30,7 @@ pub const DEFAULT_PHYSICS_THRESHOLD: f64 = 0.01;
 pub const ORDER_NAMES: [&str; 5] = ["given", "shuffled", "random", "bookkeeping", "gnn"];
 
 /// The keywords of [`plan_settings`], in the order of `asp.Assembly.plan`'s signature.
-pub const PLAN_KEYS: [&str; 29] = [
+pub const PLAN_KEYS: [&str; 30] = [
     "order",
     "model",
     "bookkeeping",
@@ -60,6 +60,7 @@ pub const PLAN_KEYS: [&str; 29] = [
     "support",
     "q",
     "epsilon",
+    "q_use",
 ];
 
 /// The ordering source `order=name` stands for, and whether the name implies bookkeeping
@@ -218,7 +219,11 @@ fn optimise_settings(k: &Keywords<'_, '_>) -> Result<Option<OptimiseSettings>, E
         Some(models) => {
             let paths: Vec<&str> = models.split(',').map(str::trim).filter(|p| !p.is_empty()).collect();
             let names: Vec<&str> = objectives.split(',').map(str::trim).filter(|n| !n.is_empty()).collect();
-            Some(asp_learn::epsilon_greedy(&paths, &names, epsilon, resolution * resolution).map_err(|e| Error::config(format!("q: {e}")))?)
+            let uses = match k.string("q_use")?.as_deref() {
+                None => asp_search::QUse::default(),
+                Some(u) => u.parse().map_err(|e: asp_search::SearchError| Error::config(format!("q_use: {e}")))?,
+            };
+            Some(asp_learn::epsilon_greedy(&paths, &names, epsilon, resolution * resolution, uses).map_err(|e| Error::config(format!("q: {e}")))?)
         }
     };
     Ok(Some(OptimiseSettings {
@@ -366,6 +371,7 @@ pub fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("support", "below")?;
     d.set_item("q", py.None())?;
     d.set_item("epsilon", DEFAULT_EPSILON)?;
+    d.set_item("q_use", asp_search::QUse::default().name())?;
     let g = GraphConfig::default();
     d.set_item("radius_bins", g.radius_bins)?;
     d.set_item("degree", g.degree)?;

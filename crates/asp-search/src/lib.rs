@@ -27,7 +27,7 @@ pub use mdp::{ActionFilter, FilterCount, Mdp, MdpExtension, ModelContext, Verdic
 pub use objective::{Accessibility, DirHistory, DirectionChanges, Objective, PathLength, StepContext, StepKind};
 pub use ordering::{Bookkeeping, BuiltinOrder, OrderingFactory, OrderingSource, PartOrdering, WithBookkeeping};
 pub use pareto::ParetoMcts;
-pub use policy::{EpsilonGreedy, Policy, PolicyContext, PolicyWorker, QFunction, QWorker, RandomPolicy};
+pub use policy::{EpsilonGreedy, Policy, PolicyContext, PolicyWorker, QFunction, QUse, QWorker, RandomPolicy};
 pub use problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StopReason, Stuck, StuckReason, Subassembly};
 pub use search::{SearchOutcome, SearchStats, SearchStatus, Solution, StopToken, Transition};
 

@@ -176,12 +176,61 @@ impl<Q: QFunction + ?Sized> QWorker for Shared<'_, Q> {
     }
 }
 
+/// Where a guided search spends its Q-function evaluations.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum QUse {
+    /// ε-greedy rollouts (thesis 5.4.5 / 6.4.4): one evaluation per rollout step; expansions
+    /// stay uniformly random.
+    #[default]
+    Rollouts,
+    /// Expansions only: the Q-values of a state, evaluated once when the search adds it to its
+    /// graph, become its priors (normalised), and an expansion adds the untried removal with the
+    /// largest prior (a random one with probability ε); rollouts stay uniformly random. One
+    /// evaluation per node instead of one per rollout step.
+    Expansions,
+    /// Both: ε-greedy rollouts and Q-ordered expansions.
+    Both,
+}
+
+impl QUse {
+    /// The names, as the command line and Python take them.
+    pub const NAMES: [&'static str; 3] = ["rollouts", "expansions", "both"];
+
+    fn rollouts(self) -> bool {
+        matches!(self, QUse::Rollouts | QUse::Both)
+    }
+
+    fn expansions(self) -> bool {
+        matches!(self, QUse::Expansions | QUse::Both)
+    }
+
+    /// The name ([`QUse::NAMES`]).
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+}
+
+impl std::str::FromStr for QUse {
+    type Err = SearchError;
+
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "rollouts" => Ok(QUse::Rollouts),
+            "expansions" => Ok(QUse::Expansions),
+            "both" => Ok(QUse::Both),
+            other => Err(SearchError::config(format!("unknown Q use '{other}' (rollouts, expansions or both)"))),
+        }
+    }
+}
+
 /// The ε-greedy policy of 5.4.5 / 6.4.4: with probability ε a random removal, otherwise the
-/// removal with the largest product of Q-values (ties: the first).
+/// removal with the largest product of Q-values (ties: the first) — in rollouts, in
+/// expansions (as priors), or both ([`QUse`]).
 #[derive(Clone, Debug)]
 pub struct EpsilonGreedy {
     epsilon: f64,
     q_functions: Vec<Arc<dyn QFunction>>,
+    uses: QUse,
 }
 
 impl EpsilonGreedy {
@@ -193,35 +242,55 @@ impl EpsilonGreedy {
         if q_functions.is_empty() {
             return Err(SearchError::config("the epsilon-greedy policy needs a Q-function"));
         }
-        Ok(EpsilonGreedy { epsilon, q_functions })
+        Ok(EpsilonGreedy { epsilon, q_functions, uses: QUse::Rollouts })
+    }
+
+    /// The same policy spending its Q evaluations where `uses` says (default: rollouts).
+    pub fn using(mut self, uses: QUse) -> Self {
+        self.uses = uses;
+        self
     }
 
     /// ε.
     pub fn epsilon(&self) -> f64 {
         self.epsilon
     }
+
+    /// Where the Q-functions are evaluated.
+    pub fn uses(&self) -> QUse {
+        self.uses
+    }
 }
 
 impl Policy for EpsilonGreedy {
     fn for_worker(&self, thread: usize) -> Result<Box<dyn PolicyWorker + '_>> {
-        let q = self.q_functions.iter().map(|q| q.for_worker(thread)).collect::<Result<Vec<_>>>()?;
-        Ok(Box::new(EpsilonGreedyWorker { epsilon: self.epsilon, q, values: Vec::new(), product: Vec::new() }))
+        let q = self
+            .q_functions
+            .iter()
+            .map(|q| q.for_worker(thread))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Box::new(EpsilonGreedyWorker {
+            epsilon: self.epsilon,
+            uses: self.uses,
+            q,
+            values: Vec::new(),
+            product: Vec::new(),
+        }))
     }
 }
 
 /// A thread's [`EpsilonGreedy`].
 struct EpsilonGreedyWorker<'q> {
     epsilon: f64,
+    uses: QUse,
     q: Vec<Box<dyn QWorker + 'q>>,
     values: Vec<f64>,
     product: Vec<f64>,
 }
 
-impl PolicyWorker for EpsilonGreedyWorker<'_> {
-    fn choose(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], rng: &mut SearchRng) -> Result<usize> {
-        if rng.random::<f64>() <= self.epsilon {
-            return Ok(rng.random_range(0..actions.len()));
-        }
+impl EpsilonGreedyWorker<'_> {
+    /// The product of the Q-values of `actions` in `self.product`.
+    fn evaluate(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize]) -> Result<()> {
         let n = actions.len();
         self.product.clear();
         self.product.resize(n, 1.0);
@@ -232,7 +301,67 @@ impl PolicyWorker for EpsilonGreedyWorker<'_> {
                 *p *= v;
             }
         }
+        Ok(())
+    }
+}
+
+impl PolicyWorker for EpsilonGreedyWorker<'_> {
+    fn choose(
+        &mut self,
+        ctx: &mut PolicyContext<'_, '_>,
+        actions: &[usize],
+        rng: &mut SearchRng,
+    ) -> Result<usize> {
+        if !self.uses.rollouts() || rng.random::<f64>() <= self.epsilon {
+            return Ok(rng.random_range(0..actions.len()));
+        }
+        self.evaluate(ctx, actions)?;
         Ok(argmax(&self.product))
+    }
+
+    fn expand(
+        &mut self,
+        _ctx: &mut PolicyContext<'_, '_>,
+        untried: &[usize],
+        priors: Option<&[f64]>,
+        rng: &mut SearchRng,
+    ) -> Result<usize> {
+        Ok(match priors {
+            Some(p) if rng.random::<f64>() > self.epsilon => argmax(p),
+            _ => rng.random_range(0..untried.len()),
+        })
+    }
+
+    fn has_priors(&self) -> bool {
+        self.uses.expansions()
+    }
+
+    /// The Q-value products, normalised to sum 1 (uniform when they are all 0 or not finite).
+    fn priors(
+        &mut self,
+        ctx: &mut PolicyContext<'_, '_>,
+        actions: &[usize],
+        out: &mut [f64],
+    ) -> Result<()> {
+        if actions.is_empty() {
+            return Ok(());
+        }
+        self.evaluate(ctx, actions)?;
+        let total: f64 = self
+            .product
+            .iter()
+            .filter(|v| v.is_finite() && **v > 0.0)
+            .sum();
+        for (o, &v) in out.iter_mut().zip(&self.product) {
+            *o = if total > 0.0 && v.is_finite() && v > 0.0 {
+                v / total
+            } else if total > 0.0 {
+                0.0
+            } else {
+                1.0 / actions.len() as f64
+            };
+        }
+        Ok(())
     }
 }
 

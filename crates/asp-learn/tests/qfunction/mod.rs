@@ -13,7 +13,7 @@ use asp_geom::distmap::{DistanceMaps, MapConfig, MapState};
 use asp_learn::{epsilon_greedy, GraphModel, ModelKind, OnnxQ};
 use asp_search::exact::exact_front;
 use asp_search::objective::parse_objectives;
-use asp_search::policy::{PolicyContext, QFunction};
+use asp_search::policy::{PolicyContext, QFunction, QUse};
 use asp_search::qgraph::{direction_history, QGraph, QGraphBuilder};
 use asp_search::{Mdp, ParetoMcts};
 use rand::SeedableRng;
@@ -80,9 +80,9 @@ fn q_values_are_the_models_scores_of_the_state_graph() {
 #[test]
 fn product_of_q_guidance_stays_feasible_and_near_the_exact_front() {
     let paths = [fixture("random_q_access.onnx"), fixture("random_q_dirchange.onnx")];
-    let policy = epsilon_greedy(&paths, &["access", "dirchange"], 0.2, 25).unwrap();
+    let policy = epsilon_greedy(&paths, &["access", "dirchange"], 0.2, 25, QUse::Rollouts).unwrap();
     // the models must come in the objectives' order
-    let err = epsilon_greedy(&paths, &["dirchange", "access"], 0.2, 25).unwrap_err().to_string();
+    let err = epsilon_greedy(&paths, &["dirchange", "access"], 0.2, 25, QUse::Rollouts).unwrap_err().to_string();
     assert!(err.contains("random_q_access.onnx") && err.contains("'dirchange'"), "{err}");
     let mut checked = 0;
     for seed in 0..4 {

@@ -134,3 +134,109 @@ fn a_guided_rollout_policy_plugs_in() {
     assert_eq!(out.stats.rollout_steps, again.stats.rollout_steps);
     assert_eq!(out.solutions, again.solutions);
 }
+
+/// A Q-function that prefers larger part indices and counts its evaluations.
+#[derive(Debug, Default)]
+struct LargestIndex(std::sync::atomic::AtomicUsize);
+
+impl asp_search::QFunction for LargestIndex {
+    fn q_values(
+        &self,
+        _: &mut asp_search::PolicyContext<'_, '_>,
+        actions: &[usize],
+        out: &mut [f64],
+    ) -> asp_search::Result<()> {
+        self.0.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        for (o, &a) in out.iter_mut().zip(actions) {
+            *o = 1.0 + a as f64;
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn q_guided_expansions_follow_the_priors_and_leave_rollouts_random() {
+    use asp_search::policy::{EpsilonGreedy, QUse};
+    use asp_search::StepKind;
+    use std::sync::atomic::Ordering;
+    use std::sync::Arc;
+    let cube = soma(3, 2);
+    let maps = maps(&cube, 5);
+    let p = problem(&maps, "access");
+    let run = |uses: QUse| {
+        let q = Arc::new(LargestIndex::default());
+        let policy = EpsilonGreedy::new(0.0, vec![q.clone()])
+            .unwrap()
+            .using(uses);
+        // one episode, one iteration per step: every expansion is its node's first
+        let out = Mcts::builder()
+            .policy(Arc::new(policy))
+            .seed(3)
+            .episodes(1)
+            .budget(1)
+            .record_transitions(true)
+            .build()
+            .unwrap()
+            .solve(&p)
+            .unwrap();
+        (out, q.0.load(Ordering::Relaxed))
+    };
+    let greedy = |t: &asp_search::Transition| t.action == *t.actions.iter().max().unwrap();
+    let (out, calls) = run(QUse::Expansions);
+    let expansions: Vec<_> = out
+        .transitions
+        .iter()
+        .filter(|t| t.kind == StepKind::Expansion)
+        .collect();
+    let rollouts: Vec<_> = out
+        .transitions
+        .iter()
+        .filter(|t| t.kind == StepKind::Simulation)
+        .collect();
+    assert!(!expansions.is_empty() && !rollouts.is_empty());
+    assert!(
+        expansions.iter().all(|t| greedy(t)),
+        "every expansion adds the removal with the largest prior"
+    );
+    assert!(
+        !rollouts
+            .iter()
+            .filter(|t| t.actions.len() > 1)
+            .all(|t| greedy(t)),
+        "rollouts stay random"
+    );
+    // one evaluation per node added (the root's included), none per rollout step
+    assert!(
+        calls <= expansions.len() + 1,
+        "{calls} evaluations for {} expansions",
+        expansions.len()
+    );
+    assert!(
+        rollouts.len() > calls,
+        "{} rollout steps, {calls} evaluations",
+        rollouts.len()
+    );
+    // rollouts: the other way round
+    let (out, calls) = run(QUse::Rollouts);
+    let rollouts: Vec<_> = out
+        .transitions
+        .iter()
+        .filter(|t| t.kind == StepKind::Simulation)
+        .collect();
+    assert!(rollouts
+        .iter()
+        .filter(|t| t.actions.len() > 1)
+        .all(|t| greedy(t)));
+    assert!(calls >= rollouts.iter().filter(|t| t.actions.len() > 1).count());
+    // both: greedy everywhere
+    let (out, _) = run(QUse::Both);
+    assert!(out
+        .transitions
+        .iter()
+        .filter(|t| t.actions.len() > 1)
+        .all(|t| greedy(t)));
+    assert!(
+        "expansions".parse::<QUse>().unwrap() == QUse::Expansions
+            && "sideways".parse::<QUse>().is_err()
+    );
+}
