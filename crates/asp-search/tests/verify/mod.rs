@@ -194,7 +194,11 @@ pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: 
             // a screw step's part has a threaded partner present, and turns about that axis
             let t = others.iter().find_map(|q| world.thread(step.part, q));
             let t = t.unwrap_or_else(|| panic!("step {k}: '{}' screws with no threaded partner", world.name(step.part)));
-            assert!(t.axis.direction.dot(direction).abs() > 0.9999 && t.axis.radial(axis_point) < 1e-3 * t.axis.radius.max(1e-9) + 1e-6);
+            assert!(
+                t.axis.direction.dot(direction).abs() > 0.9999 && t.axis.radial(axis_point) < 1e-3 * t.axis.radius.max(1e-9) + 1e-6,
+                "step {k}: '{}' screws off its axis",
+                world.name(step.part)
+            );
         }
         check_strict(world, k, &movers, &others, &poses, &mut samples, screw);
         for pose in &poses {
