@@ -545,6 +545,10 @@ impl World {
         let found: Vec<((usize, usize), Thread)> = pairs
             .par_iter()
             .filter_map(|&(p, q)| {
+                // a union of boxes (voxels, profiles) has no 60° symmetry
+                if self.geoms[p].boxes.is_some() {
+                    return None;
+                }
                 let axis = self.symmetry_axis(p)?;
                 let t = fastener::threaded_contact(&axis, &self.geoms[p].mesh, &self.geoms[q].mesh, 4.0 * self.tolerance)?;
                 Some(((p, q), t))
