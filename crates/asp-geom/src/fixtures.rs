@@ -252,3 +252,134 @@ pub fn dowel_in_two_boards() -> Assembly {
         ],
     )
 }
+
+/// Facets around a fastener (a multiple of 6, so the hexagons' corners are vertices).
+const THREAD_FACETS: u32 = 12;
+
+/// The triangles joining two closed rings of equal length, `a` to `b`: for rings running
+/// counter-clockwise about +Z, outward (away from the axis) when `b` lies above `a`, facing -Z
+/// when `b` lies outside `a` at the same height.
+fn ring_strip(a: &[u32], b: &[u32], triangles: &mut Vec<[u32; 3]>) {
+    let n = a.len();
+    for i in 0..n {
+        let j = (i + 1) % n;
+        triangles.push([a[i], a[j], b[j]]);
+        triangles.push([a[i], b[j], b[i]]);
+    }
+}
+
+/// The radius of a regular hexagon of circumradius `r` (corners at 0°, 60°, ...) at angle `a`.
+fn hexagon_radius(r: f32, a: f32) -> f32 {
+    let sector = std::f32::consts::FRAC_PI_3;
+    let off = a.rem_euclid(sector) - 0.5 * sector;
+    r * (0.5 * sector).cos() / off.cos()
+}
+
+/// A metric-like thread: the radius at angle index `i` (of [`THREAD_FACETS`]) and height `z`,
+/// for a right-handed helical V-thread of major radius `major`, depth `depth` and `pitch`, its
+/// crest at height 0 on angle 0: the profile at `z - pitch·θ/2π`, a triangle wave.
+fn thread_radius(major: f32, depth: f32, pitch: f32, i: u32, z: f32) -> f32 {
+    let u = (z / pitch - i as f32 / THREAD_FACETS as f32).rem_euclid(1.0);
+    major - depth * (1.0 - (2.0 * u - 1.0).abs())
+}
+
+/// The vertex rings of a helical surface about the Z axis through `(x, y)`: rows `z0 + k·dz`
+/// for `k` in `rows`, each [`THREAD_FACETS`] vertices at `radius(i, z)`, counter-clockwise.
+fn helical_rows(
+    vertices: &mut Vec<Vec3>,
+    (x, y): (f32, f32),
+    z0: f32,
+    dz: f32,
+    rows: std::ops::RangeInclusive<u32>,
+    radius: impl Fn(u32, f32) -> f32,
+) -> Vec<Vec<u32>> {
+    rows.map(|k| {
+        let z = z0 + k as f32 * dz;
+        (0..THREAD_FACETS)
+            .map(|i| {
+                let a = std::f32::consts::TAU * i as f32 / THREAD_FACETS as f32;
+                let r = radius(i, z);
+                vertices.push(Vec3::new(x + r * a.cos(), y + r * a.sin(), z));
+                (vertices.len() - 1) as u32
+            })
+            .collect()
+    })
+    .collect()
+}
+
+/// A hexagonal ring of circumradius `r` at height `z` (one vertex per facet angle).
+fn hexagon_ring(vertices: &mut Vec<Vec3>, (x, y): (f32, f32), r: f32, z: f32) -> Vec<u32> {
+    (0..THREAD_FACETS)
+        .map(|i| {
+            let a = std::f32::consts::TAU * i as f32 / THREAD_FACETS as f32;
+            let h = hexagon_radius(r, a);
+            vertices.push(Vec3::new(x + h * a.cos(), y + h * a.sin(), z));
+            (vertices.len() - 1) as u32
+        })
+        .collect()
+}
+
+/// Issue 9's bolt and nut, in metres: a fixed plate (33 × 33 × 4 mm, a square clearance hole of
+/// 11 mm around the Z axis), a hexagon-head bolt (major radius 5 mm, pitch 1.5 mm, a real helical
+/// V-thread of depth 0.8 mm meshed with [`THREAD_FACETS`] facets per turn and rows a facet's rise
+/// apart) whose head bears on the plate's top and whose shank reaches 3 mm below the nut, and a
+/// hexagon nut (6 mm) under the plate with the matching internal thread, its bore drawn
+/// `interference` inside the bolt's thread (0: the thread surfaces coincide, as they touch in
+/// CAD; more: they overlap). Physically the bolt leaves only by unscrewing upward (+Z: its head
+/// stops it downward, its thread sideways) and the nut only by unscrewing downward.
+/// Parts: 0 plate (fixed), 1 bolt, 2 nut.
+pub fn bolt_and_nut(interference: f32) -> Assembly {
+    let (major, depth, pitch) = (0.005f32, 0.0008f32, 0.0015f32);
+    let (head_r, head_h, plate_t, nut_h, below) = (0.009f32, 0.006f32, 0.004f32, 0.006f32, 0.003f32);
+    let dz = pitch / THREAD_FACETS as f32;
+    let z0 = -(nut_h + below);
+    let rows = |h: f32| (h / dz).round() as u32;
+    let centre = (0.0, 0.0);
+    // bolt: shank rows from z0 to the plate's top, head above
+    let mut v = Vec::new();
+    let mut t = Vec::new();
+    let shank = helical_rows(&mut v, centre, z0, dz, 0..=rows(plate_t - z0), |i, z| thread_radius(major, depth, pitch, i, z));
+    for w in shank.windows(2) {
+        ring_strip(&w[0], &w[1], &mut t);
+    }
+    let top_z = z0 + rows(plate_t - z0) as f32 * dz;
+    let head_lo = hexagon_ring(&mut v, centre, head_r, top_z);
+    let head_hi = hexagon_ring(&mut v, centre, head_r, top_z + head_h);
+    ring_strip(&shank[shank.len() - 1], &head_lo, &mut t); // the bearing face, facing -Z
+    ring_strip(&head_lo, &head_hi, &mut t);
+    v.push(Vec3::new(0.0, 0.0, top_z + head_h));
+    let top = (v.len() - 1) as u32;
+    v.push(Vec3::new(0.0, 0.0, z0));
+    let bottom = (v.len() - 1) as u32;
+    let n = THREAD_FACETS as usize;
+    for i in 0..n {
+        let j = (i + 1) % n;
+        t.push([top, head_hi[i], head_hi[j]]);
+        t.push([bottom, shank[0][j], shank[0][i]]);
+    }
+    let mut bolt = Mesh::new(v, t);
+    bolt.orient_outward();
+    // nut: the bore on the same helix (rows aligned with the bolt's), a hexagon outside
+    let mut v = Vec::new();
+    let mut t = Vec::new();
+    let first = rows(below);
+    let bore = helical_rows(&mut v, centre, z0, dz, first..=first + rows(nut_h), |i, z| {
+        thread_radius(major, depth, pitch, i, z) - interference
+    });
+    for w in bore.windows(2) {
+        ring_strip(&w[1], &w[0], &mut t); // facing the axis
+    }
+    let (nut_lo, nut_hi) = (z0 + first as f32 * dz, z0 + (first + rows(nut_h)) as f32 * dz);
+    let out_lo = hexagon_ring(&mut v, centre, head_r, nut_lo);
+    let out_hi = hexagon_ring(&mut v, centre, head_r, nut_hi);
+    ring_strip(&bore[0], &out_lo, &mut t);
+    ring_strip(&out_lo, &out_hi, &mut t);
+    ring_strip(&out_hi, &bore[bore.len() - 1], &mut t);
+    let mut nut = Mesh::new(v, t);
+    nut.orient_outward();
+    // the plate: 3 × 3 cells of 11 mm, the middle one open
+    let cells: Vec<[i32; 3]> = (0..3).flat_map(|x| (0..3).map(move |y| [x, y, 0])).filter(|c| *c != [1, 1, 0]).collect();
+    let cell = 0.011f32;
+    let plate = Mesh::from_voxels(&cells, Vec3::new(cell, cell, plate_t), Vec3::new(-1.5 * cell, -1.5 * cell, 0.0));
+    assembly("bolt_and_nut", vec![part("plate", plate, true), part("bolt", bolt, false), part("nut", nut, false)])
+}

@@ -53,6 +53,10 @@ pub struct WorldConfig {
     /// box-shaped mesh; see [`crate::boxes`]) exactly on their boxes. Default true; false tests
     /// every pair on the meshes.
     pub exact_boxes: bool,
+    /// Find threaded fasteners (bolts, screws and nuts with modelled threads, see
+    /// [`crate::fastener`]) and let them leave by screwing along their axes (whose directions
+    /// join the candidates). Default true; false tests threaded pairs like any other.
+    pub fasteners: bool,
 }
 
 impl Default for WorldConfig {
@@ -66,6 +70,7 @@ impl Default for WorldConfig {
             max_overlap_fraction: 0.4,
             overlaps: OverlapPolicy::Strict,
             exact_boxes: true,
+            fasteners: true,
         }
     }
 }
@@ -163,8 +168,8 @@ pub struct World {
     strict: BTreeSet<(usize, usize)>,
     notes: Vec<OverlapNote>,
     policy: OverlapPolicy,
-    /// Threaded contacts (ordered pairs), found when first needed.
-    threads: Mutex<BTreeMap<(usize, usize), Option<Thread>>>,
+    /// Threaded contacts (ordered pairs), found with the world.
+    threads: BTreeMap<(usize, usize), Thread>,
     fixed: PartSet,
     rows: Vec<OnceLock<Vec<PartSet>>>,
     warnings: Vec<String>,
@@ -232,12 +237,15 @@ impl World {
             strict: BTreeSet::new(),
             notes: Vec::new(),
             policy: config.overlaps,
-            threads: Mutex::new(BTreeMap::new()),
+            threads: BTreeMap::new(),
             fixed,
             rows,
             warnings,
         };
         world.measure_contacts(config.max_overlap_fraction, config.overlaps)?;
+        if config.fasteners {
+            world.find_threads();
+        }
         world.prepare_pair_shapes();
         Ok(world)
     }
@@ -527,24 +535,54 @@ impl World {
         *g.axis.get_or_init(|| if g.closed && p < self.num_parts() { fastener::symmetry_axis(&g.mesh) } else { None })
     }
 
-    /// The threaded contact of `p` with `q` (see [`crate::fastener`]): only pairs that overlap in
-    /// the input, `p` with a symmetry axis and `q` symmetric about it near the axis.
+    /// Finds every threaded contact (ordered pairs of parts in contact, the first with a
+    /// symmetry axis; see [`crate::fastener`]) and adds each thread's axis, both ways, to the
+    /// candidate directions.
+    fn find_threads(&mut self) {
+        let n = self.num_parts();
+        let pairs: Vec<(usize, usize)> =
+            (0..n).flat_map(|p| self.contacts[p].iter().filter(move |&q| q < n && q != p).map(move |q| (p, q))).collect();
+        let found: Vec<((usize, usize), Thread)> = pairs
+            .par_iter()
+            .filter_map(|&(p, q)| {
+                // a union of boxes (voxels, profiles) has no 60° symmetry
+                if self.geoms[p].boxes.is_some() {
+                    return None;
+                }
+                let axis = self.symmetry_axis(p)?;
+                let t = fastener::threaded_contact(&axis, &self.geoms[p].mesh, &self.geoms[q].mesh, 4.0 * self.tolerance)?;
+                Some(((p, q), t))
+            })
+            .collect();
+        // a bolt in a nut: both are threaded in each other, and the zone covers both threads
+        // (the nut's roots and the bolt's crests), whichever moves
+        let mut found = found;
+        let radii: BTreeMap<(usize, usize), f32> = found.iter().map(|&(k, t)| (k, t.radius)).collect();
+        for ((p, q), t) in found.iter_mut() {
+            if let Some(&r) = radii.get(&(*q, *p)) {
+                t.radius = t.radius.max(r);
+            }
+        }
+        for (_, t) in &found {
+            for d in [t.axis.direction, -t.axis.direction] {
+                if !self.directions.iter().any(|e| e.dot(d) > SCREW_ALIGNED) {
+                    self.directions.push(d);
+                }
+            }
+        }
+        self.threads = found.into_iter().collect();
+    }
+
+    /// The threaded contact of `p` with `q` (see [`crate::fastener`]), found with the world:
+    /// `p` and `q` touch or overlap, `p` has a symmetry axis, its side faces touching `q` are
+    /// mostly thread flanks, and `q` is symmetric about the axis near it.
     pub fn thread(&self, p: usize, q: usize) -> Option<Thread> {
-        if p >= self.num_parts() || q >= self.num_parts() {
-            return None;
-        }
-        let key = (p.min(q), p.max(q));
-        if !self.overlaps.contains_key(&key) && !self.ignored.contains(&key) {
-            return None;
-        }
-        if let Some(t) = self.threads.lock().unwrap_or_else(|e| e.into_inner()).get(&(p, q)) {
-            return *t;
-        }
-        let t = self
-            .symmetry_axis(p)
-            .and_then(|axis| fastener::threaded_contact(&axis, &self.geoms[p].mesh, &self.geoms[q].mesh, 4.0 * self.tolerance));
-        self.threads.lock().unwrap_or_else(|e| e.into_inner()).insert((p, q), t);
-        t
+        self.threads.get(&(p, q)).copied()
+    }
+
+    /// Every threaded contact (ordered pairs).
+    pub fn threads(&self) -> &BTreeMap<(usize, usize), Thread> {
+        &self.threads
     }
 
     /// The pair test of a threaded pair along its axis: the strict sample rule outside the
@@ -621,8 +659,14 @@ impl World {
         let Some((_, t1)) = sweep_overlap(&self.geoms[p].aabb, dir, &self.geoms[q].aabb) else {
             return false;
         };
-        if let Some(thread) = self.thread(p, q).filter(|t| t.axis.direction.dot(dir).abs() > 0.9999) {
+        if let Some(thread) = self.thread(p, q).filter(|t| t.axis.direction.dot(dir).abs() > SCREW_ALIGNED) {
             return self.screw_blocks(p, q, &thread, dir, t1);
+        }
+        if self.thread(q, p).is_some_and(|t| t.axis.direction.dot(dir).abs() > SCREW_ALIGNED) {
+            // a body a fastener is screwed into (a tapped hole drawn smooth at the thread's major
+            // diameter, as CAD draws them) would have to turn about the fastener to leave along
+            // its axis: the fastener leaves first
+            return true;
         }
         if self.is_strict_pair(p, q) && self.strict_entry(p, q, Vec3::ZERO, dir, t1, true).is_some() {
             return true;
@@ -714,7 +758,7 @@ impl World {
         // along the axis of a threaded partner still present, the part screws out
         if let Motion::Linear { direction, distance } = motion {
             let partner = present.iter().filter(|&q| q != p).find_map(|q| self.thread(p, q));
-            if let Some(t) = partner.filter(|t| t.axis.direction.dot(direction).abs() > 0.9999) {
+            if let Some(t) = partner.filter(|t| t.axis.direction.dot(direction).abs() > SCREW_ALIGNED) {
                 return Ok(Motion::Screw { axis_point: t.axis.point, direction, distance });
             }
         }
@@ -981,6 +1025,8 @@ impl World {
 
 /// About how many surface samples per part the strict overlap rule uses (plus every vertex).
 const STRICT_SAMPLES: usize = 4000;
+/// A direction is along a thread's axis when their cosine exceeds this (0.8°).
+const SCREW_ALIGNED: f32 = 0.9999;
 
 /// `x` rounded to `digits` significant digits, without an exponent (0.000123, 12.3, 1230).
 fn significant(x: f64, digits: i32) -> String {

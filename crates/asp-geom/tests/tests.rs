@@ -1,6 +1,7 @@
 //! The one integration test binary of asp-geom.
 
 mod distmap;
+mod fastener;
 mod fuzz;
 mod graph;
 mod loaders;

@@ -3,6 +3,7 @@
 mod collect;
 mod conformance;
 mod exact;
+mod fasteners;
 mod fixtures;
 mod groups;
 mod hypervolume;

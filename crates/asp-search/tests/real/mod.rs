@@ -238,3 +238,65 @@ fn issue_9_interlocking_cubes_come_apart_in_halves_and_every_step_rechecks() {
 }
 
 
+
+/// Every removal of a plan, its subassemblies' own plans included: (part, motion).
+fn all_steps(removals: &[asp_search::Step]) -> Vec<(usize, asp_geom::Motion)> {
+    let mut out = Vec::new();
+    for s in removals {
+        out.push((s.part, s.motion.clone()));
+        if let Some(plan) = s.group.as_ref().and_then(|g| g.plan.as_ref()) {
+            out.extend(all_steps(&plan.removals));
+        }
+    }
+    out
+}
+
+#[test]
+fn issue_9_pump_threaded_bolts_leave_by_screwing_and_every_step_rechecks() {
+    // a subset of the AutomatedAssemblyPlanner's pump with threaded bolts (tests/data/README.md):
+    // the body, its lid held by an M5 bolt in a tapped hole of the body (drawn smooth at the
+    // major diameter), and an M16 bolt through the body's flange and the back lid into a nut.
+    // Threads are modelled as rings; bolt and nut overlap by a millimetre at their crests
+    let w = world("pump-threaded", Some("mm"), OverlapPolicy::Strict).unwrap();
+    let find = |n: &str| (0..w.num_parts()).find(|&i| w.name(i).ends_with(&format!(" - {n}"))).unwrap();
+    let (pump, lid, backlid, bolt1, bolt11, nut1) = (find("Pump"), find("Lid"), find("Backlid"), find("Bolt1"), find("Bolt11L"), find("Nut1"));
+    // the axes: the M5 bolt along y, the M16 bolt and its nut along z
+    let y = asp_geom::math::Vec3::Y;
+    let z = asp_geom::math::Vec3::Z;
+    for (p, q, axis) in [(bolt1, pump, y), (bolt1, lid, y), (bolt11, nut1, z), (nut1, bolt11, z), (bolt11, pump, z)] {
+        let t = w.thread(p, q).unwrap_or_else(|| panic!("'{}' is threaded in '{}'", w.name(p), w.name(q)));
+        assert!(t.axis.direction.dot(axis).abs() > 0.9999, "{t:?}");
+    }
+    // the zones reach the crests (M5: 2.5 mm, M16: 8 mm), not the heads (4.25 and 13.9 mm)
+    assert!((w.thread(bolt1, pump).unwrap().radius - 0.0025).abs() < 0.0002);
+    assert!((w.thread(bolt11, nut1).unwrap().radius - 0.008).abs() < 0.0003);
+    for p in [pump, lid, backlid] {
+        assert!(w.threads().keys().all(|&(a, _)| a != p), "'{}' is no fastener", w.name(p));
+    }
+    let (checker, outcome) = plan(w, &Dfs::builder().build());
+    assert_eq!(outcome.status, Status::Found);
+    verify_plan(checker.world(), &outcome);
+    let w = checker.world();
+    let steps = all_steps(&outcome.removals);
+    for bolt in [bolt1, bolt11] {
+        let (_, motion) = steps.iter().find(|(p, _)| *p == bolt).expect("every bolt leaves");
+        assert!(matches!(motion, asp_geom::Motion::Screw { .. }), "'{}' leaves by {motion:?}", w.name(bolt));
+    }
+    // each bolt leaves away from its head: the M5 bolt's head is at low y, the M16's at high z
+    let dir = |p: usize| match steps.iter().find(|(q, _)| *q == p).unwrap().1 {
+        asp_geom::Motion::Screw { direction, .. } => direction,
+        _ => unreachable!(),
+    };
+    assert!(dir(bolt1).dot(-y) > 0.9999 && dir(bolt11).dot(z) > 0.9999, "{:?} {:?}", dir(bolt1), dir(bolt11));
+    // the M5 bolt comes out before the lid it holds, the M16 bolt before its nut
+    let pos = |p: usize| steps.iter().position(|(q, _)| *q == p).unwrap();
+    assert!(pos(bolt1) < pos(lid) && pos(bolt11) < pos(nut1));
+
+    // without the screw rule the bolts leave by straight lines (the M16 one only out of the
+    // nut it overlaps... if at all): no screw motion anywhere
+    let options = LoadOptions { unit: Units::parse("mm"), up: Some(Axis::Z), fixed: vec![] };
+    let plain = World::new(load(&data("pump-threaded"), &options).unwrap(), &WorldConfig { fasteners: false, ..WorldConfig::default() }).unwrap();
+    let (_, outcome) = plan(plain, &Dfs::builder().build());
+    eprintln!("pump-threaded without the screw rule: {:?}", outcome.status);
+    assert!(all_steps(&outcome.removals).iter().all(|(_, m)| !matches!(m, asp_geom::Motion::Screw { .. })));
+}

@@ -71,11 +71,29 @@ fn inner_points(world: &World, p: usize) -> Vec<Vec3> {
 /// rule): for each pair of a mover and a present part that overlap in the input under the
 /// strict policy, no sample of either (moved inward by the tolerance) that is outside the other
 /// at the start is inside it at a later pose.
-fn check_strict(world: &World, k: usize, movers: &[usize], others: &PartSet, poses: &[Pose], samples: &mut HashMap<usize, Vec<Vec3>>) {
+///
+/// A screw step (`screw`) is checked the same way against the mover's threaded partners, on
+/// the samples of both parts outside the thread zone (the cylinder about the axis out to the
+/// thread's radius, where the threads turn in each other): a bolt's head, a nut's faces, the
+/// material around a tapped hole may enter nothing, whether the pair overlaps in the input or
+/// only touches. Every other pair of a screw step is checked as for a straight line.
+fn check_strict(world: &World, k: usize, movers: &[usize], others: &PartSet, poses: &[Pose], samples: &mut HashMap<usize, Vec<Vec3>>, screw: Option<Vec3>) {
     for &p in movers {
-        for q in others.iter().filter(|&q| world.is_strict_pair(p, q)) {
+        for q in others.iter() {
+            let thread = screw.and_then(|_| world.thread(p, q));
+            if thread.is_none() && !world.is_strict_pair(p, q) {
+                continue;
+            }
+            if let (Some(t), Some(dir)) = (thread, screw) {
+                // the step is along this thread's axis
+                assert!(t.axis.direction.dot(dir).abs() > 0.9999, "step {k}: '{}' screws off its axis", world.name(p));
+            }
             for (a, b, sign) in [(p, q, 1.0f32), (q, p, -1.0)] {
-                let pts = samples.entry(a).or_insert_with(|| inner_points(world, a)).clone();
+                let mut pts = samples.entry(a).or_insert_with(|| inner_points(world, a)).clone();
+                if let Some(t) = thread {
+                    // both parts' samples in the assembled pose: outside the zone only
+                    pts.retain(|&x| t.axis.radial(x) > t.radius);
+                }
                 // `a`'s samples in the frame of `b`: the mover's moved by the pose, the other's
                 // by its inverse
                 let place = |pose: &Pose, x: Vec3| if sign > 0.0 { pose.transform_point(x) } else { pose.inverse_transform_point(x) };
@@ -168,9 +186,21 @@ pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: 
                 .chain(poses.last().copied())
                 .collect(),
         };
-        if !matches!(step.motion, Motion::Screw { .. }) {
-            check_strict(world, k, &movers, &others, &poses, &mut samples);
+        let screw = match step.motion {
+            Motion::Screw { direction, .. } => Some(direction),
+            _ => None,
+        };
+        if let Motion::Screw { axis_point, direction, .. } = step.motion {
+            // a screw step's part has a threaded partner present, and turns about that axis
+            let t = others.iter().find_map(|q| world.thread(step.part, q));
+            let t = t.unwrap_or_else(|| panic!("step {k}: '{}' screws with no threaded partner", world.name(step.part)));
+            assert!(
+                t.axis.direction.dot(direction).abs() > 0.9999 && t.axis.radial(axis_point) < 1e-3 * t.axis.radius.max(1e-9) + 1e-6,
+                "step {k}: '{}' screws off its axis",
+                world.name(step.part)
+            );
         }
+        check_strict(world, k, &movers, &others, &poses, &mut samples, screw);
         for pose in &poses {
             for &p in &movers {
                 if let Some(q) = penetrates(world, p, pose, &others, &mut cache, matches!(step.motion, Motion::Screw { .. })) {
