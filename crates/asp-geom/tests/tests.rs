@@ -3,6 +3,7 @@
 mod distmap;
 mod fuzz;
 mod graph;
+mod grid;
 mod loaders;
 mod overlap;
 mod physics;
