@@ -69,7 +69,7 @@ fn no_plan_exits_1_and_explains() {
     let dir = tempfile::tempdir().unwrap();
     let model = fixture_file(dir.path(), &fixtures::l_path(), "l.glb");
     let out = dir.path().join("plan.json");
-    let o = asp(&["plan", model.to_str().unwrap(), "--no-path-planner", "--out", out.to_str().unwrap()]);
+    let o = asp(&["plan", model.to_str().unwrap(), "--no-path-planner", "--no-grid", "--out", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     let table = String::from_utf8(o.stdout).unwrap();
     assert!(table.contains("block") && table.contains("blocked by housing"), "{table}");
@@ -83,6 +83,13 @@ fn no_plan_exits_1_and_explains() {
     let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(plan["assembly_sequence"][0]["motion"]["kind"], "path");
     assert_eq!(plan["stats"]["path_planner_calls"], 1);
+    // without the path planner the housing and block are a voxel model: the grid search finds
+    // the L (a move along +x, then out along +z) after the depth-first search gives up
+    let o = asp(&["plan", model.to_str().unwrap(), "--no-path-planner", "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(plan["grid"]["reason"], "fallback");
+    assert_eq!(plan["assembly_sequence"][0]["moves"].as_array().unwrap().len(), 1);
 }
 
 /// Asserts a one-line error naming `needle`, exit code 2, no panic.

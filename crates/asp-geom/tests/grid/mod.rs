@@ -429,3 +429,17 @@ fn issue_9_find_puzzles() {
     }
     eprintln!("SMALL {small:?}");
 }
+
+/// Not a test: writes the puzzles as GLB files (cells metadata) and as plain polycube meshes
+/// into `$ASP_PUZZLES_OUT` for benchmarks (`docs/benchmarks.md`).
+#[test]
+#[ignore]
+fn issue_9_write_puzzle_glbs() {
+    let dir = std::path::PathBuf::from(std::env::var("ASP_PUZZLES_OUT").expect("ASP_PUZZLES_OUT"));
+    std::fs::create_dir_all(&dir).unwrap();
+    for a in [puzzles::burr_key(), puzzles::burr_level(), puzzles::small_puzzle(), fixtures::hooked_bracket()] {
+        let name = a.source.display().to_string().replace("fixture:", "");
+        asp_geom::io::write_glb(&a, &dir.join(format!("{name}.glb"))).unwrap();
+        asp_geom::io::write_glb(&as_meshes(&a), &dir.join(format!("{name}_mesh.glb"))).unwrap();
+    }
+}
