@@ -104,3 +104,18 @@ pub const SMALL_PUZZLE_MOVES: usize = 2;
 const BURR_KEY: [&[Cell]; 6] = [&[[0, 1, 1], [0, 2, 1], [1, 1, 0], [1, 1, 1], [2, 1, 0], [2, 1, 1], [3, 1, 1], [3, 2, 1]], &[], &[[0, 1, 2], [0, 2, 2], [1, 0, 1], [1, 0, 2], [1, 1, 2], [1, 2, 1], [1, 2, 2], [1, 3, 1], [1, 3, 2]], &[[2, 0, 1], [2, 0, 2], [2, 1, 1], [2, 1, 2], [2, 2, 1], [2, 2, 2], [2, 3, 1], [2, 3, 2], [3, 1, 2], [3, 2, 2]], &[[1, 0, 1], [1, 0, 2], [1, 1, 0], [1, 1, 1], [1, 1, 2], [1, 1, 3], [2, 1, 1], [2, 1, 2], [2, 1, 3]], &[[1, 2, 0], [1, 2, 1], [1, 2, 2], [1, 2, 3], [2, 2, 0], [2, 2, 1], [2, 2, 2], [2, 2, 3]]];
 /// The notches of [`burr_level`]'s sticks.
 const BURR_LEVEL: [&[Cell]; 6] = [&[[0, 1, 1], [0, 2, 1], [1, 1, 0], [1, 1, 1], [2, 1, 0], [2, 1, 1], [3, 1, 1], [3, 2, 1]], &[[0, 1, 2], [0, 2, 2], [1, 1, 2], [1, 2, 2], [2, 1, 2], [2, 2, 2], [3, 1, 2], [3, 2, 2]], &[[0, 1, 2], [0, 2, 2], [1, 0, 1], [1, 0, 2], [1, 1, 2], [1, 2, 1], [1, 2, 2], [1, 3, 1], [1, 3, 2]], &[[2, 0, 1], [2, 0, 2], [2, 1, 1], [2, 1, 2], [2, 2, 1], [2, 2, 2], [2, 3, 1], [2, 3, 2], [3, 2, 2]], &[[1, 0, 1], [1, 0, 2], [1, 1, 0], [1, 1, 1], [1, 1, 2], [1, 1, 3], [2, 1, 1], [2, 1, 2], [2, 1, 3]], &[[1, 2, 0], [1, 2, 1], [1, 2, 2], [1, 2, 3], [2, 2, 0], [2, 2, 1], [2, 2, 3]]];
+
+/// Two [`small_puzzle`]s side by side along y, touching: they come apart as two subassemblies
+/// first (no moves), and each then needs its own moves on its frame. Pieces 0-2 the first
+/// puzzle, 3-5 the second (shifted by 3 cells along +y).
+pub fn two_small_puzzles() -> Assembly {
+    let one = small_puzzle();
+    let mut pieces: Vec<Vec<Cell>> = Vec::new();
+    for shift in [0, 3] {
+        for p in &one.parts {
+            let cells = p.meta.cells.clone().expect("voxel pieces");
+            pieces.push(cells.iter().map(|c| [c[0], c[1] + shift, c[2]]).collect());
+        }
+    }
+    voxel_puzzle("two_small_puzzles", &pieces)
+}

@@ -348,3 +348,25 @@ fn issue_9_plans_an_interlocking_burr_by_grid_moves() {
     assert_eq!(g["parts"].as_array().unwrap().len(), 6);
     assert!(plan["grid"].is_null());
 }
+
+#[test]
+fn issue_9_grid_subassemblies_with_moves_replay_from_the_json() {
+    // two puzzles side by side: the depth-first search only lifts subassemblies it cannot take
+    // apart, so the grid plan is the fallback; each puzzle's own plan moves pieces on its frame
+    let dir = tempfile::tempdir().unwrap();
+    let a = asp_geom::puzzles::two_small_puzzles();
+    let model = fixture_file(dir.path(), &a, "two.glb");
+    let o = asp(&["plan", model.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(plan["grid"]["reason"], "fallback", "{plan}");
+    let steps = plan["assembly_sequence"].as_array().unwrap();
+    let sub = steps.iter().find(|s| !s["subassembly"].is_null()).expect("a subassembly step");
+    assert_eq!(sub["subassembly"]["status"], "found");
+    assert!(sub["subassembly"]["assembly_sequence"].as_array().unwrap().iter().any(|s| s["moves"].is_array()), "{sub}");
+    let voxels = asp_geom::grid::VoxelModel::of(&a).unwrap();
+    let mut pos = voxels.cells.clone();
+    let mut present: Vec<usize> = (0..6).collect();
+    replay_json(&plan["assembly_sequence"], &mut pos, &mut present, 0.01);
+    assert!(present.is_empty(), "parts never taken out: {present:?}");
+}

@@ -186,6 +186,17 @@ fn issue_9_small_puzzle_needs_moves_and_comes_apart() {
 }
 
 #[test]
+fn issue_9_two_puzzles_come_apart_as_subassemblies_with_their_own_moves() {
+    let a = puzzles::two_small_puzzles();
+    let s = check_fixture(&a, 0);
+    let first = &s.plan.steps[0];
+    assert_eq!(first.parts.len(), 3, "one whole puzzle leaves: {first:?}");
+    let sub = first.plan.as_ref().expect("its own plan");
+    assert_eq!(sub.status, GridStatus::Found);
+    assert_eq!(sub.steps[0].moves.len(), puzzles::SMALL_PUZZLE_MOVES, "{sub:?}");
+}
+
+#[test]
 fn issue_9_polycube_meshes_without_cells_give_the_same_model_and_plan() {
     for a in [puzzles::burr_key(), puzzles::burr_level(), puzzles::small_puzzle(), fixtures::hooked_bracket(), fixtures::figure_6_2(0.02)] {
         let with_cells = VoxelModel::of(&a).expect("cells");
