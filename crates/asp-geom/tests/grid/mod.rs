@@ -454,3 +454,52 @@ fn issue_9_write_puzzle_glbs() {
         asp_geom::io::write_glb(&as_meshes(&a), &dir.join(format!("{name}_mesh.glb"))).unwrap();
     }
 }
+
+/// Not a test: figures for `docs/benchmarks.md` (solve time, states, first separation) per
+/// puzzle, and the search's throughput on a closed box whose five loose cubes slide around a
+/// 3 × 4 cavity without ever getting out (every one of the 95,040 states visited, then stuck).
+#[test]
+#[ignore]
+fn issue_9_bench_grid() {
+    let mut frame = Vec::new();
+    for x in 0..5 {
+        for y in 0..3 {
+            for z in 0..6 {
+                if !(y == 1 && (1..4).contains(&x) && (1..5).contains(&z)) {
+                    frame.push([x, y, z]);
+                }
+            }
+        }
+    }
+    let mut pieces = vec![frame];
+    pieces.extend([[1, 1, 1], [2, 1, 1], [3, 1, 1], [1, 1, 2], [2, 1, 2]].map(|c| vec![c]));
+    let boxed = VoxelModel::from_cells(pieces, vec![false; 6]);
+    let models = [
+        ("burr_key", VoxelModel::of(&puzzles::burr_key()).unwrap()),
+        ("burr_level", VoxelModel::of(&puzzles::burr_level()).unwrap()),
+        ("small_puzzle", VoxelModel::of(&puzzles::small_puzzle()).unwrap()),
+        ("two_small_puzzles", VoxelModel::of(&puzzles::two_small_puzzles()).unwrap()),
+        ("hooked_bracket", VoxelModel::of(&fixtures::hooked_bracket()).unwrap()),
+        ("closed box, 5 cubes", boxed),
+    ];
+    for (name, m) in models {
+        let runs = 5;
+        let mut best = f64::INFINITY;
+        let mut last = None;
+        for _ in 0..runs {
+            let s = solve(&m);
+            best = best.min(s.seconds);
+            last = Some(s);
+        }
+        let s = last.unwrap();
+        eprintln!(
+            "| {name} | {} | {:?} | {:?} | {} | {:.3} ms | {:.0} |",
+            m.len(),
+            s.plan.status,
+            s.first_separation_moves,
+            s.states,
+            best * 1e3,
+            s.states as f64 / best
+        );
+    }
+}
