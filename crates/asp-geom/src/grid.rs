@@ -24,7 +24,7 @@ use crate::assembly::Assembly;
 use crate::boxes;
 use crate::math::{Aabb, Vec3};
 use crate::mesh::Mesh;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
 /// A cell of the grid.
@@ -606,51 +606,60 @@ impl Solver<'_> {
     /// Breadth-first search from the local state to the first state with a separation.
     fn bfs(&mut self, local: &Local) -> Bfs {
         let n = local.units.len();
-        let mut index: HashMap<Vec<Cell>, usize> = HashMap::new();
-        // per state: offsets, parent, the move that led here
-        let mut states: Vec<(Vec<Cell>, usize, u64, Cell)> = Vec::new();
-        index.insert(local.offsets.clone(), 0);
-        states.push((local.offsets.clone(), usize::MAX, 0, [0; 3]));
+        let width = 3 * n;
+        let flat = |offsets: &[Cell]| -> Vec<i32> { offsets.iter().flat_map(|o| o.iter().copied()).collect() };
+        // every state's offsets, flat, in BFS order; the seen set holds the same keys
+        let mut arena: Vec<i32> = flat(&local.offsets);
+        let mut seen: HashSet<Box<[i32]>, Fx> = HashSet::with_hasher(Fx);
+        seen.insert(arena.clone().into_boxed_slice());
+        // per state: parent, the move that led here
+        let mut links: Vec<(usize, u64, Cell)> = vec![(usize::MAX, 0, [0; 3])];
         self.states += 1;
         let mut head = 0;
-        while head < states.len() {
+        let mut hit = vec![None; n * n];
+        let mut groups: Vec<u64> = Vec::new();
+        let mut successors: Vec<(u64, Cell)> = Vec::new();
+        let mut next = vec![0i32; width];
+        while head < links.len() {
             self.expanded += 1;
             if self.states >= self.config.max_states || (self.expanded % 1024 == 0 && (self.stop)()) {
                 return Bfs::Budget;
             }
-            let offsets = states[head].0.clone();
-            let mut successors = Vec::new();
+            let offsets: Vec<Cell> = arena[head * width..(head + 1) * width].chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+            successors.clear();
             let mut separation: Option<(u64, Cell)> = None;
             for dir in DIRECTIONS {
-                // one-step blocking: block[i] = units j that unit i hits moving one step
-                let mut block = vec![0u64; n];
+                // hit[i * n + j]: the first step at which unit i, moving along dir, meets unit j
+                let mut block = [0u64; 64];
                 for i in 0..n {
                     for j in 0..n {
-                        if i != j {
-                            let r = sub(sub(offsets[j], offsets[i]), dir);
-                            if self.pairs[local.units[i]][local.units[j]].overlaps(r) {
-                                block[i] |= 1 << j;
-                            }
+                        hit[i * n + j] = if i == j {
+                            None
+                        } else {
+                            self.pairs[local.units[i]][local.units[j]].first_hit(sub(offsets[j], offsets[i]), dir)
+                        };
+                        if hit[i * n + j] == Some(1) {
+                            block[i] |= 1 << j;
                         }
                     }
                 }
-                let mut groups: Vec<u64> = Vec::new();
+                groups.clear();
                 for seed in 0..n {
                     if seed == local.reference {
                         continue;
                     }
                     let mut g = 1u64 << seed;
                     loop {
-                        let mut next = g;
-                        for i in 0..n {
+                        let mut grown = g;
+                        for (i, b) in block.iter().enumerate().take(n) {
                             if g >> i & 1 == 1 {
-                                next |= block[i];
+                                grown |= b;
                             }
                         }
-                        if next == g {
+                        if grown == g {
                             break;
                         }
-                        g = next;
+                        g = grown;
                     }
                     if g >> local.reference & 1 == 0 && !groups.contains(&g) {
                         groups.push(g);
@@ -672,16 +681,14 @@ impl Solver<'_> {
                     let mut limit: Option<i32> = None;
                     for i in (0..n).filter(|i| g >> i & 1 == 1) {
                         for j in (0..n).filter(|j| g >> j & 1 == 0) {
-                            let r = sub(offsets[j], offsets[i]);
-                            if let Some(k) = self.pairs[local.units[i]][local.units[j]].first_hit(r, dir) {
+                            if let Some(k) = hit[i * n + j] {
                                 limit = Some(limit.map_or(k, |l: i32| l.min(k)));
                             }
                         }
                     }
                     match limit {
                         None => {
-                            let better = separation.is_none_or(|(s, _)| g.count_ones() < s.count_ones());
-                            if better {
+                            if separation.is_none_or(|(s, _)| g.count_ones() < s.count_ones()) {
                                 separation = Some((g, dir));
                             }
                         }
@@ -696,23 +703,67 @@ impl Solver<'_> {
             if let Some((g, dir)) = separation {
                 let mut moves = Vec::new();
                 let mut at = head;
-                while states[at].1 != usize::MAX {
-                    moves.push((states[at].2, states[at].3));
-                    at = states[at].1;
+                while links[at].0 != usize::MAX {
+                    moves.push((links[at].1, links[at].2));
+                    at = links[at].0;
                 }
                 moves.reverse();
                 return Bfs::Separated(moves, g, dir, offsets);
             }
-            for (g, delta) in successors {
-                let next: Vec<Cell> = (0..n).map(|i| if g >> i & 1 == 1 { add(offsets[i], delta) } else { offsets[i] }).collect();
-                if !index.contains_key(&next) {
-                    index.insert(next.clone(), states.len());
-                    states.push((next, head, g, delta));
+            for &(g, delta) in &successors {
+                for i in 0..n {
+                    let o = if g >> i & 1 == 1 { add(offsets[i], delta) } else { offsets[i] };
+                    next[3 * i..3 * i + 3].copy_from_slice(&o);
+                }
+                if !seen.contains(&next[..]) {
+                    seen.insert(next.clone().into_boxed_slice());
+                    arena.extend_from_slice(&next);
+                    links.push((head, g, delta));
                     self.states += 1;
                 }
             }
             head += 1;
         }
         Bfs::Stuck
+    }
+}
+
+/// A fast hasher for the search's keys (FxHash: multiply and rotate; not DoS-resistant, and
+/// need not be).
+#[derive(Clone, Copy, Default)]
+struct Fx;
+
+impl std::hash::BuildHasher for Fx {
+    type Hasher = FxHasher;
+    fn build_hasher(&self) -> FxHasher {
+        FxHasher(0)
+    }
+}
+
+struct FxHasher(u64);
+
+impl std::hash::Hasher for FxHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut w = [0u8; 8];
+            w[..chunk.len()].copy_from_slice(chunk);
+            self.add(u64::from_le_bytes(w));
+        }
+    }
+    fn write_i32(&mut self, v: i32) {
+        self.add(v as u32 as u64);
+    }
+    fn write_usize(&mut self, v: usize) {
+        self.add(v as u64);
+    }
+}
+
+impl FxHasher {
+    #[inline]
+    fn add(&mut self, w: u64) {
+        self.0 = (self.0.rotate_left(5) ^ w).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
     }
 }
