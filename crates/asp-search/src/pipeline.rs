@@ -10,7 +10,7 @@ use crate::mdp::{MdpExtension, ModelContext};
 use crate::objective::resolve_objectives;
 use crate::policy::Policy;
 use crate::ordering::{BuiltinOrder, OrderingSource};
-use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step};
+use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
 use crate::grid::GridRun;
 use asp_geom::grid::{GridConfig, VoxelModel};
 use crate::report::{GridEntry, OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
@@ -350,9 +350,12 @@ pub fn plan_assembly(
         None => (search(&checker as &dyn asp_geom::FeasibilityChecker), None),
     };
     // the grid plan when the depth-first search found no plan, or one with a subassembly it
-    // could not take apart (a voxel puzzle lifted off the ground in one piece)
+    // could not take apart (a voxel puzzle lifted off the ground in one piece); not when only
+    // gravity stopped it (the grid plan does not test gravity)
     let found = outcome.status == Status::Found;
-    if !found || !taken_apart(&outcome) {
+    let gravity_only = matches!(&outcome.status, Status::NoPlan { stuck, .. }
+        if !stuck.is_empty() && stuck.iter().all(|s| matches!(s.reason, StuckReason::WouldLeaveUnsupported(_))));
+    if (!found && !gravity_only) || (found && !taken_apart(&outcome)) {
         if let Some(model) = voxels {
             let run = grid.unwrap_or_else(|| GridRun::new(model, &GridConfig::default(), &budget, Instant::now()));
             if (!found && run.found()) || run.solution.complete() {
