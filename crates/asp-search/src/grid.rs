@@ -13,6 +13,9 @@ use asp_geom::grid::{self, GridConfig, GridPlan, GridSolution, GridStatus, Voxel
 use asp_geom::{Assembly, Motion, PartSet};
 use std::time::Instant;
 
+/// The longest the probe before the depth-first search may take, seconds.
+const PROBE_SECONDS: f64 = 2.0;
+
 /// A grid search of one model.
 #[derive(Clone, Debug)]
 pub struct GridRun {
@@ -31,10 +34,13 @@ impl GridRun {
         GridRun { model, solution }
     }
 
-    /// Only the model's first separation, within a small state budget: whether the grid plan
-    /// should run first ([`GridRun::needs_moves`]).
+    /// Only the model's first separation, within a small budget (200,000 states, 2 s): whether
+    /// the grid plan should run first ([`GridRun::needs_moves`]).
     pub fn probe(model: VoxelModel, budget: &Budget, started: Instant) -> GridRun {
-        GridRun::new(model, &GridConfig { max_states: 200_000, first_only: true, ..GridConfig::default() }, budget, started)
+        let stop = || budget.stop_reason(0, started).is_some() || started.elapsed().as_secs_f64() > PROBE_SECONDS;
+        let config = GridConfig { max_states: 200_000, first_only: true, ..GridConfig::default() };
+        let solution = grid::solve(&model, &config, &stop);
+        GridRun { model, solution }
     }
 
     /// Whether the whole model comes apart (down to its fixed parts, or its last part).
