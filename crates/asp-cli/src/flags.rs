@@ -118,6 +118,10 @@ pub struct ModelArgs {
     /// Never let a group of parts leave together as one rigid subassembly (single parts only).
     #[arg(long)]
     pub no_subassemblies: bool,
+    /// Never plan voxel models by grid moves (interlocking puzzles whose parts must slide in
+    /// turn before anything can leave).
+    #[arg(long)]
+    pub no_grid: bool,
     /// Path planner iterations per call.
     #[arg(long, default_value_t = 2000)]
     pub rrt_iterations: usize,

@@ -59,6 +59,7 @@ pub(crate) fn model_settings(args: &ModelArgs) -> anyhow::Result<PlanSettings> {
         },
         path_planner: !args.no_path_planner,
         subassemblies: !args.no_subassemblies,
+        grid: !args.no_grid,
         rrt_iterations: args.rrt_iterations,
         rrt_time: positive("rrt-time", args.rrt_time)?,
         ..PlanSettings::default()
@@ -360,8 +361,24 @@ pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Resu
     let fixed: Vec<&str> = r.parts.iter().filter(|p| p.fixed).map(|p| p.name.as_str()).collect();
     if !fixed.is_empty() {
         writeln!(out, "base (fixed): {}", fixed.join(", "))?;
+    } else if r.grid.is_some() {
+        writeln!(out, "base: none (taken apart in the hand, no gravity; the last part goes down first along -{})", r.up.trim_start_matches(['+', '-']))?;
     } else {
         writeln!(out, "base: ground plane under the lowest point (up {})", r.up)?;
+    }
+    if let Some(g) = &r.grid {
+        let first = g.first_separation_moves.map_or("-".to_string(), |m| m.to_string());
+        writeln!(
+            out,
+            "grid plan ({}): cells of {:.4} x {:.4} x {:.4} {}, {} states in {:.3} s, {first} moves before the first separation",
+            g.reason.replace('_', " "),
+            g.cell[0],
+            g.cell[1],
+            g.cell[2],
+            r.units,
+            g.states,
+            g.seconds
+        )?;
     }
     if let Some(o) = &r.overlaps {
         writeln!(out, "overlapping in the input ({} pairs, policy {}):", o.pairs.len(), o.policy)?;
@@ -451,6 +468,14 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
                 let others: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
                 writeln!(out, "{inner}  {} {} {}", e.name, e.reason.replace('_', " "), others.join(", "))?;
             }
+        }
+        if !step.moves.is_empty() {
+            writeln!(out, "{indent}      then {} moves:", step.moves.len())?;
+        }
+        for m in &step.moves {
+            let t = m.translation;
+            let parts: Vec<&str> = m.parts.iter().map(|&p| name(p)).collect();
+            writeln!(out, "{indent}        move {} by ({:+.4}, {:+.4}, {:+.4})", parts.join(" + "), t[0], t[1], t[2])?;
         }
     }
     Ok(())

@@ -4,6 +4,7 @@ mod distmap;
 mod fastener;
 mod fuzz;
 mod graph;
+mod grid;
 mod loaders;
 mod overlap;
 mod physics;

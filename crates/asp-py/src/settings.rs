@@ -176,6 +176,7 @@ pub fn plan_settings(dict: &Bound<'_, PyDict>) -> Result<PlanSettings, Error> {
         seed: k.value::<u64>("seed", "a non-negative integer")?.unwrap_or(defaults.seed),
         path_planner: k.flag("path_planner", defaults.path_planner)?,
         subassemblies: k.flag("subassemblies", defaults.subassemblies)?,
+        grid: defaults.grid,
         rrt_iterations: k.count("rrt_iterations")?.unwrap_or(defaults.rrt_iterations),
         rrt_time: k.positive("rrt_time")?.unwrap_or(defaults.rrt_time),
         max_tests: k.value::<u64>("max_tests", "a non-negative integer")?,

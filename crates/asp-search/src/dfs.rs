@@ -232,7 +232,7 @@ impl Search<'_, '_, '_> {
                     }
                     let part = group.iter().next().expect("a group has parts");
                     let group = Some(Box::new(Subassembly { parts: group, plan: None }));
-                    if self.descend(Step { part, motion, group }, &rest) {
+                    if self.descend(Step { part, motion, group, moves: Vec::new() }, &rest) {
                         return true;
                     }
                     if self.holds_core(state) {

@@ -7,6 +7,7 @@ pub mod collect_q;
 pub mod dfs;
 pub mod error;
 pub mod exact;
+pub mod grid;
 pub mod hypervolume;
 pub mod mcts;
 pub mod mdp;
@@ -28,7 +29,7 @@ pub use objective::{Accessibility, DirHistory, DirectionChanges, Objective, Path
 pub use ordering::{Bookkeeping, BuiltinOrder, OrderingFactory, OrderingSource, PartOrdering, WithBookkeeping};
 pub use pareto::ParetoMcts;
 pub use policy::{EpsilonGreedy, Policy, PolicyContext, PolicyWorker, QFunction, QUse, QWorker, RandomPolicy};
-pub use problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StopReason, Stuck, StuckReason, Subassembly};
+pub use problem::{Budget, GroupMove, PlanOutcome, Problem, Progress, Stats, Status, Step, StopReason, Stuck, StuckReason, Subassembly};
 pub use search::{SearchOutcome, SearchStats, SearchStatus, Solution, StopToken, Transition};
 
 /// A planner: takes a problem apart within a budget. Every planner runs the same conformance

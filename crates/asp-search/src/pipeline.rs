@@ -10,8 +10,10 @@ use crate::mdp::{MdpExtension, ModelContext};
 use crate::objective::resolve_objectives;
 use crate::policy::Policy;
 use crate::ordering::{BuiltinOrder, OrderingSource};
-use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step};
-use crate::report::{OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
+use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
+use crate::grid::GridRun;
+use asp_geom::grid::{GridConfig, VoxelModel};
+use crate::report::{GridEntry, OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
 use crate::search::{SearchOutcome, SearchStatus, StopToken, DEFAULT_BUDGET, DEFAULT_EPISODES};
 use crate::{Dfs, Mcts, Mdp, ParetoMcts, Planner, Result, SearchError};
 use asp_geom::distmap::{DistanceMaps, MapConfig, Support};
@@ -75,6 +77,10 @@ pub struct PlanSettings {
     pub path_planner: bool,
     /// Let groups of parts leave together as rigid subassemblies when no single part can.
     pub subassemblies: bool,
+    /// Plan voxel models by moves of parts and groups on their grid ([`crate::grid`]) when
+    /// several parts must move in turn before anything can leave, or when the depth-first
+    /// search finds no plan.
+    pub grid: bool,
     /// Path planner iterations per call.
     pub rrt_iterations: usize,
     /// Path planner wall-time cap per call, seconds.
@@ -124,6 +130,7 @@ impl Default for PlanSettings {
             seed: 0,
             path_planner: true,
             subassemblies: true,
+            grid: true,
             rrt_iterations: RrtConfig::default().max_iterations,
             rrt_time: RrtConfig::default().max_time.as_secs_f64(),
             max_tests: None,
@@ -317,11 +324,22 @@ pub fn plan_assembly(
     if let Some(optimise) = &settings.optimise {
         return self::optimise(Arc::new(assembly), settings, optimise);
     }
+    let budget = budget(settings)?;
+    let voxels = (settings.grid && settings.checker_extension.is_none()).then(|| VoxelModel::of(&assembly)).flatten();
+    let grid_started = Instant::now();
+    let probe = voxels.clone().map(|m| GridRun::probe(m, &budget, grid_started));
     let started = Instant::now();
     let checker = checker(assembly, settings)?;
     let world_seconds = started.elapsed().as_secs_f64();
+    let mut grid = None;
+    if let (Some(model), true) = (&voxels, probe.as_ref().is_some_and(GridRun::needs_moves)) {
+        let run = GridRun::new(model.clone(), &GridConfig::default(), &budget, grid_started);
+        if run.found() {
+            return Ok(grid_result(&checker, &run, "needs_moves", None, world_seconds));
+        }
+        grid = Some(run);
+    }
     let dfs = planner(settings, checker.world())?;
-    let budget = budget(settings)?;
     let mut search = |c: &dyn asp_geom::FeasibilityChecker| {
         let mut problem = Problem::full(c);
         problem.progress = progress;
@@ -331,6 +349,20 @@ pub fn plan_assembly(
         Some(e) => e.solve(&checker, settings.seed, &mut search)?,
         None => (search(&checker as &dyn asp_geom::FeasibilityChecker), None),
     };
+    // the grid plan when the depth-first search found no plan, or one with a subassembly it
+    // could not take apart (a voxel puzzle lifted off the ground in one piece); not when only
+    // gravity stopped it (the grid plan does not test gravity)
+    let found = outcome.status == Status::Found;
+    let gravity_only = matches!(&outcome.status, Status::NoPlan { stuck, .. }
+        if !stuck.is_empty() && stuck.iter().all(|s| matches!(s.reason, StuckReason::WouldLeaveUnsupported(_))));
+    if (!found && !gravity_only) || (found && !taken_apart(&outcome)) {
+        if let Some(model) = voxels {
+            let run = grid.unwrap_or_else(|| GridRun::new(model, &GridConfig::default(), &budget, Instant::now()));
+            if (!found && run.found()) || run.solution.complete() {
+                return Ok(grid_result(&checker, &run, "fallback", Some(&outcome), world_seconds));
+            }
+        }
+    }
     let world = checker.world();
     let mut report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
     if let Some(r) = robot {
@@ -344,6 +376,44 @@ pub fn plan_assembly(
         path_planner: outcome.stats.path_planner_seconds,
     });
     Ok(PlanResult { report, status: outcome.status, search: None })
+}
+
+/// Whether every subassembly of a found plan was taken apart by its own plan.
+fn taken_apart(outcome: &PlanOutcome) -> bool {
+    outcome.removals.iter().all(|s| {
+        s.group.as_ref().is_none_or(|g| g.plan.as_ref().is_some_and(|p| p.status == Status::Found && taken_apart(p)))
+    })
+}
+
+/// The plan of a grid search (after the depth-first search's `before`, whose counters and time
+/// it keeps).
+fn grid_result(checker: &Checker, run: &GridRun, reason: &str, before: Option<&PlanOutcome>, world_seconds: f64) -> PlanResult {
+    let world = checker.world();
+    let assembly = world.assembly();
+    let mut outcome = run.outcome(assembly);
+    if let Some(b) = before {
+        outcome.stats.counters = b.stats.counters;
+        outcome.stats.seconds += b.stats.seconds;
+        outcome.stats.path_planner_seconds = b.stats.path_planner_seconds;
+    }
+    let mut report = PlanReport::new(assembly, &outcome, world.tolerance(), world.warnings());
+    let u = |x: f32| assembly.units.from_metres(x as f64);
+    let cell = run.model.cell;
+    report.grid = Some(GridEntry {
+        cell: [u(cell.x), u(cell.y), u(cell.z)],
+        reason: reason.into(),
+        states: run.solution.states,
+        first_separation_moves: run.solution.first_separation_moves,
+        seconds: run.solution.seconds,
+    });
+    report.overlaps = crate::report::OverlapsEntry::of(world);
+    report.stats.timings = Some(Timings {
+        load: 0.0,
+        world: world_seconds,
+        search: outcome.stats.seconds,
+        path_planner: outcome.stats.path_planner_seconds,
+    });
+    PlanResult { report, status: outcome.status, search: None }
 }
 
 /// The optimiser's problem on one model: the distance maps, the objectives and the extensions'

@@ -117,12 +117,26 @@ pub struct Step {
     /// When several parts leave together as one rigid subassembly: which, and how the
     /// subassembly itself comes apart.
     pub group: Option<Box<Subassembly>>,
+    /// Moves of parts made before this removal, in order (grid plans of interlocking puzzles:
+    /// pieces slide a few cells before anything can leave). Moved parts stay where they end;
+    /// the removal starts from the moved pose, and a moved part removed later starts from
+    /// where its moves left it. Empty for plain removals.
+    pub moves: Vec<GroupMove>,
+}
+
+/// A rigid translation of some present parts, made between removals.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroupMove {
+    /// The parts that move together.
+    pub parts: PartSet,
+    /// The translation, world frame, metres.
+    pub translation: asp_geom::math::Vec3,
 }
 
 impl Step {
     /// A single part's removal.
     pub fn single(part: usize, motion: Motion) -> Step {
-        Step { part, motion, group: None }
+        Step { part, motion, group: None, moves: Vec::new() }
     }
 
     /// The parts that leave in this step (the part, or every part of the subassembly).

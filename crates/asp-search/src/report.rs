@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.5";
+pub const FORMAT_VERSION: &str = "1.6";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -65,6 +65,37 @@ pub struct PlanReport {
     /// Since format 1.5.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub robot: Option<RobotEntry>,
+    /// Plans made by the grid search of a voxel model (interlocking puzzles): its grid and
+    /// effort. Since format 1.6.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grid: Option<GridEntry>,
+}
+
+/// The grid search behind a plan (format 1.6).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct GridEntry {
+    /// The size of a grid cell along x, y, z, model units.
+    pub cell: [f64; 3],
+    /// Why the grid search made the plan: `needs_moves` (parts must move in turn before
+    /// anything can leave, so it ran first) or `fallback` (the depth-first search found no
+    /// plan).
+    pub reason: String,
+    /// States the breadth-first searches visited (every subassembly's included).
+    pub states: u64,
+    /// Moves before the model's first separation (the fewest possible).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_separation_moves: Option<usize>,
+    /// Seconds of grid search.
+    pub seconds: f64,
+}
+
+/// A move of some parts between removals (format 1.6).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct MoveEntry {
+    /// The parts that move together.
+    pub parts: Vec<usize>,
+    /// The translation, model units, model frame.
+    pub translation: [f64; 3],
 }
 
 /// The robot a plan was made for. Since format 1.5.
@@ -224,6 +255,11 @@ pub struct AssemblyStep {
     /// format 1.5.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub held: Vec<usize>,
+    /// Moves made after this step goes in, in order (assembly direction): parts already in
+    /// place, this step's among them, slide into their next poses (grid plans of interlocking
+    /// puzzles). The step's motion ends where these moves start from. Since format 1.6.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub moves: Vec<MoveEntry>,
 }
 
 /// A subassembly: parts that go in together, rigidly, as one step.
@@ -449,6 +485,7 @@ impl PlanReport {
             pareto_front: None,
             optimisation: None,
             robot: None,
+            grid: None,
         }
     }
 }
@@ -473,6 +510,15 @@ fn assembly_steps(removals: &[Step], name: &dyn Fn(usize) -> String, u: &dyn Fn(
             }),
             robot: None,
             held: Vec::new(),
+            moves: s
+                .moves
+                .iter()
+                .rev()
+                .map(|m| MoveEntry {
+                    parts: m.parts.iter().collect(),
+                    translation: [u(-m.translation.x), u(-m.translation.y), u(-m.translation.z)],
+                })
+                .collect(),
         })
         .collect()
 }

@@ -38,7 +38,7 @@ fn plans_a_fixture_prints_a_table_and_writes_the_json() {
     assert!(table.contains("found"), "{table}");
     assert!(table.contains("stick") && table.contains("handle") && table.contains("cap"), "{table}");
     let plan = json(&out);
-    assert_eq!(plan["format_version"], "1.5");
+    assert_eq!(plan["format_version"], "1.6");
     assert_eq!(plan["stats"]["checker"], "collision_world");
     assert_eq!(plan["status"], "found");
     assert_eq!(plan["up"], "+z");
@@ -69,7 +69,7 @@ fn no_plan_exits_1_and_explains() {
     let dir = tempfile::tempdir().unwrap();
     let model = fixture_file(dir.path(), &fixtures::l_path(), "l.glb");
     let out = dir.path().join("plan.json");
-    let o = asp(&["plan", model.to_str().unwrap(), "--no-path-planner", "--out", out.to_str().unwrap()]);
+    let o = asp(&["plan", model.to_str().unwrap(), "--no-path-planner", "--no-grid", "--out", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     let table = String::from_utf8(o.stdout).unwrap();
     assert!(table.contains("block") && table.contains("blocked by housing"), "{table}");
@@ -83,6 +83,13 @@ fn no_plan_exits_1_and_explains() {
     let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(plan["assembly_sequence"][0]["motion"]["kind"], "path");
     assert_eq!(plan["stats"]["path_planner_calls"], 1);
+    // without the path planner the housing and block are a voxel model: the grid search finds
+    // the L (a move along +x, then out along +z) after the depth-first search gives up
+    let o = asp(&["plan", model.to_str().unwrap(), "--no-path-planner", "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(plan["grid"]["reason"], "fallback");
+    assert_eq!(plan["assembly_sequence"][0]["moves"].as_array().unwrap().len(), 1);
 }
 
 /// Asserts a one-line error naming `needle`, exit code 2, no panic.
@@ -263,4 +270,103 @@ fn issue_9_one_process_plans_many_models_and_exits_with_the_worst_outcome() {
     let o = asp(&["plan", "--each", &data("pump")]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("one model"), "{}", stderr(&o));
+}
+
+/// Replays a plan JSON's steps in disassembly direction on the puzzle's cells (cell size
+/// `cell` model units): undo each step's `moves` (last first, negated), then take its parts out
+/// along the reversed insertion, every unit cell step checked against the parts present; a
+/// subassembly's own steps are replayed on its parts alone. Returns the parts taken out.
+fn replay_json(steps: &serde_json::Value, pos: &mut Vec<Vec<[i32; 3]>>, present: &mut Vec<usize>, cell: f64) -> usize {
+    let cells_of = |v: &serde_json::Value| -> [i32; 3] {
+        let a: Vec<f64> = v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        std::array::from_fn(|k| (a[k] / cell).round() as i32)
+    };
+    let hits = |pos: &Vec<Vec<[i32; 3]>>, moving: &[usize], others: &[usize], d: [i32; 3]| {
+        let blocked: std::collections::HashSet<[i32; 3]> = others.iter().flat_map(|&p| pos[p].iter().copied()).collect();
+        moving.iter().any(|&p| pos[p].iter().any(|c| blocked.contains(&[c[0] + d[0], c[1] + d[1], c[2] + d[2]])))
+    };
+    let mut out = 0;
+    for step in steps.as_array().unwrap().iter().rev() {
+        for m in step["moves"].as_array().map(Vec::as_slice).unwrap_or(&[]).iter().rev() {
+            let parts: Vec<usize> = m["parts"].as_array().unwrap().iter().map(|p| p.as_u64().unwrap() as usize).collect();
+            let t = cells_of(&m["translation"]).map(|x| -x);
+            let others: Vec<usize> = present.iter().copied().filter(|p| !parts.contains(p)).collect();
+            let len: i32 = t.iter().map(|x| x.abs()).sum();
+            for j in 1..=len {
+                assert!(!hits(pos, &parts, &others, t.map(|x| x.signum() * j)), "move {m} collides");
+            }
+            for &p in &parts {
+                pos[p] = pos[p].iter().map(|c| [c[0] + t[0], c[1] + t[1], c[2] + t[2]]).collect();
+            }
+        }
+        let parts: Vec<usize> = match step["subassembly"]["parts"].as_array() {
+            Some(a) => a.iter().map(|p| p.as_u64().unwrap() as usize).collect(),
+            None => vec![step["part"].as_u64().unwrap() as usize],
+        };
+        let d = cells_of(&step["motion"]["direction"]).map(|x| -x.signum());
+        let others: Vec<usize> = present.iter().copied().filter(|p| !parts.contains(p)).collect();
+        for j in 1..=40 {
+            assert!(!hits(pos, &parts, &others, d.map(|x| x * j)), "removal of {parts:?} collides at {j}");
+        }
+        if let Some(inner) = step["subassembly"]["assembly_sequence"].as_array() {
+            let mut sub = parts.clone();
+            out += replay_json(&serde_json::Value::Array(inner.clone()), pos, &mut sub, cell);
+        }
+        present.retain(|p| !parts.contains(p));
+        out += 1;
+    }
+    out
+}
+
+#[test]
+fn issue_9_plans_an_interlocking_burr_by_grid_moves() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = asp_geom::puzzles::burr_level();
+    let model = fixture_file(dir.path(), &a, "burr.glb");
+    let out = dir.path().join("plan.json");
+    let o = asp(&["plan", model.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let table = String::from_utf8(o.stdout).unwrap();
+    assert!(table.contains("grid plan") && table.contains("move piece"), "{table}");
+    let plan = json(&out);
+    assert_eq!(plan["format_version"], "1.6");
+    assert_eq!(plan["status"], "found");
+    assert_eq!(plan["grid"]["reason"], "needs_moves");
+    assert_eq!(plan["grid"]["first_separation_moves"], asp_geom::puzzles::BURR_LEVEL_MOVES);
+    // the documented rule, replayed on the cells from the JSON alone
+    let voxels = asp_geom::grid::VoxelModel::of(&a).unwrap();
+    let mut pos = voxels.cells.clone();
+    let mut present: Vec<usize> = (0..6).collect();
+    replay_json(&plan["assembly_sequence"], &mut pos, &mut present, 0.01);
+    assert!(present.is_empty(), "parts never taken out: {present:?}");
+    // without the grid search (the planner before issue 9 item 6) the burr only lifts off the
+    // ground in one piece: a subassembly of all six pieces that cannot be taken apart
+    let o = asp(&["plan", model.to_str().unwrap(), "--no-grid", "--no-path-planner", "--json"]);
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let g = &plan["assembly_sequence"][0]["subassembly"];
+    assert_eq!(g["status"], "no_plan", "{plan}");
+    assert_eq!(g["parts"].as_array().unwrap().len(), 6);
+    assert!(plan["grid"].is_null());
+}
+
+#[test]
+fn issue_9_grid_subassemblies_with_moves_replay_from_the_json() {
+    // two puzzles side by side: the depth-first search only lifts subassemblies it cannot take
+    // apart, so the grid plan is the fallback; each puzzle's own plan moves pieces on its frame
+    let dir = tempfile::tempdir().unwrap();
+    let a = asp_geom::puzzles::two_small_puzzles();
+    let model = fixture_file(dir.path(), &a, "two.glb");
+    let o = asp(&["plan", model.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(plan["grid"]["reason"], "fallback", "{plan}");
+    let steps = plan["assembly_sequence"].as_array().unwrap();
+    let sub = steps.iter().find(|s| !s["subassembly"].is_null()).expect("a subassembly step");
+    assert_eq!(sub["subassembly"]["status"], "found");
+    assert!(sub["subassembly"]["assembly_sequence"].as_array().unwrap().iter().any(|s| s["moves"].is_array()), "{sub}");
+    let voxels = asp_geom::grid::VoxelModel::of(&a).unwrap();
+    let mut pos = voxels.cells.clone();
+    let mut present: Vec<usize> = (0..6).collect();
+    replay_json(&plan["assembly_sequence"], &mut pos, &mut present, 0.01);
+    assert!(present.is_empty(), "parts never taken out: {present:?}");
 }
