@@ -113,3 +113,11 @@ def test_a_learned_q_function_ranks_the_optimum_first_and_guides_rollouts_to_it(
         guided,
         vanilla,
     )
+
+    # Q at expansions (`q_use`): with ε = 0, one episode and one iteration per step, the first
+    # removal is the root's first expansion, the action the model (run by tract in Rust) ranks first
+    plan = asp.load(model).plan(objective="access", q=str(tmp_path / "q.onnx"), q_use="expansions", epsilon=0.0,
+                                episodes=1, budget=1, threads=1, seed=0)
+    assert plan.found and plan.disassembly_sequence[0] == ranked, (plan.disassembly_sequence, ranked)
+    with pytest.raises(asp.ConfigError, match="q_use"):
+        asp.load(model).plan(objective="access", q=str(tmp_path / "q.onnx"), q_use="sideways")
