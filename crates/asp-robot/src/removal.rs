@@ -681,7 +681,10 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
     /// an obstacle, the floor or (the robot) itself: box distances to the parts and the floor,
     /// exact distances between the robot's own shapes whose boxes meet. Call it only at a
     /// collision-free configuration.
-    fn clearance(&self, placed: &[(Pose, Aabb)], held_box: &Aabb, obstacles: &Obstacles) -> f32 {
+    ///
+    /// A clearance below `need` is of no use to the caller: it returns 0 as soon as the bound
+    /// falls below it.
+    fn clearance(&self, placed: &[(Pose, Aabb)], held_box: &Aabb, obstacles: &Obstacles, need: f32) -> f32 {
         let world = self.world();
         let up = self.cell.up;
         let to_obstacles = |bb: &Aabb| {
@@ -702,10 +705,12 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
             m
         };
         let mut c = to_obstacles(held_box);
+        if c < need {
+            return 0.0;
+        }
         for (_, bb) in placed.iter().skip(self.base_shapes) {
-            // the box's lowest point along up
             c = c.min(lowest(bb, up) - self.cell.floor).min(to_obstacles(bb));
-            if c <= 0.0 {
+            if c < need {
                 return 0.0;
             }
         }
@@ -718,7 +723,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
                     query::distance(&placed[i].0, &*self.arm[i].shape, &placed[j].0, &*self.arm[j].shape).map_or(0.0, |d| d.distance)
                 };
                 c = c.min(d);
-                if c <= 0.0 {
+                if c < need {
                     return 0.0;
                 }
             }
@@ -1015,10 +1020,10 @@ impl<'a, W: Borrow<World>> ArmSpace<'a, W> {
         }
     }
 
-    /// Whether `q` is collision-free; if so, with `clearance`, a lower bound on how far every
-    /// point of the robot and the held part may move before anything collides (metres; 0
-    /// without `clearance`).
-    fn check(&self, q: &[f64], clearance: bool) -> Option<f32> {
+    /// Whether `q` is collision-free; if so, with `clearance: Some(need)`, a lower bound on how
+    /// far every point of the robot and the held part may move before anything collides
+    /// (metres; 0 when below `need` or without `clearance`).
+    fn check(&self, q: &[f64], clearance: Option<f32>) -> Option<f32> {
         let planner = self.planner;
         let mut poses = self.poses.borrow_mut();
         let tool = planner.cell.robot.collision_link_poses(q, self.opening, &mut poses);
@@ -1033,11 +1038,9 @@ impl<'a, W: Borrow<World>> ArmSpace<'a, W> {
         if planner.held_collides(self.part, self.shrunk, &displacement, self.obstacles) {
             return None;
         }
-        if !clearance {
-            return Some(0.0);
-        }
+        let Some(need) = clearance else { return Some(0.0) };
         let held_box = planner.world().aabb(self.part).transform_by(&displacement);
-        Some(planner.clearance(&placed, &held_box, self.obstacles))
+        Some(planner.clearance(&placed, &held_box, self.obstacles, need))
     }
 
     /// The sum of the tool centre's translations along the trajectory sampled at this space's
@@ -1069,7 +1072,7 @@ impl<W: Borrow<World>> Space for ArmSpace<'_, W> {
     }
 
     fn valid(&self, q: &Vec<f64>) -> bool {
-        self.check(q, false).is_some()
+        self.check(q, None).is_some()
     }
 
     /// The evenly spaced samples of [`Space::edge_valid`], but a sample whose clearance bound
@@ -1083,7 +1086,7 @@ impl<W: Borrow<World>> Space for ArmSpace<'_, W> {
         let step = self.distance(a, b) / n as f64;
         let mut i = 0;
         while i < n {
-            let Some(c) = self.check(&self.interpolate(a, b, i as f64 / n as f64), true) else {
+            let Some(c) = self.check(&self.interpolate(a, b, i as f64 / n as f64), Some(step as f32)) else {
                 return false;
             };
             // samples i + 1 ..= i + s lie within c of sample i
