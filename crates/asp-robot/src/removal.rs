@@ -423,6 +423,17 @@ impl Counters {
     }
 }
 
+/// How far [`RemovalPlanner::plan_grasps`] searches.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    /// Until no later grasp can be shorter, or the cap.
+    Bounded,
+    /// Every grasp.
+    Exhaustive,
+    /// Until the first path (the same grasps as `Bounded` up to it).
+    FirstPath,
+}
+
 /// The obstacles of one state: the present parts but the held one, the ground apart.
 struct Obstacles {
     ids: Vec<usize>,
@@ -790,7 +801,16 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
     /// ([`RemovalPlanner::plan_exhaustive`]) — or after [`RemovalConfig::path_grasps`] planned
     /// grasps (a cap: then a later grasp might have been shorter).
     pub fn plan(&self, p: usize, present: &PartSet, direction: Vec3, seed: u64, replans: usize) -> Result<RobotRemoval, RobotFailure> {
-        self.plan_grasps(p, present, direction, seed, replans, false)
+        self.plan_grasps(p, present, direction, seed, replans, Mode::Bounded)
+    }
+
+    /// Whether the robot can take the part out, with the first path found: the same grasps in
+    /// the same order with the same seeds as [`RemovalPlanner::plan`], stopping at the first
+    /// path that passes the re-check. So it succeeds exactly when `plan` does (and fails with
+    /// the same failure), at a fraction of the cost; its path is not the shortest. For
+    /// feasibility tests (the optimiser's `robot` filter).
+    pub fn removable(&self, p: usize, present: &PartSet, direction: Vec3, seed: u64, replans: usize) -> Result<RobotRemoval, RobotFailure> {
+        self.plan_grasps(p, present, direction, seed, replans, Mode::FirstPath)
     }
 
     /// [`RemovalPlanner::plan`] without its shortcuts: every grasp is examined and every
@@ -798,7 +818,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
     /// same seeds, so its length is the shortest of all of them: the reference `plan` is
     /// tested against.
     pub fn plan_exhaustive(&self, p: usize, present: &PartSet, direction: Vec3, seed: u64, replans: usize) -> Result<RobotRemoval, RobotFailure> {
-        self.plan_grasps(p, present, direction, seed, replans, true)
+        self.plan_grasps(p, present, direction, seed, replans, Mode::Exhaustive)
     }
 
     fn plan_grasps(
@@ -808,8 +828,9 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         direction: Vec3,
         seed: u64,
         replans: usize,
-        exhaustive: bool,
+        mode: Mode,
     ) -> Result<RobotRemoval, RobotFailure> {
+        let exhaustive = mode == Mode::Exhaustive;
         let counters = &self.counters;
         counters.add(C::Plans, 1);
         let world = self.world();
@@ -843,7 +864,8 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         let mut solved: Vec<(Pose, Vec<f64>)> = Vec::new();
         let mut best: Option<RobotRemoval> = None;
         for (n, &(bound, gi)) in order.iter().enumerate() {
-            if !exhaustive && (tried >= cap || best.as_ref().is_some_and(|b| b.length <= bound)) {
+            let found = mode == Mode::FirstPath && best.is_some();
+            if found || !exhaustive && (tried >= cap || best.as_ref().is_some_and(|b| b.length <= bound)) {
                 counters.add(C::Pruned, (order.len() - n) as u64);
                 break;
             }
@@ -931,6 +953,9 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
                         length,
                         reachable_grasps: reached,
                     });
+                    if mode == Mode::FirstPath {
+                        break;
+                    }
                 }
             }
         }

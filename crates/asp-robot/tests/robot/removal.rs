@@ -301,6 +301,40 @@ fn the_bounded_grasp_search_finds_the_exhaustive_shortest_path() {
     assert!(beyond_the_first > 0, "every shortest path came from the first planned grasp: the test shows nothing");
 }
 
+/// The feasibility test that stops at the first path (the optimiser's filter) gives the same
+/// verdict and the same failure as the full plan, on every part that can leave the full frame
+/// along a straight line and in a state with the top profiles gone; its path is never shorter.
+#[test]
+fn the_first_path_gives_the_verdict_of_the_full_plan() {
+    let world = World::new(profiles(), &WorldConfig::default()).unwrap();
+    let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
+    let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
+    let full = PartSet::full(world.num_parts());
+    let (mut ok, mut failed) = (0, 0);
+    for k in [1, 2] {
+        for p in 0..world.num_parts() {
+            if world.fixed().contains(p) {
+                continue;
+            }
+            let Some(d) = lift_direction(&world, p, &full) else { continue };
+            let first = planner.removable(p, &full, d, 9, k);
+            let best = planner.plan(p, &full, d, 9, k);
+            match (&first, &best) {
+                (Ok(a), Ok(b)) => {
+                    assert!(a.length >= b.length, "part {p}: first {} < best {}", a.length, b.length);
+                    ok += 1;
+                }
+                (Err(a), Err(b)) => {
+                    assert_eq!(a, b, "part {p}");
+                    failed += 1;
+                }
+                _ => panic!("part {p} k {k}: first path {first:?} but plan {best:?}"),
+            }
+        }
+    }
+    assert!(ok > 0 && failed > 0, "{ok} removable, {failed} not");
+}
+
 /// Skipping edge samples by their clearance bound gives the same plans as testing every sample,
 /// with fewer tests.
 #[test]
