@@ -171,16 +171,18 @@ pub enum RobotFailure {
     NoReachableGrasp {
         /// Grasps of the part.
         grasps: usize,
-        /// Grasps whose pose (or lifted pose) inverse kinematics did not reach.
+        /// Grasps whose pose (or lifted pose) inverse kinematics did not reach (of those whose
+        /// gripper alone is collision-free there).
         unreachable: usize,
-        /// Grasps reached only with the arm or gripper colliding (at the grasp or the lift).
+        /// Grasps where the gripper alone collides at the grasp or lifted pose (tested first,
+        /// without inverse kinematics), or the arm reached them only colliding.
         colliding: usize,
     },
     /// Grasps are reachable but no collision-free path to the drop-off was found: the drop-off
     /// pose is unreachable or in collision with the part in hand, or the path planner found no
     /// path within its budget.
     NoPath {
-        /// Reachable grasps.
+        /// Reachable grasps (among those examined).
         reachable: usize,
         /// Of those, grasps whose drop-off pose is unreachable or in collision.
         drop_off_blocked: usize,
@@ -245,7 +247,8 @@ pub struct RobotRemoval {
     pub gripper_path: Vec<Vec3>,
     /// The path length (eq. 5.3): the tool centre's travel, metres.
     pub length: f64,
-    /// Grasps that were reachable (grasp and lift collision-free).
+    /// Grasps found reachable (grasp and lift collision-free) among those examined: the search
+    /// stops when no later grasp can be shorter, so this is not a count over all grasps.
     pub reachable_grasps: usize,
 }
 
