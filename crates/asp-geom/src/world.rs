@@ -621,6 +621,13 @@ impl World {
         &self.geoms[i].mesh
     }
 
+    /// The exact boxes of part `i` in its assembled pose when it is a known union of
+    /// axis-aligned boxes that describes its mesh (see [`crate::boxes`]; `None` otherwise, and
+    /// always with `WorldConfig::exact_boxes` off).
+    pub fn boxes(&self, i: usize) -> Option<&[Aabb]> {
+        self.geoms[i].boxes.as_deref()
+    }
+
     /// Which part the tests of the pair (`p`, `q`) shrink, and by how much (metres): normally the
     /// moving part `p` by the tolerance; for parts overlapping in the input, the one that
     /// separates with the least shrinking, by the tolerance plus that.

@@ -159,6 +159,11 @@ impl Robot {
         if !distance.is_finite() || distance > bound {
             return IkOutcome::Unreachable { position_error: distance - bound, rotation_error: f64::NAN, attempts: 0 };
         }
+        if let Some((wrist, bound)) = self.wrist_reach(&t) {
+            if wrist > bound {
+                return IkOutcome::Unreachable { position_error: wrist - bound, rotation_error: f64::NAN, attempts: 0 };
+            }
+        }
         let limits = self.limits();
         let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
         let mut best = (f64::INFINITY, f64::INFINITY);
@@ -181,6 +186,29 @@ impl Robot {
             }
         }
         IkOutcome::Unreachable { position_error: best.0, rotation_error: best.1, attempts: cfg.restarts + 1 }
+    }
+
+    /// For a tool target, the distance from the shoulder to the last revolute joint's origin
+    /// that the target implies (the links after it are rigid with the tool, so the target fixes
+    /// that point), and the farthest the chain can put that point from the shoulder. `None` when
+    /// the last movable joint is prismatic or is the first one.
+    fn wrist_reach(&self, target: &Isometry3<f64>) -> Option<(f64, f64)> {
+        let last = *self.movable.last()?;
+        let first = self.movable[0];
+        if last == first || self.joints[last].kind != JointKind::Revolute {
+            return None;
+        }
+        // link last + 1's frame (its origin lies on the joint's axis) in the tool frame
+        let mut tip = Isometry3::identity();
+        for j in &self.joints[last + 1..] {
+            tip *= j.origin;
+        }
+        let wrist = (target * tip.inverse()).translation.vector;
+        let bound: f64 = self.joints[first + 1..=last]
+            .iter()
+            .map(|j| j.origin.translation.vector.norm() + if j.kind == JointKind::Prismatic { j.limits.0.abs().max(j.limits.1.abs()) } else { 0.0 })
+            .sum();
+        Some(((wrist - self.shoulder()).norm(), bound + 1e-9))
     }
 
     /// A configuration drawn uniformly within the joint limits.

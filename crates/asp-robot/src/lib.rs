@@ -14,7 +14,7 @@ pub mod shape;
 pub use error::{Result, RobotError};
 pub use grasp::{antipodal_grasps, grasps_from_meta, part_grasps, GraspConfig};
 pub use ik::{IkConfig, IkOutcome, IkSolution};
-pub use removal::{RemovalConfig, RemovalPlanner, RobotCell, RobotFailure, RobotRemoval};
+pub use removal::{PlanStats, RemovalConfig, RemovalPlanner, RobotCell, RobotFailure, RobotRemoval};
 pub use checker::{HoldingChecker, RobotChecker};
 pub use search::{CellSetup, RobotExtension, RobotSetup, ROBOT_PATH};
 pub use robot::{ChainSpec, Finger, Joint, JointKind, Link, Robot};

@@ -452,6 +452,80 @@ impl Robot {
         out
     }
 
+    /// The world pose of the link of every collision shape at `q` with the gripper opened to
+    /// `opening`, in [`Robot::collision_shapes`] order, and the tool centre's pose: the same
+    /// poses from one forward kinematics pass (the planners' inner loop).
+    pub(crate) fn collision_link_poses(&self, q: &[f64], opening: f32, out: &mut Vec<Pose>) -> Pose {
+        out.clear();
+        let frames = self.link_frames(q);
+        let end = self.first_tool_link();
+        for (i, l) in self.links.iter().enumerate().take(end) {
+            let pose = pose_from_na(&frames[i]);
+            out.extend(l.shapes.iter().map(|_| pose));
+        }
+        let tool_na = *frames.last().expect("a chain has links");
+        let n = self.links.len();
+        let mut t = tool_na;
+        for i in (end..n).rev() {
+            let pose = pose_from_na(&t);
+            out.extend(self.links[i].shapes.iter().map(|_| pose));
+            if i > end {
+                t *= self.joints[i - 1].origin.inverse();
+            }
+        }
+        let max = self.max_opening().max(f32::MIN_POSITIVE) as f64;
+        let frac = (opening as f64 / max).clamp(0.0, 1.0);
+        for f in &self.fingers {
+            let (lo, hi) = f.joint.limits;
+            let pose = pose_from_na(&(tool_na * f.origin_in_tool * f.joint.motion(lo + frac * (hi - lo))));
+            out.extend(f.link.shapes.iter().map(|_| pose));
+        }
+        pose_from_na(&tool_na)
+    }
+
+    /// Per movable joint (configuration order), a bound on the distance from the joint's origin
+    /// to any point of the links after it and to any point within `tool_reach` of the tool
+    /// centre, in every configuration: moving the joints linearly by `Δq` moves no such point
+    /// farther than `Σ levers[i] |Δq_i|` (revolute joints; a prismatic joint moves them by its
+    /// travel, and its bound is 1).
+    pub fn lever_arms(&self, tool_reach: f64) -> Vec<f64> {
+        let n = self.links.len();
+        // chain[m]: the farthest link m's frame can be from the previous joint's origin, summed
+        let step = |t: usize| {
+            let j = &self.joints[t];
+            j.origin.translation.vector.norm() + if j.kind == JointKind::Prismatic { j.limits.0.abs().max(j.limits.1.abs()) } else { 0.0 }
+        };
+        self.movable
+            .iter()
+            .map(|&j| {
+                if self.joints[j].kind == JointKind::Prismatic {
+                    return 1.0;
+                }
+                // joint j's origin is link j + 1's frame origin
+                let mut dist = 0.0;
+                let mut best: f64 = 0.0;
+                for m in j + 1..n {
+                    if m > j + 1 {
+                        dist += step(m - 1);
+                    }
+                    let reach = self.links[m].shapes.iter().map(|s| s.reach() as f64).fold(0.0, f64::max);
+                    best = best.max(dist + reach);
+                }
+                best.max(dist + tool_reach)
+            })
+            .collect()
+    }
+
+    /// The farthest a point of the gripper (links rigid with the tool centre, fingers at any
+    /// opening) lies from the tool centre.
+    pub fn gripper_reach(&self) -> f64 {
+        [0.0, self.max_opening()]
+            .iter()
+            .flat_map(|&o| self.gripper_shapes(&Pose::IDENTITY, o))
+            .map(|(pose, s)| (pose.translation.length() + s.reach()) as f64)
+            .fold(0.0, f64::max)
+    }
+
     /// An upper bound on the distance from the first movable joint's origin to the tool centre.
     pub fn reach_bound(&self) -> f64 {
         let first = self.movable[0];

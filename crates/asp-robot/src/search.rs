@@ -4,7 +4,9 @@
 //!   robot can carry out);
 //! * the optimiser: [`RobotSetup`] is an [`MdpExtension`] with the filter `robot` (reasons
 //!   `blocked`, `no reachable grasp`, `no path`) and the objective `robot-path` (reward: minus
-//!   the robot's path length in metres, eq. 5.8). Expansion and replay plan `k` times
+//!   the robot's path length in metres, eq. 5.8). The filter asks only whether a path exists
+//!   ([`RobotModel::feasible`]: the first path found, the same verdict as the full plan); the
+//!   objective plans the shortest for the step taken. Expansion and replay plan `k` times
 //!   ([`RemovalConfig::replans`]) and keep the shortest, simulation plans once (5.4.2). The lift
 //!   direction is the distance maps' straight-line removal direction of the step.
 //!
@@ -152,6 +154,8 @@ pub struct RobotModel {
     replans: usize,
     assembly: Arc<Assembly>,
     cache: Mutex<HashMap<(Vec<u64>, usize, usize), Result<RobotRemoval, RobotFailure>>>,
+    /// Steps the robot can do, known from a first path only ([`RemovalPlanner::removable`]).
+    feasible: Mutex<std::collections::HashSet<(Vec<u64>, usize, usize)>>,
 }
 
 impl RobotModel {
@@ -169,6 +173,36 @@ impl RobotModel {
         };
         self.cache.lock().expect("not poisoned").insert(key, r.clone());
         r
+    }
+
+    /// Whether the robot can do `step`: the verdict of [`RobotModel::plan`] from the first
+    /// path found ([`RemovalPlanner::removable`]: the same grasps and seeds, so the same
+    /// verdict and the same failure), without searching for the shortest.
+    pub fn feasible(&self, step: &mut StepContext<'_, '_>) -> Result<(), RobotFailure> {
+        let replans = if step.kind() == StepKind::Simulation { 1 } else { self.replans.max(1) };
+        let present = step.present();
+        let key = (present.words().to_vec(), step.part(), replans);
+        if let Some(r) = self.cache.lock().expect("not poisoned").get(&key) {
+            return r.as_ref().map(|_| ()).map_err(Clone::clone);
+        }
+        if self.feasible.lock().expect("not poisoned").contains(&key) {
+            return Ok(());
+        }
+        let r = match step.motion() {
+            Some(Motion::Linear { direction, .. }) => self.planner.removable(step.part(), &present, direction, step.seed(), replans),
+            _ => Err(RobotFailure::Blocked { by: None }),
+        };
+        match r {
+            Ok(_) => {
+                self.feasible.lock().expect("not poisoned").insert(key);
+                Ok(())
+            }
+            Err(f) => {
+                // the full plan would fail the same way
+                self.cache.lock().expect("not poisoned").insert(key, Err(f.clone()));
+                Err(f)
+            }
+        }
     }
 
     /// The planner.
@@ -191,7 +225,7 @@ impl ActionFilter for RobotFilter {
     }
 
     fn check(&self, step: &mut StepContext<'_, '_>, _memory: &[u64]) -> Verdict {
-        match self.0.plan(step) {
+        match self.0.feasible(step) {
             Ok(_) => Verdict::Feasible,
             Err(f) => Verdict::Infeasible { reason: f.index() },
         }
@@ -256,6 +290,7 @@ impl RobotExtension {
             replans: self.setup.config.replans,
             assembly: model.assembly.clone(),
             cache: Mutex::new(HashMap::new()),
+            feasible: Mutex::new(Default::default()),
         });
         *slot = Some((id, m.clone()));
         Ok(m)

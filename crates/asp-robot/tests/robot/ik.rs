@@ -57,3 +57,20 @@ fn same_seed_same_solution() {
     let cfg = IkConfig { seed: 9, ..Default::default() };
     assert_eq!(robot.ik(&target, None, &cfg), robot.ik(&target, None, &cfg));
 }
+
+/// The wrist bound (the last joint's origin, fixed by the target, must lie within the chain's
+/// length of the shoulder) rejects without a single descent a target the tool-centre bound lets
+/// through, and never rejects a pose the arm takes.
+#[test]
+fn the_wrist_bound_rejects_at_once_only_what_no_configuration_reaches() {
+    let robot = Robot::panda();
+    // 0.7 m in front of the shoulder, approaching back towards the robot: the wrist would be
+    // 0.91 m away (the chain up to it is 0.80 m long), the tool centre is within its 1.09 m bound
+    let target = Pose::from_parts(Vec3::new(0.7, 0.0, 0.333), asp_geom::math::Rot::from_rotation_y(-std::f32::consts::FRAC_PI_2));
+    assert!(matches!(robot.ik(&target, None, &IkConfig::default()), IkOutcome::Unreachable { attempts: 0, .. }));
+    let cfg = IkConfig { restarts: 0, max_iterations: 1, ..Default::default() };
+    for q in super::configurations(&robot, 300, 11) {
+        let out = robot.ik(&robot.tool_pose(&q), None, &cfg);
+        assert!(!matches!(out, IkOutcome::Unreachable { attempts: 0, .. }), "{q:?} rejected by a bound");
+    }
+}

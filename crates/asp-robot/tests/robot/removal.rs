@@ -246,39 +246,215 @@ fn a_drop_off_inside_a_closed_box_has_no_path() {
     }
 }
 
+/// A 50 cm bar lying across the robot's front on a fixed plate: its grasps' lower bounds spread
+/// over about 30 cm (one end is much nearer the drop-off than the other).
+fn bar_world() -> World {
+    let mut plate = box_part("plate", [-0.1, -0.35, -0.02], [0.3, 0.35, 0.0]);
+    plate.fixed = true;
+    let parts = vec![plate, box_part("bar", [0.09, -0.25, 0.0], [0.11, 0.25, 0.02])];
+    World::new(assemble("bar", parts, Axis::Z), &WorldConfig::default()).unwrap()
+}
+
+/// The fast search (grasps by lower bound, each planned at once, stopping when no later grasp
+/// can beat the best path) finds the same shortest path as planning every reachable grasp
+/// (eq. 5.4), while planning fewer grasps: on a bar whose grasps' bounds spread over 30 cm, and
+/// on the top profiles of a generated frame. Some cases must need more than the first planned
+/// grasp (its path is longer than another grasp's), so a bound that overestimates, stopping too
+/// early, gives a longer path there.
+#[test]
+fn the_bounded_grasp_search_finds_the_exhaustive_shortest_path() {
+    // no cap: only the bound may stop the search
+    let exact = RemovalConfig { path_grasps: usize::MAX, ..RemovalConfig::default() };
+    let first = RemovalConfig { path_grasps: 1, ..RemovalConfig::default() };
+    let (mut pruning, mut beyond_the_first) = (0, 0);
+    let bar = bar_world();
+    let frame = World::new(profiles(), &WorldConfig::default()).unwrap();
+    let frame_cell = RobotCell::for_assembly(frame.assembly(), Robot::panda(), None, None);
+    let bar_cell = RobotCell::for_assembly(bar.assembly(), Robot::panda(), Some(Vec3::new(-0.35, 0.0, -0.02)), None);
+    let full = PartSet::full(frame.num_parts());
+    let mut cases: Vec<(&World, &RobotCell, usize, Vec3, u64)> = (1..=3).map(|seed| (&bar, &bar_cell, 1, Vec3::Z, seed)).collect();
+    for p in 0..frame.num_parts() {
+        if frame.fixed().contains(p) {
+            continue;
+        }
+        if let Some(d) = lift_direction(&frame, p, &full).filter(|d| d.z > 0.9) {
+            cases.extend((1..=2).map(|seed| (&frame, &frame_cell, p, d, seed)));
+        }
+    }
+    for (world, cell, p, d, seed) in cases {
+        let planner = RemovalPlanner::new(world, cell.clone(), exact.clone());
+        let state = PartSet::full(world.num_parts());
+        let fast = planner.plan(p, &state, d, seed, 1);
+        let f = planner.stats();
+        planner.reset_stats();
+        let all = planner.plan_exhaustive(p, &state, d, seed, 1);
+        let e = planner.stats();
+        let (Ok(fast), Ok(all)) = (fast, all) else { continue };
+        assert_eq!((fast.grasp_index, fast.length), (all.grasp_index, all.length), "{} parts, part {p}, seed {seed}", world.num_parts());
+        assert_eq!(fast.joints, all.joints);
+        assert!(f.grasps_planned <= e.grasps_planned);
+        pruning += (f.grasps_pruned > 0) as usize;
+        let one = RemovalPlanner::new(world, cell.clone(), first.clone()).plan(p, &state, d, seed, 1).expect("a first path");
+        beyond_the_first += (one.length > all.length) as usize;
+    }
+    assert!(pruning > 0, "the bound never pruned a grasp");
+    assert!(beyond_the_first > 0, "every shortest path came from the first planned grasp: the test shows nothing");
+}
+
+/// The feasibility test that stops at the first path (the optimiser's filter) gives the same
+/// verdict and the same failure as the full plan, on every part that can leave the full frame
+/// along a straight line and in a state with the top profiles gone; its path is never shorter.
+#[test]
+fn the_first_path_gives_the_verdict_of_the_full_plan() {
+    let world = World::new(profiles(), &WorldConfig::default()).unwrap();
+    let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
+    let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
+    let full = PartSet::full(world.num_parts());
+    let (mut ok, mut failed) = (0, 0);
+    for k in [1, 2] {
+        for p in 0..world.num_parts() {
+            if world.fixed().contains(p) {
+                continue;
+            }
+            let Some(d) = lift_direction(&world, p, &full) else { continue };
+            let first = planner.removable(p, &full, d, 9, k);
+            let best = planner.plan(p, &full, d, 9, k);
+            match (&first, &best) {
+                (Ok(a), Ok(b)) => {
+                    assert!(a.length >= b.length, "part {p}: first {} < best {}", a.length, b.length);
+                    ok += 1;
+                }
+                (Err(a), Err(b)) => {
+                    assert_eq!(a, b, "part {p}");
+                    failed += 1;
+                }
+                _ => panic!("part {p} k {k}: first path {first:?} but plan {best:?}"),
+            }
+        }
+    }
+    assert!(ok > 0 && failed > 0, "{ok} removable, {failed} not");
+}
+
+/// Skipping edge samples by their clearance bound gives the same plans as testing every sample,
+/// with fewer tests.
+#[test]
+fn clearance_skipping_keeps_the_plans() {
+    let world = World::new(profiles(), &WorldConfig::default()).unwrap();
+    let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
+    let skipping = RemovalPlanner::new(&world, cell.clone(), RemovalConfig::default());
+    let every = RemovalPlanner::new(&world, cell, RemovalConfig { clearance_skipping: false, ..RemovalConfig::default() });
+    let state = PartSet::full(world.num_parts());
+    let mut planned = 0;
+    for p in 0..world.num_parts() {
+        if world.fixed().contains(p) {
+            continue;
+        }
+        let Some(d) = lift_direction(&world, p, &state) else { continue };
+        let a = skipping.plan(p, &state, d, 5, 1);
+        let b = every.plan(p, &state, d, 5, 1);
+        assert_eq!(a, b, "part {p}");
+        planned += a.is_ok() as usize;
+        if planned >= 3 {
+            break;
+        }
+    }
+    assert!(planned >= 1);
+    let (s, e) = (skipping.stats(), every.stats());
+    assert!(s.skipped_samples > 0 && s.robot_checks < e.robot_checks, "{s:?} vs {e:?}");
+}
+
+/// Self-collision: the arm in the middle of its limits is free, some random configurations
+/// fold it into itself, and no planned configuration does.
+#[test]
+fn the_arm_does_not_pass_through_itself() {
+    let world = bar_world();
+    let robot = Robot::panda();
+    let cell = RobotCell::for_assembly(world.assembly(), robot.clone(), Some(Vec3::new(-0.35, 0.0, -0.02)), None);
+    let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
+    assert!(!planner.self_collision_pairs().is_empty());
+    assert!(!planner.self_collision(&robot.mid_configuration(), 0.04));
+    let qs = super::configurations(&robot, 400, 5);
+    let folded = qs.iter().filter(|q| planner.self_collision(q, 0.04)).count();
+    assert!(folded > 0 && folded < qs.len(), "{folded} of {} random configurations self-collide", qs.len());
+    let state = PartSet::full(world.num_parts());
+    let r = planner.plan(1, &state, Vec3::Z, 3, 2).expect("the bar comes out");
+    for w in r.joints.windows(2) {
+        for i in 0..=50 {
+            let t = i as f64 / 50.0;
+            let q: Vec<f64> = w[0].iter().zip(&w[1]).map(|(a, b)| a + (b - a) * t).collect();
+            assert!(!planner.self_collision(&q, r.grasp.width));
+        }
+    }
+}
+
 /// Per-part planning time on generated profile assemblies (a measurement for
 /// docs/benchmarks.md, not a timed test): every part that can leave the full assembly along a
-/// straight line is planned with k = 1 and with the default k; prints times and outcomes.
-/// `cargo test -p asp-robot --test tests per_part_planning_time -- --ignored --nocapture`
+/// straight line is planned with k = 1 and with the default k; prints times, outcomes and the
+/// time per phase. `ASP_ROBOT_BENCH=single-1,double-1` picks models (default: single- and
+/// double-layer, seeds 1 and 2), `ASP_ROBOT_BENCH_K=1` the k values, and
+/// `ASP_ROBOT_ABLATE=1` also runs each speed-up switched off.
+/// `cargo test --workspace --test tests -- per_part_planning_time --ignored --nocapture`
 #[test]
 #[ignore = "a measurement, run by hand"]
 fn per_part_planning_time() {
-    for (name, params) in [("single-layer", asp_gen::ProfileParams::single_layer()), ("double-layer", asp_gen::ProfileParams::double_layer())] {
-        for seed in [1, 2] {
-            let assembly = asp_gen::ProfileAssembly::generate(&params, seed).unwrap().to_assembly("p");
-            let world = World::new(assembly, &WorldConfig::default()).unwrap();
-            let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
-            let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
-            let state = PartSet::full(world.num_parts());
-            let parts: Vec<(usize, Vec3)> = (0..world.num_parts())
-                .filter(|&p| !world.fixed().contains(p))
-                .filter_map(|p| lift_direction(&world, p, &state).map(|d| (p, d)))
-                .collect();
-            for k in [1, RemovalConfig::default().replans] {
+    let pick = std::env::var("ASP_ROBOT_BENCH").unwrap_or_else(|_| "single-1,single-2,double-1,double-2".into());
+    let ks: Vec<usize> = std::env::var("ASP_ROBOT_BENCH_K")
+        .map(|v| v.split(',').map(|k| k.trim().parse().unwrap()).collect())
+        .unwrap_or_else(|_| vec![1, RemovalConfig::default().replans]);
+    let ablate = std::env::var("ASP_ROBOT_ABLATE").is_ok();
+    let mut variants: Vec<(&str, RemovalConfig)> = vec![("default", RemovalConfig::default())];
+    if ablate {
+        variants.push(("no gripper pre-check", RemovalConfig { gripper_precheck: false, ..RemovalConfig::default() }));
+        variants.push(("one lever arm", RemovalConfig { per_joint_levers: false, ..RemovalConfig::default() }));
+        variants.push(("no self-collision", RemovalConfig { self_collision: false, ..RemovalConfig::default() }));
+        variants.push(("no clearance skipping", RemovalConfig { clearance_skipping: false, ..RemovalConfig::default() }));
+    }
+    for item in pick.split(',') {
+        let (name, seed) = item.trim().split_once('-').expect("name-seed");
+        let params = match name {
+            "single" => asp_gen::ProfileParams::single_layer(),
+            "double" => asp_gen::ProfileParams::double_layer(),
+            other => panic!("unknown model {other}"),
+        };
+        let seed: u64 = seed.parse().unwrap();
+        let assembly = asp_gen::ProfileAssembly::generate(&params, seed).unwrap().to_assembly("p");
+        let world = World::new(assembly, &WorldConfig::default()).unwrap();
+        let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
+        let state = PartSet::full(world.num_parts());
+        let parts: Vec<(usize, Vec3)> = (0..world.num_parts())
+            .filter(|&p| !world.fixed().contains(p))
+            .filter_map(|p| lift_direction(&world, p, &state).map(|d| (p, d)))
+            .collect();
+        for (variant, config) in &variants {
+            let planner = RemovalPlanner::new(&world, cell.clone(), config.clone());
+            for &k in &ks {
+                planner.reset_stats();
                 let started = std::time::Instant::now();
                 let mut ok = 0;
+                let mut total = 0.0;
                 let mut reasons = [0; 3];
                 for &(p, d) in &parts {
                     match planner.plan(p, &state, d, 1, k) {
-                        Ok(_) => ok += 1,
+                        Ok(r) => {
+                            ok += 1;
+                            total += r.length;
+                        }
                         Err(e) => reasons[e.index()] += 1,
                     }
                 }
                 let t = started.elapsed().as_secs_f64();
+                let n = parts.len().max(1) as f64;
+                let s = planner.stats();
+                let ms = |ns: u64| ns as f64 / 1e6 / n;
                 println!(
-                    "{name} seed {seed} k={k}: {} parts planned in {t:.2} s = {:.1} ms per part; {ok} removable, failures (blocked, no grasp, no path) {reasons:?}",
+                    "{name}-layer seed {seed} [{variant}] k={k}: {} parts in {t:.2} s = {:.1} ms per part; {ok} removable (lengths sum {total:.3} m), failures (blocked, no grasp, no path) {reasons:?}",
                     parts.len(),
-                    1000.0 * t / parts.len().max(1) as f64
+                    1000.0 * t / n
+                );
+                println!(
+                    "    per part ms: lift {:.2}, gripper {:.2}, ik {:.2}, arm checks {:.2}, drop-off {:.2}, rrt {:.2}, length+re-check {:.2}; grasps examined {}, pruned {}, gripper-rejected {}, unreachable {}, planned {}; robot checks {}, held-part checks {}, samples skipped {}",
+                    ms(s.lift_ns), ms(s.gripper_ns), ms(s.ik_ns), ms(s.reach_check_ns), ms(s.drop_off_ns), ms(s.rrt_ns), ms(s.recheck_ns),
+                    s.grasps_examined, s.grasps_pruned, s.gripper_rejected, s.unreachable, s.grasps_planned, s.robot_checks, s.held_checks, s.skipped_samples
                 );
             }
         }
