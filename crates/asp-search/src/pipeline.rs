@@ -368,6 +368,13 @@ pub fn plan_assembly(
     if let Some(r) = robot {
         report.attach_robot(r);
     }
+    finish_report(&mut report, world, &outcome, world_seconds);
+    Ok(PlanResult { report, status: outcome.status, search: None })
+}
+
+/// What every feasibility plan's report carries besides its steps: the overlapping pairs and
+/// where the time went (loading is timed by the caller).
+fn finish_report(report: &mut PlanReport, world: &asp_geom::World, outcome: &PlanOutcome, world_seconds: f64) {
     report.overlaps = crate::report::OverlapsEntry::of(world);
     report.stats.timings = Some(Timings {
         load: 0.0,
@@ -375,7 +382,6 @@ pub fn plan_assembly(
         search: outcome.stats.seconds,
         path_planner: outcome.stats.path_planner_seconds,
     });
-    Ok(PlanResult { report, status: outcome.status, search: None })
 }
 
 /// Whether every subassembly of a found plan was taken apart by its own plan.
@@ -406,13 +412,7 @@ fn grid_result(checker: &Checker, run: &GridRun, reason: &str, before: Option<&P
         first_separation_moves: run.solution.first_separation_moves,
         seconds: run.solution.seconds,
     });
-    report.overlaps = crate::report::OverlapsEntry::of(world);
-    report.stats.timings = Some(Timings {
-        load: 0.0,
-        world: world_seconds,
-        search: outcome.stats.seconds,
-        path_planner: outcome.stats.path_planner_seconds,
-    });
+    finish_report(&mut report, world, &outcome, world_seconds);
     PlanResult { report, status: outcome.status, search: None }
 }
 
