@@ -308,15 +308,9 @@ fn helical_rows(
 }
 
 /// A hexagonal ring of circumradius `r` at height `z` (one vertex per facet angle).
-fn hexagon_ring(vertices: &mut Vec<Vec3>, (x, y): (f32, f32), r: f32, z: f32) -> Vec<u32> {
-    (0..THREAD_FACETS)
-        .map(|i| {
-            let a = std::f32::consts::TAU * i as f32 / THREAD_FACETS as f32;
-            let h = hexagon_radius(r, a);
-            vertices.push(Vec3::new(x + h * a.cos(), y + h * a.sin(), z));
-            (vertices.len() - 1) as u32
-        })
-        .collect()
+fn hexagon_ring(vertices: &mut Vec<Vec3>, centre: (f32, f32), r: f32, z: f32) -> Vec<u32> {
+    let angle = |i: u32| std::f32::consts::TAU * i as f32 / THREAD_FACETS as f32;
+    helical_rows(vertices, centre, z, 0.0, 0..=0, |i, _| hexagon_radius(r, angle(i))).remove(0)
 }
 
 /// Issue 9's bolt and nut, in metres: a fixed plate (33 × 33 × 4 mm, a square clearance hole of

@@ -309,7 +309,7 @@ fn connected(cells: &[Cell]) -> bool {
 
 /// Not a test: the seeded search that found the puzzles' shapes (run with `--ignored`).
 #[test]
-#[ignore]
+#[ignore = "a tool, not a test: the seeded search that found the puzzles"]
 fn issue_9_find_puzzles() {
     let sticks = puzzles::burr_sticks();
     let mut best: Option<(usize, Vec<Vec<Cell>>)> = None;
@@ -444,7 +444,7 @@ fn issue_9_find_puzzles() {
 /// Not a test: writes the puzzles as GLB files (cells metadata) and as plain polycube meshes
 /// into `$ASP_PUZZLES_OUT` for benchmarks (`docs/benchmarks.md`).
 #[test]
-#[ignore]
+#[ignore = "a tool, not a test: writes the puzzles to $ASP_PUZZLES_OUT for benchmarks"]
 fn issue_9_write_puzzle_glbs() {
     let dir = std::path::PathBuf::from(std::env::var("ASP_PUZZLES_OUT").expect("ASP_PUZZLES_OUT"));
     std::fs::create_dir_all(&dir).unwrap();
@@ -459,7 +459,7 @@ fn issue_9_write_puzzle_glbs() {
 /// puzzle, and the search's throughput on a closed box whose five loose cubes slide around a
 /// 3 × 4 cavity without ever getting out (every one of the 95,040 states visited, then stuck).
 #[test]
-#[ignore]
+#[ignore = "a benchmark, not a test: figures in docs/benchmarks.md"]
 fn issue_9_bench_grid() {
     let mut frame = Vec::new();
     for x in 0..5 {
