@@ -143,12 +143,15 @@ impl FeasibilityChecker for RobotChecker<'_> {
 /// when holding at most `N - 1` of the remaining, non-fixed parts in place (a second gripper or
 /// a fixture) makes it stand. Candidates to hold: the parts that would fall first, then the
 /// other remaining parts in index order; sets of one part, then of two (when `N ≥ 3`, among the
-/// first 12 candidates). The held parts of each admitted removal are kept
-/// ([`HoldingChecker::held`]).
+/// first 12 candidates). The same holds for groups leaving as one rigid subassembly: every
+/// group operation of the inner checker is passed through, so holding parts never takes away a
+/// plan the inner checker finds (more grippers, never fewer plans). The held parts of each
+/// admitted removal are kept ([`HoldingChecker::held`]).
 pub struct HoldingChecker<'c> {
     inner: &'c Checker,
     grippers: usize,
-    held: Mutex<HashMap<(Vec<u64>, usize), PartSet>>,
+    /// Held parts by (state, removed parts).
+    held: Mutex<HashMap<(Vec<u64>, Vec<u64>), PartSet>>,
 }
 
 impl std::fmt::Debug for HoldingChecker<'_> {
@@ -163,9 +166,32 @@ impl<'c> HoldingChecker<'c> {
         HoldingChecker { inner, grippers, held: Mutex::new(HashMap::new()) }
     }
 
-    /// The parts held while the rest of `state` stands without `part` (empty when none).
-    pub fn held(&self, part: usize, state: &PartSet) -> Vec<usize> {
-        self.held.lock().expect("not poisoned").get(&(state.words().to_vec(), part)).map_or_else(Vec::new, |h| h.iter().collect())
+    /// The parts held while the rest of `state` stands without `removed` (a part or a rigid
+    /// group; empty when none).
+    pub fn held(&self, removed: &PartSet, state: &PartSet) -> Vec<usize> {
+        let key = (state.words().to_vec(), removed.words().to_vec());
+        self.held.lock().expect("not poisoned").get(&key).map_or_else(Vec::new, |h| h.iter().collect())
+    }
+
+    /// `outcome` of removing `removed` from `state`, admitted when holding parts makes the rest
+    /// stand (and the held parts kept).
+    fn admit(&self, removed: &PartSet, state: &PartSet, outcome: Outcome) -> Outcome {
+        match outcome {
+            Outcome::Unstable { floating, motion } if self.grippers >= 2 => {
+                let mut rest = state.clone();
+                for p in removed.iter() {
+                    rest.remove(p);
+                }
+                match self.holding(&rest, &floating) {
+                    Some(h) => {
+                        self.held.lock().expect("not poisoned").insert((state.words().to_vec(), removed.words().to_vec()), h);
+                        Outcome::Removed(motion)
+                    }
+                    None => Outcome::Unstable { floating, motion },
+                }
+            }
+            other => other,
+        }
     }
 
     fn holding(&self, rest: &PartSet, floating: &PartSet) -> Option<PartSet> {
@@ -209,16 +235,25 @@ impl FeasibilityChecker for HoldingChecker<'_> {
 
     fn test_removal(&self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome {
         let outcome = self.inner.test_removal(part, state, kind);
-        match outcome {
-            Outcome::Unstable { floating, motion } if self.grippers >= 2 => match self.holding(&state.without(part), &floating) {
-                Some(h) => {
-                    self.held.lock().expect("not poisoned").insert((state.words().to_vec(), part), h);
-                    Outcome::Removed(motion)
-                }
-                None => Outcome::Unstable { floating, motion },
-            },
-            other => other,
-        }
+        self.admit(&PartSet::from_indices(self.inner.num_parts(), [part]), state, outcome)
+    }
+
+    fn group_candidates(&self, state: &PartSet) -> Vec<PartSet> {
+        self.inner.group_candidates(state)
+    }
+
+    fn in_movable_group(&self, part: usize, state: &PartSet) -> bool {
+        self.inner.in_movable_group(part, state)
+    }
+
+    fn test_group_removal(&self, group: &PartSet, state: &PartSet) -> Outcome {
+        let outcome = self.inner.test_group_removal(group, state);
+        self.admit(group, state, outcome)
+    }
+
+    /// A subassembly is planned on its own base by the inner checker (nothing held inside it).
+    fn subassembly(&self, group: &PartSet) -> Option<(usize, Box<dyn FeasibilityChecker + '_>)> {
+        self.inner.subassembly(group)
     }
 
     fn stability(&self, state: &PartSet) -> Stability {

@@ -132,7 +132,7 @@ impl CheckerExtension for CellSetup {
         let (mut steps, mut held) = (Vec::new(), Vec::new());
         for s in &outcome.removals {
             steps.push(robot.as_ref().and_then(|(_, rc)| rc.removal(s.part, &state)));
-            held.push(holding.as_ref().map_or_else(Vec::new, |h| h.held(s.part, &state)));
+            held.push(holding.as_ref().map_or_else(Vec::new, |h| h.held(&PartSet::from_indices(checker.num_parts(), s.parts()), &state)));
             for p in s.parts() {
                 state.remove(p);
             }
