@@ -6,6 +6,8 @@ import { OrbitControls } from 'three/addons/OrbitControls.js';
 const data = JSON.parse(document.getElementById('asp-data').textContent);
 const STEP_SECONDS = 1.2;
 const PAUSE_SECONDS = 0.35;
+// a grid move (docs/plan-format.md, "Grid plans") takes this fraction of an insertion's time
+const MOVE_TIME = 0.5;
 
 function decode(base64, Type) {
   const bin = atob(base64);
@@ -92,7 +94,37 @@ const parts = data.parts.map((p, i) => {
   geometry.boundingBox.getCenter(centre);
   return { ...p, index: i, mesh, material, colour, centre };
 });
-const steps = data.steps.map((s) => ({ ...s, group: s.group || [s.part], motion: prepareMotion(s.motion) }));
+const steps = data.steps.map((s) => {
+  const moves = (s.moves || []).map((m) => ({ parts: m.parts, t: vec(m.translation) }));
+  return { ...s, group: s.group || [s.part], motion: prepareMotion(s.motion), moves, duration: 1 + MOVE_TIME * moves.length };
+});
+
+// --- grid moves: the same rules as asp-viz's Scene::offset and Scene::pose_during
+// Where part i sits, relative to its assembled pose, once step k went in and `done` of its
+// moves are made: minus every later move of it (k = steps.length: the end, in place).
+function offset(i, k, done) {
+  const d = new THREE.Vector3();
+  for (let j = k; j < steps.length; j++) {
+    const moves = steps[j].moves;
+    for (let m = j === k ? done : 0; m < moves.length; m++) if (moves[m].parts.includes(i)) d.sub(moves[m].t);
+  }
+  return d;
+}
+// The pose {t, q} of part i at time u (0 .. duration) of step k: the step's parts follow its
+// insertion while u <= 1, then each move slides its parts in turn; the rest stay put.
+function partPose(k, u, i) {
+  const s = steps[k];
+  let done = 0, f = 0;
+  if (u > 1) {
+    const w = (u - 1) / MOVE_TIME;
+    done = Math.min(Math.max(Math.floor(w), 0), s.moves.length);
+    f = done < s.moves.length ? Math.min(1, Math.max(0, w - done)) : 0;
+  }
+  const t = offset(i, k, done);
+  if (f > 0 && done < s.moves.length && s.moves[done].parts.includes(i)) t.addScaledVector(s.moves[done].t, f);
+  const base = s.group.includes(i) ? poseAt(s.motion, Math.min(u, 1)) : poseAt(null, 1);
+  return { t: base.t.clone().add(t), q: base.q };
+}
 
 // the bounds of the model and of every motion's start: the camera sees all of it
 const bounds = new THREE.Box3();
@@ -102,7 +134,7 @@ for (const s of steps) {
   for (const i of s.group) {
     const box = parts[i].mesh.geometry.boundingBox;
     for (let k = 0; k <= 8; k++) {
-      const pose = poseAt(s.motion, k / 8);
+      const pose = partPose(steps.indexOf(s), k / 8, i);
       for (const x of [box.min.x, box.max.x]) for (const y of [box.min.y, box.max.y]) for (const z of [box.min.z, box.max.z])
         bounds.expandByPoint(apply(pose, new THREE.Vector3(x, y, z)));
     }
@@ -145,13 +177,14 @@ controls.update();
 // the motion of the part in flight, drawn as a line from its start to its place
 const pathMaterial = new THREE.LineBasicMaterial({ color: 0xe65100 });
 let pathLine = null;
-function showPath(step) {
+function showPath(k) {
   if (pathLine) { scene.remove(pathLine); pathLine.geometry.dispose(); pathLine = null; }
+  const step = k >= 0 ? steps[k] : null;
   if (!step || !step.motion) return;
   const c = parts[step.part].centre;
   const samples = step.motion.kind === 'path' ? 64 : 1;
   const points = [];
-  for (let k = 0; k <= samples; k++) points.push(apply(poseAt(step.motion, k / samples), c));
+  for (let j = 0; j <= samples; j++) points.push(apply(partPose(k, j / samples, step.part), c));
   pathLine = new THREE.Line(new THREE.BufferGeometry().setFromPoints(points), pathMaterial);
   scene.add(pathLine);
 }
@@ -167,24 +200,23 @@ function place(part, pose) {
   part.mesh.quaternion.copy(pose.q);
 }
 function apply_state() {
+  const k = state.flying;
   for (const p of parts) {
     p.mesh.visible = initial.has(p.index);
-    place(p, poseAt(null, 1));
+    // in flight: step k's timeline (its insertion, then its moves); at rest: every move of the
+    // steps shown is made
+    place(p, k >= 0 ? partPose(k, state.t, p.index) : { t: offset(p.index, state.shown, 0), q: new THREE.Quaternion() });
     p.material.emissive.setRGB(0, 0, 0);
   }
   // a step puts in one part, or a whole subassembly (`group`: its parts move together)
-  for (let k = 0; k < state.shown; k++) for (const i of steps[k].group) parts[i].mesh.visible = true;
-  const flying = state.flying >= 0 ? steps[state.flying] : null;
-  if (flying) {
-    for (const i of flying.group) {
-      const p = parts[i];
-      p.mesh.visible = true;
-      place(p, poseAt(flying.motion, flying.motion ? state.t : 1));
-      p.material.emissive.setRGB(0.25, 0.18, 0.0);
-    }
+  for (let j = 0; j < state.shown; j++) for (const i of steps[j].group) parts[i].mesh.visible = true;
+  if (k >= 0) {
+    const s = steps[k];
+    const moving = state.t <= 1 || !s.moves.length ? s.group : s.moves[Math.min(s.moves.length - 1, Math.floor((state.t - 1) / MOVE_TIME))].parts;
+    for (const i of moving) parts[i].material.emissive.setRGB(0.25, 0.18, 0.0);
   }
   const current = state.flying >= 0 ? state.flying : state.shown - 1;
-  showPath(current >= 0 ? steps[current] : null);
+  showPath(current);
   updatePanel(current);
 }
 
@@ -283,8 +315,11 @@ const screen = new THREE.Vector3();
 function frame() {
   const dt = Math.min(clock.getDelta(), 0.1);
   if (state.flying >= 0) {
-    state.t = Math.min(1, state.t + dt / STEP_SECONDS);
-    if (state.t >= 1) { state.flying = -1; state.wait = 0; }
+    // without a recorded motion the part is placed at once; its moves still play
+    const s = steps[state.flying];
+    if (!s.motion && state.t < 1) state.t = 1;
+    state.t = Math.min(s.duration, state.t + dt / STEP_SECONDS);
+    if (state.t >= s.duration) { state.flying = -1; state.t = 1; state.wait = 0; }
     apply_state();
   } else if (state.playing) {
     state.wait += dt;
@@ -314,6 +349,11 @@ const api = {
   // the pose of step k's part a fraction s through its motion (model units): {t: [x,y,z], q: [x,y,z,w]}
   poseAt: (k, s) => {
     const p = poseAt(steps[k].motion, s);
+    return { t: [p.t.x, p.t.y, p.t.z], q: [p.q.x, p.q.y, p.q.z, p.q.w] };
+  },
+  // the pose of part i at time u of step k's timeline (its insertion, then its grid moves)
+  partPose: (k, u, i) => {
+    const p = partPose(k, u, i);
     return { t: [p.t.x, p.t.y, p.t.z], q: [p.q.x, p.q.y, p.q.z, p.q.w] };
   },
   state: () => ({

@@ -8,4 +8,4 @@ pub mod scene;
 pub mod view;
 
 pub use error::{Result, VizError};
-pub use scene::{Insertion, Scene, Step};
+pub use scene::{Insertion, Move, Scene, Step, MOVE_TIME};

@@ -7,7 +7,9 @@
 //!   at the start come first; each step adds its part when it starts to move.
 //! - [`TOPIC_TRANSFORMS`] (`foxglove.FrameTransforms`): `world` → `model` (turns the model's up
 //!   axis to Foxglove's +z, once), and `model` → `part/<index>`, the part's pose along its
-//!   insertion motion, [`McapOptions::rate`] times a second while it moves.
+//!   insertion motion, [`McapOptions::rate`] times a second while it moves, and after it the
+//!   step's grid moves (each slides its parts in turn, [`MOVE_TIME`] of a step each;
+//!   docs/plan-format.md, "Grid plans").
 //! - [`TOPIC_PATHS`] (`foxglove.SceneUpdate`): the insertion path of each step's part (the
 //!   centre of its bounds), a line strip entity `path/<index>` in the `model` frame, published
 //!   when the step starts. Removal paths are the same curves run backwards.
@@ -15,7 +17,7 @@
 //! Lengths are metres; log times start at 0 and increase.
 
 use crate::error::{Result, VizError};
-use crate::scene::{part_colour, Rgb, Scene, BASE, STUCK};
+use crate::scene::{part_colour, Rgb, Scene, BASE, MOVE_TIME, STUCK};
 use asp_geom::math::{Axis, Pose, Rot, Vec3};
 use asp_geom::Assembly;
 use asp_search::report::PlanReport;
@@ -42,7 +44,8 @@ pub const FRAME_TRANSFORMS_SCHEMA: &str = include_str!("../assets/foxglove/Frame
 /// The timing of the animation.
 #[derive(Clone, Debug)]
 pub struct McapOptions {
-    /// Seconds per step: the part moves during the first 80 %, then rests.
+    /// Seconds per step: the part moves during the first 80 %, then rests. Each grid move
+    /// after it takes [`MOVE_TIME`] of this, likewise.
     pub step_seconds: f64,
     /// Poses per second while a part moves.
     pub rate: f64,
@@ -111,39 +114,49 @@ fn write_mcap(path: &Path, scene: &Scene, options: &McapOptions, file: std::fs::
     // t = 0: the model frame, the parts present at the start
     let mut first = vec![transform(0, FRAME_WORLD, FRAME_MODEL, &Pose::from_parts(Vec3::ZERO, model_to_world))];
     for &i in &scene.initial {
-        first.push(transform(0, FRAME_MODEL, &part_frame(i), &Pose::IDENTITY));
+        first.push(transform(0, FRAME_MODEL, &part_frame(i), &Pose::from_translation(scene.offset(i, 0, 0))));
     }
     out.put(tf_ch, TOPIC_TRANSFORMS, 0, &json!({ "transforms": first })).map_err(err)?;
     let entities: Vec<Value> = scene.initial.iter().map(|&i| part_entity(scene, i, 0)).collect();
     out.put(parts_ch, TOPIC_PARTS, 0, &json!({ "deletions": [], "entities": entities })).map_err(err)?;
 
     let step_ns = (options.step_seconds * 1e9) as u64;
+    let move_ns = (options.step_seconds * f64::from(MOVE_TIME) * 1e9) as u64;
     let lead = step_ns / 4;
     let frames = ((options.step_seconds * 0.8 * options.rate).round() as u64).max(1);
+    let move_frames = ((options.step_seconds * f64::from(MOVE_TIME) * 0.8 * options.rate).round() as u64).max(1);
+    let mut start = lead;
     for (k, step) in scene.steps.iter().enumerate() {
-        let start = lead + k as u64 * step_ns;
         // a subassembly's parts appear and move together
         let entities: Vec<Value> = step.parts.iter().map(|&i| part_entity(scene, i, start)).collect();
         out.put(parts_ch, TOPIC_PARTS, start, &json!({ "deletions": [], "entities": entities })).map_err(err)?;
-        let frames_of: Vec<String> = step.parts.iter().map(|&i| part_frame(i)).collect();
-        match &step.motion {
-            Some(motion) => {
-                let centre = scene.assembly.parts[step.part].mesh.aabb().map(|b| (b.mins + b.maxs) / 2.0).unwrap_or(Vec3::ZERO);
-                let curve = motion.trace(centre, 64);
-                out.put(paths_ch, TOPIC_PATHS, start, &json!({ "deletions": [], "entities": [path_entity(step.part, start, &curve, diag)] }))
-                    .map_err(err)?;
-                for j in 0..=frames {
-                    let t = start + j * (step_ns * 4 / 5) / frames;
-                    let pose = motion.pose_at(j as f32 / frames as f32);
-                    let transforms: Vec<Value> = frames_of.iter().map(|f| transform(t, FRAME_MODEL, f, &pose)).collect();
-                    out.put(tf_ch, TOPIC_TRANSFORMS, t, &json!({ "transforms": transforms })).map_err(err)?;
-                }
+        if let Some(motion) = &step.motion {
+            let centre = scene.assembly.parts[step.part].mesh.aabb().map(|b| (b.mins + b.maxs) / 2.0).unwrap_or(Vec3::ZERO);
+            let offset = scene.offset(step.part, k, 0);
+            let curve: Vec<Vec3> = motion.trace(centre, 64).into_iter().map(|p| p + offset).collect();
+            out.put(paths_ch, TOPIC_PATHS, start, &json!({ "deletions": [], "entities": [path_entity(step.part, start, &curve, diag)] }))
+                .map_err(err)?;
+        }
+        // the poses of `parts` at time `u` of the step's timeline, logged at `t`
+        let mut put_poses = |t: u64, u: f32, parts: &[usize]| {
+            let transforms: Vec<Value> = parts.iter().map(|&i| transform(t, FRAME_MODEL, &part_frame(i), &scene.pose_during(k, u, i))).collect();
+            out.put(tf_ch, TOPIC_TRANSFORMS, t, &json!({ "transforms": transforms }))
+        };
+        if step.motion.is_some() {
+            for j in 0..=frames {
+                put_poses(start + j * (step_ns * 4 / 5) / frames, j as f32 / frames as f32, &step.parts).map_err(err)?;
             }
-            None => {
-                let transforms: Vec<Value> = frames_of.iter().map(|f| transform(start, FRAME_MODEL, f, &Pose::IDENTITY)).collect();
-                out.put(tf_ch, TOPIC_TRANSFORMS, start, &json!({ "transforms": transforms })).map_err(err)?;
+        } else {
+            put_poses(start, 1.0, &step.parts).map_err(err)?;
+        }
+        for (m, mv) in step.moves.iter().enumerate() {
+            let begin = start + step_ns + m as u64 * move_ns;
+            for j in 0..=move_frames {
+                let u = 1.0 + MOVE_TIME * (m as f32 + j as f32 / move_frames as f32);
+                put_poses(begin + j * (move_ns * 4 / 5) / move_frames, u, &mv.parts).map_err(err)?;
             }
         }
+        start += step_ns + step.moves.len() as u64 * move_ns;
     }
     let Out { mut writer, summary, .. } = out;
     writer.finish().map_err(err)?;

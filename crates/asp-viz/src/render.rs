@@ -158,7 +158,8 @@ pub fn write(path: &Path, scene: &Scene, options: &RenderOptions) -> Result<Stor
 }
 
 /// The panels of a plan: for an unfinished plan first the parts never removed (stuck ones in
-/// red), then one per step.
+/// red), then one per step (the state once the step is in, before its grid moves), and when
+/// the last step has grid moves, one more of the model in place.
 fn panel_specs(scene: &Scene) -> Vec<PanelSpec> {
     let colour_of_placed = |i: usize| {
         if scene.stuck.contains(&i) {
@@ -173,7 +174,7 @@ fn panel_specs(scene: &Scene) -> Vec<PanelSpec> {
     let found = scene.report.status == "found";
     if !found {
         specs.push(PanelSpec {
-            parts: scene.initial.iter().map(|&i| (i, colour_of_placed(i), Pose::IDENTITY)).collect(),
+            parts: scene.initial.iter().map(|&i| (i, colour_of_placed(i), Pose::from_translation(scene.offset(i, 0, 0)))).collect(),
             part: None,
             colour: STUCK,
             title: format!("{}: {} parts left", scene.report.status.replace('_', " "), scene.initial.len()),
@@ -183,9 +184,11 @@ fn panel_specs(scene: &Scene) -> Vec<PanelSpec> {
     let mut placed: Vec<usize> = scene.initial.clone();
     for (k, step) in scene.steps.iter().enumerate() {
         let colour = part_colour(step.part);
-        let mut parts: Vec<(usize, Rgb, Pose)> = placed.iter().map(|&i| (i, colour_of_placed(i), Pose::IDENTITY)).collect();
+        // the state once the step is in, before its moves (grid plans) slide parts on
+        let at = |i: usize| scene.pose_during(k, 1.0, i);
+        let mut parts: Vec<(usize, Rgb, Pose)> = placed.iter().map(|&i| (i, colour_of_placed(i), at(i))).collect();
         // a subassembly's parts go in together, in the step's colour
-        parts.extend(step.parts.iter().map(|&i| (i, colour, Pose::IDENTITY)));
+        parts.extend(step.parts.iter().map(|&i| (i, colour, at(i))));
         let (kind, arrow) = match &step.motion {
             Some(m) => {
                 let centre = scene.assembly.parts[step.part]
@@ -197,12 +200,25 @@ fn panel_specs(scene: &Scene) -> Vec<PanelSpec> {
                     crate::Insertion::Linear { .. } => "linear",
                     crate::Insertion::Path { .. } => "path",
                 };
-                (kind, m.trace(centre, 48))
+                let offset = scene.offset(step.part, k, 0);
+                (kind, m.trace(centre, 48).into_iter().map(|p| p + offset).collect())
             }
             None => ("motion not recorded", Vec::new()),
         };
-        specs.push(PanelSpec { parts, part: Some(step.part), colour, title: format!("{}. {} ({kind})", k + 1, step.name), arrow });
+        let then = match step.moves.len() {
+            0 => String::new(),
+            1 => ", then 1 move".to_string(),
+            n => format!(", then {n} moves"),
+        };
+        specs.push(PanelSpec { parts, part: Some(step.part), colour, title: format!("{}. {} ({kind}{then})", k + 1, step.name), arrow });
         placed.extend(&step.parts);
+    }
+    // a grid plan whose last step slides parts on: one more panel, everything in place
+    if let Some(last) = scene.steps.last().filter(|s| !s.moves.is_empty()) {
+        let parts = placed.iter().map(|&i| (i, colour_of_placed(i), Pose::IDENTITY)).collect();
+        let n = last.moves.len();
+        let title = format!("{}. {n} move{} into place", scene.steps.len() + 1, if n == 1 { "" } else { "s" });
+        specs.push(PanelSpec { parts, part: None, colour: GREY, title, arrow: Vec::new() });
     }
     specs
 }

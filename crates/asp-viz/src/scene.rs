@@ -170,6 +170,18 @@ fn segment_weight(a: &Pose, b: &Pose, pivot: Vec3, radius: f32) -> f32 {
     travel + turn * radius
 }
 
+/// A rigid slide, in a grid plan, of parts already in place (docs/plan-format.md, "Grid plans").
+#[derive(Clone, Debug, PartialEq)]
+pub struct Move {
+    /// The parts that move together.
+    pub parts: Vec<usize>,
+    /// Their translation, metres, model frame.
+    pub translation: Vec3,
+}
+
+/// The time a move takes in the pictures' timelines, as a fraction of an insertion's.
+pub const MOVE_TIME: f32 = 0.5;
+
 /// One step of the pictures: a part, or a subassembly, going in.
 #[derive(Clone, Debug)]
 pub struct Step {
@@ -183,6 +195,15 @@ pub struct Step {
     /// Its insertion motion; `None` for the partial sequence of a `no_plan` or
     /// `budget_exhausted` plan, which records the order but not the motions.
     pub motion: Option<Insertion>,
+    /// The moves made after the step goes in, in order (grid plans; usually none).
+    pub moves: Vec<Move>,
+}
+
+impl Step {
+    /// The length of the step's timeline: its insertion (1), then each move ([`MOVE_TIME`]).
+    pub fn duration(&self) -> f32 {
+        1.0 + MOVE_TIME * self.moves.len() as f32
+    }
 }
 
 /// A plan with its model: what every picture draws.
@@ -244,7 +265,15 @@ impl Scene {
                         None => part.name.clone(),
                         Some(g) => format!("{} + {} parts (subassembly)", part.name, g.parts.len() - 1),
                     };
-                    Ok(Step { part: s.part, parts, name, motion: Some(Insertion::from_entry(&s.motion, metres, radius)) })
+                    let mut moves = Vec::with_capacity(s.moves.len());
+                    for m in &s.moves {
+                        if let Some(&p) = m.parts.iter().find(|&&p| p >= n) {
+                            return Err(bad(p));
+                        }
+                        let t = m.translation.map(|c| (c * metres) as f32);
+                        moves.push(Move { parts: m.parts.clone(), translation: Vec3::new(t[0], t[1], t[2]) });
+                    }
+                    Ok(Step { part: s.part, parts, name, motion: Some(Insertion::from_entry(&s.motion, metres, radius)), moves })
                 })
                 .collect::<Result<_>>()?
         } else {
@@ -275,7 +304,10 @@ impl Scene {
             }
             let rest: Vec<usize> = (0..n).filter(|i| !core.contains(i) && !order.contains(i)).collect();
             order.extend(rest);
-            order.into_iter().map(|p| Step { part: p, parts: vec![p], name: assembly.parts[p].name.clone(), motion: None }).collect()
+            order
+                .into_iter()
+                .map(|p| Step { part: p, parts: vec![p], name: assembly.parts[p].name.clone(), motion: None, moves: Vec::new() })
+                .collect()
         };
         let mut placed = vec![false; n];
         for &p in steps.iter().flat_map(|s| &s.parts) {
@@ -290,6 +322,49 @@ impl Scene {
         Ok(Scene { assembly, report, steps, initial, stuck, metres_per_unit: metres, order_recorded })
     }
 
+    /// Where part `i` sits, relative to its assembled pose, once step `k` went in and the first
+    /// `done` of its moves are made: minus the translation of every later move that names it
+    /// (docs/plan-format.md, "Grid plans"). Zero when no later move names it, so always after
+    /// the last step, and for every plan without moves. `k == steps.len()` is the end.
+    pub fn offset(&self, i: usize, k: usize, done: usize) -> Vec3 {
+        let mut d = Vec3::ZERO;
+        for (j, step) in self.steps.iter().enumerate().skip(k) {
+            for m in step.moves.iter().skip(if j == k { done } else { 0 }) {
+                if m.parts.contains(&i) {
+                    d -= m.translation;
+                }
+            }
+        }
+        d
+    }
+
+    /// The pose of part `i` (in place, or going in with step `k`) at time `u` of step `k`'s
+    /// timeline (0 ..= [`Step::duration`]): the step's parts follow its insertion while
+    /// `u ≤ 1`, then its moves slide their parts in turn, [`MOVE_TIME`] each; every other part
+    /// rests where the moves so far left it ([`Scene::offset`]). Which parts are visible is
+    /// the caller's business.
+    pub fn pose_during(&self, k: usize, u: f32, i: usize) -> Pose {
+        let step = &self.steps[k];
+        let (done, f) = if u <= 1.0 {
+            (0, 0.0)
+        } else {
+            let w = (u - 1.0) / MOVE_TIME;
+            let j = (w.floor().max(0.0) as usize).min(step.moves.len());
+            (j, if j < step.moves.len() { (w - j as f32).clamp(0.0, 1.0) } else { 0.0 })
+        };
+        let mut t = self.offset(i, k, done);
+        if let Some(m) = step.moves.get(done) {
+            if f > 0.0 && m.parts.contains(&i) {
+                t += m.translation * f;
+            }
+        }
+        let base = match &step.motion {
+            Some(m) if step.parts.contains(&i) => m.pose_at(u.min(1.0)),
+            _ => Pose::IDENTITY,
+        };
+        Pose::from_parts(base.translation + t, base.rotation)
+    }
+
     /// Whether part `i` is a base part (fixed in the plan).
     pub fn is_base(&self, i: usize) -> bool {
         self.report.parts.get(i).is_some_and(|p| p.fixed)
@@ -302,12 +377,14 @@ impl Scene {
             points.push(b.mins);
             points.push(b.maxs);
         }
-        for (s, &p) in self.steps.iter().flat_map(|s| s.parts.iter().map(move |p| (s, p))) {
-            if let (Some(m), Some(b)) = (&s.motion, self.assembly.parts[p].mesh.aabb()) {
-                for k in 0..=8 {
-                    let pose = m.pose_at(k as f32 / 8.0);
-                    for c in corners(b.mins, b.maxs) {
-                        points.push(pose.transform_point(c));
+        for (k, s) in self.steps.iter().enumerate() {
+            for &p in &s.parts {
+                if let (Some(_), Some(b)) = (&s.motion, self.assembly.parts[p].mesh.aabb()) {
+                    for j in 0..=8 {
+                        let pose = self.pose_during(k, j as f32 / 8.0, p);
+                        for c in corners(b.mins, b.maxs) {
+                            points.push(pose.transform_point(c));
+                        }
                     }
                 }
             }

@@ -40,8 +40,8 @@ pub fn write_html(path: &Path, scene: &Scene) -> Result<()> {
 }
 
 /// The JSON the page's script reads: meshes in model units (base64 little-endian `f32`
-/// positions, `u16`/`u32` indices), the steps with their motions as in the plan, the base, the
-/// stuck parts and their explanation.
+/// positions, `u16`/`u32` indices), the steps with their motions and grid moves as in the plan,
+/// the base, the stuck parts and their explanation.
 fn page_data(scene: &Scene) -> Value {
     let r = &scene.report;
     let per_metre = 1.0 / scene.metres_per_unit;
@@ -109,7 +109,15 @@ fn page_data(scene: &Scene) -> Value {
                     "radius": *radius as f64 * per_metre,
                 }),
             };
-            json!({ "part": s.part, "name": s.name, "motion": motion, "group": s.parts })
+            let moves: Vec<Value> = s
+                .moves
+                .iter()
+                .map(|m| {
+                    let t = m.translation;
+                    json!({ "parts": m.parts, "translation": [t.x as f64 * per_metre, t.y as f64 * per_metre, t.z as f64 * per_metre] })
+                })
+                .collect();
+            json!({ "part": s.part, "name": s.name, "motion": motion, "group": s.parts, "moves": moves })
         })
         .collect();
     let explanation: Vec<Value> = r

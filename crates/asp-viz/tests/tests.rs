@@ -2,6 +2,7 @@
 
 mod common;
 mod mcap_file;
+mod moves;
 mod page;
 mod plots;
 mod storyboard;

@@ -189,6 +189,37 @@ fn the_viewer_moves_path_motions_as_the_plan_format_documents() {
     browser.assert_no_errors();
 }
 
+/// A burr's grid plan: the page plays each step's moves after its insertion, with the poses of
+/// `Scene::pose_during` (which the library's tests check for pieces passing through others).
+#[test]
+fn the_viewer_plays_grid_moves_as_the_scene_does() {
+    let Some(mut browser) = Browser::launch() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("burr.glb");
+    write_glb(&asp_geom::puzzles::burr_level(), &model).unwrap();
+    let plan = dir.path().join("burr.json");
+    let o = asp(&["plan", model.to_str().unwrap(), "--quiet", "--out", plan.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let scene = asp_viz::Scene::from_plan_file(&plan, None).unwrap();
+    let k = scene.steps.iter().position(|s| !s.moves.is_empty()).expect("the burr's plan has moves");
+    let duration = scene.steps[k].duration();
+    browser.open(&view(&plan, "burr.html"));
+    for i in 0..scene.assembly.parts.len() {
+        for u in [0.0f32, 0.5, 1.0, 1.2, 1.5, duration - 0.1, duration] {
+            let js = browser.eval(&format!("aspViewer.partPose({k}, {u}, {i})"));
+            let t: Vec<f64> = js["t"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+            let rust = scene.pose_during(k, u, i).translation; // metres; the fixture's unit is the metre
+            let d = ((t[0] - rust.x as f64).powi(2) + (t[1] - rust.y as f64).powi(2) + (t[2] - rust.z as f64).powi(2)).sqrt();
+            assert!(d < 1e-6, "step {k}, u = {u}, part {i}: page {t:?}, library {rust:?}");
+        }
+    }
+    // playing the step runs its moves too, and ends with every shown part at rest
+    browser.eval(&format!("aspViewer.goto({k}); aspViewer.step(); true"));
+    browser.wait_for("aspViewer.state().t > 1", 10.0);
+    browser.wait_for("aspViewer.state().flying === null", 10.0);
+    browser.assert_no_errors();
+}
+
 #[test]
 fn render_writes_a_storyboard_png_of_the_right_size() {
     let out = shared_dir().join("lack.png");
