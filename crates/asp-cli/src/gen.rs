@@ -4,7 +4,7 @@
 
 use anyhow::bail;
 use asp_gen::batch::{write_batch, Batch, Generator};
-use asp_gen::{ProfileParams, SomaParams};
+use asp_gen::{ConnectorMode, ProfileParams, SomaParams};
 use clap::{Args, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -71,6 +71,16 @@ pub enum Preset {
     DoubleLayer,
 }
 
+/// How connectors become parts (`--connectors`).
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum Connectors {
+    /// Every connector is a part of its own.
+    Separate,
+    /// Every connector is merged into the profile it holds: only profiles are parts (the
+    /// thesis' 21- and 30-part assemblies).
+    Attached,
+}
+
 /// Flags of `asp gen profiles`; each flag overrides the preset.
 #[derive(Args, Debug)]
 pub struct ProfilesArgs {
@@ -104,6 +114,9 @@ pub struct ProfilesArgs {
     /// ε_g, the least distance between parallel profiles for the gripper, metres [default: 0.06].
     #[arg(long)]
     pub grasp_clearance: Option<f64>,
+    /// Connectors as parts of their own, or attached to the profile they hold.
+    #[arg(long, value_enum, default_value = "separate")]
+    pub connectors: Connectors,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub batch: BatchArgs,
@@ -139,6 +152,10 @@ pub fn run(args: &GenArgs) -> anyhow::Result<ExitCode> {
             count(&mut p.supports, a.supports);
             count(&mut p.front, a.front);
             count(&mut p.back, a.back);
+            p.connectors = match a.connectors {
+                Connectors::Separate => ConnectorMode::Separate,
+                Connectors::Attached => ConnectorMode::Attached,
+            };
             (Generator::Profiles(p), a.preset.and(Some(name)), &a.batch)
         }
     };

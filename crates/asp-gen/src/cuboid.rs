@@ -84,6 +84,35 @@ pub fn grid_union(lines: [&[f64]; 3], cells: &[[i32; 3]]) -> (Mesh, Vec<Cuboid>)
     (mesh, boxes)
 }
 
+/// The closed surface of a union of boxes that touch but do not overlap (a profile and the
+/// connectors it carries): [`grid_union`] on the grid of all their faces (coordinates rounded to
+/// the nanometre, so faces computed two ways meet), keeping the cells whose centre lies in a box.
+pub fn box_union(boxes: &[Cuboid]) -> Mesh {
+    let round = |v: f64| (v * 1e9).round() / 1e9;
+    let lines: [Vec<f64>; 3] = [0, 1, 2].map(|a| {
+        let mut l: Vec<f64> = boxes.iter().flat_map(|b| [round(b.mins[a]), round(b.maxs[a])]).collect();
+        l.sort_by(f64::total_cmp);
+        l.dedup();
+        l
+    });
+    let mut cells = Vec::new();
+    for i in 0..lines[0].len().saturating_sub(1) {
+        for j in 0..lines[1].len().saturating_sub(1) {
+            for k in 0..lines[2].len().saturating_sub(1) {
+                let idx = [i, j, k];
+                let centre = [0, 1, 2].map(|a| 0.5 * (lines[a][idx[a]] + lines[a][idx[a] + 1]));
+                let inside = boxes
+                    .iter()
+                    .any(|b| (0..3).all(|a| round(b.mins[a]) < centre[a] && centre[a] < round(b.maxs[a])));
+                if inside {
+                    cells.push([i as i32, j as i32, k as i32]);
+                }
+            }
+        }
+    }
+    grid_union([&lines[0], &lines[1], &lines[2]], &cells).0
+}
+
 fn vec3(v: [f64; 3]) -> Vec3 {
     Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
 }

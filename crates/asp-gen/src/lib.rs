@@ -12,5 +12,5 @@ pub use batch::{assembly_seed, generate_batch, write_batch, Batch, Generated, Ge
 pub use check::DisassemblyCheck;
 pub use error::{GenError, Result};
 pub use manifest::{Manifest, ManifestEntry};
-pub use profiles::{ProfileAssembly, ProfileParams};
+pub use profiles::{ConnectorMode, ProfileAssembly, ProfileParams};
 pub use soma::{SomaCube, SomaParams};

@@ -15,7 +15,7 @@
 //! closer than ε_g to a parallel one, is discarded and drawn again.
 
 use crate::check::{check_disassembly, BoxModel, DisassemblyCheck};
-use crate::cuboid::{grid_union, Cuboid};
+use crate::cuboid::{box_union, grid_union, Cuboid};
 use crate::error::{GenError, Result};
 use asp_geom::math::Axis;
 use asp_geom::{Assembly, Mesh, Part, Units};
@@ -65,6 +65,30 @@ pub struct ProfileParams {
     pub grasp_spacing: f64,
     /// Distance kept free of grasp points at both ends of a profile.
     pub grasp_margin: f64,
+    /// Whether connectors are parts of their own or travel with the profile they hold (the
+    /// thesis' 21- and 30-part assemblies, 5.5.1). Left out of the JSON when `separate`, so
+    /// older manifests and batch specs read and write unchanged.
+    #[serde(default, skip_serializing_if = "ConnectorMode::is_separate")]
+    pub connectors: ConnectorMode,
+}
+
+/// How connectors become parts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ConnectorMode {
+    /// Every connector is a part of its own (`u_connector_NN`, `o_connector_NN`).
+    #[default]
+    Separate,
+    /// Every connector is merged into the profile it holds ([`Connector::holds`]): its boxes
+    /// join that profile's mesh and box list, and the assembly has only profile parts.
+    Attached,
+}
+
+impl ConnectorMode {
+    /// Whether connectors are parts of their own.
+    pub fn is_separate(&self) -> bool {
+        *self == ConnectorMode::Separate
+    }
 }
 
 impl Default for ProfileParams {
@@ -92,6 +116,7 @@ impl ProfileParams {
             connector_length: 0.02,
             grasp_spacing: 0.02,
             grasp_margin: 0.03,
+            connectors: ConnectorMode::Separate,
         }
     }
 
@@ -312,15 +337,29 @@ impl ProfileAssembly {
         })
     }
 
-    /// The boxes of every part (profiles, then connectors).
+    /// The boxes of every part: profiles, then connectors; with attached connectors
+    /// ([`ConnectorMode::Attached`]) only profiles, each with the cells of the connectors it
+    /// holds after its own box.
     pub fn part_boxes(&self) -> Vec<Vec<Cuboid>> {
+        if self.params.connectors == ConnectorMode::Attached {
+            return (0..self.profiles.len()).map(|i| self.profile_part_boxes(i)).collect();
+        }
         let profiles = self.profiles.iter().map(|p| vec![p.cuboid]);
         profiles.chain(self.connectors.iter().map(|c| c.cells.clone())).collect()
     }
 
-    /// Whether each part is fixed (profiles, then connectors).
+    /// Profile `i`'s box followed by the cells of the connectors that hold it.
+    fn profile_part_boxes(&self, i: usize) -> Vec<Cuboid> {
+        let held = self.connectors.iter().filter(|c| c.holds == i).flat_map(|c| c.cells.iter().copied());
+        std::iter::once(self.profiles[i].cuboid).chain(held).collect()
+    }
+
+    /// Whether each part is fixed (profiles, then connectors unless they are attached).
     pub fn fixed(&self) -> Vec<bool> {
         let profiles = self.profiles.iter().map(|p| p.fixed);
+        if self.params.connectors == ConnectorMode::Attached {
+            return profiles.collect();
+        }
         profiles.chain(self.connectors.iter().map(|c| c.fixed)).collect()
     }
 
@@ -377,18 +416,23 @@ impl ProfileAssembly {
 
     /// The assembly (metres, +Z up): profiles named `profile_NN`, then connectors named
     /// `u_connector_NN` / `o_connector_NN`, with their metadata in their extras (written to
-    /// the file's `extras.asp`): kind, role, exact boxes, grasp points.
+    /// the file's `extras.asp`): kind, role, exact boxes, grasp points. With attached
+    /// connectors there are only profiles: each profile's mesh is the closed surface of its box
+    /// and its connectors' cells, `boxes` lists them all (the profile's first), and
+    /// `connectors` names each merged connector's shape and the profile it is fastened to.
     pub fn to_assembly(&self, source: &str) -> Assembly {
         let axis_name = |a: usize| ["x", "y", "z"][a];
+        let attached = self.params.connectors == ConnectorMode::Attached;
+        let shape_name = |s: ConnectorShape| match s {
+            ConnectorShape::U => "U",
+            ConnectorShape::O => "O",
+        };
         let mut parts: Vec<Part> = self
             .profiles
             .iter()
             .enumerate()
-            .map(|(i, p)| Part::new(
-                profile_name(i),
-                p.cuboid.mesh(),
-                p.fixed,
-                json!({
+            .map(|(i, p)| {
+                let mut extras = json!({
                     "kind": "profile",
                     "role": p.role,
                     "layer": p.layer,
@@ -397,10 +441,24 @@ impl ProfileAssembly {
                     "size": self.params.profile_size,
                     "boxes": [box_array(&p.cuboid)],
                     "grasp_points": self.grasp_points(i),
-                }),
-            ))
+                });
+                if !attached {
+                    return Part::new(profile_name(i), p.cuboid.mesh(), p.fixed, extras);
+                }
+                let boxes = self.profile_part_boxes(i);
+                extras["boxes"] = json!(boxes.iter().map(box_array).collect::<Vec<_>>());
+                let merged: Vec<_> = self
+                    .connectors
+                    .iter()
+                    .filter(|c| c.holds == i)
+                    .map(|c| json!({ "shape": shape_name(c.shape), "attached_to": profile_name(c.attached_to) }))
+                    .collect();
+                extras["connectors"] = json!(merged);
+                Part::new(profile_name(i), box_union(&boxes), p.fixed, extras)
+            })
             .collect();
-        for (k, c) in self.connectors.iter().enumerate() {
+        let separate = if attached { &[][..] } else { &self.connectors[..] };
+        for (k, c) in separate.iter().enumerate() {
             let shape = match c.shape {
                 ConnectorShape::U => "U",
                 ConnectorShape::O => "O",

@@ -7,8 +7,11 @@
 //!   the robot's path length in metres, eq. 5.8). The filter asks only whether a path exists
 //!   ([`RobotModel::feasible`]: the first path found, the same verdict as the full plan); the
 //!   objective plans the shortest for the step taken. Expansion and replay plan `k` times
-//!   ([`RemovalConfig::replans`]) and keep the shortest, simulation plans once (5.4.2). The lift
-//!   direction is the distance maps' straight-line removal direction of the step.
+//!   ([`RemovalConfig::replans`]) and keep the shortest; simulation plans once (5.4.2) and takes
+//!   the first path found, the one the filter found when it admitted the step (rollouts ask the
+//!   filter lazily, [`asp_search::search`]). Verdicts are remembered per state and part and
+//!   carry over between numbers of replans ([`RobotModel`]). The lift direction is the
+//!   distance maps' straight-line removal direction of the step.
 //!
 //! Both describe their plan's steps for the plan JSON ([`RobotReport`]).
 
@@ -147,62 +150,121 @@ impl CheckerExtension for CellSetup {
 }
 
 /// The robot on one model for the optimiser: its planner on a collision world of the model and
-/// the plans made so far, by state, part and number of replans.
+/// what it has learnt so far, by state and part: the plans made (by number of replans) and the
+/// verdicts of first paths.
+///
+/// Verdicts carry over between numbers of replans `k`: the `k` plans of a grasp use the seeds
+/// of the first `k` of any larger number, so a path found with `k` replans is found with more,
+/// and a part with no path after `k` replans has none after fewer; `blocked` and `no reachable
+/// grasp` do not depend on `k` at all. A simulation (one plan) therefore reuses what an
+/// expansion (`k` plans) learnt and the other way round, and a full plan's verdict is the first
+/// path's ([`RemovalPlanner::removable`]).
 #[derive(Debug)]
 pub struct RobotModel {
     planner: RemovalPlanner<Arc<World>>,
     replans: usize,
     assembly: Arc<Assembly>,
-    cache: Mutex<HashMap<(Vec<u64>, usize, usize), Result<RobotRemoval, RobotFailure>>>,
-    /// Steps the robot can do, known from a first path only ([`RemovalPlanner::removable`]).
-    feasible: Mutex<std::collections::HashSet<(Vec<u64>, usize, usize)>>,
+    /// Plans by state, part, replans and whether it is the first path found (simulation).
+    cache: Mutex<HashMap<(Vec<u64>, usize, usize, bool), Result<RobotRemoval, RobotFailure>>>,
+    /// Per (state, part): what is known of its feasibility.
+    verdicts: Mutex<HashMap<(Vec<u64>, usize), Known>>,
+}
+
+/// What is known of one step's feasibility.
+#[derive(Clone, Debug, Default)]
+struct Known {
+    /// The fewest replans with which a path was found.
+    path_with: Option<usize>,
+    /// The most replans with which none was found, and why.
+    failed_with: Option<(usize, RobotFailure)>,
+}
+
+impl Known {
+    /// The verdict for `replans` plans per grasp, when it follows from what is known.
+    fn verdict(&self, replans: usize) -> Option<Result<(), RobotFailure>> {
+        if self.path_with.is_some_and(|k| k <= replans) {
+            return Some(Ok(()));
+        }
+        match &self.failed_with {
+            Some((_, f)) if !matches!(f, RobotFailure::NoPath { .. }) => Some(Err(f.clone())),
+            Some((k, f)) if *k >= replans => Some(Err(f.clone())),
+            _ => None,
+        }
+    }
+
+    fn learn(&mut self, replans: usize, r: Result<(), &RobotFailure>) {
+        match r {
+            Ok(()) => self.path_with = Some(self.path_with.map_or(replans, |k| k.min(replans))),
+            Err(f) => {
+                if self.failed_with.as_ref().is_none_or(|(k, _)| *k < replans) {
+                    self.failed_with = Some((replans, f.clone()));
+                }
+            }
+        }
+    }
 }
 
 impl RobotModel {
-    /// The robot's plan for `step` (`k` plans for expansion and replay, one for simulation).
+    fn replans(&self, step: &StepContext<'_, '_>) -> usize {
+        if step.kind() == StepKind::Simulation {
+            1
+        } else {
+            self.replans.max(1)
+        }
+    }
+
+    /// The robot's plan for `step`: for expansion and replay the shortest path of `k` plans per
+    /// grasp ([`RemovalPlanner::plan`]); for simulation (a rollout's estimate) the first path
+    /// found with one plan per grasp ([`RemovalPlanner::removable`], the path the `robot`
+    /// filter found when it admitted the step, so a rollout step costs no second search).
     pub fn plan(&self, step: &mut StepContext<'_, '_>) -> Result<RobotRemoval, RobotFailure> {
-        let replans = if step.kind() == StepKind::Simulation { 1 } else { self.replans.max(1) };
+        let replans = self.replans(step);
+        let first = step.kind() == StepKind::Simulation;
         let present = step.present();
-        let key = (present.words().to_vec(), step.part(), replans);
+        let key = (present.words().to_vec(), step.part(), replans, first);
         if let Some(r) = self.cache.lock().expect("not poisoned").get(&key) {
             return r.clone();
         }
-        let r = match step.motion() {
-            Some(Motion::Linear { direction, .. }) => self.planner.plan(step.part(), &present, direction, step.seed(), replans),
+        let known = self.verdicts.lock().expect("not poisoned").get(&(key.0.clone(), key.1)).and_then(|k| k.verdict(replans));
+        let r = match (known, step.motion()) {
+            (Some(Err(f)), _) => Err(f),
+            (_, Some(Motion::Linear { direction, .. })) if first => {
+                self.planner.removable(step.part(), &present, direction, step.seed(), replans)
+            }
+            (_, Some(Motion::Linear { direction, .. })) => self.planner.plan(step.part(), &present, direction, step.seed(), replans),
             _ => Err(RobotFailure::Blocked { by: None }),
         };
+        self.verdicts
+            .lock()
+            .expect("not poisoned")
+            .entry((key.0.clone(), key.1))
+            .or_default()
+            .learn(replans, r.as_ref().map(|_| ()));
         self.cache.lock().expect("not poisoned").insert(key, r.clone());
         r
     }
 
     /// Whether the robot can do `step`: the verdict of [`RobotModel::plan`] from the first
     /// path found ([`RemovalPlanner::removable`]: the same grasps and seeds, so the same
-    /// verdict and the same failure), without searching for the shortest.
+    /// verdict and the same failure), without searching for the shortest; known verdicts (of
+    /// this or another number of replans, see [`RobotModel`]) are not planned again.
     pub fn feasible(&self, step: &mut StepContext<'_, '_>) -> Result<(), RobotFailure> {
-        let replans = if step.kind() == StepKind::Simulation { 1 } else { self.replans.max(1) };
+        let replans = self.replans(step);
         let present = step.present();
-        let key = (present.words().to_vec(), step.part(), replans);
-        if let Some(r) = self.cache.lock().expect("not poisoned").get(&key) {
-            return r.as_ref().map(|_| ()).map_err(Clone::clone);
-        }
-        if self.feasible.lock().expect("not poisoned").contains(&key) {
-            return Ok(());
+        let key = (present.words().to_vec(), step.part());
+        if let Some(v) = self.verdicts.lock().expect("not poisoned").get(&key).and_then(|k| k.verdict(replans)) {
+            return v;
         }
         let r = match step.motion() {
             Some(Motion::Linear { direction, .. }) => self.planner.removable(step.part(), &present, direction, step.seed(), replans),
             _ => Err(RobotFailure::Blocked { by: None }),
         };
-        match r {
-            Ok(_) => {
-                self.feasible.lock().expect("not poisoned").insert(key);
-                Ok(())
-            }
-            Err(f) => {
-                // the full plan would fail the same way
-                self.cache.lock().expect("not poisoned").insert(key, Err(f.clone()));
-                Err(f)
-            }
+        self.verdicts.lock().expect("not poisoned").entry(key.clone()).or_default().learn(replans, r.as_ref().map(|_| ()));
+        if step.kind() == StepKind::Simulation {
+            // the simulation's plan of this step ([`RobotModel::plan`])
+            self.cache.lock().expect("not poisoned").insert((key.0, key.1, replans, true), r.clone());
         }
+        r.map(|_| ())
     }
 
     /// The planner.
@@ -290,7 +352,7 @@ impl RobotExtension {
             replans: self.setup.config.replans,
             assembly: model.assembly.clone(),
             cache: Mutex::new(HashMap::new()),
-            feasible: Mutex::new(Default::default()),
+            verdicts: Mutex::new(HashMap::new()),
         });
         *slot = Some((id, m.clone()));
         Ok(m)

@@ -66,8 +66,9 @@ pub trait ActionFilter: Send + Sync + Debug {
 
 /// How many removals each filter rejected, per reason (one counter per reason of every filter
 /// of a problem, in the problem's order; [`Mdp::filter_counts`] makes one).
+/// Also counts the removals the filters were asked about ([`FilterCounts::checks`]).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct FilterCounts(Vec<u64>);
+pub struct FilterCounts(Vec<u64>, u64);
 
 impl FilterCounts {
     /// Adds `other`'s counts (of the same problem).
@@ -75,6 +76,12 @@ impl FilterCounts {
         for (a, b) in self.0.iter_mut().zip(&other.0) {
             *a += b;
         }
+        self.1 += other.1;
+    }
+
+    /// Removals put to the filters (each asked of every filter until one rejects it).
+    pub fn checks(&self) -> u64 {
+        self.1
     }
 }
 
@@ -310,7 +317,7 @@ impl Mdp {
 
     /// Zeroed rejection counters for this problem's filters.
     pub fn filter_counts(&self) -> FilterCounts {
-        FilterCounts(vec![0; self.reasons.len()])
+        FilterCounts(vec![0; self.reasons.len()], 0)
     }
 
     /// The counts by filter and reason (reasons without rejections left out).
@@ -374,18 +381,32 @@ impl Mdp {
         out: &mut Vec<usize>,
         counts: &mut FilterCounts,
     ) {
-        out.retain(|&part| {
-            let mut ctx = StepContext::new(self, state, part, kind);
-            for (f, filter) in self.filters.iter().enumerate() {
-                if let Verdict::Infeasible { reason } = filter.check(&mut ctx, memory) {
-                    let base = self.reason_base[f];
-                    let slots = self.reason_base.get(f + 1).copied().unwrap_or(self.reasons.len()) - base;
-                    counts.0[base + reason.min(slots - 1)] += 1;
-                    return false;
-                }
+        out.retain(|&part| self.admits(state, memory, part, kind, counts));
+    }
+
+    /// Whether every filter admits removing `part` from `state` (a removal the maps already
+    /// found collision-free and supported: [`Mdp::candidate_actions`]); a rejection is counted
+    /// in `counts`. Rollouts ask this lazily, one candidate at a time in the policy's order,
+    /// instead of filtering every candidate of every state ([`Mdp::feasible_actions`]).
+    pub fn admits(&self, state: &mut MapState<'_>, memory: &[u64], part: usize, kind: StepKind, counts: &mut FilterCounts) -> bool {
+        counts.1 += 1;
+        let mut ctx = StepContext::new(self, state, part, kind);
+        for (f, filter) in self.filters.iter().enumerate() {
+            if let Verdict::Infeasible { reason } = filter.check(&mut ctx, memory) {
+                let base = self.reason_base[f];
+                let slots = self.reason_base.get(f + 1).copied().unwrap_or(self.reasons.len()) - base;
+                counts.0[base + reason.min(slots - 1)] += 1;
+                return false;
             }
-            true
-        });
+        }
+        true
+    }
+
+    /// The removals of `state` that are collision-free and supported on the maps, before the
+    /// filters (increasing part order); [`Mdp::admits`] tells which the filters keep.
+    #[inline]
+    pub fn candidate_actions(&self, state: &mut MapState<'_>, out: &mut Vec<usize>) {
+        state.feasible_actions(out);
     }
 
     /// Why `part` cannot leave `state` (with `memory`), or `None` when it can.

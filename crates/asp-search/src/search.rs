@@ -93,6 +93,7 @@ pub struct SearchSettings {
     pub(crate) prior_weight: f64,
     pub(crate) record: bool,
     pub(crate) record_limit: usize,
+    pub(crate) lazy_filters: bool,
 }
 
 /// Stops running searches from another thread (Ctrl-C from Python, a caller's deadline): each
@@ -136,6 +137,7 @@ impl Default for SearchSettings {
             prior_weight: 0.0,
             record: false,
             record_limit: DEFAULT_RECORD_LIMIT,
+            lazy_filters: true,
         }
     }
 }
@@ -188,6 +190,10 @@ impl SearchSettings {
     /// The cap on recorded transitions (all threads).
     pub fn record_transitions_limit(&self) -> usize {
         self.record_limit
+    }
+    /// Whether rollouts ask the problem's filters lazily ([`SearchBuilder::lazy_filters`]).
+    pub fn lazy_filters(&self) -> bool {
+        self.lazy_filters
     }
 }
 
@@ -288,6 +294,22 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
     /// memory.
     pub fn record_transitions(mut self, yes: bool) -> Self {
         self.settings.record = yes;
+        self
+    }
+
+    /// Whether rollouts ask the problem's feasibility filters lazily (default true): the rollout
+    /// policy draws from the removals the maps allow, the filters are asked about the drawn one
+    /// only, and a rejected one is dropped before the policy draws again, so a state costs
+    /// filter checks until its first admitted removal instead of one per candidate. A filter
+    /// that is expensive (a robot planning a path per removal) makes rollouts that much cheaper.
+    /// With `false` every candidate of every rollout state is filtered first and the policy
+    /// draws among the admitted ones. Either way the rollout takes an admitted removal, ends
+    /// where none is admitted and depends only on the seed; the random policy's draws have the
+    /// same distribution, but the random streams differ, so the two give different searches.
+    /// Without filters both are the same search. Expansions always filter a new node's
+    /// removals (its untried set).
+    pub fn lazy_filters(mut self, yes: bool) -> Self {
+        self.settings.lazy_filters = yes;
         self
     }
 
@@ -452,6 +474,10 @@ pub struct SearchStats {
     /// that rejects on replay what a rollout admitted); they are left out of the answer.
     #[serde(default)]
     pub replay_failures: u64,
+    /// Removals put to the problem's feasibility filters (all threads; [`FilterCounts::checks`]),
+    /// recording included.
+    #[serde(default)]
+    pub filter_checks: u64,
 }
 
 /// The result of a search.
@@ -812,6 +838,14 @@ struct Worker<'p, V: Variant> {
     stats: SearchStats,
     filtered: FilterCounts,
     deadline: Option<Instant>,
+    /// When the search started.
+    start: Instant,
+    /// The complete sequences' values that entered the archive during the current episode,
+    /// with the seconds and the episode's iterations when they did (trace rows inside an
+    /// episode).
+    found: Vec<(Vec<f64>, f64, u64)>,
+    /// Iterations of the current episode so far.
+    episode_iterations: u64,
     stopped: bool,
     /// The first plug-in error; it stops this worker, and through `abort` the others.
     error: Option<SearchError>,
@@ -904,6 +938,9 @@ impl<'p, V: Variant> Worker<'p, V> {
             stats: SearchStats::default(),
             filtered,
             deadline: settings.time_limit.map(|t| start + t),
+            start,
+            found: Vec::new(),
+            episode_iterations: 0,
             stopped: false,
             error: None,
             abort,
@@ -971,6 +1008,7 @@ impl<'p, V: Variant> Worker<'p, V> {
 
     /// One episode: search steps from the root down to a complete sequence.
     fn episode(&mut self) {
+        self.episode_iterations = 0;
         self.path.clear();
         self.path_edges.clear();
         self.path_prefix.clear();
@@ -992,6 +1030,7 @@ impl<'p, V: Variant> Worker<'p, V> {
                     return;
                 }
                 self.stats.iterations += 1;
+                self.episode_iterations += 1;
                 if self.should_stop() {
                     self.stopped = true;
                     return;
@@ -1204,38 +1243,62 @@ impl<'p, V: Variant> Worker<'p, V> {
         }
 
         // Rollout with the rollout policy (from a transposed child too: more evidence).
-        // a new child's feasible removals are in `actions` already
+        // a new child's feasible removals are in `actions` already. With lazy filters the
+        // other states offer the maps' candidates and the filters are asked about the drawn one.
+        let lazy = self.settings.lazy_filters && !self.problem.filters().is_empty();
         let mut known = new_child;
         loop {
+            let filtered = known || !lazy;
             if !known {
-                self.problem.feasible_actions(
-                    &mut self.sim,
-                    &self.memory,
-                    StepKind::Simulation,
-                    &mut self.actions,
-                    &mut self.filtered,
-                );
+                if lazy {
+                    self.problem.candidate_actions(&mut self.sim, &mut self.actions);
+                } else {
+                    self.problem.feasible_actions(
+                        &mut self.sim,
+                        &self.memory,
+                        StepKind::Simulation,
+                        &mut self.actions,
+                        &mut self.filtered,
+                    );
+                }
             }
             known = false;
+            // the recording needs the state's admitted removals: with lazy filters it filters
+            // them on its own (the filters' verdicts depend on the step only, so the search
+            // draws the same removals either way)
+            let recording = self.record.as_mut().is_some_and(|r| r.pending.is_some() || r.active());
+            let mut admitted = Vec::new();
+            if recording && !filtered {
+                let rec = self.record.as_mut().expect("recording");
+                self.problem.feasible_actions(&mut self.sim, &self.memory, StepKind::Simulation, &mut admitted, &mut rec.counts);
+            }
             if let Some(rec) = &mut self.record {
-                rec.finish(&self.actions);
+                rec.finish(if filtered { &self.actions } else { &admitted });
             }
-            if self.actions.is_empty() {
-                break;
+            let mut chosen = None;
+            while !self.actions.is_empty() {
+                let k = {
+                    let mut ctx = PolicyContext { state: &mut self.sim, memory: &self.memory, problem: self.problem };
+                    self.policy.choose(&mut ctx, &self.actions, &mut self.rng)?
+                };
+                let Some(&p) = self.actions.get(k) else {
+                    return Err(SearchError::plugin(
+                        "rollout policy",
+                        format!("chose action {k} of {}", self.actions.len()),
+                    ));
+                };
+                if filtered
+                    || self.problem.admits(&mut self.sim, &self.memory, p, StepKind::Simulation, &mut self.filtered)
+                {
+                    chosen = Some(p);
+                    break;
+                }
+                self.actions.remove(k);
             }
-            let k = {
-                let mut ctx = PolicyContext { state: &mut self.sim, memory: &self.memory, problem: self.problem };
-                self.policy.choose(&mut ctx, &self.actions, &mut self.rng)?
-            };
-            let Some(&p) = self.actions.get(k) else {
-                return Err(SearchError::plugin(
-                    "rollout policy",
-                    format!("chose action {k} of {}", self.actions.len()),
-                ));
-            };
+            let Some(p) = chosen else { break };
             if let Some(rec) = &mut self.record {
                 if rec.active() {
-                    rec.begin(StepKind::Simulation, self.sim.present(), &self.memory, &self.actions, p);
+                    rec.begin(StepKind::Simulation, self.sim.present(), &self.memory, if filtered { &self.actions } else { &admitted }, p);
                 }
             }
             self.problem.step(&mut self.sim, &mut self.memory, p, StepKind::Simulation, &mut rewards[..m]);
@@ -1254,6 +1317,8 @@ impl<'p, V: Variant> Worker<'p, V> {
             let seq = &self.sequence;
             if self.archive.insert(&ret[..m], || seq.clone()) {
                 self.archive_changed = true;
+                let seconds = self.start.elapsed().as_secs_f64();
+                self.found.push((ret[..m].to_vec(), seconds, self.episode_iterations + 1));
             }
         } else {
             self.stats.dead_rollouts += 1;
@@ -1326,6 +1391,24 @@ impl<'p, V: Variant> Worker<'p, V> {
     /// Publishes the archive to the shared front and the trace.
     fn sync(&mut self, shared: &Mutex<Shared>, reference: &[f64], start: Instant, iterations: u64) {
         let mut s = shared.lock().unwrap_or_else(|e| e.into_inner());
+        // the improvements inside the episode first, each as it was found
+        for (point, seconds, at) in std::mem::take(&mut self.found) {
+            if !s.front.insert(&point, || ()) {
+                continue;
+            }
+            let value = front_value(&s.front, reference);
+            if s.last_value != Some(value) && !s.front.is_empty() && at < iterations {
+                s.last_value = Some(value);
+                let point = TracePoint {
+                    episode: s.episodes + 1,
+                    iterations: s.iterations + at,
+                    seconds,
+                    value,
+                    front_size: s.front.len(),
+                };
+                s.trace.push(point);
+            }
+        }
         s.episodes += 1;
         s.iterations += iterations;
         if self.archive_changed {
@@ -1561,6 +1644,7 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Resul
         dead &= *status == Status::Dead;
     }
     stats.filtered = problem.report_filtered(&filtered);
+    stats.filter_checks = filtered.checks();
     for (.., record) in results {
         if let Some(r) = record {
             transitions.extend(r.transitions);

@@ -370,3 +370,23 @@ fn issue_9_grid_subassemblies_with_moves_replay_from_the_json() {
     replay_json(&plan["assembly_sequence"], &mut pos, &mut present, 0.01);
     assert!(present.is_empty(), "parts never taken out: {present:?}");
 }
+
+#[test]
+fn gen_profiles_attaches_connectors_on_request() {
+    let dir = tempfile::tempdir().unwrap();
+    let parts = |flags: &[&str], sub: &str| {
+        let out = dir.path().join(sub);
+        let mut args = vec!["gen", "profiles", "--preset", "single-layer", "--seed", "1", "-q", "--out", out.to_str().unwrap()];
+        args.extend_from_slice(flags);
+        let o = asp(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let m: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+        let e = &m["assemblies"][0];
+        (e["parts"].as_u64().unwrap(), e["counts"]["u_connectors"].as_u64().unwrap() + e["counts"]["o_connectors"].as_u64().unwrap())
+    };
+    let (attached, connectors) = parts(&["--connectors", "attached"], "a");
+    assert_eq!(attached, 29, "21 removable and 8 fixed profiles, no connector parts");
+    assert_eq!(parts(&[], "s"), (29 + connectors, connectors), "separate by default");
+    let bad = asp(&["gen", "profiles", "--connectors", "glued", "--out", dir.path().to_str().unwrap()]);
+    assert_eq!(bad.status.code(), Some(2));
+}

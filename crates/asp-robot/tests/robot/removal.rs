@@ -460,3 +460,61 @@ fn per_part_planning_time() {
         }
     }
 }
+
+/// How far a greedy robot disassembly gets from different robot bases: on attached-connector
+/// profile assemblies (the thesis' 21/30 profiles), from the full state remove, in part order,
+/// the first part that leaves along a straight line and that the robot takes out (k = 1), until
+/// none does (collision only, no stability). Prints per base (gap in front of the model, base
+/// height) the parts removed and those the robot could reach in the full state.
+/// `ASP_ROBOT_BASES="gap:height,..."` (metres, default a small grid),
+/// `cargo test --workspace --test tests -- robot_cell_reach --ignored --nocapture`
+#[test]
+#[ignore = "a measurement, run by hand"]
+fn robot_cell_reach() {
+    let bases: Vec<(f32, f32)> = std::env::var("ASP_ROBOT_BASES")
+        .unwrap_or_else(|_| "0.3:0,0.2:0,0.1:0,0.3:0.3,0.2:0.3,0.1:0.3".into())
+        .split(',')
+        .map(|b| {
+            let (g, h) = b.split_once(':').expect("gap:height");
+            (g.trim().parse().unwrap(), h.trim().parse().unwrap())
+        })
+        .collect();
+    let attached = |p: asp_gen::ProfileParams| asp_gen::ProfileParams { connectors: asp_gen::ConnectorMode::Attached, ..p };
+    for (name, params, seed) in [
+        ("single", asp_gen::ProfileParams::single_layer(), 1),
+        ("single", asp_gen::ProfileParams::single_layer(), 2),
+        ("double", asp_gen::ProfileParams::double_layer(), 1),
+    ] {
+        let assembly = asp_gen::ProfileAssembly::generate(&attached(params), seed).unwrap().to_assembly("p");
+        let world = World::new(assembly, &WorldConfig::default()).unwrap();
+        let movable: Vec<usize> = (0..world.num_parts()).filter(|&p| !world.fixed().contains(p)).collect();
+        for &(gap, height) in &bases {
+            // the default cell's base, moved: `gap` in front of the model's −x face, `height` up
+            let default = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
+            let lo = world.assembly().parts.iter().flat_map(|p| p.mesh.vertices.iter()).fold(f32::INFINITY, |m, v| m.min(v.x));
+            let at = default.robot.base_pose().translation;
+            let base = Vec3::new(lo - gap, at.y, at.z + height);
+            let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), Some(base), None);
+            let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
+            let started = std::time::Instant::now();
+            let mut state = PartSet::full(world.num_parts());
+            let first = movable
+                .iter()
+                .filter(|&&p| lift_direction(&world, p, &state).is_some_and(|d| planner.removable(p, &state, d, 1, 1).is_ok()))
+                .count();
+            let straight = movable.iter().filter(|&&p| lift_direction(&world, p, &state).is_some()).count();
+            let mut removed = 0;
+            while let Some(p) = movable.iter().copied().find(|&p| {
+                state.contains(p) && lift_direction(&world, p, &state).is_some_and(|d| planner.removable(p, &state, d, 1, 1).is_ok())
+            }) {
+                state.remove(p);
+                removed += 1;
+            }
+            println!(
+                "{name}-layer seed {seed}, base {gap} m in front, {height} m up: full state {first} of {straight} straight-line removable parts; greedy disassembly removes {removed} of {} ({:.1} s)",
+                movable.len(),
+                started.elapsed().as_secs_f64()
+            );
+        }
+    }
+}

@@ -193,3 +193,54 @@ fn the_beam_plans_under_physics_with_held_parts() {
     }
     assert!(three.report.robot.is_none());
 }
+
+/// Four stacks of two blocks on a fixed plate in front of the robot.
+fn stacks() -> Assembly {
+    let mut plate = box_part("plate", [-0.1, -0.3, -0.02], [0.35, 0.3, 0.0]);
+    plate.fixed = true;
+    let mut parts = vec![plate];
+    for (i, y) in [-0.18f32, -0.06, 0.06, 0.18].into_iter().enumerate() {
+        parts.push(box_part(&format!("low{i}"), [0.1, y - 0.02, 0.0], [0.14, y + 0.02, 0.04]));
+        parts.push(box_part(&format!("top{i}"), [0.1, y - 0.02, 0.04], [0.14, y + 0.02, 0.08]));
+    }
+    assemble("stacks", parts, Axis::Z)
+}
+
+/// One search of `stacks()` with the robot filter asked lazily or for every candidate: its
+/// best sequence and value, the removals put to the filter, and the robot's path searches.
+fn robot_search(lazy: bool) -> (Vec<usize>, f64, u64, u64) {
+    use asp_search::mdp::{MdpExtension, ModelContext};
+    use asp_search::pipeline::optimiser_problem;
+    use asp_search::Mcts;
+    let assembly = Arc::new(stacks());
+    let ext = Arc::new(RobotExtension::new(RobotSetup::panda()));
+    let o = OptimiseSettings {
+        objectives: "robot-path".into(),
+        resolution: 5,
+        extensions: vec![ext.clone() as Arc<dyn MdpExtension>],
+        ..OptimiseSettings::default()
+    };
+    let settings = PlanSettings { seed: 7, ..PlanSettings::default() };
+    let problem = optimiser_problem(&assembly, &settings, &o).unwrap();
+    let mdp = problem.mdp;
+    let search = Mcts::builder().seed(7).episodes(1).budget(2).threads(1).lazy_filters(lazy).build().unwrap();
+    let outcome = search.solve(&mdp).unwrap();
+    let best = outcome.best().expect("a complete sequence").clone();
+    // the answer replays: every step admitted by the robot again (expansion's k plans)
+    mdp.evaluate(&best.sequence).unwrap();
+    assert_eq!(best.sequence.len(), 8);
+    let model = ext.model(&ModelContext { assembly: &assembly, maps: mdp.maps_arc(), seed: 7 }).unwrap();
+    let plans = model.planner().stats().plans;
+    (best.sequence, best.values[0], outcome.stats.filter_checks, plans)
+}
+
+#[test]
+fn lazy_robot_rollouts_repeat_themselves_with_fewer_robot_plans() {
+    let lazy = robot_search(true);
+    assert_eq!(robot_search(true), lazy, "same seed, same threads: the same search");
+    let eager = robot_search(false);
+    // lazy rollouts ask the robot only until a drawn removal is admitted
+    assert!(lazy.2 < eager.2, "filter checks lazy {} vs eager {}", lazy.2, eager.2);
+    assert!(lazy.3 < eager.3, "robot path searches lazy {} vs eager {}", lazy.3, eager.3);
+    assert!(lazy.1 < 0.0 && eager.1 < 0.0);
+}
