@@ -20,7 +20,7 @@
 
 use crate::model::GraphModel;
 use tract_onnx::prelude::tract_ndarray::linalg::general_mat_mul;
-use tract_onnx::prelude::tract_ndarray::{ArrayView2, ArrayViewMut2};
+use tract_onnx::prelude::tract_ndarray::{ArrayView2, ArrayViewMut2, ShapeBuilder};
 
 /// The constant added to messages (`asp.train.gnn.EPS`).
 const EPS: f32 = 1e-7;
@@ -55,6 +55,23 @@ impl Dense {
         let a = ArrayView2::from_shape((rows, self.input), &x[..rows * self.input]).expect("shape");
         let w = ArrayView2::from_shape((self.input, self.output), &self.w).expect("shape");
         let mut c = ArrayViewMut2::from_shape((rows, self.output), out).expect("shape");
+        general_mat_mul(1.0, &a, &w, 1.0, &mut c);
+    }
+
+    /// [`apply`](Self::apply) on column-major `x` and `out` (feature-major: column `j` of all
+    /// rows is contiguous). matrixmultiply packs a column-major left operand with contiguous
+    /// reads: 2-3× faster than row-major for the `[e, w] × [w, w]` products of the edges.
+    fn apply_columns(&self, x: &[f32], rows: usize, out: &mut [f32]) {
+        let out = &mut out[..rows * self.output];
+        for (column, &b) in out.chunks_exact_mut(rows.max(1)).zip(&self.b) {
+            column.fill(b);
+        }
+        if rows == 0 {
+            return;
+        }
+        let a = ArrayView2::from_shape((rows, self.input).f(), &x[..rows * self.input]).expect("shape");
+        let w = ArrayView2::from_shape((self.input, self.output), &self.w).expect("shape");
+        let mut c = ArrayViewMut2::from_shape((rows, self.output).f(), out).expect("shape");
         general_mat_mul(1.0, &a, &w, 1.0, &mut c);
     }
 }
@@ -312,43 +329,45 @@ impl QNet {
         grow(&mut s.mean, n * w);
         grow(&mut s.sums, n * 2 * w);
         grow(&mut s.u, n * w);
+        // edge activations are column-major ([j * e + k]: feature j of edge k), see apply_columns
         // the first layer's edge share: the cached encodings
-        s.a_next[..e * w].copy_from_slice(&edges[..e * w]);
+        for (k, row) in edges[..e * w].chunks_exact(w).enumerate() {
+            for (j, &v) in row.iter().enumerate() {
+                s.a_next[j * e + k] = v;
+            }
+        }
         for layer in 0..self.layers {
             let last = layer + 1 == self.layers;
             // z = relu(W1 h_t + W1 a + W1 h_s + b1)
             self.e1.apply(&h, n, false, &mut s.p);
-            for k in 0..e {
-                let (t, src) = (targets[k] as usize, sources[k] as usize);
-                let (pt, ps) = (&s.p[t * w..(t + 1) * w], &s.p[src * w..(src + 1) * w]);
-                let a = &s.a_next[k * w..(k + 1) * w];
-                for (j, z) in s.z[k * w..(k + 1) * w].iter_mut().enumerate() {
-                    *z = (pt[j] + a[j] + ps[j] + self.e1.b[j]).max(0.0);
+            for j in 0..w {
+                let b1 = self.e1.b[j];
+                let a = &s.a_next[j * e..(j + 1) * e];
+                let z = &mut s.z[j * e..(j + 1) * e];
+                for k in 0..e {
+                    let (t, src) = (targets[k] as usize, sources[k] as usize);
+                    z[k] = (s.p[t * w + j] + a[k] + s.p[src * w + j] + b1).max(0.0);
                 }
             }
-            // the new edge state a' (and, but for the last layer, W1 a' for the next)
-            let stride = if last { w } else { 2 * w };
+            // the new edge state a' (columns 0..w) and, but for the last layer, W1 a' for the
+            // next (columns w..2w)
             if last {
-                self.e2.apply(&s.z, e, true, &mut s.a);
+                self.e2.apply_columns(&s.z, e, &mut s.a);
             } else {
-                self.e2_fused.apply(&s.z, e, true, &mut s.a);
-                for k in 0..e {
-                    s.a_next[k * w..(k + 1) * w].copy_from_slice(&s.a[k * stride + w..k * stride + 2 * w]);
-                }
+                self.e2_fused.apply_columns(&s.z, e, &mut s.a);
+                s.a_next[..e * w].copy_from_slice(&s.a[w * e..2 * w * e]);
             }
             // messages m = relu(h_t + a') + eps and the learned softmax over each target's edges
             let tau = self.temperature[layer];
             let mean = &mut s.mean[..n * w];
             mean.fill(0.0);
-            for k in 0..e {
-                let t = targets[k] as usize;
-                let ht = &h[t * w..(t + 1) * w];
-                let a = &s.a[k * stride..k * stride + w];
-                let m = &mut s.m[k * w..(k + 1) * w];
-                let mt = &mut mean[t * w..(t + 1) * w];
-                for j in 0..w {
-                    m[j] = (ht[j] + a[j]).max(0.0) + EPS;
-                    mt[j] += m[j] * tau;
+            for j in 0..w {
+                let a = &s.a[j * e..(j + 1) * e];
+                let m = &mut s.m[j * e..(j + 1) * e];
+                for k in 0..e {
+                    let t = targets[k] as usize;
+                    m[k] = (h[t * w + j] + a[k]).max(0.0) + EPS;
+                    mean[t * w + j] += m[k] * tau;
                 }
             }
             for t in 0..n {
@@ -359,15 +378,13 @@ impl QNet {
             }
             let sums = &mut s.sums[..n * 2 * w];
             sums.fill(0.0);
-            for k in 0..e {
-                let t = targets[k] as usize;
-                let m = &s.m[k * w..(k + 1) * w];
-                let mt = &mean[t * w..(t + 1) * w];
-                let st = &mut sums[t * 2 * w..(t + 1) * 2 * w];
-                for j in 0..w {
-                    let weight = (m[j] * tau - mt[j]).min(SCORE_CLAMP).exp();
-                    st[j] += weight * m[j];
-                    st[w + j] += weight;
+            for j in 0..w {
+                let m = &s.m[j * e..(j + 1) * e];
+                for k in 0..e {
+                    let t = targets[k] as usize;
+                    let weight = (m[k] * tau - mean[t * w + j]).min(SCORE_CLAMP).exp();
+                    sums[t * 2 * w + j] += weight * m[k];
+                    sums[t * 2 * w + w + j] += weight;
                 }
             }
             // h = phi_n(h + aggregate)
