@@ -244,7 +244,8 @@ impl QNet {
         let mut got = vec![0.0; n];
         self.forward_graph(&x, n, &index, &attr, &nodes, &mut got, &mut Scratch::default());
         for (k, (a, b)) in got.iter().zip(&want).enumerate() {
-            if !((a - b).abs() <= SELF_CHECK_TOLERANCE * b.abs().max(1.0)) {
+            let close = (a - b).abs() <= SELF_CHECK_TOLERANCE * b.abs().max(1.0);
+            if !close {
                 return Err(format!("the Rust forward pass gives {a} for node {k} of a test graph, tract {b}"));
             }
         }
@@ -423,10 +424,10 @@ impl QNet {
         }
         let hidden = grow(&mut s.q_hidden, wanted.len() * w);
         self.q1_node.apply(&s.z, wanted.len(), false, hidden);
-        for (o, row) in out.iter_mut().zip(hidden.chunks_exact_mut(w)) {
+        for (o, row) in out.iter_mut().zip(hidden.chunks_exact(w)) {
             let mut q = self.q2.b[0];
-            for j in 0..w {
-                q += (row[j] + s.mean[j]).max(0.0) * self.q2.w[j];
+            for ((r, p), v) in row.iter().zip(&s.mean[..w]).zip(&self.q2.w) {
+                q += (r + p).max(0.0) * v;
             }
             *o = q;
         }
