@@ -4,6 +4,7 @@ pub mod error;
 pub mod model;
 pub mod ordering;
 pub mod qfunction;
+pub mod qnet;
 
 pub use error::{LearnError, Result};
 pub use model::{GraphModel, ModelKind, RemovabilityModel, ShapePolicy};

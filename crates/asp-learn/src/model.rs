@@ -114,6 +114,9 @@ pub struct GraphModel {
     policy: ShapePolicy,
     symbolic: Mutex<Option<Arc<Pooled>>>,
     buckets: Mutex<HashMap<(usize, usize), Arc<Pooled>>>,
+    /// The file's float32 initialisers in file order: name, shape, values (the Rust forward
+    /// pass of Q models reads its weights here, `qnet.rs`).
+    initializers: Vec<(String, Vec<usize>, Vec<f32>)>,
 }
 
 /// A removability model (the graph model of `--order gnn`).
@@ -226,6 +229,7 @@ impl GraphModel {
             policy: ShapePolicy::default(),
             symbolic: Mutex::new(None),
             buckets: Mutex::new(HashMap::new()),
+            initializers: graph.initializer.iter().filter_map(float_initializer).collect(),
         };
         // run once, so a model tract cannot execute fails here and not in the middle of a search
         let x = vec![0.0; 2 * node_dim];
@@ -394,10 +398,35 @@ impl GraphModel {
         Ok(plan)
     }
 
+    /// The float32 initialiser `name`: its shape and values.
+    pub(crate) fn initializer(&self, name: &str) -> Option<(&[usize], &[f32])> {
+        self.initializers.iter().find(|(n, _, _)| n == name).map(|(_, s, v)| (s.as_slice(), v.as_slice()))
+    }
+
+    /// The values of the float32 initialisers of rank 0, in file order.
+    pub(crate) fn scalar_initializers(&self) -> Vec<f32> {
+        self.initializers.iter().filter(|(_, s, _)| s.is_empty()).map(|(_, _, v)| v[0]).collect()
+    }
+
     /// How many padded-size plans are cached (for tests and benchmarks).
     pub fn cached_plans(&self) -> usize {
         self.buckets.lock().map(|p| p.len()).unwrap_or(0)
     }
+}
+
+/// A float32 initialiser stored in the file (raw little-endian bytes or `float_data`).
+fn float_initializer(t: &pb::TensorProto) -> Option<(String, Vec<usize>, Vec<f32>)> {
+    if t.data_type != FLOAT {
+        return None;
+    }
+    let shape: Vec<usize> = t.dims.iter().map(|&d| usize::try_from(d).ok()).collect::<Option<_>>()?;
+    let len: usize = shape.iter().product();
+    let values: Vec<f32> = if !t.raw_data.is_empty() {
+        t.raw_data.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()
+    } else {
+        t.float_data.clone()
+    };
+    (values.len() == len).then(|| (t.name.clone(), shape, values))
 }
 
 /// The bucket of a size: the smallest of 8, 12, 16, 24, 32, 48, ... that is at least `v`.

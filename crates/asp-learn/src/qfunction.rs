@@ -3,12 +3,16 @@
 //! that `asp plan --objective ... --q MODEL[,MODEL]` uses.
 //!
 //! Each search thread gets its own [`QWorker`], which builds the graph builder of the model's
-//! maps on its first call and reuses its buffers; the model's plans are shared (one per padded
-//! size, see [`GraphModel`]). The values of every feasible action of a state come from one
-//! inference.
+//! maps on its first call and reuses its buffers. The values of every feasible action of a state
+//! come from one inference: by default the Rust forward pass of [`QNet`] (when the file holds the
+//! trainer's architecture and agrees with tract at load), with each part pair's edge encoding
+//! cached in the worker, so a state costs its nodes and the per-edge layers only; otherwise, or
+//! with [`OnnxQ::tract_only`], the graph with its edge attributes run by tract (one plan per
+//! padded size, see [`GraphModel`]).
 
 use crate::error::{LearnError, Result};
 use crate::model::{GraphModel, ModelKind};
+use crate::qnet::{QNet, Scratch};
 use asp_search::policy::{EpsilonGreedy, Policy, PolicyContext, QFunction, QUse, QWorker};
 use asp_search::qgraph::{self, QGraph, QGraphBuilder, QGraphConfig};
 use asp_search::SearchError;
@@ -25,6 +29,8 @@ pub struct OnnxQ {
     model: Arc<GraphModel>,
     config: QGraphConfig,
     objective: String,
+    /// The Rust forward pass, or why the model has none.
+    net: std::result::Result<Arc<QNet>, String>,
 }
 
 impl OnnxQ {
@@ -51,7 +57,20 @@ impl OnnxQ {
             .get("asp.objective")
             .cloned()
             .ok_or_else(|| mismatch("no metadata property 'asp.objective' (the objective the model estimates)".into()))?;
-        Ok(OnnxQ { model, config, objective })
+        let net = QNet::from_model(&model).map(Arc::new);
+        Ok(OnnxQ { model, config, objective, net })
+    }
+
+    /// The same Q-function evaluated by tract on the full graph (edge attributes rebuilt per
+    /// state) instead of the Rust forward pass: the reference of the parity tests and benchmarks.
+    pub fn tract_only(mut self) -> Self {
+        self.net = Err("tract_only".into());
+        self
+    }
+
+    /// Whether states are scored by the Rust forward pass ([`QNet`]); `Err` says why not.
+    pub fn rust_forward(&self) -> std::result::Result<(), &str> {
+        self.net.as_ref().map(|_| ()).map_err(String::as_str)
     }
 
     /// The objective whose return the model estimates (`asp.objective`).
@@ -102,7 +121,7 @@ impl QFunction for OnnxQ {
 
 impl OnnxQ {
     fn worker(&self) -> OnnxQWorker<'_> {
-        OnnxQWorker { q: self, builder: None, graph: QGraph::default() }
+        OnnxQWorker { q: self, builder: None, graph: QGraph::default(), fast: PairCache::default() }
     }
 }
 
@@ -111,6 +130,57 @@ struct OnnxQWorker<'q> {
     q: &'q OnnxQ,
     builder: Option<QGraphBuilder>,
     graph: QGraph,
+    fast: PairCache,
+}
+
+/// The Rust forward pass's per-thread state: each part pair's edge encoding, computed the first
+/// time the pair is an edge (an edge's attributes depend on its two parts only), and buffers.
+#[derive(Default)]
+struct PairCache {
+    /// Parts of the maps (the slot table is `parts × parts`, target-major).
+    parts: usize,
+    /// Per `(target, source)`: the offset of its encoding in `encodings`, `u32::MAX` until known.
+    slot: Vec<u32>,
+    encodings: Vec<f32>,
+    /// The context node's edge encoding (the same for every target).
+    context: Vec<f32>,
+    row: Vec<f32>,
+    row_scratch: Vec<f32>,
+    edges: Vec<f32>,
+    sources: Vec<u32>,
+    targets: Vec<u32>,
+    wanted: Vec<usize>,
+    values: Vec<f32>,
+    scratch: Scratch,
+}
+
+impl PairCache {
+    fn prepare(&mut self, net: &QNet, builder: &QGraphBuilder, maps: &asp_geom::distmap::DistanceMaps) {
+        let n = maps.num_parts();
+        if self.parts == n && !self.context.is_empty() {
+            return;
+        }
+        self.parts = n;
+        self.slot = vec![u32::MAX; n * n];
+        self.encodings.clear();
+        self.row.resize(net.edge_dim(), 0.0);
+        self.context = vec![0.0; net.width()];
+        builder.edge_attributes(maps, 0, None, &mut self.row);
+        net.encode_edge(&self.row, &mut self.context, &mut self.row_scratch);
+    }
+
+    /// The offset of the encoding of the edge from part `s` to part `t` in `encodings`.
+    fn pair(&mut self, net: &QNet, builder: &QGraphBuilder, maps: &asp_geom::distmap::DistanceMaps, t: usize, s: usize) -> usize {
+        let key = t * self.parts + s;
+        if self.slot[key] == u32::MAX {
+            let at = self.encodings.len();
+            self.encodings.resize(at + net.width(), 0.0);
+            builder.edge_attributes(maps, t, Some(s), &mut self.row);
+            net.encode_edge(&self.row, &mut self.encodings[at..], &mut self.row_scratch);
+            self.slot[key] = at as u32;
+        }
+        self.slot[key] as usize
+    }
 }
 
 impl QWorker for OnnxQWorker<'_> {
@@ -126,6 +196,44 @@ impl QWorker for OnnxQWorker<'_> {
         }
         let builder = self.builder.get_or_insert_with(|| QGraphBuilder::new(maps, self.q.config.neighbours));
         let history = qgraph::direction_history(ctx.problem, ctx.memory);
+        if let Ok(net) = &self.q.net {
+            builder.build_structure(ctx.state, history, actions, &mut self.graph);
+            let g = &self.graph;
+            let c = &mut self.fast;
+            c.prepare(net, builder, maps);
+            let (n, e) = (g.num_nodes(), g.num_edges());
+            let context = n - 1;
+            c.edges.clear();
+            c.sources.clear();
+            c.targets.clear();
+            for k in 0..e {
+                let (s_pos, t_pos) = (g.edge_index[k] as usize, g.edge_index[e + k] as usize);
+                c.sources.push(s_pos as u32);
+                c.targets.push(t_pos as u32);
+                if s_pos == context {
+                    c.edges.extend_from_slice(&c.context);
+                } else {
+                    let at = c.pair(net, builder, maps, g.nodes[t_pos] as usize, g.nodes[s_pos] as usize);
+                    c.edges.extend_from_slice(&c.encodings[at..at + net.width()]);
+                }
+            }
+            let parts = &g.nodes[..n - 1];
+            c.wanted.clear();
+            for &a in actions {
+                let k = parts.binary_search(&(a as i64)).map_err(|_| plugin(format!("action {a} is not a present part")))?;
+                c.wanted.push(k);
+            }
+            c.values.resize(actions.len(), 0.0);
+            net.forward(&g.x, n, &c.sources, &c.targets, &c.edges, &c.wanted, &mut c.values, &mut c.scratch);
+            for (o, (&v, &a)) in out.iter_mut().zip(c.values.iter().zip(actions)) {
+                let v = f64::from(v);
+                if !v.is_finite() {
+                    return Err(plugin(format!("the model gave {v} for part {a}")));
+                }
+                *o = v.max(MIN_Q);
+            }
+            return Ok(());
+        }
         builder.build(ctx.state, history, actions, &mut self.graph);
         let g = &self.graph;
         let (n, e) = (g.num_nodes(), g.num_edges());

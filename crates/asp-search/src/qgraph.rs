@@ -170,6 +170,44 @@ impl QGraphBuilder {
     /// ([`direction_history`]), `actions` the feasible removals a Q-function is asked about
     /// (flagged on their nodes). Parts in `actions` must be present.
     pub fn build(&mut self, state: &mut MapState<'_>, history: Option<DirMask>, actions: &[usize], out: &mut QGraph) {
+        self.build_with(state, history, actions, out, true);
+    }
+
+    /// [`build`](Self::build) without the edge attributes (`out.edge_attr` stays empty): the
+    /// nodes, their attributes and the edges. An edge's attributes depend only on its two parts
+    /// ([`edge_attributes`](Self::edge_attributes)), so an evaluator that caches them per pair
+    /// needs no more than this per state.
+    pub fn build_structure(&mut self, state: &mut MapState<'_>, history: Option<DirMask>, actions: &[usize], out: &mut QGraph) {
+        self.build_with(state, history, actions, out, false);
+    }
+
+    /// The attributes of the edge from part `s` to part `t` (`row` has `edge_dim` floats), or of
+    /// the context node's edge to a part when `s` is `None`. They do not depend on the state.
+    pub fn edge_attributes(&self, maps: &DistanceMaps, t: usize, s: Option<usize>, row: &mut [f32]) {
+        let d = self.config.directions;
+        row.fill(0.0);
+        let Some(s) = s else {
+            row[0] = 1.0;
+            return;
+        };
+        let d_max = maps.d_max();
+        let v = self.centres[s] - self.centres[t];
+        let len = v.length();
+        if len > 0.0 {
+            let u = v / len;
+            row[1..4].copy_from_slice(&[u.x, u.y, u.z]);
+        }
+        row[4] = len / self.diagonal;
+        for (o, v) in row[EDGE_HEAD..EDGE_HEAD + d].iter_mut().zip(maps.map(t, s)) {
+            *o = (v / d_max).clamp(0.0, 1.0);
+        }
+        let blocked = maps.blocked(t, s);
+        for (dir, o) in row[EDGE_HEAD + d..EDGE_HEAD + 2 * d].iter_mut().enumerate() {
+            *o = f32::from(u8::from(!blocked.contains(dir)));
+        }
+    }
+
+    fn build_with(&mut self, state: &mut MapState<'_>, history: Option<DirMask>, actions: &[usize], out: &mut QGraph, attributes: bool) {
         let maps = state.maps();
         let d = self.config.directions;
         let (node_dim, edge_dim) = (self.config.node_dim(), self.config.edge_dim());
@@ -240,29 +278,19 @@ impl QGraphBuilder {
                 taken += 1;
                 out.edge_index.push(i64::from(s_pos));
                 out.targets.push(t_pos as i64);
-                let start = out.edge_attr.len();
-                out.edge_attr.resize(start + edge_dim, 0.0);
-                let row = &mut out.edge_attr[start..];
-                let v = self.centres[s] - self.centres[t];
-                let len = v.length();
-                if len > 0.0 {
-                    let u = v / len;
-                    row[1..4].copy_from_slice(&[u.x, u.y, u.z]);
-                }
-                row[4] = len / self.diagonal;
-                for (o, v) in row[EDGE_HEAD..EDGE_HEAD + d].iter_mut().zip(maps.map(t, s)) {
-                    *o = (v / d_max).clamp(0.0, 1.0);
-                }
-                let blocked = maps.blocked(t, s);
-                for (dir, o) in row[EDGE_HEAD + d..EDGE_HEAD + 2 * d].iter_mut().enumerate() {
-                    *o = f32::from(u8::from(!blocked.contains(dir)));
+                if attributes {
+                    let start = out.edge_attr.len();
+                    out.edge_attr.resize(start + edge_dim, 0.0);
+                    self.edge_attributes(maps, t, Some(s), &mut out.edge_attr[start..]);
                 }
             }
             out.edge_index.push(context as i64);
             out.targets.push(t_pos as i64);
-            let start = out.edge_attr.len();
-            out.edge_attr.resize(start + edge_dim, 0.0);
-            out.edge_attr[start] = 1.0;
+            if attributes {
+                let start = out.edge_attr.len();
+                out.edge_attr.resize(start + edge_dim, 0.0);
+                out.edge_attr[start] = 1.0;
+            }
         }
         let targets = std::mem::take(&mut out.targets);
         out.edge_index.extend_from_slice(&targets);

@@ -45,6 +45,9 @@ fn q_values_are_the_models_scores_of_the_state_graph() {
     let err = OnnxQ::load(fixture("random_gnn.onnx"), 25).unwrap_err().to_string();
     assert!(err.contains("asp.kind is 'removability', expected 'q'"), "{err}");
 
+    // the reference path: tract on the full graph (the Rust forward pass is checked against it
+    // in `the_rust_forward_pass_gives_tracts_values`)
+    let q = q.tract_only();
     let p = problem(&soma(2), "access,dirchange");
     let mut state = MapState::new(p.maps());
     let mut memory = p.initial_memory();
@@ -121,4 +124,91 @@ fn product_of_q_guidance_stays_feasible_and_near_the_exact_front() {
     assert!(checked >= 3, "{checked}");
     // the model files are loaded once and shared: the policy holds both
     let _ = GraphModel::open_kind(&paths[1], ModelKind::Q).unwrap();
+}
+
+/// Random removal walks on `p` (seeded); calls `visit` on every state with its feasible actions.
+fn walk_states(p: &Mdp, walks: u64, mut visit: impl FnMut(&mut MapState<'_>, &[u64], &[usize])) {
+    use rand::RngExt;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    let mut actions = Vec::new();
+    let mut rewards = vec![0.0; p.objectives().len()];
+    for _ in 0..walks {
+        let mut state = MapState::new(p.maps());
+        let mut memory = p.initial_memory();
+        loop {
+            state.feasible_actions(&mut actions);
+            if actions.is_empty() {
+                break;
+            }
+            visit(&mut state, &memory, &actions);
+            let a = actions[rng.random_range(0..actions.len())];
+            p.step(&mut state, &mut memory, a, asp_search::StepKind::Simulation, &mut rewards);
+        }
+    }
+}
+
+#[test]
+fn the_rust_forward_pass_gives_tracts_values() {
+    // both fixtures (width 32, 3 layers), on a generated 4×4×4 Soma cube and a double-layer
+    // profile assembly, in every state of random removal walks: the Rust forward pass with its
+    // per-pair edge cache (one worker for all states, so cached pairs are reused across states)
+    // against tract on the graph with its edge attributes
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+    let cube = asp_gen::SomaCube::random(4, &mut rng).unwrap().to_assembly(0.05, "soma4");
+    let profiles = asp_gen::ProfileAssembly::generate(&asp_gen::ProfileParams::double_layer(), 901).unwrap().to_assembly("profiles");
+    for name in ["random_q_access.onnx", "random_q_dirchange.onnx"] {
+        let fast = OnnxQ::load(fixture(name), 25).unwrap();
+        assert_eq!(fast.rust_forward(), Ok(()), "{name}");
+        let tract = fast.clone().tract_only();
+        assert!(tract.rust_forward().is_err());
+        for assembly in [&cube, &profiles] {
+            let p = problem(assembly, "access,dirchange");
+            let (mut fast_worker, mut tract_worker) = (fast.for_worker(0).unwrap(), tract.for_worker(0).unwrap());
+            let (mut states, mut worst, mut largest_state) = (0, 0.0f64, 0);
+            walk_states(&p, 6, |state, memory, actions| {
+                let mut a = vec![0.0; actions.len()];
+                let mut b = vec![0.0; actions.len()];
+                fast_worker.q_values(&mut PolicyContext { state: &mut *state, memory, problem: &p }, actions, &mut a).unwrap();
+                tract_worker.q_values(&mut PolicyContext { state: &mut *state, memory, problem: &p }, actions, &mut b).unwrap();
+                for (x, y) in a.iter().zip(&b) {
+                    worst = worst.max((x - y).abs() / y.abs().max(1.0));
+                }
+                states += 1;
+                largest_state = largest_state.max(state.present().len());
+            });
+            assert!(states >= 20 && largest_state >= 15, "{name} on {}: {states} states, {largest_state} parts", assembly.parts.len());
+            assert!(worst <= 1e-5, "{name} on {} parts: fast and tract differ by {worst}", assembly.parts.len());
+        }
+    }
+}
+
+#[test]
+fn a_model_the_rust_forward_pass_does_not_know_stays_on_tract() {
+    // a Q file whose weights are not under the trainer's names: refused by the Rust forward pass
+    // with a reason, and still a working Q-function through tract
+    // same-length renaming keeps the protobuf valid: the initialiser and the node inputs naming it
+    let mut bytes = std::fs::read(fixture("random_q_access.onnx")).unwrap();
+    let (from, to) = (b"phi_e.0.weight", b"phi_x.0.weight");
+    let mut renamed = 0;
+    for k in 0..bytes.len() - from.len() {
+        if &bytes[k..k + from.len()] == from {
+            bytes[k..k + to.len()].copy_from_slice(to);
+            renamed += 1;
+        }
+    }
+    assert!(renamed >= 2, "{renamed}");
+    let model = GraphModel::from_bytes_kind(&bytes, "renamed.onnx", ModelKind::Q).unwrap();
+    let q = OnnxQ::new(Arc::new(model), 25).unwrap();
+    let why = q.rust_forward().unwrap_err().to_string();
+    assert!(why.contains("phi_e.0.weight"), "{why}");
+    let reference = OnnxQ::load(fixture("random_q_access.onnx"), 25).unwrap().tract_only();
+    let p = problem(&soma(2), "access");
+    let mut state = MapState::new(p.maps());
+    let memory = p.initial_memory();
+    let mut actions = Vec::new();
+    state.feasible_actions(&mut actions);
+    let (mut a, mut b) = (vec![0.0; actions.len()], vec![0.0; actions.len()]);
+    q.q_values(&mut PolicyContext { state: &mut state, memory: &memory, problem: &p }, &actions, &mut a).unwrap();
+    reference.q_values(&mut PolicyContext { state: &mut state, memory: &memory, problem: &p }, &actions, &mut b).unwrap();
+    assert_eq!(a, b);
 }

@@ -1,0 +1,466 @@
+//! The forward pass of the trainer's Q network (`py/asp/train/q.py`, `QNetwork`) written out in
+//! Rust, for the Q-function's inner loop (issue 12: one inference per guided rollout step).
+//!
+//! Why not tract: the exported graph (docs/learning.md, "Q models") costs about 22 M
+//! multiply-adds per state at 40 parts (81 directions, width 64), and tract runs it near the
+//! machine's speed (2 ms). Most of that work does not depend on the state: an edge's attributes
+//! are a function of its two parts only (`QGraphBuilder::edge_attributes`), so their encoding and
+//! the first layer's projection of it are cached per part pair; the dense one-hot aggregation of
+//! the export (`[n, e]` matrix products) becomes a sum over each node's incoming edges; the first
+//! linear map of `phi_e` is applied to nodes instead of edges (`W(h_t + a + h_s) = W h_t + W a +
+//! W h_s`) and, for the next layer, folded into the second (`W1 (W2 z + b2)`); and `phi_Q` runs on
+//! the asked nodes only. What is left per state is two `[e, w] × [w, w]` products per layer.
+//!
+//! The weights are read from the ONNX file's initialisers by the PyTorch parameter names the
+//! exporter keeps (`node_encoder.weight`, `phi_e.0.weight`, ...) and the per-layer softmax
+//! temperatures (the file's scalar initialisers, in order). [`QNet::from_model`] refuses a file
+//! whose tensors do not have this shape, and then checks itself against tract on a generated
+//! graph: a model that is not this architecture (or a future trainer's) falls back to tract
+//! instead of giving other values.
+
+use crate::model::GraphModel;
+use tract_onnx::prelude::tract_ndarray::linalg::general_mat_mul;
+use tract_onnx::prelude::tract_ndarray::{ArrayView2, ArrayViewMut2, ShapeBuilder};
+
+/// The constant added to messages (`asp.train.gnn.EPS`).
+const EPS: f32 = 1e-7;
+/// Shifted softmax scores are clamped here before `exp` (`asp.train.gnn.SCORE_CLAMP`).
+const SCORE_CLAMP: f32 = 50.0;
+/// Largest |fast − tract| / max(1, |tract|) the self-check at load accepts.
+const SELF_CHECK_TOLERANCE: f32 = 1e-4;
+
+/// A linear map `y = x W + b` with `W` stored `[in, out]` (PyTorch's weight transposed).
+#[derive(Clone, Debug)]
+struct Dense {
+    input: usize,
+    output: usize,
+    w: Vec<f32>,
+    b: Vec<f32>,
+}
+
+impl Dense {
+    /// `out[rows, output] = x[rows, input] W (+ b)`.
+    fn apply(&self, x: &[f32], rows: usize, bias: bool, out: &mut [f32]) {
+        let out = &mut out[..rows * self.output];
+        if bias {
+            for row in out.chunks_exact_mut(self.output) {
+                row.copy_from_slice(&self.b);
+            }
+        } else {
+            out.fill(0.0);
+        }
+        if rows == 0 {
+            return;
+        }
+        let a = ArrayView2::from_shape((rows, self.input), &x[..rows * self.input]).expect("shape");
+        let w = ArrayView2::from_shape((self.input, self.output), &self.w).expect("shape");
+        let mut c = ArrayViewMut2::from_shape((rows, self.output), out).expect("shape");
+        general_mat_mul(1.0, &a, &w, 1.0, &mut c);
+    }
+
+    /// [`apply`](Self::apply) on column-major `x` and `out` (feature-major: column `j` of all
+    /// rows is contiguous). matrixmultiply packs a column-major left operand with contiguous
+    /// reads: 2-3× faster than row-major for the `[e, w] × [w, w]` products of the edges.
+    fn apply_columns(&self, x: &[f32], rows: usize, out: &mut [f32]) {
+        let out = &mut out[..rows * self.output];
+        for (column, &b) in out.chunks_exact_mut(rows.max(1)).zip(&self.b) {
+            column.fill(b);
+        }
+        if rows == 0 {
+            return;
+        }
+        let a = ArrayView2::from_shape((rows, self.input).f(), &x[..rows * self.input]).expect("shape");
+        let w = ArrayView2::from_shape((self.input, self.output), &self.w).expect("shape");
+        let mut c = ArrayViewMut2::from_shape((rows, self.output).f(), out).expect("shape");
+        general_mat_mul(1.0, &a, &w, 1.0, &mut c);
+    }
+}
+
+/// The Q network's weights (immutable, shared by every thread).
+#[derive(Clone, Debug)]
+pub struct QNet {
+    width: usize,
+    layers: usize,
+    node_dim: usize,
+    edge_dim: usize,
+    node_mean: Vec<f32>,
+    node_std: Vec<f32>,
+    edge_mean: Vec<f32>,
+    edge_std: Vec<f32>,
+    node_encoder: Dense,
+    /// `edge_encoder` followed by `phi_e`'s first map without its bias: an edge attribute row to
+    /// its share of the first layer's pre-activation.
+    edge_encoder: Dense,
+    /// `phi_e.0` (the first linear map of the edge MLP).
+    e1: Dense,
+    /// `phi_e.2`, and next to it `phi_e.2` followed by `phi_e.0` (no bias of the latter): the new
+    /// edge state and its share of the next layer's pre-activation in one product.
+    e2_fused: Dense,
+    /// `phi_e.2` alone (the last layer).
+    e2: Dense,
+    n1: Dense,
+    n2: Dense,
+    temperature: Vec<f32>,
+    /// `phi_q.0`'s columns reading `h_i`.
+    q1_node: Dense,
+    /// `phi_q.0`'s columns reading the pooled embedding (with the bias).
+    q1_pool: Dense,
+    q2: Dense,
+}
+
+/// Per-thread buffers of [`QNet::forward`] (reused; no allocation once warm).
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    xs: Vec<f32>,
+    h: Vec<f32>,
+    p: Vec<f32>,
+    z: Vec<f32>,
+    a: Vec<f32>,
+    a_next: Vec<f32>,
+    m: Vec<f32>,
+    mean: Vec<f32>,
+    sums: Vec<f32>,
+    u: Vec<f32>,
+    inv_count: Vec<f32>,
+    rows: Vec<f32>,
+    enc: Vec<f32>,
+    q_hidden: Vec<f32>,
+}
+
+fn grow(v: &mut Vec<f32>, len: usize) -> &mut [f32] {
+    if v.len() < len {
+        v.resize(len, 0.0);
+    }
+    &mut v[..len]
+}
+
+impl QNet {
+    /// The network of a loaded Q model, if its file holds the trainer's architecture and the
+    /// forward pass agrees with tract on a generated graph; `Err` says why not (the caller then
+    /// keeps tract).
+    pub fn from_model(model: &GraphModel) -> std::result::Result<Self, String> {
+        let net = Self::read(model)?;
+        net.self_check(model)?;
+        Ok(net)
+    }
+
+    fn read(model: &GraphModel) -> std::result::Result<Self, String> {
+        let (node_dim, edge_dim) = (model.node_dim(), model.edge_dim());
+        let meta = |key: &str| -> std::result::Result<usize, String> {
+            model.metadata().get(key).and_then(|v| v.parse().ok()).ok_or_else(|| format!("no integer metadata '{key}'"))
+        };
+        let (width, layers) = (meta("asp.width")?, meta("asp.layers")?);
+        if width == 0 || layers == 0 {
+            return Err("asp.width and asp.layers must be positive".into());
+        }
+        let tensor = |name: &str, dims: &[usize]| -> std::result::Result<Vec<f32>, String> {
+            let (shape, data) = model.initializer(name).ok_or_else(|| format!("no float tensor '{name}'"))?;
+            if shape != dims {
+                return Err(format!("tensor '{name}' has shape {shape:?}, expected {dims:?}"));
+            }
+            Ok(data.to_vec())
+        };
+        // a PyTorch Linear (weight [out, in]) as `x W + b`
+        let linear = |name: &str, input: usize, output: usize| -> std::result::Result<Dense, String> {
+            let w = tensor(&format!("{name}.weight"), &[output, input])?;
+            let b = tensor(&format!("{name}.bias"), &[output])?;
+            Ok(Dense { input, output, w: transpose(&w, output, input), b })
+        };
+        let node_encoder = linear("node_encoder", node_dim, width)?;
+        let edge_encoder = linear("edge_encoder", edge_dim, width)?;
+        let e1 = linear("phi_e.0", width, width)?;
+        let e2 = linear("phi_e.2", width, width)?;
+        let n1 = linear("phi_n.0", width, width)?;
+        let n2 = linear("phi_n.2", width, width)?;
+        let q1 = linear("phi_q.0", 2 * width, width)?;
+        let q2 = linear("phi_q.2", width, 1)?;
+        let temperature = model.scalar_initializers();
+        if temperature.len() != layers {
+            return Err(format!("{} scalar tensors, expected one temperature per layer ({layers})", temperature.len()));
+        }
+        // edge_encoder then e1 (without e1's bias, added once per edge with the node terms)
+        let edge_encoder = compose(&edge_encoder, &e1, false);
+        // e2 next to (e2 then e1 without bias)
+        let e2e1 = compose(&e2, &e1, false);
+        let mut w = vec![0.0; width * 2 * width];
+        for r in 0..width {
+            w[r * 2 * width..r * 2 * width + width].copy_from_slice(&e2.w[r * width..(r + 1) * width]);
+            w[r * 2 * width + width..(r + 1) * 2 * width].copy_from_slice(&e2e1.w[r * width..(r + 1) * width]);
+        }
+        let e2_fused = Dense { input: width, output: 2 * width, w, b: [e2.b.clone(), e2e1.b].concat() };
+        let q1_node = Dense { input: width, output: width, w: q1.w[..width * width].to_vec(), b: vec![0.0; width] };
+        let q1_pool = Dense { input: width, output: width, w: q1.w[width * width..].to_vec(), b: q1.b.clone() };
+        Ok(QNet {
+            width,
+            layers,
+            node_dim,
+            edge_dim,
+            node_mean: tensor("node_mean", &[node_dim])?,
+            node_std: tensor("node_std", &[node_dim])?,
+            edge_mean: tensor("edge_mean", &[edge_dim])?,
+            edge_std: tensor("edge_std", &[edge_dim])?,
+            node_encoder,
+            edge_encoder,
+            e1,
+            e2_fused,
+            e2,
+            n1,
+            n2,
+            temperature,
+            q1_node,
+            q1_pool,
+            q2,
+        })
+    }
+
+    /// Compares [`forward_graph`](Self::forward_graph) with tract on a generated graph of 13
+    /// parts (values in the features' ranges, nearest-neighbour-like edges, a context node).
+    fn self_check(&self, model: &GraphModel) -> std::result::Result<(), String> {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 40) as f32) / ((1u64 << 24) as f32)
+        };
+        let parts = 13;
+        let n = parts + 1;
+        let mut x: Vec<f32> = (0..n * self.node_dim).map(|_| uniform()).collect();
+        for k in 0..n {
+            x[k * self.node_dim] = 1.0;
+        }
+        let (mut sources, mut targets) = (Vec::new(), Vec::new());
+        for t in 0..parts {
+            for j in 1..=4 {
+                sources.push(((t + j) % parts) as i64);
+                targets.push(t as i64);
+            }
+            sources.push(parts as i64);
+            targets.push(t as i64);
+        }
+        let e = sources.len();
+        let attr: Vec<f32> = (0..e * self.edge_dim).map(|_| uniform()).collect();
+        let index = [sources, targets].concat();
+        let want = model.score(&x, n, &index, e, &attr).map_err(|err| err.to_string())?;
+        let nodes: Vec<usize> = (0..n).collect();
+        let mut got = vec![0.0; n];
+        self.forward_graph(&x, n, &index, &attr, &nodes, &mut got, &mut Scratch::default());
+        for (k, (a, b)) in got.iter().zip(&want).enumerate() {
+            let close = (a - b).abs() <= SELF_CHECK_TOLERANCE * b.abs().max(1.0);
+            if !close {
+                return Err(format!("the Rust forward pass gives {a} for node {k} of a test graph, tract {b}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Hidden width.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Floats per edge attribute row.
+    pub fn edge_dim(&self) -> usize {
+        self.edge_dim
+    }
+
+    /// An edge attribute row (`edge_dim` floats) to what [`forward`](Self::forward) reads of
+    /// that edge (`width` floats: the first layer's share of it). Depends only on the row, so
+    /// callers cache it per part pair. `scratch` holds `edge_dim` floats.
+    pub fn encode_edge(&self, attr: &[f32], out: &mut [f32], scratch: &mut Vec<f32>) {
+        self.encode_edges(attr, 1, out, scratch);
+    }
+
+    fn encode_edges(&self, attr: &[f32], rows: usize, out: &mut [f32], scratch: &mut Vec<f32>) {
+        let d = self.edge_dim;
+        let xs = grow(scratch, rows * d);
+        for (o, row) in xs.chunks_exact_mut(d).zip(attr.chunks_exact(d)) {
+            for (k, (o, v)) in o.iter_mut().zip(row).enumerate() {
+                *o = (v - self.edge_mean[k]) / self.edge_std[k];
+            }
+        }
+        self.edge_encoder.apply(xs, rows, true, out);
+    }
+
+    /// The Q-values of the `wanted` nodes of a graph in the model's input layout (`x [n,
+    /// node_dim]`, `edge_index [2, e]`, `edge_attr [e, edge_dim]`), into `out`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn forward_graph(&self, x: &[f32], n: usize, edge_index: &[i64], edge_attr: &[f32], wanted: &[usize], out: &mut [f32], s: &mut Scratch) {
+        let e = edge_index.len() / 2;
+        let mut enc = std::mem::take(&mut s.enc);
+        let mut rows = std::mem::take(&mut s.rows);
+        grow(&mut enc, e * self.width);
+        self.encode_edges(edge_attr, e, &mut enc, &mut rows);
+        let sources: Vec<u32> = edge_index[..e].iter().map(|&v| v as u32).collect();
+        let targets: Vec<u32> = edge_index[e..].iter().map(|&v| v as u32).collect();
+        self.forward(x, n, &sources, &targets, &enc[..e * self.width], wanted, out, s);
+        s.enc = enc;
+        s.rows = rows;
+    }
+
+    /// The Q-values of the `wanted` nodes into `out`: `x [n, node_dim]` the node attributes,
+    /// edge `k` from `sources[k]` to `targets[k]` with `edges[k * width..]` its
+    /// [`encode_edge`](Self::encode_edge).
+    #[allow(clippy::too_many_arguments)]
+    pub fn forward(&self, x: &[f32], n: usize, sources: &[u32], targets: &[u32], edges: &[f32], wanted: &[usize], out: &mut [f32], s: &mut Scratch) {
+        let w = self.width;
+        let e = sources.len();
+        let nd = self.node_dim;
+        // standardised node attributes, encoded
+        let xs = grow(&mut s.xs, n * nd);
+        for (o, row) in xs.chunks_exact_mut(nd).zip(x.chunks_exact(nd)) {
+            for (k, (o, v)) in o.iter_mut().zip(row).enumerate() {
+                *o = (v - self.node_mean[k]) / self.node_std[k];
+            }
+        }
+        let mut h = std::mem::take(&mut s.h);
+        grow(&mut h, n * w);
+        self.node_encoder.apply(&s.xs, n, true, &mut h);
+        let inv_count = grow(&mut s.inv_count, n);
+        inv_count.fill(0.0);
+        for &t in targets {
+            inv_count[t as usize] += 1.0;
+        }
+        for c in inv_count.iter_mut() {
+            *c = 1.0 / c.max(1.0);
+        }
+        grow(&mut s.p, n * w);
+        grow(&mut s.z, e * w);
+        grow(&mut s.a, e * 2 * w);
+        grow(&mut s.a_next, e * w);
+        grow(&mut s.m, e * w);
+        grow(&mut s.mean, n * w);
+        grow(&mut s.sums, n * 2 * w);
+        grow(&mut s.u, n * w);
+        // edge activations are column-major ([j * e + k]: feature j of edge k), see apply_columns
+        // the first layer's edge share: the cached encodings
+        for (k, row) in edges[..e * w].chunks_exact(w).enumerate() {
+            for (j, &v) in row.iter().enumerate() {
+                s.a_next[j * e + k] = v;
+            }
+        }
+        for layer in 0..self.layers {
+            let last = layer + 1 == self.layers;
+            // z = relu(W1 h_t + W1 a + W1 h_s + b1)
+            self.e1.apply(&h, n, false, &mut s.p);
+            for j in 0..w {
+                let b1 = self.e1.b[j];
+                let a = &s.a_next[j * e..(j + 1) * e];
+                let z = &mut s.z[j * e..(j + 1) * e];
+                for k in 0..e {
+                    let (t, src) = (targets[k] as usize, sources[k] as usize);
+                    z[k] = (s.p[t * w + j] + a[k] + s.p[src * w + j] + b1).max(0.0);
+                }
+            }
+            // the new edge state a' (columns 0..w) and, but for the last layer, W1 a' for the
+            // next (columns w..2w)
+            if last {
+                self.e2.apply_columns(&s.z, e, &mut s.a);
+            } else {
+                self.e2_fused.apply_columns(&s.z, e, &mut s.a);
+                s.a_next[..e * w].copy_from_slice(&s.a[w * e..2 * w * e]);
+            }
+            // messages m = relu(h_t + a') + eps and the learned softmax over each target's edges
+            let tau = self.temperature[layer];
+            let mean = &mut s.mean[..n * w];
+            mean.fill(0.0);
+            for j in 0..w {
+                let a = &s.a[j * e..(j + 1) * e];
+                let m = &mut s.m[j * e..(j + 1) * e];
+                for k in 0..e {
+                    let t = targets[k] as usize;
+                    m[k] = (h[t * w + j] + a[k]).max(0.0) + EPS;
+                    mean[t * w + j] += m[k] * tau;
+                }
+            }
+            for t in 0..n {
+                let c = s.inv_count[t];
+                for v in &mut mean[t * w..(t + 1) * w] {
+                    *v *= c;
+                }
+            }
+            let sums = &mut s.sums[..n * 2 * w];
+            sums.fill(0.0);
+            for j in 0..w {
+                let m = &s.m[j * e..(j + 1) * e];
+                for k in 0..e {
+                    let t = targets[k] as usize;
+                    let weight = (m[k] * tau - mean[t * w + j]).min(SCORE_CLAMP).exp();
+                    sums[t * 2 * w + j] += weight * m[k];
+                    sums[t * 2 * w + w + j] += weight;
+                }
+            }
+            // h = phi_n(h + aggregate)
+            for t in 0..n {
+                let st = &sums[t * 2 * w..(t + 1) * 2 * w];
+                for j in 0..w {
+                    s.u[t * w + j] = h[t * w + j] + st[j] / st[w + j].max(1.0);
+                }
+            }
+            self.n1.apply(&s.u, n, true, &mut s.p);
+            for v in &mut s.p[..n * w] {
+                *v = v.max(0.0);
+            }
+            self.n2.apply(&s.p, n, true, &mut h);
+        }
+        // q_i = phi_Q([h_i, hbar]), hbar the mean of the real nodes (x[:, 0] = 1)
+        let mut weight = 0.0f32;
+        let pooled = grow(&mut s.u, w);
+        pooled.fill(0.0);
+        for t in 0..n {
+            let r = x[t * nd];
+            weight += r;
+            for j in 0..w {
+                pooled[j] += r * h[t * w + j];
+            }
+        }
+        let norm = weight.max(1.0);
+        for v in pooled.iter_mut() {
+            *v /= norm;
+        }
+        let pool = grow(&mut s.mean, w);
+        self.q1_pool.apply(&s.u[..w], 1, true, pool);
+        let rows = grow(&mut s.z, wanted.len() * w);
+        for (r, &k) in rows.chunks_exact_mut(w).zip(wanted) {
+            r.copy_from_slice(&h[k * w..(k + 1) * w]);
+        }
+        let hidden = grow(&mut s.q_hidden, wanted.len() * w);
+        self.q1_node.apply(&s.z, wanted.len(), false, hidden);
+        for (o, row) in out.iter_mut().zip(hidden.chunks_exact(w)) {
+            let mut q = self.q2.b[0];
+            for ((r, p), v) in row.iter().zip(&s.mean[..w]).zip(&self.q2.w) {
+                q += (r + p).max(0.0) * v;
+            }
+            *o = q;
+        }
+        s.h = h;
+    }
+}
+
+/// `[rows, cols]` row-major to `[cols, rows]`.
+fn transpose(m: &[f32], rows: usize, cols: usize) -> Vec<f32> {
+    let mut t = vec![0.0; m.len()];
+    for r in 0..rows {
+        for c in 0..cols {
+            t[c * rows + r] = m[r * cols + c];
+        }
+    }
+    t
+}
+
+/// `first` then `second` as one map (`x W1 W2 + b1 W2 (+ b2)`), products in `f64`.
+fn compose(first: &Dense, second: &Dense, second_bias: bool) -> Dense {
+    let (i, k, o) = (first.input, first.output, second.output);
+    let mut w = vec![0.0f32; i * o];
+    for r in 0..i {
+        for c in 0..o {
+            let v: f64 = (0..k).map(|j| f64::from(first.w[r * k + j]) * f64::from(second.w[j * o + c])).sum();
+            w[r * o + c] = v as f32;
+        }
+    }
+    let b = (0..o)
+        .map(|c| {
+            let v: f64 = (0..k).map(|j| f64::from(first.b[j]) * f64::from(second.w[j * o + c])).sum();
+            (v + if second_bias { f64::from(second.b[c]) } else { 0.0 }) as f32
+        })
+        .collect();
+    Dense { input: i, output: o, w, b }
+}
