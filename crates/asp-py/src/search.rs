@@ -13,6 +13,7 @@ use asp_search::QUse;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 /// One episode's report: `(transitions_jsonl, episodes, iterations, seconds, value, front_size,
@@ -26,6 +27,8 @@ pub struct PySearch {
     objectives: Vec<String>,
     directions: usize,
     index: String,
+    /// Swaps counted when the result was taken.
+    swaps: AtomicUsize,
 }
 
 impl PySearch {
@@ -47,7 +50,7 @@ impl PySearch {
         let index = serde_json::to_string(search.index()).expect("the index serialises");
         let objectives = search.index().objectives.clone();
         let directions = search.problem().maps().num_directions();
-        Ok(PySearch { inner: Mutex::new(Some(search)), objectives, directions, index })
+        Ok(PySearch { inner: Mutex::new(Some(search)), objectives, directions, index, swaps: AtomicUsize::new(0) })
     }
 
     fn lock(&self) -> MutexGuard<'_, Option<SteppedSearch>> {
@@ -91,7 +94,7 @@ impl PySearch {
     /// Policies swapped in so far.
     #[getter]
     fn swaps(&self) -> usize {
-        self.lock().as_ref().map_or(0, SteppedSearch::swaps)
+        self.lock().as_ref().map_or_else(|| self.swaps.load(Ordering::Relaxed), SteppedSearch::swaps)
     }
 
     /// Whether the search has ended.
@@ -161,6 +164,7 @@ impl PySearch {
             }
         }
         let mut search = guard.take().expect("checked");
+        self.swaps.store(search.swaps(), Ordering::Relaxed);
         let result = py.detach(|| search.take_result()).map_err(|e| Error::from(e).into_py(py))?;
         let mut csv = Vec::new();
         if let Some(s) = &result.search {
