@@ -18,7 +18,8 @@ setting; ``--q``: the retrained setting, :mod:`asp.train.online`).
 ``python -m asp.train bench-mcts MODEL... --objective LIST --settings vanilla,online,pretrained,retrained
 --q MODELS --seconds 10,60`` compares the four settings at equal wall time (``asp bench mcts``'s table).
 
-Exit status 0 on success, 2 on bad input.
+Exit status 0 on success, 2 on bad input; `q-online` exits 1 when it found no complete sequence and
+130 when Ctrl-C ended it (after writing the plan of the episodes finished).
 """
 
 from __future__ import annotations
@@ -322,6 +323,8 @@ def _q_online(args: argparse.Namespace) -> int:
     opt = r.plan.optimisation or {}
     print(f"{r.plan.status}: {r.episodes} episodes, {r.swaps} model swaps, "
           + (f"hypervolume {opt.get('hypervolume')}" if opt.get("hypervolume") is not None else f"values {opt.get('values')}"))
+    if r.interrupted:
+        return 130
     return 0 if r.plan.found else 1
 
 

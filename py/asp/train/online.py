@@ -98,6 +98,8 @@ class OnlineResult:
     models: list[Path]
     trace: list[tuple[float, float, int]]
     """``(seconds, value, episodes)`` after each episode (training time included)."""
+    interrupted: bool = False
+    """Ctrl-C ended the search (the plan is that of the episodes finished)."""
 
 
 def _log_stderr(message: str) -> None:
@@ -174,9 +176,16 @@ def run_online(
     started = time.monotonic()
     trace: list[tuple[float, float, int]] = []
     episodes = 0
+    interrupted = False
     with open(lines_path, "w", encoding="utf-8") as lines_file:
         while True:
-            e = search.episode()
+            try:
+                e = search.episode()
+            except KeyboardInterrupt:  # the search has ended: keep what it found
+                interrupted = True
+                if log:
+                    log("interrupted: writing the plan of the episodes finished")
+                break
             episodes = e.episodes
             lines = e.transitions_jsonl
             lines_file.write(lines)
@@ -232,6 +241,7 @@ def run_online(
         search_seconds=search_seconds,
         models=[p for p in paths if p.exists()],
         trace=trace,
+        interrupted=interrupted,
     )
     doc = {
         "setting": "retrained" if pretrained else "online",
@@ -246,6 +256,7 @@ def run_online(
         "train_seconds": round(train_seconds, 3),
         "seconds": round(search_seconds, 3),
         "models": [str(p) for p in result.models],
+        "interrupted": interrupted,
     }
     (out / "online.json").write_text(json.dumps(doc, indent=2, default=str) + "\n")
     if log:
