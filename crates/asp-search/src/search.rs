@@ -43,6 +43,14 @@
 //! transitions per thread in order, threads in order, up to
 //! [`SearchBuilder::record_transitions_limit`] (split among the threads).
 //!
+//! # Stepping
+//! `solve_stepped` runs the same loop on one thread with an [`EpisodeHook`] called between
+//! episodes: it gets each episode's [`EpisodeEnd`] (its recorded transitions, the front so far)
+//! and may go on, swap the policy ([`Next::Policy`]: the tree stays, the thread's
+//! [`PolicyWorker`] is rebuilt) or stop. A hook that always goes on changes nothing: the answer
+//! is `solve`'s. [`crate::stepped::SteppedSearch`] drives it from another thread (Python's
+//! `Assembly.search`, the online Q-learning of thesis 6.5).
+//!
 //! # Plug-ins
 //! The rollout and expansion policy ([`Policy`], one [`PolicyWorker`] per thread), the
 //! objectives and the feasibility filters of the [`Mdp`] are the search's plug-ins. One that
