@@ -143,11 +143,12 @@ def test_bench_mcts_prints_the_four_settings_and_the_cli_points_to_it(cube: Path
     run_online(cube, tmp_path / "pre", OnlineConfig(objective="access", episodes=2, seed=1, **SMALL), log=None)
     q = str(tmp_path / "pre" / "q_access.onnx")
     p = subprocess.run(
-        [sys.executable, "-m", "asp.train", "bench-mcts", str(cube), "--objective", "access", "--q", q,
+        [sys.executable, "-m", "asp.train", "bench-mcts", str(cube.parent), "--objective", "access", "--q", q,
          "--seconds", "1,2", "--resolution", "5", "--steps-per-episode", "2", "--batch", "4", "--csv", str(tmp_path / "b.csv")],
         capture_output=True, text=True, timeout=600,
     )
     assert p.returncode == 0, p.stderr
+    assert "soma4_000" in p.stdout, p.stdout  # a folder of models is expanded
     for setting in ("vanilla", "online", "pretrained", "retrained"):
         assert f"  {setting}" in p.stdout, p.stdout
     assert "access at 2 s" in p.stdout and "mean over 1 model(s)" in p.stdout

@@ -329,10 +329,10 @@ def bench_mcts(
     last = float(checkpoints[-1])
     measure = "hypervolume" if len(objectives) > 1 else objectives[0]
     rows: list[dict] = []
-    names = [name for (_, _, name, _) in _asp.model_items([os.fspath(m) for m in models])]
+    items = [(path, name) for (path, _, name, _) in _asp.model_items([os.fspath(m) for m in models])]
     with tempfile.TemporaryDirectory() as tmp:
         scratch = Path(work) if work is not None else Path(tmp)
-        for path, name in zip(models, names):
+        for path, name in items:
             assembly = asp.load(path, **(load or {}))
             for setting in settings:
                 per_checkpoint: list[list[float]] = [[] for _ in checkpoints]
