@@ -39,7 +39,7 @@ use std::time::Duration;
 /// What the search thread sends back.
 enum Message {
     Episode(EpisodeEnd),
-    Done(Result<PlanResult>),
+    Done(Box<Result<PlanResult>>),
 }
 
 /// What [`SteppedSearch::poll`] found.
@@ -111,7 +111,7 @@ impl SteppedSearch {
                     Ok(Next::Continue) => o,
                     Ok(Next::Policy(p)) => OptimiseSettings { policy: Some(p), ..o },
                     Ok(Next::Stop) | Err(_) => {
-                        let _ = outbox.send(Message::Done(Err(SearchError::config("the stepped search ended before its first episode"))));
+                        let _ = outbox.send(Message::Done(Box::new(Err(SearchError::config("the stepped search ended before its first episode")))));
                         return;
                     }
                 };
@@ -130,7 +130,7 @@ impl SteppedSearch {
                     pipeline::optimise_problem(assembly, &settings, &o, problem, Some(&mut hook), record)
                 }))
                 .unwrap_or_else(|_| Err(SearchError::plugin("stepped search", "panicked")));
-                let _ = outbox.send(Message::Done(result));
+                let _ = outbox.send(Message::Done(Box::new(result)));
             })
             .map_err(|e| SearchError::config(format!("cannot start the search thread: {e}")))?;
         Ok(SteppedSearch {
@@ -222,8 +222,8 @@ impl SteppedSearch {
             Ok(Message::Done(result)) => {
                 self.waiting = false;
                 self.ended = true;
-                let failed = result.as_ref().err().map(|e| e.to_string());
-                self.result = Some(result);
+                let failed = result.as_ref().as_ref().err().map(|e| e.to_string());
+                self.result = Some(*result);
                 match failed {
                     // a plug-in's error surfaces at once (and again from finish)
                     Some(message) => Err(SearchError::plugin("stepped search", message)),
