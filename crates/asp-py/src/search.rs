@@ -66,6 +66,8 @@ impl PySearch {
             match polled {
                 Err(e) => return Err(raised.unwrap_or_else(|| Error::from(e).into_py(py))),
                 Ok(Poll::Pending) => {}
+                // interrupted: the search ends, even when the episode ended by itself meanwhile
+                Ok(Poll::Episode(end)) if raised.is_some() && !end.finished => search.request_finish(),
                 Ok(p) => {
                     if let Some(e) = raised {
                         return Err(e);
