@@ -19,11 +19,13 @@ from asp.errors import AspError, ConfigError, LoadError
 from asp.graph import Graph
 from asp.qgraphs import QGraphs
 from asp.result import ORDERS, Plan
+from asp.search import Episode, Search
 
 __all__ = [
     "Assembly",
     "AspError",
     "ConfigError",
+    "Episode",
     "Graph",
     "LoadError",
     "ORDERS",
@@ -31,6 +33,7 @@ __all__ = [
     "Part",
     "Plan",
     "QGraphs",
+    "Search",
     "__version__",
     "load",
     "plan",

@@ -36,6 +36,19 @@ class Assembly:
         """``(nodes int64, x float32, edge_index int64, edge_attr float32, node_dim, edge_dim, features)``,
         the arrays as little-endian bytes."""
     def q_graphs(self, settings: Dict[str, Any]) -> QGraphs: ...
+    def search(self, settings: Dict[str, Any], record: bool) -> Search:
+        """A stepped optimiser run with ``Assembly.plan``'s keywords (an objective needed)."""
+
+class Search:
+    index_json: str
+    swaps: int
+    ended: bool
+    def episode(self) -> Tuple[str, int, int, float, float, int, bool, bool, bool, bool]:
+        """``(transitions_jsonl, episodes, iterations, seconds, value, front_size, finished,
+        exhausted, stopped, capped)``."""
+    def set_q(self, paths: Sequence[Union[str, PathLike[str]]], epsilon: float = ..., q_use: str = ...) -> None: ...
+    def result(self) -> Tuple[str, bool, str]:
+        """``(plan_json, found, trace_csv)``."""
 
 class QGraphs:
     features: str
@@ -94,3 +107,5 @@ def bench_item(
     fixed: Sequence[str] = ...,
 ) -> str: ...
 def bench_table(rows: Sequence[str]) -> str: ...
+def mcts_table(rows: Sequence[str]) -> Tuple[str, str]:
+    """``(table, csv)`` of ``asp bench mcts`` for rows (JSON lists of its rows)."""

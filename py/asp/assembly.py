@@ -3,12 +3,14 @@ in one call."""
 
 from __future__ import annotations
 
+import inspect
 import math
 import os
 from dataclasses import dataclass
 from typing import Any, Iterable, Optional, Sequence, Tuple, Union
 
 from asp import _asp
+from asp.errors import ConfigError
 from asp.graph import Graph
 from asp.qgraphs import QGraphs
 from asp.result import Plan
@@ -242,6 +244,39 @@ class Assembly:
         }
         json, found, trace = self._native.plan(settings)
         return Plan(json, found, trace)
+
+    def search(self, *, record: bool = True, **settings: Any) -> "Search":
+        """A stepped optimiser run: the search of :meth:`plan` with ``objective``, run episode by
+        episode on one thread (its tree kept between episodes), with Q-functions swapped in
+        between episodes — what the online settings of thesis 6.5 need
+        (``python -m asp.train q-online``).
+
+        :param record: record each episode's transitions (the ``asp-transitions`` records).
+        :param settings: the keywords of :meth:`plan` (``objective`` required; ``threads`` is 1,
+            ``episodes`` the most episodes, ``time_limit`` the wall time from the first episode,
+            ``q`` the first episodes' Q models).
+        :raises ConfigError: no objective, or a bad setting (as :meth:`plan`).
+        :raises TypeError: an unknown keyword.
+
+        The maps are built here, without the GIL; see :class:`asp.Search`.
+        """
+        from asp.search import Search
+
+        bound = inspect.signature(Assembly.plan).bind(self, **settings)
+        bound.apply_defaults()
+        kw = dict(bound.arguments)
+        del kw["self"]
+        if kw.get("objective") is None:
+            raise ConfigError("objective: a search needs objectives")
+        if isinstance(kw["objective"], (list, tuple)):
+            kw["objective"] = list(kw["objective"])
+        if kw.get("model") is not None:
+            kw["model"] = str(kw["model"])
+        q = kw.get("q")
+        if q is not None and not isinstance(q, str):
+            kw["q"] = ",".join(os.fspath(m) for m in q)
+        kw["threads"] = 1
+        return Search(self._native.search(kw, record), kw)
 
     def graph(
         self,

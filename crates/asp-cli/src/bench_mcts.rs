@@ -107,8 +107,16 @@ pub fn run(a: &MctsArgs) -> anyhow::Result<std::process::ExitCode> {
                 let policy = asp_learn::epsilon_greedy(&paths, &objectives, a.epsilon, a.resolution * a.resolution, uses).context("--q")?;
                 MctsSetting { name: name.into(), policy }
             }
+            "online" | "retrained" => bail!(
+                "--settings: '{name}' trains the Q-functions during the search, which runs from Python: \
+                 python -m asp.train bench-mcts {} --objective {} --settings {} --q MODELS --seconds {} (pip install ./py[train])",
+                a.models.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(" "),
+                a.objective,
+                a.settings,
+                a.seconds
+            ),
             other => bail!(
-                "--settings: unknown setting '{other}' (vanilla, pretrained, pretrained-expansions, pretrained-both; the settings that train during the search run from Python)"
+                "--settings: unknown setting '{other}' (vanilla, pretrained, pretrained-expansions, pretrained-both here; online and retrained from Python: python -m asp.train bench-mcts)"
             ),
         });
     }
@@ -151,12 +159,7 @@ pub fn run(a: &MctsArgs) -> anyhow::Result<std::process::ExitCode> {
             .with_context(|| format!("{}: cannot write the benchmark rows", path.display()))?;
     }
     if let Some(path) = &a.csv {
-        let mut csv = String::from("model,setting,seconds,mean,std,episodes\n");
-        for r in &rows {
-            for (t, v) in r.checkpoints.iter().zip(&r.values) {
-                csv.push_str(&format!("{},{},{t},{},{},{}\n", r.model, r.setting, v.mean, v.std, r.episodes.mean));
-            }
-        }
+        let csv = bench_mcts::csv(&rows);
         collect::write_atomic(path, csv.as_bytes()).with_context(|| format!("{}: cannot write the CSV", path.display()))?;
     }
     stdout.flush()?;

@@ -3,6 +3,7 @@
 
 use crate::errors::Error;
 use crate::qgraphs::PyQGraphs;
+use crate::search::PySearch;
 use crate::settings::GraphSettings;
 use crate::{run, settings};
 use asp_geom::{AssemblyGraph, PartSet, World};
@@ -169,6 +170,13 @@ impl PyAssembly {
     /// (a dict), as a handle that gives the `asp-q/1` graph of any state (built without the GIL).
     fn q_graphs(&self, py: Python<'_>, settings: &Bound<'_, PyDict>) -> PyResult<PyQGraphs> {
         PyQGraphs::build(py, self.inner.clone(), settings)
+    }
+
+    /// A stepped optimiser run with the keyword settings of `asp.Assembly.plan` (a dict with an
+    /// objective), recording every episode's transitions when `record` is set (see
+    /// `crate::search`). The maps are built here, without the GIL.
+    fn search(&self, py: Python<'_>, settings: &Bound<'_, PyDict>, record: bool) -> PyResult<PySearch> {
+        PySearch::start(py, self.inner.clone(), settings, record)
     }
 
     fn __repr__(&self) -> String {

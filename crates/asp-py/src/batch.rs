@@ -199,3 +199,18 @@ pub fn bench_table(py: Python<'_>, rows: Vec<String>) -> PyResult<String> {
     bench::write_table(&mut out, &all).expect("writing to memory");
     Ok(String::from_utf8_lossy(&out).into_owned())
 }
+
+/// The table and CSV `asp bench mcts` writes, of its rows (JSON lists of `MctsRow`s,
+/// concatenated in order): `(table, csv)`. `python -m asp.train bench-mcts` measures the
+/// settings that train during the search and prints them through this.
+#[pyfunction]
+pub fn mcts_table(py: Python<'_>, rows: Vec<String>) -> PyResult<(String, String)> {
+    let mut all: Vec<asp_search::bench_mcts::MctsRow> = Vec::new();
+    for r in &rows {
+        let part: Vec<asp_search::bench_mcts::MctsRow> = serde_json::from_str(r).map_err(|e| json_error("benchmark rows", e).into_py(py))?;
+        all.extend(part);
+    }
+    let mut table = Vec::new();
+    asp_search::bench_mcts::write_table(&mut table, &all).expect("writing to memory");
+    Ok((String::from_utf8_lossy(&table).into_owned(), asp_search::bench_mcts::csv(&all)))
+}

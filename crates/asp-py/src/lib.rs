@@ -7,6 +7,7 @@
 //! - [`settings`]: Python keywords into [`asp_search::pipeline::PlanSettings`], order names;
 //! - [`qgraphs`]: the `asp-q/1` graphs of optimiser states (`Assembly.q_graphs`);
 //! - [`run`]: the pipeline with the GIL released, interruptible by Ctrl-C;
+//! - [`search`]: the stepped optimiser run of `Assembly.search` (online Q-learning);
 //! - [`batch`]: the items of `asp.batch` (generation, collection, benchmarks), JSON in and out;
 //! - [`errors`]: asp's errors as `asp.errors` exceptions.
 
@@ -15,6 +16,7 @@ pub mod batch;
 pub mod errors;
 pub mod qgraphs;
 pub mod run;
+pub mod search;
 pub mod settings;
 
 use pyo3::prelude::*;
@@ -43,6 +45,7 @@ fn asp_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(order_names, m)?)?;
     m.add_class::<assembly::PyAssembly>()?;
     m.add_class::<qgraphs::PyQGraphs>()?;
+    m.add_class::<search::PySearch>()?;
     m.add_function(wrap_pyfunction!(batch::profile_preset, m)?)?;
     m.add_function(wrap_pyfunction!(batch::generator_canonical, m)?)?;
     m.add_function(wrap_pyfunction!(batch::gen_item, m)?)?;
@@ -52,5 +55,6 @@ fn asp_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(batch::collect_index, m)?)?;
     m.add_function(wrap_pyfunction!(batch::bench_item, m)?)?;
     m.add_function(wrap_pyfunction!(batch::bench_table, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::mcts_table, m)?)?;
     Ok(())
 }

@@ -69,13 +69,21 @@ pub fn parse_methods<E: From<SearchError>>(
     Ok(out)
 }
 
-/// Mean and standard deviation (population) of a measure over the runs.
+/// Mean and standard deviation (population) of a measure over the runs. JSON writes a NaN (a
+/// measure not reached yet) as `null`, which reads back as NaN.
 #[derive(Clone, Copy, Debug, Default, Serialize, serde::Deserialize, PartialEq)]
 pub struct MeanStd {
     /// Mean.
+    #[serde(deserialize_with = "nan_or_number")]
     pub mean: f64,
     /// Standard deviation.
+    #[serde(deserialize_with = "nan_or_number")]
     pub std: f64,
+}
+
+/// A number, or NaN for `null`.
+fn nan_or_number<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Ok(<Option<f64> as serde::Deserialize>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 impl MeanStd {

@@ -216,6 +216,17 @@ pub fn write_table(out: &mut impl std::io::Write, rows: &[MctsRow]) -> std::io::
     Ok(())
 }
 
+/// The rows as CSV: `model,setting,seconds,mean,std,episodes`, one line per checkpoint.
+pub fn csv(rows: &[MctsRow]) -> String {
+    let mut csv = String::from("model,setting,seconds,mean,std,episodes\n");
+    for r in rows {
+        for (t, v) in r.checkpoints.iter().zip(&r.values) {
+            csv.push_str(&format!("{},{},{t},{},{},{}\n", r.model, r.setting, v.mean, v.std, r.episodes.mean));
+        }
+    }
+    csv
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

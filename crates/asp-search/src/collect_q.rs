@@ -248,18 +248,7 @@ fn collect_one(item: &ModelItem, out: &Path, settings: &TransitionSettings) -> R
     let o = OptimiseSettings { pareto: count > 1, threads: Some(1), time_limit: None, ..settings.optimise.clone() };
     let assembly = Arc::new(pipeline::load(&item.path, &plan)?);
     let problem = pipeline::optimiser_problem(&assembly, &plan, &o)?.mdp;
-    let maps = problem.maps();
-    let objectives = problem.objective_names();
-    let mut reward_ranges = Vec::with_capacity(objectives.len());
-    for objective in problem.objectives() {
-        let Some((lo, hi)) = objective.reward_range(maps) else {
-            return Err(SearchError::config(format!(
-                "objective '{}' has no reward range, so its rewards cannot be normalised for learning",
-                objective.name()
-            )));
-        };
-        reward_ranges.push([lo, hi]);
-    }
+    let (ranges, graph, objectives) = problem_entry(&problem)?;
     macro_rules! configure {
         ($builder:expr) => {{
             let mut b = $builder
@@ -281,9 +270,36 @@ fn collect_one(item: &ModelItem, out: &Path, settings: &TransitionSettings) -> R
     let folder = out.join(&item.dir);
     std::fs::create_dir_all(&folder).map_err(|e| io_error(&folder, e))?;
     write_lines(&folder.join("transitions.jsonl"), &problem, &outcome.transitions)?;
+    let mut entry = model_entry(item, &plan, &o, &problem, ranges)?;
+    entry.transitions = outcome.transitions.len();
+    entry.capped = outcome.transitions_capped;
+    entry.episodes_run = outcome.stats.episodes;
+    Ok((entry, graph, objectives))
+}
+
+/// The reward range of every objective of `problem` (learning normalises rewards by them), its
+/// graph configuration and its objectives' names.
+fn problem_entry(problem: &Mdp) -> Result<(Vec<[f64; 2]>, QGraphConfig, Vec<String>)> {
+    let maps = problem.maps();
+    let mut reward_ranges = Vec::with_capacity(problem.num_objectives());
+    for objective in problem.objectives() {
+        let Some((lo, hi)) = objective.reward_range(maps) else {
+            return Err(SearchError::config(format!(
+                "objective '{}' has no reward range, so its rewards cannot be normalised for learning",
+                objective.name()
+            )));
+        };
+        reward_ranges.push([lo, hi]);
+    }
+    Ok((reward_ranges, QGraphConfig::for_maps(maps), problem.objective_names()))
+}
+
+/// The index entry of `item` searched on `problem` (built with `plan` and `o`), without its
+/// transitions (`transitions`, `capped` and `episodes_run` are 0 and false).
+fn model_entry(item: &ModelItem, plan: &PlanSettings, o: &OptimiseSettings, problem: &Mdp, reward_ranges: Vec<[f64; 2]>) -> Result<TransitionsModel> {
+    let maps = problem.maps();
     let model = std::fs::canonicalize(&item.path).map_err(|e| io_error(&item.path, e))?;
-    let graph = QGraphConfig::for_maps(maps);
-    let entry = TransitionsModel {
+    Ok(TransitionsModel {
         name: item.name.clone(),
         dir: item.dir.clone(),
         model: model.display().to_string(),
@@ -293,7 +309,7 @@ fn collect_one(item: &ModelItem, out: &Path, settings: &TransitionSettings) -> R
             fixed: plan.fixed.clone(),
         },
         maps: MapsArgs {
-            objective: objectives.join(","),
+            objective: problem.objective_names().join(","),
             resolution: maps.hemisphere().resolution(),
             d_max: o.d_max,
             support: match o.support {
@@ -308,32 +324,54 @@ fn collect_one(item: &ModelItem, out: &Path, settings: &TransitionSettings) -> R
         parts: maps.num_parts(),
         removable: problem.removals(),
         reward_ranges,
-        transitions: outcome.transitions.len(),
-        capped: outcome.transitions_capped,
-        episodes_run: outcome.stats.episodes,
-    };
-    Ok((entry, graph, objectives))
+        transitions: 0,
+        capped: false,
+        episodes_run: 0,
+    })
+}
+
+/// The `index.json` of a data set holding the transitions of one model searched on `problem`
+/// (as `asp collect transitions` would write it, with no transitions yet): what a stepped
+/// search (`asp.Assembly.search`) tells the online learner, which writes its episodes' lines
+/// under `<item.dir>/transitions.jsonl` and keeps the counts up to date.
+pub fn stepped_index(item: &ModelItem, plan: &PlanSettings, o: &OptimiseSettings, problem: &Mdp, episodes: usize) -> Result<TransitionsIndex> {
+    let (ranges, graph, objectives) = problem_entry(problem)?;
+    let entry = model_entry(item, plan, o, problem, ranges)?;
+    Ok(TransitionsIndex {
+        format: FORMAT.into(),
+        version: VERSION,
+        features: graph.features(),
+        node_dim: graph.node_dim(),
+        edge_dim: graph.edge_dim(),
+        objectives,
+        seed: plan.seed,
+        episodes,
+        assemblies: vec![entry],
+    })
+}
+
+/// Writes `transitions` as lines of `transitions.jsonl` (one JSON object and a newline each).
+pub fn write_transition_lines(w: &mut dyn std::io::Write, problem: &Mdp, transitions: &[Transition]) -> std::io::Result<()> {
+    for t in transitions {
+        let line = TransitionLine {
+            episode: t.episode,
+            kind: kind_name(t.kind),
+            present: t.present.iter().collect(),
+            history: history(problem, &t.memory),
+            actions: &t.actions,
+            action: t.action,
+            rewards: &t.rewards,
+            next_history: history(problem, &t.next_memory),
+            next_actions: &t.next_actions,
+            complete: t.complete,
+        };
+        serde_json::to_writer(&mut *w, &line).map_err(std::io::Error::other)?;
+        w.write_all(b"\n")?;
+    }
+    Ok(())
 }
 
 /// Writes one JSON line per transition.
 fn write_lines(path: &Path, problem: &Mdp, transitions: &[Transition]) -> Result<()> {
-    collect::write_atomic_with(path, |w| {
-        for t in transitions {
-            let line = TransitionLine {
-                episode: t.episode,
-                kind: kind_name(t.kind),
-                present: t.present.iter().collect(),
-                history: history(problem, &t.memory),
-                actions: &t.actions,
-                action: t.action,
-                rewards: &t.rewards,
-                next_history: history(problem, &t.next_memory),
-                next_actions: &t.next_actions,
-                complete: t.complete,
-            };
-            serde_json::to_writer(&mut *w, &line).map_err(std::io::Error::other)?;
-            w.write_all(b"\n")?;
-        }
-        Ok(())
-    })
+    collect::write_atomic_with(path, |w| write_transition_lines(w, problem, transitions))
 }

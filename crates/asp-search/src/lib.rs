@@ -20,6 +20,7 @@ pub mod problem;
 pub mod qgraph;
 pub mod report;
 pub mod search;
+pub mod stepped;
 
 pub use dfs::Dfs;
 pub use error::{Result, SearchError};
@@ -30,7 +31,7 @@ pub use ordering::{Bookkeeping, BuiltinOrder, OrderingFactory, OrderingSource, P
 pub use pareto::ParetoMcts;
 pub use policy::{EpsilonGreedy, Policy, PolicyContext, PolicyWorker, QFunction, QUse, QWorker, RandomPolicy};
 pub use problem::{Budget, GroupMove, PlanOutcome, Problem, Progress, Stats, Status, Step, StopReason, Stuck, StuckReason, Subassembly};
-pub use search::{SearchOutcome, SearchStats, SearchStatus, Solution, StopToken, Transition};
+pub use search::{EpisodeEnd, EpisodeHook, Next, SearchOutcome, SearchStats, SearchStatus, Solution, StopToken, Transition};
 
 /// A planner: takes a problem apart within a budget. Every planner runs the same conformance
 /// tests (`tests/conformance`).

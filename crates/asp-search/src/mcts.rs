@@ -14,7 +14,7 @@
 
 use crate::error::{Result, SearchError};
 use crate::mdp::Mdp;
-use crate::search::{exploration_term, run, search_type, SearchOutcome, SelectContext, Tree, Variant};
+use crate::search::{exploration_term, run, search_type, EpisodeHook, SearchOutcome, SelectContext, Tree, Variant};
 
 search_type!(
     /// Single-objective Monte Carlo tree search with max-backup UCT.
@@ -25,13 +25,24 @@ search_type!(
 impl Mcts {
     /// Searches for the sequence with the largest total of the problem's single objective.
     pub fn solve(&self, problem: &Mdp) -> Result<SearchOutcome> {
+        self.solve_with(problem, None)
+    }
+
+    /// [`Mcts::solve`] episode by episode on one thread: `hook` is told what each episode did
+    /// and may swap the policy or stop the search between episodes (see [`EpisodeHook`]). With
+    /// a hook that always continues the answer is [`Mcts::solve`]'s with one thread.
+    pub fn solve_stepped(&self, problem: &Mdp, hook: &mut EpisodeHook<'_>) -> Result<SearchOutcome> {
+        self.solve_with(problem, Some(hook))
+    }
+
+    fn solve_with(&self, problem: &Mdp, hook: Option<&mut EpisodeHook<'_>>) -> Result<SearchOutcome> {
         if problem.num_objectives() != 1 {
             return Err(SearchError::config(format!(
                 "single-objective MCTS needs exactly one objective, got {}; use Pareto-MCTS",
                 problem.num_objectives()
             )));
         }
-        run::<MaxBackup>(problem, &self.settings)
+        run::<MaxBackup>(problem, &self.settings, hook)
     }
 }
 

@@ -19,7 +19,7 @@
 use crate::error::Result;
 use crate::hypervolume::{hypervolume_2d_in_place, ParetoFront};
 use crate::mdp::{Mdp, MAX_OBJECTIVES};
-use crate::search::{exploration_term, run, search_type, SearchOutcome, SelectContext, Tree, Variant};
+use crate::search::{exploration_term, run, search_type, EpisodeHook, SearchOutcome, SelectContext, Tree, Variant};
 
 /// Reference coordinate of the normalised hypervolume used by MOUCB.
 const NORMALISED_REFERENCE: f64 = -0.1;
@@ -33,7 +33,14 @@ search_type!(
 impl ParetoMcts {
     /// Searches for the Pareto front of the problem's objectives.
     pub fn solve(&self, problem: &Mdp) -> Result<SearchOutcome> {
-        run::<FrontBackup>(problem, &self.settings)
+        run::<FrontBackup>(problem, &self.settings, None)
+    }
+
+    /// [`ParetoMcts::solve`] episode by episode on one thread: `hook` is told what each episode
+    /// did and may swap the policy or stop the search between episodes (see [`EpisodeHook`]).
+    /// With a hook that always continues the answer is [`ParetoMcts::solve`]'s with one thread.
+    pub fn solve_stepped(&self, problem: &Mdp, hook: &mut EpisodeHook<'_>) -> Result<SearchOutcome> {
+        run::<FrontBackup>(problem, &self.settings, Some(hook))
     }
 }
 

@@ -14,7 +14,7 @@ use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step
 use crate::grid::GridRun;
 use asp_geom::grid::{GridConfig, VoxelModel};
 use crate::report::{GridEntry, OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
-use crate::search::{SearchOutcome, SearchStatus, StopToken, DEFAULT_BUDGET, DEFAULT_EPISODES};
+use crate::search::{EpisodeHook, SearchOutcome, SearchStatus, StopToken, DEFAULT_BUDGET, DEFAULT_EPISODES};
 use crate::{Dfs, Mcts, Mdp, ParetoMcts, Planner, Result, SearchError};
 use asp_geom::distmap::{DistanceMaps, MapConfig, Support};
 use asp_geom::io::LoadOptions;
@@ -468,10 +468,31 @@ pub fn optimiser_problem(assembly: &Arc<Assembly>, settings: &PlanSettings, o: &
 /// Optimises a sequence of `assembly` on distance maps (MCTS for one objective, Pareto-MCTS
 /// for several).
 pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<PlanResult> {
-    let OptimiserProblem { mdp, map_seconds } = optimiser_problem(&assembly, settings, o)?;
+    let problem = optimiser_problem(&assembly, settings, o)?;
+    optimise_problem(assembly, settings, o, problem, None, false)
+}
+
+/// [`optimise`] on a problem built by [`optimiser_problem`], episode by episode on one thread
+/// when a `hook` is given ([`crate::Mcts::solve_stepped`]: it sees each episode's transitions,
+/// recorded when `record` is set, and may swap the policy between episodes). The one search loop and report of `asp plan
+/// --objective`, the stepped search of `asp.Assembly.search` and the online Q-learning.
+pub fn optimise_problem(
+    assembly: Arc<Assembly>,
+    settings: &PlanSettings,
+    o: &OptimiseSettings,
+    problem: OptimiserProblem,
+    hook: Option<&mut EpisodeHook<'_>>,
+    record: bool,
+) -> Result<PlanResult> {
+    let OptimiserProblem { mdp, map_seconds } = problem;
     let maps = mdp.maps_arc().clone();
     let model = ModelContext { assembly: &assembly, maps: &maps, seed: settings.seed };
-    let threads = o.threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let stepped = hook.is_some();
+    let threads = match (&hook, o.threads) {
+        (Some(_), _) => 1,
+        (None, Some(t)) => t,
+        (None, None) => std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
     macro_rules! configure {
         ($builder:expr) => {{
             let mut b = $builder
@@ -479,7 +500,8 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
                 .episodes(o.episodes)
                 .threads(threads)
                 .seed(settings.seed)
-                .exploration(o.exploration);
+                .exploration(o.exploration)
+                .record_transitions(stepped && record);
             if let Some(t) = o.time_limit {
                 b = b.time_limit(Duration::from_secs_f64(positive("the time limit", t)?));
             }
@@ -492,10 +514,11 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
             b.build()?
         }};
     }
-    let outcome = if o.pareto {
-        configure!(ParetoMcts::builder()).solve(&mdp)?
-    } else {
-        configure!(Mcts::builder()).solve(&mdp)?
+    let outcome = match (o.pareto, hook) {
+        (true, None) => configure!(ParetoMcts::builder()).solve(&mdp)?,
+        (false, None) => configure!(Mcts::builder()).solve(&mdp)?,
+        (true, Some(h)) => configure!(ParetoMcts::builder()).solve_stepped(&mdp, h)?,
+        (false, Some(h)) => configure!(Mcts::builder()).solve_stepped(&mdp, h)?,
     };
     let plan = adapt(&maps, &outcome);
     let mut warnings = assembly.warnings.clone();

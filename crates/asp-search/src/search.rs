@@ -43,6 +43,14 @@
 //! transitions per thread in order, threads in order, up to
 //! [`SearchBuilder::record_transitions_limit`] (split among the threads).
 //!
+//! # Stepping
+//! `solve_stepped` runs the same loop on one thread with an [`EpisodeHook`] called between
+//! episodes: it gets each episode's [`EpisodeEnd`] (its recorded transitions, the front so far)
+//! and may go on, swap the policy ([`Next::Policy`]: the tree stays, the thread's
+//! [`PolicyWorker`] is rebuilt) or stop. A hook that always goes on changes nothing: the answer
+//! is `solve`'s. [`crate::stepped::SteppedSearch`] drives it from another thread (Python's
+//! `Assembly.search`, the online Q-learning of thesis 6.5).
+//!
 //! # Plug-ins
 //! The rollout and expansion policy ([`Policy`], one [`PolicyWorker`] per thread), the
 //! objectives and the feasibility filters of the [`Mdp`] are the search's plug-ins. One that
@@ -537,6 +545,50 @@ pub struct Transition {
     pub complete: bool,
 }
 
+/// What the stepped search ([`crate::Mcts::solve_stepped`], [`crate::ParetoMcts::solve_stepped`])
+/// tells its hook after each episode.
+#[derive(Clone, Debug)]
+pub struct EpisodeEnd {
+    /// Episodes finished so far.
+    pub episodes: u64,
+    /// Iterations since the previous report.
+    pub iterations: u64,
+    /// Seconds since the previous report (the hook's own time included).
+    pub seconds: f64,
+    /// The front's hypervolume (several objectives) or the best total so far (0 before the first
+    /// complete sequence), as the trace reports it.
+    pub value: f64,
+    /// Points on the front so far.
+    pub front_size: usize,
+    /// The transitions the episode recorded ([`SearchBuilder::record_transitions`]; the limit
+    /// holds per episode), in the order it took them.
+    pub transitions: Vec<Transition>,
+    /// Whether the episode reached the recording limit.
+    pub transitions_capped: bool,
+    /// The last report: the search ends after it (the hook's answer is ignored).
+    pub finished: bool,
+    /// Whether every sequence has been explored (the search ends).
+    pub exhausted: bool,
+    /// Whether a time limit or a stop token stopped the search.
+    pub stopped: bool,
+}
+
+/// The hook's answer between two episodes of a stepped search.
+#[derive(Clone, Debug)]
+pub enum Next {
+    /// Run the next episode with the same policy.
+    Continue,
+    /// Run the next episodes with this policy (e.g. Q-functions retrained on the transitions
+    /// so far); the tree stays.
+    Policy(Arc<dyn Policy>),
+    /// End the search now (its answer is that of the episodes run).
+    Stop,
+}
+
+/// The stepped search's hook: called between episodes with what the last one did. An error
+/// ends the search with it.
+pub type EpisodeHook<'h> = dyn FnMut(EpisodeEnd) -> Result<Next> + Send + 'h;
+
 /// A worker's recording: the transitions so far, the step being recorded (until the feasible
 /// actions of its `s'` are known) and scratch.
 struct Recorder {
@@ -678,9 +730,14 @@ impl<V> Tree<V> {
         &self.memory[n as usize * self.w..(n as usize + 1) * self.w]
     }
 
+    /// Whether node `n` has priors (it was added while the policy gave priors).
+    fn has_priors(&self, n: u32) -> bool {
+        self.prior_spans.get(n as usize).is_some_and(|s| s.0 != NONE)
+    }
+
     /// The prior node `n` gave `action` (0 when it gave none).
     fn prior_of(&self, n: u32, action: usize) -> f32 {
-        let Some(&(from, to)) = self.prior_spans.get(n as usize) else { return 0.0 };
+        let Some(&(from, to)) = self.prior_spans.get(n as usize).filter(|s| s.0 != NONE) else { return 0.0 };
         self.node_priors[from as usize..to as usize].iter().find(|(a, _)| *a as usize == action).map_or(0.0, |p| p.1)
     }
 
@@ -815,8 +872,9 @@ struct Worker<'p, V: Variant> {
     tree: Tree<V::Value>,
     rng: SearchRng,
     sim: MapState<'p>,
-    policy: Box<dyn PolicyWorker + 'p>,
-    /// Whether the policy gives priors.
+    /// The thread's index.
+    thread: usize,
+    /// Whether the current policy gives priors.
     priors: bool,
     actions: Vec<usize>,
     candidates: Vec<u32>,
@@ -872,8 +930,6 @@ impl<'p, V: Variant> Worker<'p, V> {
         let mut filtered = problem.filter_counts();
         let mut actions = Vec::with_capacity(n);
         problem.feasible_actions(&mut sim, &memory, StepKind::Expansion, &mut actions, &mut filtered);
-        let policy = settings.policy.for_worker(thread)?;
-        let priors = policy.has_priors();
         let full = PartSet::full(n);
         let complete = sim.is_complete();
         let root = Node {
@@ -911,7 +967,7 @@ impl<'p, V: Variant> Worker<'p, V> {
         if settings.transpositions {
             tree.index.insert(state_hash(&tree.sets[0].present, tree.memory(0), problem), 0);
         }
-        let mut worker = Worker {
+        let worker = Worker {
             problem,
             settings,
             m,
@@ -920,8 +976,8 @@ impl<'p, V: Variant> Worker<'p, V> {
             tree,
             rng: rng_for(settings.seed, thread as u64),
             sim,
-            policy,
-            priors,
+            thread,
+            priors: false,
             actions,
             candidates: Vec::with_capacity(n),
             untried: Vec::with_capacity(n),
@@ -954,20 +1010,34 @@ impl<'p, V: Variant> Worker<'p, V> {
                 counts: problem.filter_counts(),
             }),
         };
-        if worker.priors {
-            worker.record_priors()?;
-        }
         Ok(worker)
+    }
+
+    /// Takes `policy` (this thread's worker of the search's policy, or of a policy swapped in
+    /// between episodes) as the one the next episodes use. A policy that gives priors asks for
+    /// the root's at the start (the simulated state is the root's then); nodes added while the
+    /// policy gave none have none ([`Tree::prior_of`]).
+    fn adopt(&mut self, policy: &mut dyn PolicyWorker) -> Result<()> {
+        self.priors = policy.has_priors();
+        if !self.priors {
+            return Ok(());
+        }
+        if self.tree.prior_spans.is_empty() && self.tree.nodes.len() == 1 && self.stats.iterations == 0 {
+            return self.record_priors(policy);
+        }
+        self.tree.prior_spans.resize(self.tree.nodes.len(), (NONE, NONE));
+        self.tree.edge_priors.resize(self.tree.edges.len(), 0.0);
+        Ok(())
     }
 
     /// Asks the policy for the priors of `self.actions` in the simulated state (that of the
     /// node just added) and keeps them for that node.
-    fn record_priors(&mut self) -> Result<()> {
+    fn record_priors(&mut self, policy: &mut dyn PolicyWorker) -> Result<()> {
         let count = self.actions.len();
         self.prior_buf.clear();
         self.prior_buf.resize(count, 0.0);
         let mut ctx = PolicyContext { state: &mut self.sim, memory: &self.memory, problem: self.problem };
-        self.policy.priors(&mut ctx, &self.actions, &mut self.prior_buf)?;
+        policy.priors(&mut ctx, &self.actions, &mut self.prior_buf)?;
         let from = self.tree.node_priors.len() as u32;
         self.tree.node_priors.extend(self.actions.iter().zip(&self.prior_buf).map(|(&a, &p)| (a as u16, p as f32)));
         self.tree.prior_spans.push((from, self.tree.node_priors.len() as u32));
@@ -1007,7 +1077,7 @@ impl<'p, V: Variant> Worker<'p, V> {
     }
 
     /// One episode: search steps from the root down to a complete sequence.
-    fn episode(&mut self) {
+    fn episode(&mut self, policy: &mut dyn PolicyWorker) {
         self.episode_iterations = 0;
         self.path.clear();
         self.path_edges.clear();
@@ -1024,7 +1094,7 @@ impl<'p, V: Variant> Worker<'p, V> {
                 if self.tree.nodes[current as usize].status != Status::Open {
                     break;
                 }
-                if let Err(e) = self.iterate() {
+                if let Err(e) = self.iterate(policy) {
                     self.error = Some(e);
                     self.stopped = true;
                     return;
@@ -1073,7 +1143,7 @@ impl<'p, V: Variant> Worker<'p, V> {
     }
 
     /// Selection, expansion, rollout and backpropagation from the end of the path.
-    fn iterate(&mut self) -> Result<()> {
+    fn iterate(&mut self, policy: &mut dyn PolicyWorker) -> Result<()> {
         let m = self.m;
         let w = self.w;
         let base = self.path.len();
@@ -1114,7 +1184,7 @@ impl<'p, V: Variant> Worker<'p, V> {
         ret[..m].copy_from_slice(&self.path_prefix[self.path_prefix.len() - m..]);
         self.untried.clear();
         self.untried.extend(self.tree.sets[parent as usize].untried.iter());
-        let untried_priors = if self.priors {
+        let untried_priors = if self.priors && self.tree.has_priors(parent) {
             self.untried_priors.clear();
             for &a in &self.untried {
                 self.untried_priors.push(self.tree.prior_of(parent, a) as f64);
@@ -1125,7 +1195,7 @@ impl<'p, V: Variant> Worker<'p, V> {
         };
         let pick = {
             let mut ctx = PolicyContext { state: &mut self.sim, memory: &self.memory, problem: self.problem };
-            self.policy.expand(&mut ctx, &self.untried, untried_priors, &mut self.rng)?
+            policy.expand(&mut ctx, &self.untried, untried_priors, &mut self.rng)?
         };
         let Some(&action) = self.untried.get(pick) else {
             return Err(SearchError::plugin(
@@ -1207,7 +1277,7 @@ impl<'p, V: Variant> Worker<'p, V> {
                 self.tree.values.push(V::Value::default());
                 self.tree.memory.extend_from_slice(&self.memory[..w]);
                 if self.priors {
-                    self.record_priors()?;
+                    self.record_priors(policy)?;
                 }
                 id
             };
@@ -1279,7 +1349,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             while !self.actions.is_empty() {
                 let k = {
                     let mut ctx = PolicyContext { state: &mut self.sim, memory: &self.memory, problem: self.problem };
-                    self.policy.choose(&mut ctx, &self.actions, &mut self.rng)?
+                    policy.choose(&mut ctx, &self.actions, &mut self.rng)?
                 };
                 let Some(&p) = self.actions.get(k) else {
                     return Err(SearchError::plugin(
@@ -1431,9 +1501,21 @@ impl<'p, V: Variant> Worker<'p, V> {
         }
     }
 
-    /// Runs `episodes` episodes (or until the time limit, a stop or the root is finished).
-    fn run(&mut self, episodes: usize, shared: &Mutex<Shared>, reference: &[f64], start: Instant) {
-        for _ in 0..episodes {
+    /// Runs `episodes` episodes (or until the time limit, a stop or the root is finished) with
+    /// the settings' policy. With a `hook` (the stepped search) the hook is asked before every
+    /// episode after the first, with what the previous one did, whether to go on, swap the
+    /// policy or stop, and once more when the search ends.
+    fn run(&mut self, episodes: usize, shared: &Mutex<Shared>, reference: &[f64], start: Instant, mut hook: Option<&mut EpisodeHook<'_>>) {
+        let mut current = self.settings.policy.clone();
+        let mut policy = match current.for_worker(self.thread) {
+            Ok(p) => p,
+            Err(e) => return self.fail(e),
+        };
+        if let Err(e) = self.adopt(&mut *policy) {
+            return self.fail(e);
+        }
+        let mut last = (self.stats.iterations, start.elapsed());
+        for k in 0..episodes {
             if self.stopped || self.root_finished() {
                 break;
             }
@@ -1441,8 +1523,27 @@ impl<'p, V: Variant> Worker<'p, V> {
                 self.stopped = true;
                 break;
             }
+            if let (Some(h), true) = (hook.as_deref_mut(), k > 0) {
+                let report = self.report(shared, start, &mut last, false);
+                match h(report) {
+                    Ok(Next::Continue) => {}
+                    Ok(Next::Stop) => break,
+                    Ok(Next::Policy(p)) => {
+                        drop(policy);
+                        current = p;
+                        policy = match current.for_worker(self.thread) {
+                            Ok(p) => p,
+                            Err(e) => return self.fail(e),
+                        };
+                        if let Err(e) = self.adopt(&mut *policy) {
+                            return self.fail(e);
+                        }
+                    }
+                    Err(e) => return self.fail(e),
+                }
+            }
             let before = self.stats.iterations;
-            self.episode();
+            self.episode(&mut *policy);
             if let Some(rec) = &mut self.record {
                 rec.episode += 1;
             }
@@ -1451,6 +1552,52 @@ impl<'p, V: Variant> Worker<'p, V> {
             }
             self.sync(shared, reference, start, self.stats.iterations - before);
         }
+        if let Some(h) = hook {
+            let report = self.report(shared, start, &mut last, true);
+            if let Err(e) = h(report) {
+                return self.fail(e);
+            }
+        }
+        self.finish();
+    }
+
+    /// Ends the run with a plug-in's (or the hook's) error.
+    fn fail(&mut self, e: SearchError) {
+        self.error = Some(e);
+        self.stopped = true;
+        self.finish();
+    }
+
+    /// What the episode just run did, for the stepped search's hook: its transitions (taken out
+    /// of the recording, whose limit is then per episode), and the front so far.
+    fn report(&mut self, shared: &Mutex<Shared>, start: Instant, last: &mut (u64, Duration), last_call: bool) -> EpisodeEnd {
+        let (transitions, transitions_capped) = match &mut self.record {
+            Some(rec) => {
+                let capped = std::mem::replace(&mut rec.capped, false);
+                (std::mem::take(&mut rec.transitions), capped)
+            }
+            None => (Vec::new(), false),
+        };
+        let s = shared.lock().unwrap_or_else(|e| e.into_inner());
+        let now = start.elapsed();
+        let report = EpisodeEnd {
+            episodes: self.stats.episodes,
+            iterations: self.stats.iterations - last.0,
+            seconds: (now - last.1).as_secs_f64(),
+            value: if s.front.is_empty() { 0.0 } else { s.last_value.unwrap_or(0.0) },
+            front_size: s.front.len(),
+            transitions,
+            transitions_capped,
+            finished: last_call,
+            exhausted: self.root_finished(),
+            stopped: self.stopped,
+        };
+        *last = (self.stats.iterations, now);
+        report
+    }
+
+    /// The statistics and the graph's answers at the end of a run.
+    fn finish(&mut self) {
         self.stats.tree_nodes = self.tree.nodes.len() as u64;
         self.stats.exhausted = self.root_finished();
         let c = self.sim.counters();
@@ -1556,8 +1703,16 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "(no message)".into())
 }
 
-/// Runs the search of variant `V` on `problem`.
-pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Result<SearchOutcome> {
+/// Runs the search of variant `V` on `problem`; with a `hook`, one thread, episode by episode
+/// (see [`EpisodeHook`]).
+pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings, hook: Option<&mut EpisodeHook<'_>>) -> Result<SearchOutcome> {
+    if hook.is_some() && settings.threads != 1 {
+        return Err(SearchError::config(format!(
+            "a stepped search runs on one thread, not {} (the policy may change between its episodes)",
+            settings.threads
+        )));
+    }
+    let hook = Mutex::new(hook);
     let m = problem.num_objectives();
     let reference = match &settings.reference {
         Some(r) if r.len() != m => {
@@ -1588,7 +1743,8 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings) -> Resul
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             let first_episode = (0..t).map(share).sum::<usize>() as u64;
             let mut w = Worker::<V>::new(problem, settings, t, start, &abort, first_episode)?;
-            w.run(share(t), &shared, &reference, start);
+            let mut hook = hook.lock().unwrap_or_else(|e| e.into_inner());
+            w.run(share(t), &shared, &reference, start, hook.as_deref_mut());
             match w.error.take() {
                 Some(e) => Err(e),
                 None => Ok((w.archive, w.stats, w.filtered, w.tree.nodes[0].status, w.record.take())),

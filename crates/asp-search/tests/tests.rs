@@ -13,5 +13,6 @@ mod pareto;
 mod qgraph;
 mod real;
 mod seams;
+mod stepped;
 mod transitions;
 mod verify;

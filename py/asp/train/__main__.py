@@ -8,9 +8,18 @@ accuracy). ``--holdout NAME...`` keeps assemblies out of training and reports th
 
 ``python -m asp.train q DATA_DIR... --objective NAME --out q.onnx [options]`` learns the Q-function of
 one objective by deep Q-learning on ``asp-transitions`` data sets (:mod:`asp.train.q`) and writes the
-ONNX Q model plus ``q.onnx.json`` (settings, loss curve, ranking quality per held-out assembly).
+ONNX Q model plus ``q.onnx.json`` (settings, loss curve, ranking quality per held-out assembly) and
+``q.onnx.pt`` (the weights, for retraining).
 
-Exit status 0 on success, 2 on bad input.
+``python -m asp.train q-online MODEL --objective LIST --seconds S --out DIR [--q PRETRAINED...]`` runs
+the optimiser on MODEL with its Q-functions trained after every episode (thesis 6.5's online
+setting; ``--q``: the retrained setting, :mod:`asp.train.online`).
+
+``python -m asp.train bench-mcts MODEL... --objective LIST --settings vanilla,online,pretrained,retrained
+--q MODELS --seconds 10,60`` compares the four settings at equal wall time (``asp bench mcts``'s table).
+
+Exit status 0 on success, 2 on bad input; `q-online` exits 1 when it found no complete sequence and
+130 when Ctrl-C ended it (after writing the plan of the episodes finished).
 """
 
 from __future__ import annotations
@@ -23,6 +32,7 @@ import sys
 from pathlib import Path
 
 from ..data import DataError
+from ..errors import AspError
 from .export import ExportError, export_onnx, write_parity_cases
 from .trainer import AssemblyData, TrainConfig, evaluate, load_assemblies, train
 
@@ -58,7 +68,50 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--holdout", nargs="+", metavar="NAME", default=[], help="assemblies to evaluate on, not train on")
     g.add_argument("--leave-one-out", type=Path, metavar="OUT_DIR", help="one model per assembly, trained on the others")
     _q_parser(sub)
+    _online_parsers(sub)
     return p
+
+
+def _online_flags(o) -> None:
+    o.add_argument("--objective", required=True, metavar="LIST", help="objectives, comma-separated (several: Pareto-MCTS)")
+    o.add_argument("--steps-per-episode", type=int, default=20, help="deep Q-learning steps after each episode (default 20)")
+    o.add_argument("--batch", type=int, default=5, help="transitions per step (default 5, the thesis')")
+    o.add_argument("--buffer", type=int, default=10_000, help="replay buffer capacity (default 10000)")
+    o.add_argument("--target-sync", type=int, default=100, help="steps between target network syncs (default 100)")
+    o.add_argument("--lr", type=float, default=1e-3, help="Adam learning rate (default 1e-3)")
+    o.add_argument("--layers", type=int, default=3, help="GNN layers of a new network (default 3)")
+    o.add_argument("--width", type=int, default=64, help="hidden width of a new network (default 64)")
+    o.add_argument("--threads", type=int, default=1, help="PyTorch CPU threads (default 1)")
+    o.add_argument("--epsilon", type=float, default=0.2, help="probability of a random removal in a guided rollout (default 0.2)")
+    o.add_argument("--q-use", choices=["rollouts", "expansions", "both"], default="rollouts", help="where the Q models guide (default rollouts)")
+    o.add_argument("--budget", type=int, default=5, help="MCTS iterations per step (default 5)")
+    o.add_argument("--resolution", type=int, default=9, help="distance map resolution (default 9)")
+    o.add_argument("--unit", help="the model's unit (mm, ...), as asp plan --unit")
+    o.add_argument("--up", help="the up axis (+z, ...), as asp plan --up")
+    o.add_argument(
+        "--aggregation", choices=["scatter", "dense"], default="dense",
+        help="aggregation ops in the ONNX files (default dense)",
+    )
+
+
+def _online_parsers(sub) -> None:
+    o = sub.add_parser("q-online", help="optimise with Q-functions trained after each episode (thesis 6.5)")
+    o.add_argument("model", metavar="MODEL", help="the model to plan (.glb, .gltf or a folder of OBJ/STL parts)")
+    o.add_argument("--out", type=Path, required=True, help="folder for plan.json, trace.csv, the models and the transitions")
+    o.add_argument("--seconds", type=float, help="wall time of the search, training included")
+    o.add_argument("--episodes", type=int, help="the most episodes (reproducible without --seconds)")
+    o.add_argument("--q", metavar="MODELS", help="pretrained Q models, comma-separated, one per objective: the retrained setting")
+    o.add_argument("--seed", type=int, default=0, help="seed of the search and the networks (default 0)")
+    _online_flags(o)
+    b = sub.add_parser("bench-mcts", help="vanilla, online, pretrained and retrained MCTS at equal wall time (thesis Fig. 6.6/6.7)")
+    b.add_argument("models", nargs="+", metavar="MODEL", help="models, or folders of them")
+    b.add_argument("--settings", default="vanilla,online,pretrained,retrained", help="settings, comma-separated (default all four)")
+    b.add_argument("--q", metavar="MODELS", help="pretrained Q models, one per objective (pretrained, retrained)")
+    b.add_argument("--seconds", default="10,60", help="checkpoints, seconds, increasing; each run lasts the last (default 10,60)")
+    b.add_argument("--runs", type=int, default=1, help="runs per model and setting, seeds 0, 1, ... (default 1)")
+    b.add_argument("--csv", type=Path, help="also write the rows as CSV")
+    b.add_argument("--json", type=Path, help="also write the rows as JSON")
+    _online_flags(b)
 
 
 def _q_parser(sub) -> None:
@@ -191,7 +244,7 @@ def _removability(args: argparse.Namespace) -> int:
 
 
 def _q(args: argparse.Namespace) -> int:
-    from .q import QConfig, config_dict, export_q, open_q_assemblies, ranking_quality, train_q, BindingGraphs
+    from .q import QConfig, config_dict, export_q, open_q_assemblies, ranking_quality, save_q_weights, train_q, BindingGraphs
 
     assemblies, features, node_dim, edge_dim = open_q_assemblies(args.data, args.objective)
     by_name = {a.name: a for a in assemblies}
@@ -214,6 +267,7 @@ def _q(args: argparse.Namespace) -> int:
     model, summary = train_q(train_set, node_dim, edge_dim, config, graphs, log=_log)
     parity = export_q(model, args.out, features, args.objective, aggregation=args.aggregation, tolerance=args.parity_tolerance)
     _log(f"wrote {args.out} (ONNX matches PyTorch to {parity:.2g}, padded graphs included)")
+    save_q_weights(model, str(args.out) + ".pt", features, args.objective)
     train_rank = {a.name: ranking_quality(model, a, graphs, max_states=args.eval_states) for a in train_set}
     held = {a.name: ranking_quality(model, a, graphs, max_states=args.eval_states) for a in test_set}
     for name, r in held.items():
@@ -241,22 +295,83 @@ def _q(args: argparse.Namespace) -> int:
     return 0
 
 
+def _online_config(args: argparse.Namespace, **more):
+    from .online import OnlineConfig
+
+    return OnlineConfig(
+        objective=args.objective, steps_per_episode=args.steps_per_episode, batch=args.batch, buffer=args.buffer,
+        target_sync=args.target_sync, lr=args.lr, layers=args.layers, width=args.width, threads=args.threads,
+        epsilon=args.epsilon, q_use=args.q_use, budget=args.budget, resolution=args.resolution,
+        aggregation=args.aggregation, **more,
+    )
+
+
+def _load_args(args: argparse.Namespace) -> dict:
+    return {k: v for k, v in (("unit", args.unit), ("up", args.up)) if v is not None}
+
+
+def _q_online(args: argparse.Namespace) -> int:
+    from .online import run_online
+
+    if args.seconds is None and args.episodes is None:
+        raise DataError("give --seconds, --episodes or both")
+    q = [p.strip() for p in args.q.split(",") if p.strip()] if args.q else None
+    more = {"seconds": args.seconds, "seed": args.seed, "q": q}
+    if args.episodes is not None:
+        more["episodes"] = args.episodes
+    r = run_online(args.model, args.out, _online_config(args, **more), load=_load_args(args))
+    opt = r.plan.optimisation or {}
+    print(f"{r.plan.status}: {r.episodes} episodes, {r.swaps} model swaps, "
+          + (f"hypervolume {opt.get('hypervolume')}" if opt.get("hypervolume") is not None else f"values {opt.get('values')}"))
+    if r.interrupted:
+        return 130
+    return 0 if r.plan.found else 1
+
+
+def _bench_mcts(args: argparse.Namespace) -> int:
+    from .online import bench_mcts
+
+    try:
+        checkpoints = [float(t) for t in args.seconds.split(",") if t.strip()]
+    except ValueError:
+        raise DataError(f"--seconds: '{args.seconds}' is not a list of seconds") from None
+    settings = [s.strip() for s in args.settings.split(",") if s.strip()]
+    q = [p.strip() for p in args.q.split(",") if p.strip()] if args.q else None
+    table, csv, rows = bench_mcts(
+        args.models, args.objective, settings, checkpoints, runs=args.runs, q=q,
+        config=_online_config(args), load=_load_args(args),
+    )
+    print(table, end="")
+    if args.csv is not None:
+        args.csv.write_text(csv)
+    if args.json is not None:
+        args.json.write_text(json.dumps(rows, indent=2) + "\n")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     args = _parser().parse_args(argv)
-    for flag in ("epochs", "batch", "layers", "width", "threads", "steps", "buffer", "target_sync", "eval_states"):
+    for flag in ("epochs", "batch", "layers", "width", "threads", "steps", "buffer", "target_sync", "eval_states", "episodes", "runs", "budget"):
         value = getattr(args, flag, None)
         if value is not None and value < 1:
             print(f"error: --{flag.replace('_', '-')} must be at least 1", file=sys.stderr)
             return 2
-    if args.seconds is not None and args.seconds <= 0:
+    if isinstance(args.seconds, float) and args.seconds <= 0:
         print("error: --seconds must be positive", file=sys.stderr)
+        return 2
+    if getattr(args, "steps_per_episode", 1) < 0:
+        print("error: --steps-per-episode must be at least 0", file=sys.stderr)
         return 2
     try:
         if args.command == "q":
             return _q(args)
+        if args.command == "q-online":
+            return _q_online(args)
+        if args.command == "bench-mcts":
+            return _bench_mcts(args)
         return _removability(args)
-    except (DataError, ExportError) as err:
+    except (DataError, ExportError, ValueError, AspError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
 

@@ -58,6 +58,9 @@ __all__ = [
     "GraphCache",
     "open_q_assemblies",
     "train_q",
+    "DeepQLearner",
+    "save_q_weights",
+    "load_q_weights",
     "ranking_quality",
     "export_q",
     "synthetic_q_graph",
@@ -505,63 +508,72 @@ def _loss_curve(losses: list[float], points: int = 20) -> list[dict]:
     ]
 
 
-def train_q(
-    assemblies: Sequence[QAssembly],
-    node_dim: int,
-    edge_dim: int,
-    config: QConfig,
-    graph_source: GraphSource,
-    log: Callable[[str], None] | None = None,
-) -> tuple[QNetwork, dict]:
-    """Deep Q-learning on the transitions of ``assemblies``. Returns ``(model, summary)``.
+class DeepQLearner:
+    """Deep Q-learning of one objective's Q-function, step by step: the network, its target copy,
+    Adam, the replay buffer and the seeded sampling (thesis 5.4.4, 6.5.1).
 
-    The summary holds the steps run, whether time stopped them, the seconds, the transitions read,
-    the buffer size, the graph cache's hit rate and the loss curve (mean loss per twentieth).
+    :func:`train_q` fills the buffer from data sets and runs ``config.steps`` steps; the online
+    settings of 6.5 (:mod:`asp.train.online`) push each search episode's transitions and run a few
+    steps after each episode. ``model`` continues training a network (the "retrained" setting; its
+    input statistics are kept), else a new one is made (seeded) and :meth:`start` fits its input
+    statistics on the buffer.
     """
-    for name in ("steps", "batch", "buffer", "layers", "width", "threads", "target_sync", "cache"):
-        if getattr(config, name) < 1:
-            raise ValueError(f"{name} must be at least 1")
-    if config.loss not in ("huber", "mse"):
-        raise ValueError(f"loss must be 'huber' or 'mse', not {config.loss!r}")
-    _seed_everything(config)
-    rng = np.random.default_rng(config.seed)
-    graphs = GraphCache(graph_source, node_dim, edge_dim, capacity=config.cache)
-    total = sum(a.assembly.num_transitions for a in assemblies)
-    if total == 0:
-        raise DataError("no transition to train on (" + ", ".join(a.name for a in assemblies) + ")")
-    buffer = ReplayBuffer(config.buffer)
-    streaming = total > config.buffer
-    if streaming:
-        stream = _stream(assemblies)
-        for _ in range(config.buffer):
-            buffer.push(next(stream))
-    else:  # everything fits: read each file once (to its end, which checks its count)
-        for a in assemblies:
-            for t in a.assembly.transitions():
-                buffer.push(_Record(a, t, a.reward(t)))
-    read = len(buffer)
-    ingest = max(1, config.batch // 8)
-    if log:
-        how = f"streaming {ingest} new per step" if streaming else "all of them"
-        log(f"replay buffer: {len(buffer)} of {total} transitions ({how})")
 
-    model = QNetwork(node_dim, edge_dim, width=config.width, layers=config.layers)
-    _fit_inputs(model, buffer, graphs, rng, config.normalisation_states)
-    target = copy.deepcopy(model).eval()
-    for p in target.parameters():
-        p.requires_grad_(False)
-    optimiser = torch.optim.Adam(model.parameters(), lr=config.lr)
-    loss_fn = nn.SmoothL1Loss(beta=1.0) if config.loss == "huber" else nn.MSELoss()
-    start = time.monotonic()
-    losses: list[float] = []
-    stopped = False
-    for step in range(config.steps):
+    def __init__(
+        self,
+        node_dim: int,
+        edge_dim: int,
+        config: QConfig,
+        graph_source: GraphSource,
+        model: QNetwork | None = None,
+    ) -> None:
+        for name in ("steps", "batch", "buffer", "layers", "width", "threads", "target_sync", "cache"):
+            if getattr(config, name) < 1:
+                raise ValueError(f"{name} must be at least 1")
+        if config.loss not in ("huber", "mse"):
+            raise ValueError(f"loss must be 'huber' or 'mse', not {config.loss!r}")
+        _seed_everything(config)
+        self.config = config
+        self.rng = np.random.default_rng(config.seed)
+        self.graphs = GraphCache(graph_source, node_dim, edge_dim, capacity=config.cache)
+        self.buffer = ReplayBuffer(config.buffer)
+        self.fresh = model is None
+        self.model = model if model is not None else QNetwork(node_dim, edge_dim, width=config.width, layers=config.layers)
+        self.target: QNetwork | None = None
+        self.optimiser: torch.optim.Optimizer | None = None
+        self.loss_fn = nn.SmoothL1Loss(beta=1.0) if config.loss == "huber" else nn.MSELoss()
+        self.losses: list[float] = []
+
+    @property
+    def steps(self) -> int:
+        """Gradient steps run so far."""
+        return len(self.losses)
+
+    def push(self, source: QAssembly, t: Transition) -> None:
+        """Adds a transition of ``source`` to the replay buffer (the oldest leaves when it is full)."""
+        self.buffer.push(_Record(source, t, source.reward(t)))
+
+    def start(self) -> None:
+        """Fits a new network's input statistics on the buffer, then makes the target network and
+        the optimiser (once, before the first step)."""
+        if self.target is not None:
+            return
+        if self.fresh:
+            _fit_inputs(self.model, self.buffer, self.graphs, self.rng, self.config.normalisation_states)
+        self.target = copy.deepcopy(self.model).eval()
+        for p in self.target.parameters():
+            p.requires_grad_(False)
+        self.optimiser = torch.optim.Adam(self.model.parameters(), lr=self.config.lr)
+
+    def step(self) -> float:
+        """One gradient step on a batch sampled from the buffer; returns its loss. The target
+        network is synced every ``target_sync`` steps."""
+        self.start()
+        assert self.target is not None and self.optimiser is not None
+        model, target = self.model, self.target
         model.train()
-        if streaming:
-            for _ in range(ingest):
-                buffer.push(next(stream))
-            read += ingest
-        records = buffer.sample(rng, config.batch)
+        records = self.buffer.sample(self.rng, self.config.batch)
+        graphs = self.graphs
         states = [graphs(r.source.assembly, r.t.present, r.t.actions, r.t.history) for r in records]
         action_at = [int(_positions(g, np.array([r.t.action]), r.source.assembly)[0]) for g, r in zip(states, records)]
         rewards = torch.tensor([r.reward for r in records], dtype=torch.float32)
@@ -587,14 +599,61 @@ def train_q(
         y = rewards + bootstrap
         q, offsets = _run(model, states)
         pred = q.index_select(0, torch.from_numpy(offsets + np.asarray(action_at, dtype=np.int64)))
-        loss = loss_fn(pred, y)
-        optimiser.zero_grad()
+        loss = self.loss_fn(pred, y)
+        self.optimiser.zero_grad()
         loss.backward()
         nn.utils.clip_grad_norm_(model.parameters(), 10.0)
-        optimiser.step()
-        losses.append(float(loss.item()))
-        if (step + 1) % config.target_sync == 0:
+        self.optimiser.step()
+        self.losses.append(float(loss.item()))
+        if self.steps % self.config.target_sync == 0:
             target.load_state_dict(model.state_dict())
+        model.eval()
+        return self.losses[-1]
+
+
+def train_q(
+    assemblies: Sequence[QAssembly],
+    node_dim: int,
+    edge_dim: int,
+    config: QConfig,
+    graph_source: GraphSource,
+    log: Callable[[str], None] | None = None,
+) -> tuple[QNetwork, dict]:
+    """Deep Q-learning on the transitions of ``assemblies``. Returns ``(model, summary)``.
+
+    The summary holds the steps run, whether time stopped them, the seconds, the transitions read,
+    the buffer size, the graph cache's hit rate and the loss curve (mean loss per twentieth).
+    """
+    learner = DeepQLearner(node_dim, edge_dim, config, graph_source)
+    total = sum(a.assembly.num_transitions for a in assemblies)
+    if total == 0:
+        raise DataError("no transition to train on (" + ", ".join(a.name for a in assemblies) + ")")
+    buffer = learner.buffer
+    streaming = total > config.buffer
+    if streaming:
+        stream = _stream(assemblies)
+        for _ in range(config.buffer):
+            buffer.push(next(stream))
+    else:  # everything fits: read each file once (to its end, which checks its count)
+        for a in assemblies:
+            for t in a.assembly.transitions():
+                learner.push(a, t)
+    read = len(buffer)
+    ingest = max(1, config.batch // 8)
+    if log:
+        how = f"streaming {ingest} new per step" if streaming else "all of them"
+        log(f"replay buffer: {len(buffer)} of {total} transitions ({how})")
+
+    learner.start()
+    start = time.monotonic()
+    losses = learner.losses
+    stopped = False
+    for step in range(config.steps):
+        if streaming:
+            for _ in range(ingest):
+                buffer.push(next(stream))
+            read += ingest
+        learner.step()
         if log and ((step + 1) % max(1, config.steps // 20) == 0 or step == 0):
             recent = float(np.mean(losses[-max(1, config.steps // 20) :]))
             log(f"step {step + 1}/{config.steps}: loss {recent:.3g} ({time.monotonic() - start:.1f} s)")
@@ -603,7 +662,9 @@ def train_q(
             if log:
                 log(f"stopped after {config.seconds:g} s at step {step + 1}")
             break
+    model = learner.model
     model.eval()
+    graphs = learner.graphs
     summary = {
         "steps": len(losses),
         "time_capped": stopped,
@@ -749,6 +810,38 @@ def export_q(
     )
     assert diff is not None
     return diff
+
+
+def save_q_weights(model: QNetwork, path: Path | str, features: str, objective: str) -> None:
+    """Write the network's weights and shape beside its ONNX file (``q.onnx.pt``), so that a later
+    run can retrain it (the "retrained" setting of 6.5, ``python -m asp.train q-online --q``)."""
+    torch.save(
+        {
+            "state_dict": model.state_dict(),
+            "node_dim": model.node_dim,
+            "edge_dim": model.edge_dim,
+            "width": model.width,
+            "layers": model.layers,
+            "aggregation": model.aggregation,
+            "features": features,
+            "objective": objective,
+        },
+        str(path),
+    )
+
+
+def load_q_weights(path: Path | str) -> tuple[QNetwork, str, str]:
+    """The network :func:`save_q_weights` wrote, with its features and objective."""
+    try:
+        saved = torch.load(str(path), map_location="cpu", weights_only=True)
+        model = QNetwork(saved["node_dim"], saved["edge_dim"], width=saved["width"], layers=saved["layers"], aggregation=saved["aggregation"])
+        model.load_state_dict(saved["state_dict"])
+    except FileNotFoundError:
+        raise DataError(f"{path}: file not found (python -m asp.train q writes the weights beside the ONNX model)") from None
+    except (KeyError, RuntimeError, OSError, ValueError) as err:
+        raise DataError(f"{path}: not Q network weights written by asp.train: {err}") from None
+    model.eval()
+    return model, str(saved["features"]), str(saved["objective"])
 
 
 def config_dict(config: QConfig) -> dict:

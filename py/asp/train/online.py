@@ -1,0 +1,373 @@
+"""Q-functions trained during the search: the online settings of thesis 6.5.
+
+- **online** ("MCTS + Q-functions"): the first episode's rollouts are random; after each episode
+  its transitions (every step of the selection/expansion and the simulation, as recorded by the
+  search) go into a replay buffer of 10,000 per objective, a few deep Q-learning steps run on
+  batches from it (the thesis: batches of 5, 20 steps, so 100 samples per episode), each network
+  is exported to ONNX (parity-checked) and the search continues with the ε-greedy policy over the
+  new models, keeping its tree.
+- **retrained** ("MCTS + retrained Q-functions"): the same, starting from pretrained networks
+  (``--q``; the weights ``python -m asp.train q`` writes beside each ONNX file as ``.onnx.pt``), which
+  also guide the first episode.
+
+The search is :meth:`asp.Assembly.search` (Rust, the search loop of ``asp plan --objective``); the
+learning is :class:`asp.train.q.DeepQLearner`, the loop of ``python -m asp.train q`` one step at a
+time. With a fixed episode count (no time limit), one PyTorch thread and a seed, a run is
+reproducible.
+
+:func:`bench_mcts` compares vanilla, online, pretrained and retrained at equal wall time and
+prints ``asp bench mcts``'s table through the wheel.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+
+from ..qdata import DataError, TransitionDataset
+from .q import BindingGraphs, DeepQLearner, QAssembly, QConfig, export_q, load_q_weights, save_q_weights
+
+__all__ = ["OnlineConfig", "OnlineResult", "run_online", "bench_mcts", "SETTINGS", "values_at"]
+
+#: The settings :func:`bench_mcts` knows (thesis 6.5's four, in its order).
+SETTINGS = ("vanilla", "online", "pretrained", "retrained")
+
+
+@dataclass(frozen=True)
+class OnlineConfig:
+    """Settings of a search that trains its Q-functions after each episode."""
+
+    objective: str
+    """Objectives, comma-separated (one network each; several run Pareto-MCTS)."""
+    seconds: Optional[float] = None
+    """Wall time of the search (training between episodes included); ``None``: ``episodes`` only."""
+    episodes: int = 1_000_000
+    """The most episodes."""
+    q: Optional[Sequence[str]] = None
+    """Pretrained Q models (ONNX, with their ``.pt`` weights beside them), one per objective: the
+    retrained setting."""
+    steps_per_episode: int = 20
+    """Deep Q-learning steps after each episode (the thesis: 20 for 5×5 cubes)."""
+    batch: int = 5
+    """Transitions per step (the thesis: 5)."""
+    buffer: int = 10_000
+    """Replay buffer capacity (the thesis: 10,000)."""
+    lr: float = 1e-3
+    target_sync: int = 100
+    layers: int = 3
+    width: int = 64
+    seed: int = 0
+    """Seeds the search and the networks (objective ``k``'s network: ``seed + k``)."""
+    epsilon: float = 0.2
+    q_use: str = "rollouts"
+    budget: int = 5
+    resolution: int = 9
+    threads: int = 1
+    """PyTorch threads (reproducible for one count)."""
+    aggregation: str = "dense"
+    parity_tolerance: float = 1e-5
+    search: Optional[dict] = None
+    """Further keywords of :meth:`asp.Assembly.plan` (``exploration``, ``d_max``, ``support``, ...)."""
+    keep_models: bool = False
+    """Keep every episode's models (``models/<episode>_q_<objective>.onnx``: the ones swapped in
+    after that episode), not only the last."""
+
+
+@dataclass
+class OnlineResult:
+    """What :func:`run_online` did."""
+
+    plan: "object"
+    """The :class:`asp.Plan` of the search."""
+    episodes: int
+    swaps: int
+    """Q models swapped into the search."""
+    transitions: int
+    steps: int
+    """Deep Q-learning steps per network."""
+    train_seconds: float
+    search_seconds: float
+    models: list[Path]
+    trace: list[tuple[float, float, int]]
+    """``(seconds, value, episodes)`` after each episode (training time included)."""
+    interrupted: bool = False
+    """Ctrl-C ended the search (the plan is that of the episodes finished)."""
+
+
+def _log_stderr(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+def run_online(
+    model: str | os.PathLike,
+    out: str | os.PathLike,
+    config: OnlineConfig,
+    load: Optional[dict] = None,
+    log: Optional[Callable[[str], None]] = _log_stderr,
+    record_transitions: bool = True,
+) -> OnlineResult:
+    """Runs the search of ``model`` with its Q-functions trained after every episode; writes to
+    ``out``: ``plan.json``, ``trace.csv``, the final models ``q_<objective>.onnx`` (with their
+    ``.pt`` weights), ``transitions/`` (the episodes' transitions as an ``asp-transitions`` data
+    set) and ``online.json`` (settings and counts)."""
+    import asp
+    import torch
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    objectives = [o.strip() for o in config.objective.split(",") if o.strip()]
+    if not objectives:
+        raise DataError("--objective names no objective")
+    pretrained = list(config.q or [])
+    if pretrained and len(pretrained) != len(objectives):
+        raise DataError(f"{len(pretrained)} Q models for {len(objectives)} objectives ({', '.join(objectives)}): give one per objective")
+    networks = []
+    for path, objective in zip(pretrained, objectives):
+        net, features, trained_for = load_q_weights(str(path) + ".pt")
+        if trained_for != objective:
+            raise DataError(f"{path}.pt: estimates '{trained_for}', its place in --q is that of '{objective}'")
+        networks.append(net)
+
+    assembly = asp.load(model, **(load or {}))
+    settings = dict(config.search or {})
+    settings.update(
+        objective=",".join(objectives),
+        pareto=len(objectives) > 1,
+        seed=config.seed,
+        budget=config.budget,
+        resolution=config.resolution,
+        episodes=config.episodes,
+        time_limit=config.seconds,
+        epsilon=config.epsilon,
+        q_use=config.q_use,
+        q=",".join(os.fspath(p) for p in pretrained) if pretrained else None,
+    )
+    search = assembly.search(record=True, **settings)
+    index = search.index
+    data_dir = out / "transitions"
+    (data_dir / "model").mkdir(parents=True, exist_ok=True)
+    (data_dir / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+    data = TransitionDataset.open(data_dir)
+    source = data.assemblies[0]
+    if networks and any(n.node_dim != data.node_dim or n.edge_dim != data.edge_dim for n in networks):
+        raise DataError(f"the --q networks read other graphs than this search's '{data.features}'")
+    graphs = BindingGraphs(data.features, data.node_dim, data.edge_dim)
+    torch.set_num_threads(config.threads)
+    learners = []
+    for k, objective in enumerate(objectives):
+        qc = QConfig(
+            steps=max(config.steps_per_episode, 1), batch=config.batch, buffer=config.buffer, lr=config.lr,
+            seed=config.seed + k, layers=config.layers, width=config.width, threads=config.threads,
+            target_sync=config.target_sync,
+        )
+        learners.append((QAssembly(source, data.objective_index(objective)), DeepQLearner(data.node_dim, data.edge_dim, qc, graphs, networks[k] if networks else None)))
+    paths = [out / f"q_{o}.onnx" for o in objectives]
+    lines_path = source.transitions_path
+    transitions = 0
+    train_seconds = 0.0
+    started = time.monotonic()
+    trace: list[tuple[float, float, int]] = []
+    episodes = 0
+    interrupted = False
+    with open(lines_path, "w", encoding="utf-8") as lines_file:
+        while True:
+            try:
+                e = search.episode()
+            except KeyboardInterrupt:  # the search has ended: keep what it found
+                interrupted = True
+                if log:
+                    log("interrupted: writing the plan of the episodes finished")
+                break
+            episodes = e.episodes
+            lines = e.transitions_jsonl
+            lines_file.write(lines)
+            parsed = [source._parse(line, transitions + i + 1) for i, line in enumerate(lines.splitlines()) if line.strip()]
+            transitions += len(parsed)
+            trace.append((time.monotonic() - started, e.value, e.episodes))
+            if e.finished:
+                break
+            t0 = time.monotonic()
+            losses = []
+            for q_assembly, learner in learners:
+                for t in parsed:
+                    learner.push(q_assembly, t)
+                if len(learner.buffer) == 0:
+                    continue
+                for _ in range(config.steps_per_episode):
+                    losses.append(learner.step())
+            exported = False
+            if all(learner.steps > 0 or not learner.fresh for _, learner in learners):
+                for (q_assembly, learner), path, objective in zip(learners, paths, objectives):
+                    export_q(learner.model, path, data.features, objective, aggregation=config.aggregation, tolerance=config.parity_tolerance)
+                    if config.keep_models:
+                        (out / "models").mkdir(exist_ok=True)
+                        (out / "models" / f"{e.episodes}_{path.name}").write_bytes(path.read_bytes())
+                search.set_q(paths, config.epsilon, config.q_use)
+                exported = True
+            train_seconds += time.monotonic() - t0
+            if log:
+                loss = f", loss {np.mean(losses):.3g}" if losses else ""
+                swap = "new Q models" if exported else "no model yet"
+                log(f"episode {e.episodes}: {len(parsed)} transitions, value {e.value:.6g}, front {e.front_size}{loss}; "
+                    f"{swap} ({time.monotonic() - started:.1f} s)")
+    plan = search.result()
+    search_seconds = time.monotonic() - started
+    for (_, learner), path, objective in zip(learners, paths, objectives):
+        if learner.steps > 0 or not learner.fresh:
+            if learner.steps == 0 or not path.exists():
+                export_q(learner.model, path, data.features, objective, aggregation=config.aggregation, tolerance=config.parity_tolerance)
+            save_q_weights(learner.model, str(path) + ".pt", data.features, objective)
+    index["assemblies"][0]["transitions"] = transitions
+    index["assemblies"][0]["episodes_run"] = episodes
+    (data_dir / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+    (out / "plan.json").write_text(plan.json if plan.json.endswith("\n") else plan.json + "\n")
+    if plan.trace_csv is not None:
+        (out / "trace.csv").write_text(plan.trace_csv)
+    result = OnlineResult(
+        plan=plan,
+        episodes=episodes,
+        swaps=search.swaps,
+        transitions=transitions,
+        steps=learners[0][1].steps,
+        train_seconds=train_seconds,
+        search_seconds=search_seconds,
+        models=[p for p in paths if p.exists()],
+        trace=trace,
+        interrupted=interrupted,
+    )
+    doc = {
+        "setting": "retrained" if pretrained else "online",
+        "model": str(model),
+        "objectives": objectives,
+        "pretrained": [os.fspath(p) for p in pretrained],
+        "settings": {k: v for k, v in config.__dict__.items() if k != "search"} | {"search": config.search},
+        "episodes": episodes,
+        "swaps": result.swaps,
+        "transitions": transitions,
+        "steps_per_network": result.steps,
+        "train_seconds": round(train_seconds, 3),
+        "seconds": round(search_seconds, 3),
+        "models": [str(p) for p in result.models],
+        "interrupted": interrupted,
+    }
+    (out / "online.json").write_text(json.dumps(doc, indent=2, default=str) + "\n")
+    if log:
+        log(f"{episodes} episodes, {result.swaps} model swaps, {transitions} transitions, "
+            f"{train_seconds:.1f} s of {search_seconds:.1f} s training; wrote {out}")
+    return result
+
+
+# -- the benchmark -------------------------------------------------------------------------------
+def values_at(trace: Sequence[tuple[float, float]], checkpoints: Sequence[float]) -> list[float]:
+    """The value of a trace ``(seconds, value)`` at each checkpoint: its last value at or before
+    it (NaN before the first), as ``asp bench mcts`` reads its traces."""
+    out = []
+    for t in checkpoints:
+        v = math.nan
+        for s, value in trace:
+            if s <= t:
+                v = value
+            else:
+                break
+        out.append(v)
+    return out
+
+
+def _trace_of(csv: str) -> tuple[list[tuple[float, float]], int]:
+    rows = [line.split(",") for line in csv.strip().splitlines()[1:] if line.strip()]
+    trace = [(float(r[2]), float(r[3])) for r in rows]
+    episodes = int(rows[-1][0]) if rows else 0
+    return trace, episodes
+
+
+def _mean_std(values: Sequence[float]) -> dict:
+    if not values:
+        return {"mean": 0.0, "std": 0.0}
+    a = np.asarray(values, dtype=np.float64)
+    mean = float(a.mean())
+    return {"mean": mean if math.isfinite(mean) else None, "std": float(a.std()) if math.isfinite(mean) else None}
+
+
+def bench_mcts(
+    models: Sequence[str | os.PathLike],
+    objective: str,
+    settings: Sequence[str],
+    checkpoints: Sequence[float],
+    runs: int = 1,
+    q: Optional[Sequence[str]] = None,
+    config: Optional[OnlineConfig] = None,
+    load: Optional[dict] = None,
+    work: Optional[Path] = None,
+    log: Optional[Callable[[str], None]] = _log_stderr,
+) -> tuple[str, str, list[dict]]:
+    """Each setting of :data:`SETTINGS` named in ``settings`` searches each model for the last
+    checkpoint's wall time, ``runs`` times (seeds 0, 1, ...); returns ``asp bench mcts``'s table,
+    its CSV and the rows. ``vanilla`` and ``pretrained`` run :meth:`asp.Assembly.plan` (one
+    thread), ``online`` and ``retrained`` :func:`run_online` (training time counts)."""
+    import tempfile
+
+    import asp
+    from asp import _asp
+
+    unknown = [s for s in settings if s not in SETTINGS]
+    if unknown:
+        raise DataError(f"unknown setting '{unknown[0]}' (known: {', '.join(SETTINGS)})")
+    if any(s in ("pretrained", "retrained") for s in settings) and not q:
+        raise DataError("the pretrained and retrained settings need --q MODELS (one per objective)")
+    if not checkpoints or any(not (t > 0) for t in checkpoints) or any(a >= b for a, b in zip(checkpoints, checkpoints[1:])):
+        raise DataError(f"checkpoints must be positive and increasing, got {list(checkpoints)}")
+    objectives = [o.strip() for o in objective.split(",") if o.strip()]
+    base = config or OnlineConfig(objective=objective)
+    last = float(checkpoints[-1])
+    measure = "hypervolume" if len(objectives) > 1 else objectives[0]
+    rows: list[dict] = []
+    items = [(path, name) for (path, _, name, _) in _asp.model_items([os.fspath(m) for m in models])]
+    with tempfile.TemporaryDirectory() as tmp:
+        scratch = Path(work) if work is not None else Path(tmp)
+        for path, name in items:
+            assembly = asp.load(path, **(load or {}))
+            for setting in settings:
+                per_checkpoint: list[list[float]] = [[] for _ in checkpoints]
+                episodes: list[float] = []
+                map_seconds = 0.0
+                for run in range(runs):
+                    if setting in ("vanilla", "pretrained"):
+                        plan = assembly.plan(
+                            objective=objectives, pareto=len(objectives) > 1, seed=run, threads=1, time_limit=last,
+                            episodes=10**12, budget=base.budget, resolution=base.resolution, epsilon=base.epsilon,
+                            q_use=base.q_use, q=list(q) if setting == "pretrained" else None, **(base.search or {}),
+                        )
+                        trace, done = _trace_of(plan.trace_csv or "")
+                    else:
+                        c = replace(base, objective=objective, seconds=last, seed=run, q=list(q) if setting == "retrained" else None)
+                        r = run_online(path, scratch / f"{name}-{setting}-{run}", c, load=load, log=None)
+                        plan = r.plan
+                        trace, done = _trace_of(plan.trace_csv or "")
+                    opt = plan.optimisation or {}
+                    map_seconds = float(opt.get("map_seconds", 0.0))
+                    for k, v in enumerate(values_at(trace, checkpoints)):
+                        per_checkpoint[k].append(v)
+                    episodes.append(float(done))
+                    if log:
+                        log(f"{name} {setting} run {run}: {done} episodes, " + ", ".join(
+                            f"{v:.6g} at {t:g} s" for t, v in zip(checkpoints, values_at(trace, checkpoints))))
+                rows.append({
+                    "model": name,
+                    "setting": setting,
+                    "measure": measure,
+                    "checkpoints": [float(t) for t in checkpoints],
+                    "values": [_mean_std(v) for v in per_checkpoint],
+                    "episodes": _mean_std(episodes),
+                    "runs": runs,
+                    "map_seconds": map_seconds,
+                })
+    table, csv = _asp.mcts_table([json.dumps(rows)])
+    return table, csv, rows
