@@ -6,6 +6,7 @@
 //! cargo run --release -p asp-search --example optimise_figures -- speed 5 400      # 5×5×5, 400 episodes
 //! cargo run --release -p asp-search --example optimise_figures -- hv 6 1,10,60     # HV after 1, 10, 60 s
 //! cargo run --release -p asp-search --example optimise_figures -- exact 3 20       # 20 3×3×3 cubes
+//! cargo run --release -p asp-search --example optimise_figures -- exact 4 3 10 2  # 10 s on 2 threads
 //! cargo run --release -p asp-search --example optimise_figures -- small            # classic, profiles
 //! cargo run --release -p asp-search --example optimise_figures -- maps             # map build times
 //! ```
@@ -88,8 +89,12 @@ fn main() {
         "exact" => {
             let size: usize = arg(1, "3").parse().expect("size");
             let count: u64 = arg(2, "20").parse().expect("count");
+            // optional: search for this many seconds (episodes unbounded) on this many threads
+            // instead of the default budget
+            let time = args.get(3).map(|t| Duration::from_secs_f64(t.parse().expect("seconds")));
+            let threads: usize = arg(4, "1").parse().expect("threads");
             let fractions: Vec<f64> = (0..count)
-                .filter_map(|seed| exact_fraction(&format!("cube {seed}"), &soma_cube(size, seed), seed))
+                .filter_map(|seed| exact_fraction(&format!("cube {seed}"), &soma_cube(size, seed), seed, time, threads))
                 .collect();
             summary(&fractions);
         }
@@ -99,7 +104,7 @@ fn main() {
                 instances.push((format!("profiles, {supports} supports, seed {seed}"), small_profiles(supports, seed)));
             }
             let fractions: Vec<f64> =
-                instances.iter().filter_map(|(name, a)| exact_fraction(name, a, 0)).collect();
+                instances.iter().filter_map(|(name, a)| exact_fraction(name, a, 0, None, 1)).collect();
             summary(&fractions);
         }
         "maps" => {
@@ -139,7 +144,9 @@ fn small_profiles(supports: usize, seed: u64) -> Assembly {
 /// front: the fraction of its hypervolume reached, with the tight reference point just below
 /// the worst total of each objective over all feasible sequences. `None` when the exact front
 /// is out of reach or there is no sequence.
-fn exact_fraction(name: &str, assembly: &Assembly, seed: u64) -> Option<f64> {
+/// The Pareto-MCTS hypervolume as a fraction of the exact front's: with the default budget, or
+/// for `time` (episodes unbounded) on `threads`.
+fn exact_fraction(name: &str, assembly: &Assembly, seed: u64, time: Option<Duration>, threads: usize) -> Option<f64> {
     let (mdp, _) = mdp(assembly);
     let t = Instant::now();
     let Ok(exact) = exact_front(&mdp, 5_000_000) else {
@@ -151,13 +158,11 @@ fn exact_fraction(name: &str, assembly: &Assembly, seed: u64) -> Option<f64> {
         return None;
     }
     let reference: Vec<f64> = exact.worst.iter().map(|w| w - 1e-3 * w.abs().max(1.0)).collect();
-    let out = ParetoMcts::builder()
-        .seed(seed)
-        .reference(reference.clone())
-        .build()
-        .expect("settings")
-        .solve(&mdp)
-        .expect("search");
+    let mut builder = ParetoMcts::builder().seed(seed).threads(threads).reference(reference.clone());
+    if let Some(t) = time {
+        builder = builder.episodes(usize::MAX).time_limit(t);
+    }
+    let out = builder.build().expect("settings").solve(&mdp).expect("search");
     let fraction = out.value / exact.hypervolume(&reference);
     println!(
         "  {name}: {} parts, exact front {} points from {} states in {exact_seconds:.2} s; Pareto-MCTS {} points, HV fraction {fraction:.4}, {} episodes{}",
