@@ -1712,6 +1712,9 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings, hook: Op
             settings.threads
         )));
     }
+    // the hook (one thread only) is locked by the thread that runs it; without one no thread
+    // may wait on the lock, or the threads would run one after the other
+    let stepped = hook.is_some();
     let hook = Mutex::new(hook);
     let m = problem.num_objectives();
     let reference = match &settings.reference {
@@ -1743,8 +1746,8 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings, hook: Op
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             let first_episode = (0..t).map(share).sum::<usize>() as u64;
             let mut w = Worker::<V>::new(problem, settings, t, start, &abort, first_episode)?;
-            let mut hook = hook.lock().unwrap_or_else(|e| e.into_inner());
-            w.run(share(t), &shared, &reference, start, hook.as_deref_mut());
+            let mut guard = stepped.then(|| hook.lock().unwrap_or_else(|e| e.into_inner()));
+            w.run(share(t), &shared, &reference, start, guard.as_mut().and_then(|h| h.as_deref_mut()));
             match w.error.take() {
                 Some(e) => Err(e),
                 None => Ok((w.archive, w.stats, w.filtered, w.tree.nodes[0].status, w.record.take())),

@@ -240,3 +240,63 @@ fn q_guided_expansions_follow_the_priors_and_leave_rollouts_random() {
             && "sideways".parse::<QUse>().is_err()
     );
 }
+
+/// A random rollout policy whose first choice on each thread waits (up to 20 s) until every
+/// thread has made its first choice: it sees whether the search threads run at the same time
+/// (`alone`: some thread waited in vain).
+#[derive(Debug)]
+struct MeetingPolicy {
+    threads: usize,
+    arrived: std::sync::Mutex<usize>,
+    all: std::sync::Condvar,
+    alone: std::sync::atomic::AtomicBool,
+}
+
+struct MeetingWorker<'a> {
+    policy: &'a MeetingPolicy,
+    waited: bool,
+}
+
+impl asp_search::Policy for MeetingPolicy {
+    fn for_worker(&self, _thread: usize) -> asp_search::Result<Box<dyn asp_search::PolicyWorker + '_>> {
+        Ok(Box::new(MeetingWorker { policy: self, waited: false }))
+    }
+}
+
+impl asp_search::PolicyWorker for MeetingWorker<'_> {
+    fn choose(&mut self, _: &mut asp_search::PolicyContext<'_, '_>, actions: &[usize], rng: &mut asp_search::policy::SearchRng) -> asp_search::Result<usize> {
+        if !std::mem::replace(&mut self.waited, true) {
+            let p = self.policy;
+            let mut arrived = p.arrived.lock().unwrap();
+            *arrived += 1;
+            p.all.notify_all();
+            let (arrived, _) = p.all.wait_timeout_while(arrived, std::time::Duration::from_secs(20), |n| *n < p.threads).unwrap();
+            if *arrived < p.threads {
+                p.alone.store(true, std::sync::atomic::Ordering::SeqCst);
+            }
+        }
+        use rand::RngExt;
+        Ok(rng.random_range(0..actions.len()))
+    }
+}
+
+/// Root-parallel threads search at the same time (a lock held for a whole thread's run once
+/// made two threads take as long as one, with the same answers).
+#[test]
+fn search_threads_run_at_the_same_time() {
+    use std::sync::Arc;
+    let cube = soma(3, 2);
+    let maps = maps(&cube, 5);
+    for pareto in [false, true] {
+        let p = problem(&maps, if pareto { "access,dirchange" } else { "access" });
+        let policy = Arc::new(MeetingPolicy { threads: 2, arrived: Default::default(), all: Default::default(), alone: Default::default() });
+        let out = if pareto {
+            asp_search::ParetoMcts::builder().threads(2).episodes(8).seed(1).policy(policy.clone()).build().unwrap().solve(&p)
+        } else {
+            Mcts::builder().threads(2).episodes(8).seed(1).policy(policy.clone()).build().unwrap().solve(&p)
+        };
+        assert!(out.is_ok());
+        assert_eq!(*policy.arrived.lock().unwrap(), 2, "pareto {pareto}: both threads made rollouts");
+        assert!(!policy.alone.load(std::sync::atomic::Ordering::SeqCst), "pareto {pareto}: one thread ran its rollouts while the other waited");
+    }
+}
