@@ -1,7 +1,7 @@
 //! `asp plot`: the Pareto front of a plan JSON, or the search's progress from `--trace` CSVs.
 
 use anyhow::bail;
-use asp_viz::plot::{read_front, read_trace, write_front, write_traces, TraceAxis};
+use asp_viz::plot::{is_bench_csv, read_bench, read_front, read_trace, write_front, write_traces, TraceAxis};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -19,7 +19,8 @@ pub enum XArg {
 #[derive(Args, Debug)]
 pub struct PlotArgs {
     /// A plan JSON with a `pareto_front` (the front is plotted), or one or more `--trace` CSVs
-    /// (their values over time, on one plot).
+    /// (their values over time, on one plot), or an `asp bench mcts --csv` (each setting's value
+    /// over wall time as a fraction of the best reached on each model, averaged over models).
     #[arg(required = true, num_args = 1..)]
     pub inputs: Vec<PathBuf>,
     /// The picture to write: `.svg` or `.png`.
@@ -44,7 +45,14 @@ pub fn run(args: &PlotArgs) -> anyhow::Result<ExitCode> {
         if csvs != args.inputs.len() {
             bail!("give one plan JSON, or one or more trace CSVs, not both");
         }
-        let traces = args.inputs.iter().map(|p| read_trace(p)).collect::<Result<Vec<_>, _>>()?;
+        let mut traces = Vec::new();
+        for p in &args.inputs {
+            if is_bench_csv(p)? {
+                traces.extend(read_bench(p)?);
+            } else {
+                traces.push(read_trace(p)?);
+            }
+        }
         let axis = match args.x {
             XArg::Seconds => TraceAxis::Seconds,
             XArg::Episodes => TraceAxis::Episodes,

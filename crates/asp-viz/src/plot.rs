@@ -1,6 +1,8 @@
 //! `asp plot`: the Pareto front of a plan JSON (a scatter with the front's staircase; three or
 //! more objectives as pairwise panels) and the search's progress from `--trace` CSVs (the
-//! hypervolume, or the best total, over seconds or episodes; several traces on one plot).
+//! hypervolume, or the best total, over seconds or episodes; several traces on one plot), or an
+//! `asp bench mcts --csv` (one line per setting: its value over wall time as a fraction of the
+//! best any setting reached on each model, averaged over the models).
 //! SVG or PNG by the output's extension; PNG text uses the vendored DejaVu Sans.
 
 use crate::error::{Result, VizError};
@@ -106,6 +108,8 @@ pub struct Trace {
     pub seconds: Vec<f64>,
     /// The hypervolume (Pareto) or best total (one objective) at each row.
     pub values: Vec<f64>,
+    /// Whether `values` are fractions of the best reached (a bench CSV's settings).
+    pub relative: bool,
 }
 
 /// The x axis of a progress plot.
@@ -132,6 +136,7 @@ pub fn read_trace(path: &Path) -> Result<Trace> {
         episodes: Vec::new(),
         seconds: Vec::new(),
         values: Vec::new(),
+        relative: false,
     };
     for (k, line) in lines.enumerate() {
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
@@ -150,6 +155,71 @@ pub fn read_trace(path: &Path) -> Result<Trace> {
         return Err(VizError::input(path, "the trace has no rows"));
     }
     Ok(trace)
+}
+
+/// Reads an `asp bench mcts --csv` (`model,setting,seconds,mean,std,episodes`) as one trace per
+/// setting, in the order the settings first appear: at each checkpoint the setting's mean value
+/// divided by the best value any setting reached on that model (at any checkpoint), averaged
+/// over the models; `episodes` the mean episodes of the run. Values must be positive (the
+/// hypervolume, or an objective total of a maximised objective).
+pub fn read_bench(path: &Path) -> Result<Vec<Trace>> {
+    let text = std::fs::read_to_string(path).map_err(|e| VizError::io(path, e))?;
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let header: Vec<&str> = lines.next().ok_or_else(|| VizError::input(path, "empty CSV"))?.split(',').map(str::trim).collect();
+    let col = |name: &str| {
+        header.iter().position(|h| *h == name).ok_or_else(|| VizError::input(path, format!("the bench CSV has no column '{name}' (columns: {})", header.join(","))))
+    };
+    let (cm, cset, cs, cv, ce) = (col("model")?, col("setting")?, col("seconds")?, col("mean")?, col("episodes")?);
+    // (model, setting, seconds, value, episodes)
+    let mut rows: Vec<(String, String, f64, f64, f64)> = Vec::new();
+    for (k, line) in lines.enumerate() {
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let num = |c: usize| -> Result<f64> {
+            cells
+                .get(c)
+                .and_then(|s| s.parse::<f64>().ok())
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| VizError::input(path, format!("row {}: '{}' is not a number in column {}", k + 2, cells.get(c).unwrap_or(&""), header[c])))
+        };
+        let text = |c: usize| cells.get(c).map(|s| s.to_string()).ok_or_else(|| VizError::input(path, format!("row {}: no column {}", k + 2, header[c])));
+        rows.push((text(cm)?, text(cset)?, num(cs)?, num(cv)?, num(ce)?));
+    }
+    if rows.is_empty() {
+        return Err(VizError::input(path, "the bench CSV has no rows"));
+    }
+    let best = |model: &str| rows.iter().filter(|r| r.0 == model).map(|r| r.3).fold(f64::NEG_INFINITY, f64::max);
+    if let Some(r) = rows.iter().find(|r| best(&r.0) <= 0.0) {
+        return Err(VizError::input(path, format!("model {}: no positive value to compare the settings with", r.0)));
+    }
+    let mut settings: Vec<String> = Vec::new();
+    for r in &rows {
+        if !settings.contains(&r.1) {
+            settings.push(r.1.clone());
+        }
+    }
+    let mut traces = Vec::with_capacity(settings.len());
+    for setting in settings {
+        let mut seconds: Vec<f64> = rows.iter().filter(|r| r.1 == setting).map(|r| r.2).collect();
+        seconds.sort_by(f64::total_cmp);
+        seconds.dedup();
+        let mut trace = Trace { label: setting.clone(), episodes: Vec::new(), seconds: Vec::new(), values: Vec::new(), relative: true };
+        for t in seconds {
+            let at: Vec<&(String, String, f64, f64, f64)> = rows.iter().filter(|r| r.1 == setting && r.2 == t).collect();
+            let n = at.len() as f64;
+            trace.seconds.push(t);
+            trace.values.push(at.iter().map(|r| r.3 / best(&r.0)).sum::<f64>() / n);
+            trace.episodes.push(at.iter().map(|r| r.4).sum::<f64>() / n);
+        }
+        traces.push(trace);
+    }
+    Ok(traces)
+}
+
+/// Whether the CSV at `path` is an `asp bench mcts --csv` (its header names `setting`), not a
+/// `--trace`.
+pub fn is_bench_csv(path: &Path) -> Result<bool> {
+    let text = std::fs::read_to_string(path).map_err(|e| VizError::io(path, e))?;
+    Ok(text.lines().next().is_some_and(|h| h.split(',').any(|c| c.trim() == "setting")))
 }
 
 /// Writes the front plot to `out` (SVG or PNG by extension). Returns the number of points drawn
@@ -240,7 +310,11 @@ fn traces_all<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, traces: &[Trace
     chart
         .configure_mesh()
         .x_desc(x_desc)
-        .y_desc("hypervolume (Pareto) or best total")
+        .y_desc(if traces.iter().all(|t| t.relative) {
+            "fraction of the best any setting reached"
+        } else {
+            "hypervolume (Pareto) or best total"
+        })
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(e)?;

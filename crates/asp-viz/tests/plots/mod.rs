@@ -2,7 +2,7 @@
 //! right size, clear errors on bad input.
 
 use asp_search::report::{ParetoEntry, PlanReport};
-use asp_viz::plot::{read_front, read_trace, staircase, write_front, write_traces, TraceAxis};
+use asp_viz::plot::{is_bench_csv, read_bench, read_front, read_trace, staircase, write_front, write_traces, TraceAxis};
 use std::path::Path;
 
 fn front_file(dir: &Path, points: &[Vec<f64>]) -> std::path::PathBuf {
@@ -76,6 +76,43 @@ fn traces_plot_every_row_of_every_file() {
     let png = dir.path().join("hv.png");
     write_traces(&png, &traces, TraceAxis::Episodes).unwrap();
     assert_eq!(png_size(&png), (900, 560));
+}
+
+/// `asp bench mcts --csv`: one line per setting, each model's values divided by the best any
+/// setting reached on it, averaged over the models.
+#[test]
+fn a_bench_csv_plots_each_setting_relative_to_the_best() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("bench.csv");
+    std::fs::write(
+        &csv,
+        "model,setting,seconds,mean,std,episodes\n\
+         a,vanilla,10,80,0,1000\na,vanilla,60,100,0,1000\na,pretrained,10,50,0,20\na,pretrained,60,90,0,20\n\
+         b,vanilla,10,4,0,3000\nb,vanilla,60,4,0,3000\nb,pretrained,10,2,0,40\nb,pretrained,60,5,0,40\n",
+    )
+    .unwrap();
+    assert!(is_bench_csv(&csv).unwrap());
+    let traces = read_bench(&csv).unwrap();
+    let labels: Vec<&str> = traces.iter().map(|t| t.label.as_str()).collect();
+    assert_eq!(labels, ["vanilla", "pretrained"]);
+    let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+    assert_eq!(traces[0].seconds, [10.0, 60.0]);
+    // model a's best is 100 (vanilla at 60 s), b's 5 (pretrained at 60 s)
+    assert!(close(&traces[0].values, &[(0.8 + 0.8) / 2.0, (1.0 + 0.8) / 2.0]), "{:?}", traces[0].values);
+    assert!(close(&traces[1].values, &[(0.5 + 0.4) / 2.0, (0.9 + 1.0) / 2.0]), "{:?}", traces[1].values);
+    assert!(close(&traces[1].episodes, &[30.0, 30.0]));
+    let svg = dir.path().join("bench.svg");
+    write_traces(&svg, &traces, TraceAxis::Seconds).unwrap();
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert_eq!(circles(&text), 4);
+    assert!(text.contains("fraction of the best"), "the axis says the values are relative");
+    // a trace CSV is not a bench CSV; a bench CSV without a positive value is refused
+    let trace = dir.path().join("t.csv");
+    std::fs::write(&trace, "episode,iterations,seconds,value,front_size\n1,1,0.1,1,1\n").unwrap();
+    assert!(!is_bench_csv(&trace).unwrap());
+    std::fs::write(&csv, "model,setting,seconds,mean,std,episodes\nc,vanilla,10,0,0,5\n").unwrap();
+    let e = read_bench(&csv).unwrap_err().to_string();
+    assert!(e.contains("bench.csv") && e.contains("model c"), "{e}");
 }
 
 #[test]
