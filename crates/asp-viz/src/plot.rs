@@ -140,13 +140,7 @@ pub fn read_trace(path: &Path) -> Result<Trace> {
     };
     for (k, line) in lines.enumerate() {
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        let num = |c: usize| -> Result<f64> {
-            cells
-                .get(c)
-                .and_then(|s| s.parse::<f64>().ok())
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| VizError::input(path, format!("row {}: '{}' is not a number in column {}", k + 2, cells.get(c).unwrap_or(&""), header[c])))
-        };
+        let num = |c: usize| number(path, &cells, &header, k, c);
         trace.episodes.push(num(ce)?);
         trace.seconds.push(num(cs)?);
         trace.values.push(num(cv)?);
@@ -155,6 +149,15 @@ pub fn read_trace(path: &Path) -> Result<Trace> {
         return Err(VizError::input(path, "the trace has no rows"));
     }
     Ok(trace)
+}
+
+/// The finite number in column `c` of data row `k` (0-based; the file's row `k + 2`) of a CSV.
+fn number(path: &Path, cells: &[&str], header: &[&str], k: usize, c: usize) -> Result<f64> {
+    cells
+        .get(c)
+        .and_then(|s| s.parse::<f64>().ok())
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| VizError::input(path, format!("row {}: '{}' is not a number in column {}", k + 2, cells.get(c).unwrap_or(&""), header[c])))
 }
 
 /// Reads an `asp bench mcts --csv` (`model,setting,seconds,mean,std,episodes`) as one trace per
@@ -174,13 +177,7 @@ pub fn read_bench(path: &Path) -> Result<Vec<Trace>> {
     let mut rows: Vec<(String, String, f64, f64, f64)> = Vec::new();
     for (k, line) in lines.enumerate() {
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        let num = |c: usize| -> Result<f64> {
-            cells
-                .get(c)
-                .and_then(|s| s.parse::<f64>().ok())
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| VizError::input(path, format!("row {}: '{}' is not a number in column {}", k + 2, cells.get(c).unwrap_or(&""), header[c])))
-        };
+        let num = |c: usize| number(path, &cells, &header, k, c);
         let text = |c: usize| cells.get(c).map(|s| s.to_string()).ok_or_else(|| VizError::input(path, format!("row {}: no column {}", k + 2, header[c])));
         rows.push((text(cm)?, text(cset)?, num(cs)?, num(cv)?, num(ce)?));
     }
