@@ -213,6 +213,16 @@ impl RobotModel {
         }
     }
 
+    /// The verdict known for `part` in the state `present` with `replans` plans per grasp.
+    fn known(&self, present: &[u64], part: usize, replans: usize) -> Option<Result<(), RobotFailure>> {
+        self.verdicts.lock().expect("not poisoned").get(&(present.to_vec(), part)).and_then(|k| k.verdict(replans))
+    }
+
+    /// Remembers the verdict of planning `part` in the state `present` with `replans` plans.
+    fn learn(&self, present: &[u64], part: usize, replans: usize, r: Result<(), &RobotFailure>) {
+        self.verdicts.lock().expect("not poisoned").entry((present.to_vec(), part)).or_default().learn(replans, r);
+    }
+
     /// The robot's plan for `step`: for expansion and replay the shortest path of `k` plans per
     /// grasp ([`RemovalPlanner::plan`]); for simulation (a rollout's estimate) the first path
     /// found with one plan per grasp ([`RemovalPlanner::removable`], the path the `robot`
@@ -225,7 +235,7 @@ impl RobotModel {
         if let Some(r) = self.cache.lock().expect("not poisoned").get(&key) {
             return r.clone();
         }
-        let known = self.verdicts.lock().expect("not poisoned").get(&(key.0.clone(), key.1)).and_then(|k| k.verdict(replans));
+        let known = self.known(&key.0, key.1, replans);
         let r = match (known, step.motion()) {
             (Some(Err(f)), _) => Err(f),
             (_, Some(Motion::Linear { direction, .. })) if first => {
@@ -234,12 +244,7 @@ impl RobotModel {
             (_, Some(Motion::Linear { direction, .. })) => self.planner.plan(step.part(), &present, direction, step.seed(), replans),
             _ => Err(RobotFailure::Blocked { by: None }),
         };
-        self.verdicts
-            .lock()
-            .expect("not poisoned")
-            .entry((key.0.clone(), key.1))
-            .or_default()
-            .learn(replans, r.as_ref().map(|_| ()));
+        self.learn(&key.0, key.1, replans, r.as_ref().map(|_| ()));
         self.cache.lock().expect("not poisoned").insert(key, r.clone());
         r
     }
@@ -252,14 +257,14 @@ impl RobotModel {
         let replans = self.replans(step);
         let present = step.present();
         let key = (present.words().to_vec(), step.part());
-        if let Some(v) = self.verdicts.lock().expect("not poisoned").get(&key).and_then(|k| k.verdict(replans)) {
+        if let Some(v) = self.known(&key.0, key.1, replans) {
             return v;
         }
         let r = match step.motion() {
             Some(Motion::Linear { direction, .. }) => self.planner.removable(step.part(), &present, direction, step.seed(), replans),
             _ => Err(RobotFailure::Blocked { by: None }),
         };
-        self.verdicts.lock().expect("not poisoned").entry(key.clone()).or_default().learn(replans, r.as_ref().map(|_| ()));
+        self.learn(&key.0, key.1, replans, r.as_ref().map(|_| ()));
         if step.kind() == StepKind::Simulation {
             // the simulation's plan of this step ([`RobotModel::plan`])
             self.cache.lock().expect("not poisoned").insert((key.0, key.1, replans, true), r.clone());

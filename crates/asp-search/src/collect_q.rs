@@ -219,17 +219,7 @@ pub fn collect_transitions(
         }
     }
     let assemblies = collected.into_iter().map(|(entry, ..)| entry).collect();
-    let index = TransitionsIndex {
-        format: FORMAT.into(),
-        version: VERSION,
-        features: graph.features(),
-        node_dim: graph.node_dim(),
-        edge_dim: graph.edge_dim(),
-        objectives,
-        seed: settings.seed,
-        episodes: settings.optimise.episodes,
-        assemblies,
-    };
+    let index = index_of(&graph, objectives, settings.seed, settings.optimise.episodes, assemblies);
     collect::write_json(&out.join("index.json"), &index)?;
     Ok(index)
 }
@@ -337,17 +327,22 @@ fn model_entry(item: &ModelItem, plan: &PlanSettings, o: &OptimiseSettings, prob
 pub fn stepped_index(item: &ModelItem, plan: &PlanSettings, o: &OptimiseSettings, problem: &Mdp, episodes: usize) -> Result<TransitionsIndex> {
     let (ranges, graph, objectives) = problem_entry(problem)?;
     let entry = model_entry(item, plan, o, problem, ranges)?;
-    Ok(TransitionsIndex {
+    Ok(index_of(&graph, objectives, plan.seed, episodes, vec![entry]))
+}
+
+/// The `index.json` of a data set of `assemblies` whose state graphs are `graph`'s.
+fn index_of(graph: &QGraphConfig, objectives: Vec<String>, seed: u64, episodes: usize, assemblies: Vec<TransitionsModel>) -> TransitionsIndex {
+    TransitionsIndex {
         format: FORMAT.into(),
         version: VERSION,
         features: graph.features(),
         node_dim: graph.node_dim(),
         edge_dim: graph.edge_dim(),
         objectives,
-        seed: plan.seed,
+        seed,
         episodes,
-        assemblies: vec![entry],
-    })
+        assemblies,
+    }
 }
 
 /// Writes `transitions` as lines of `transitions.jsonl` (one JSON object and a newline each).
