@@ -2,7 +2,7 @@
 //! `asp plan --q` runs at every guided rollout step.
 //!
 //! ```text
-//! cargo run --release -p asp-learn --example q_infer -- MODEL.glb Q.onnx [STATES]
+//! cargo run --release -p asp-learn --example q_infer -- MODEL.glb Q.onnx [STATES [search]]
 //! ```
 //!
 //! Walks random removal sequences on the model's distance maps (resolution from the Q model's
@@ -10,6 +10,9 @@
 //! path (building the full graph, then scoring it) and of the Q-function as the search calls it
 //! (`QWorker::q_values`: the Rust forward pass with its per-pair edge cache, when the model has
 //! one), and the largest difference between the two paths' values.
+//!
+//! With a fourth argument `search`, only the search's path runs (no tract, no comparison), which
+//! is what `perf record` of this example should see.
 
 use asp_geom::distmap::{DistanceMaps, MapConfig, MapState};
 use asp_learn::OnnxQ;
@@ -54,9 +57,14 @@ impl Elapsed {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [model, q, rest @ ..] = &args[..] else {
-        return Err("usage: q_infer MODEL.glb Q.onnx [STATES]".into());
+        return Err("usage: q_infer MODEL.glb Q.onnx [STATES [search]]".into());
     };
     let states: usize = rest.first().map(|s| s.parse()).transpose()?.unwrap_or(2000);
+    let search_only = match rest.get(1).map(String::as_str) {
+        None => false,
+        Some("search") => true,
+        Some(other) => return Err(format!("unknown mode '{other}' (only 'search')").into()),
+    };
     let assembly = asp_geom::io::load(std::path::Path::new(model), &Default::default())?;
     let probe = asp_learn::GraphModel::open_kind(q, asp_learn::ModelKind::Q)?;
     let config = asp_learn::qfunction::parse_features(probe.features()).ok_or("not an asp-q/1 model")?;
@@ -89,13 +97,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             builder.build(&mut state, direction_history(&problem, &memory), &actions, &mut graph);
             let built = t.elapsed().as_secs_f64();
             let t = Instant::now();
-            let scores = q.model().score(&graph.x, graph.num_nodes(), &graph.edge_index, graph.num_edges(), &graph.edge_attr)?;
+            let scores = if search_only {
+                Vec::new()
+            } else {
+                q.model().score(&graph.x, graph.num_nodes(), &graph.edge_index, graph.num_edges(), &graph.edge_attr)?
+            };
             let scored = t.elapsed().as_secs_f64();
             values.resize(actions.len(), 0.0);
             let t = Instant::now();
             worker.q_values(&mut PolicyContext { state: &mut state, memory: &memory, problem: &problem }, &actions, &mut values)?;
             let search = t.elapsed().as_secs_f64();
-            for (v, &a) in values.iter().zip(&actions) {
+            for (v, &a) in values.iter().zip(&actions).filter(|_| !search_only) {
                 let k = graph.nodes.iter().position(|&p| p == a as i64).ok_or("action without a node")?;
                 let r = f64::from(scores[k]).max(asp_learn::qfunction::MIN_Q);
                 worst = worst.max((v - r).abs() / r.abs().max(1.0));

@@ -11,6 +11,13 @@
 //! W h_s`) and, for the next layer, folded into the second (`W1 (W2 z + b2)`); and `phi_Q` runs on
 //! the asked nodes only. What is left per state is two `[e, w] × [w, w]` products per layer.
 //!
+//! Those products and the per-edge loops (messages, a branch-free `exp` for the softmax) are
+//! written row-major over contiguous features so that they vectorise, and are compiled once per
+//! instruction set `pulp` knows (AVX-512, AVX2 with FMA, plain); the widest the CPU has is chosen
+//! at run time, without `unsafe` code here. The products fuse multiply-adds on the SIMD paths, so
+//! two machines with different instruction sets may differ in the last bits; one machine always
+//! gives the same values (the searches' same-seed determinism holds).
+//!
 //! The weights are read from the ONNX file's initialisers by the PyTorch parameter names the
 //! exporter keeps (`node_encoder.weight`, `phi_e.0.weight`, ...) and the per-layer softmax
 //! temperatures (the file's scalar initialisers, in order). [`QNet::from_model`] refuses a file
@@ -19,8 +26,7 @@
 //! instead of giving other values.
 
 use crate::model::GraphModel;
-use tract_onnx::prelude::tract_ndarray::linalg::general_mat_mul;
-use tract_onnx::prelude::tract_ndarray::{ArrayView2, ArrayViewMut2, ShapeBuilder};
+use pulp::Simd;
 
 /// The constant added to messages (`asp.train.gnn.EPS`).
 const EPS: f32 = 1e-7;
@@ -39,41 +45,111 @@ struct Dense {
 }
 
 impl Dense {
-    /// `out[rows, output] = x[rows, input] W (+ b)`.
-    fn apply(&self, x: &[f32], rows: usize, bias: bool, out: &mut [f32]) {
-        let out = &mut out[..rows * self.output];
-        if bias {
-            for row in out.chunks_exact_mut(self.output) {
-                row.copy_from_slice(&self.b);
-            }
-        } else {
-            out.fill(0.0);
-        }
-        if rows == 0 {
-            return;
-        }
-        let a = ArrayView2::from_shape((rows, self.input), &x[..rows * self.input]).expect("shape");
-        let w = ArrayView2::from_shape((self.input, self.output), &self.w).expect("shape");
-        let mut c = ArrayViewMut2::from_shape((rows, self.output), out).expect("shape");
-        general_mat_mul(1.0, &a, &w, 1.0, &mut c);
+    /// `out[rows, output] = x[rows, input] W (+ b)`, row-major.
+    #[inline(always)]
+    fn apply<S: Simd>(&self, simd: S, x: &[f32], rows: usize, bias: bool, out: &mut [f32]) {
+        gemm(simd, x, rows, self.input, &self.w, self.output, bias.then_some(&self.b[..]), &mut out[..rows * self.output]);
     }
+}
 
-    /// [`apply`](Self::apply) on column-major `x` and `out` (feature-major: column `j` of all
-    /// rows is contiguous). matrixmultiply packs a column-major left operand with contiguous
-    /// reads: 2-3× faster than row-major for the `[e, w] × [w, w]` products of the edges.
-    fn apply_columns(&self, x: &[f32], rows: usize, out: &mut [f32]) {
-        let out = &mut out[..rows * self.output];
-        for (column, &b) in out.chunks_exact_mut(rows.max(1)).zip(&self.b) {
-            column.fill(b);
-        }
-        if rows == 0 {
-            return;
-        }
-        let a = ArrayView2::from_shape((rows, self.input).f(), &x[..rows * self.input]).expect("shape");
-        let w = ArrayView2::from_shape((self.input, self.output), &self.w).expect("shape");
-        let mut c = ArrayViewMut2::from_shape((rows, self.output).f(), out).expect("shape");
-        general_mat_mul(1.0, &a, &w, 1.0, &mut c);
+/// `out[r, :] = bias + x[r, :] W` for row-major `x [rows, k]`, `W [k, cols]` and `out [rows,
+/// cols]`. Tiles of four rows by two SIMD vectors of columns are summed in registers with fused
+/// multiply-adds, so each load of a row of `W` serves four rows of `x`; columns past the last
+/// whole tile (all of them without SIMD) are summed one by one.
+#[inline(always)]
+fn gemm<S: Simd>(simd: S, x: &[f32], rows: usize, k: usize, w: &[f32], cols: usize, bias: Option<&[f32]>, out: &mut [f32]) {
+    let tile = 2 * lanes::<S>();
+    // without SIMD (one lane) every column takes the plain loop below: a scalar mul_add would be
+    // a library call
+    let whole = if tile > 2 { cols / tile * tile } else { 0 };
+    let mut r0 = 0;
+    while r0 + 4 <= rows {
+        gemm_rows::<S, 4>(simd, x, r0, k, w, cols, whole, bias, out);
+        r0 += 4;
     }
+    while r0 < rows {
+        gemm_rows::<S, 1>(simd, x, r0, k, w, cols, whole, bias, out);
+        r0 += 1;
+    }
+    for r in 0..rows {
+        for c in whole..cols {
+            let mut v = bias.map_or(0.0, |b| b[c]);
+            for j in 0..k {
+                v += x[r * k + j] * w[j * cols + c];
+            }
+            out[r * cols + c] = v;
+        }
+    }
+}
+
+/// `f32` lanes of a SIMD vector of `S`.
+#[inline(always)]
+fn lanes<S: Simd>() -> usize {
+    std::mem::size_of::<S::f32s>() / std::mem::size_of::<f32>()
+}
+
+/// Rows `r0..r0 + R` of [`gemm`], columns `0..whole` (whole tiles of two vectors): `R × 2`
+/// accumulators in registers, so each load of a row of `W` serves `R` rows of `x`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn gemm_rows<S: Simd, const R: usize>(simd: S, x: &[f32], r0: usize, k: usize, w: &[f32], cols: usize, whole: usize, bias: Option<&[f32]>, out: &mut [f32]) {
+    let tile = 2 * lanes::<S>();
+    let xs: [&[f32]; R] = std::array::from_fn(|r| &x[(r0 + r) * k..(r0 + r + 1) * k]);
+    for c0 in (0..whole).step_by(tile) {
+        let c1 = c0 + tile;
+        let start = bias.map_or([simd.splat_f32s(0.0); 2], |b| pair::<S>(&b[c0..c1]));
+        let mut acc = [start; R];
+        for (j, row) in w[..k * cols].chunks_exact(cols).enumerate() {
+            let [w0, w1] = pair::<S>(&row[c0..c1]);
+            #[allow(clippy::needless_range_loop)] // unrolled: the accumulators stay in registers
+            for r in 0..R {
+                let xv = simd.splat_f32s(xs[r][j]);
+                acc[r][0] = simd.mul_add_f32s(xv, w0, acc[r][0]);
+                acc[r][1] = simd.mul_add_f32s(xv, w1, acc[r][1]);
+            }
+        }
+        for (r, acc) in acc.iter().enumerate() {
+            let at = (r0 + r) * cols;
+            let o: &mut [S::f32s] = pulp::bytemuck::cast_slice_mut(&mut out[at + c0..at + c1]);
+            o.copy_from_slice(acc);
+        }
+    }
+}
+
+/// Two SIMD vectors from `2 · lanes` floats (a function, not a closure: closures are not
+/// inlined into the SIMD-compiled caller).
+#[inline(always)]
+fn pair<S: Simd>(v: &[f32]) -> [S::f32s; 2] {
+    let v: &[S::f32s] = pulp::bytemuck::cast_slice(v);
+    [v[0], v[1]]
+}
+
+/// `e^x` for `x <= SCORE_CLAMP` (Cephes' `expf` polynomial after reduction by `ln 2`; within
+/// 2 ulp of the correctly rounded value; 0 below `-87`). Branch-free, so loops of it vectorise,
+/// where the C library's `expf` is a call per element.
+#[inline(always)]
+fn exp(x: f32) -> f32 {
+    const LOG2E: f32 = std::f32::consts::LOG2_E;
+    const LN2_HI: f32 = 0.693_359_4;
+    const LN2_LO: f32 = -2.121_944_4e-4;
+    // 1.5 · 2^23: adding it rounds to an integer held in the low mantissa bits
+    const MAGIC: f32 = 12_582_912.0;
+    let x = x.clamp(-87.0, 88.0);
+    let t = x * LOG2E + MAGIC;
+    let k = t - MAGIC;
+    let r = x - k * LN2_HI - k * LN2_LO;
+    let mut p = 1.987_569_1e-4f32;
+    p = p * r + 1.398_199_9e-3;
+    p = p * r + 8.333_452e-3;
+    p = p * r + 4.166_579_6e-2;
+    p = p * r + 1.666_666_5e-1;
+    p = p * r + 5.000_000_1e-1;
+    let y = p * r * r + r + 1.0;
+    // 2^k from the integer in t's mantissa (k in -126..=127 after the clamp)
+    // (wrapping u32 arithmetic is the two's complement of k + 127, and has no overflow check
+    // that would keep the loop from vectorising)
+    let scale = f32::from_bits(t.to_bits().wrapping_sub(MAGIC.to_bits()).wrapping_add(127) << 23);
+    y * scale
 }
 
 /// The Q network's weights (immutable, shared by every thread).
@@ -116,7 +192,6 @@ pub struct Scratch {
     p: Vec<f32>,
     z: Vec<f32>,
     a: Vec<f32>,
-    a_next: Vec<f32>,
     m: Vec<f32>,
     mean: Vec<f32>,
     sums: Vec<f32>,
@@ -277,7 +352,7 @@ impl QNet {
                 *o = (v - self.edge_mean[k]) / self.edge_std[k];
             }
         }
-        self.edge_encoder.apply(xs, rows, true, out);
+        self.edge_encoder.apply(pulp::Scalar::new(), xs, rows, true, out);
     }
 
     /// The Q-values of the `wanted` nodes of a graph in the model's input layout (`x [n,
@@ -299,8 +374,18 @@ impl QNet {
     /// The Q-values of the `wanted` nodes into `out`: `x [n, node_dim]` the node attributes,
     /// edge `k` from `sources[k]` to `targets[k]` with `edges[k * width..]` its
     /// [`encode_edge`](Self::encode_edge).
+    ///
+    /// Runs on the widest SIMD instruction set the CPU has (`pulp`, see the module's notes).
     #[allow(clippy::too_many_arguments)]
     pub fn forward(&self, x: &[f32], n: usize, sources: &[u32], targets: &[u32], edges: &[f32], wanted: &[usize], out: &mut [f32], s: &mut Scratch) {
+        pulp::Arch::new().dispatch(Forward { net: self, x, n, sources, targets, edges, wanted, out, s });
+    }
+
+    /// The forward pass, row-major throughout (node `t`'s or edge `k`'s `width` features are
+    /// contiguous), so every per-edge loop runs over contiguous features and vectorises.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn forward_any<S: Simd>(&self, simd: S, x: &[f32], n: usize, sources: &[u32], targets: &[u32], edges: &[f32], wanted: &[usize], out: &mut [f32], s: &mut Scratch) {
         let w = self.width;
         let e = sources.len();
         let nd = self.node_dim;
@@ -313,7 +398,7 @@ impl QNet {
         }
         let mut h = std::mem::take(&mut s.h);
         grow(&mut h, n * w);
-        self.node_encoder.apply(&s.xs, n, true, &mut h);
+        self.node_encoder.apply(simd, &s.xs, n, true, &mut h);
         let inv_count = grow(&mut s.inv_count, n);
         inv_count.fill(0.0);
         for &t in targets {
@@ -325,81 +410,78 @@ impl QNet {
         grow(&mut s.p, n * w);
         grow(&mut s.z, e * w);
         grow(&mut s.a, e * 2 * w);
-        grow(&mut s.a_next, e * w);
         grow(&mut s.m, e * w);
         grow(&mut s.mean, n * w);
         grow(&mut s.sums, n * 2 * w);
         grow(&mut s.u, n * w);
-        // edge activations are column-major ([j * e + k]: feature j of edge k), see apply_columns
-        // the first layer's edge share: the cached encodings
-        for (k, row) in edges[..e * w].chunks_exact(w).enumerate() {
-            for (j, &v) in row.iter().enumerate() {
-                s.a_next[j * e + k] = v;
-            }
-        }
         for layer in 0..self.layers {
             let last = layer + 1 == self.layers;
+            // this layer's edge share of the pre-activation: the cached encodings first, then
+            // columns w..2w of the previous layer's fused product
+            let (a_in, stride): (&[f32], usize) = if layer == 0 { (&edges[..e * w], w) } else { (&s.a[..e * 2 * w], 2 * w) };
             // z = relu(W1 h_t + W1 a + W1 h_s + b1)
-            self.e1.apply(&h, n, false, &mut s.p);
-            for j in 0..w {
-                let b1 = self.e1.b[j];
-                let a = &s.a_next[j * e..(j + 1) * e];
-                let z = &mut s.z[j * e..(j + 1) * e];
-                for k in 0..e {
-                    let (t, src) = (targets[k] as usize, sources[k] as usize);
-                    z[k] = (s.p[t * w + j] + a[k] + s.p[src * w + j] + b1).max(0.0);
+            self.e1.apply(simd, &h, n, false, &mut s.p);
+            let (p, b1) = (&s.p[..n * w], &self.e1.b[..w]);
+            for (k, z) in s.z[..e * w].chunks_exact_mut(w).enumerate() {
+                let (t, src) = (targets[k] as usize, sources[k] as usize);
+                let (pt, ps, a) = (&p[t * w..(t + 1) * w], &p[src * w..(src + 1) * w], &a_in[k * stride + (stride - w)..k * stride + stride]);
+                for ((((z, &pt), &a), &ps), &b1) in z.iter_mut().zip(pt).zip(a).zip(ps).zip(b1) {
+                    *z = (pt + a + ps + b1).max(0.0);
                 }
             }
-            // the new edge state a' (columns 0..w) and, but for the last layer, W1 a' for the
-            // next (columns w..2w)
-            if last {
-                self.e2.apply_columns(&s.z, e, &mut s.a);
+            // the new edge state a' (columns 0..w of a row) and, but for the last layer, W1 a'
+            // for the next (columns w..2w)
+            let stride = if last {
+                self.e2.apply(simd, &s.z, e, true, &mut s.a);
+                w
             } else {
-                self.e2_fused.apply_columns(&s.z, e, &mut s.a);
-                s.a_next[..e * w].copy_from_slice(&s.a[w * e..2 * w * e]);
-            }
+                self.e2_fused.apply(simd, &s.z, e, true, &mut s.a);
+                2 * w
+            };
             // messages m = relu(h_t + a') + eps and the learned softmax over each target's edges
             let tau = self.temperature[layer];
             let mean = &mut s.mean[..n * w];
             mean.fill(0.0);
-            for j in 0..w {
-                let a = &s.a[j * e..(j + 1) * e];
-                let m = &mut s.m[j * e..(j + 1) * e];
-                for k in 0..e {
-                    let t = targets[k] as usize;
-                    m[k] = (h[t * w + j] + a[k]).max(0.0) + EPS;
-                    mean[t * w + j] += m[k] * tau;
+            for (k, m) in s.m[..e * w].chunks_exact_mut(w).enumerate() {
+                let t = targets[k] as usize;
+                let (ht, a, mt) = (&h[t * w..(t + 1) * w], &s.a[k * stride..k * stride + w], &mut mean[t * w..(t + 1) * w]);
+                for (((m, mt), &ht), &a) in m.iter_mut().zip(mt.iter_mut()).zip(ht).zip(a) {
+                    *m = (ht + a).max(0.0) + EPS;
+                    *mt += *m * tau;
                 }
             }
-            for t in 0..n {
+            for (t, row) in mean.chunks_exact_mut(w).enumerate() {
                 let c = s.inv_count[t];
-                for v in &mut mean[t * w..(t + 1) * w] {
+                for v in row {
                     *v *= c;
                 }
             }
             let sums = &mut s.sums[..n * 2 * w];
             sums.fill(0.0);
-            for j in 0..w {
-                let m = &s.m[j * e..(j + 1) * e];
-                for k in 0..e {
-                    let t = targets[k] as usize;
-                    let weight = (m[k] * tau - mean[t * w + j]).min(SCORE_CLAMP).exp();
-                    sums[t * 2 * w + j] += weight * m[k];
-                    sums[t * 2 * w + w + j] += weight;
+            for (k, m) in s.m[..e * w].chunks_exact(w).enumerate() {
+                let t = targets[k] as usize;
+                let (mt, st) = (&mean[t * w..(t + 1) * w], &mut sums[t * 2 * w..(t + 1) * 2 * w]);
+                let (num, den) = st.split_at_mut(w);
+                for (((num, den), &m), &mt) in num.iter_mut().zip(den.iter_mut()).zip(m).zip(mt) {
+                    let weight = exp((m * tau - mt).min(SCORE_CLAMP));
+                    *num += weight * m;
+                    *den += weight;
                 }
             }
             // h = phi_n(h + aggregate)
             for t in 0..n {
                 let st = &sums[t * 2 * w..(t + 1) * 2 * w];
-                for j in 0..w {
-                    s.u[t * w + j] = h[t * w + j] + st[j] / st[w + j].max(1.0);
+                let (ht, u) = (&h[t * w..(t + 1) * w], &mut s.u[t * w..(t + 1) * w]);
+                let (num, den) = st.split_at(w);
+                for (((u, &ht), &num), &den) in u.iter_mut().zip(ht).zip(num).zip(den) {
+                    *u = ht + num / den.max(1.0);
                 }
             }
-            self.n1.apply(&s.u, n, true, &mut s.p);
+            self.n1.apply(simd, &s.u, n, true, &mut s.p);
             for v in &mut s.p[..n * w] {
                 *v = v.max(0.0);
             }
-            self.n2.apply(&s.p, n, true, &mut h);
+            self.n2.apply(simd, &s.p, n, true, &mut h);
         }
         // q_i = phi_Q([h_i, hbar]), hbar the mean of the real nodes (x[:, 0] = 1)
         let mut weight = 0.0f32;
@@ -417,13 +499,13 @@ impl QNet {
             *v /= norm;
         }
         let pool = grow(&mut s.mean, w);
-        self.q1_pool.apply(&s.u[..w], 1, true, pool);
+        self.q1_pool.apply(simd, &s.u[..w], 1, true, pool);
         let rows = grow(&mut s.z, wanted.len() * w);
         for (r, &k) in rows.chunks_exact_mut(w).zip(wanted) {
             r.copy_from_slice(&h[k * w..(k + 1) * w]);
         }
         let hidden = grow(&mut s.q_hidden, wanted.len() * w);
-        self.q1_node.apply(&s.z, wanted.len(), false, hidden);
+        self.q1_node.apply(simd, &s.z, wanted.len(), false, hidden);
         for (o, row) in out.iter_mut().zip(hidden.chunks_exact(w)) {
             let mut q = self.q2.b[0];
             for ((r, p), v) in row.iter().zip(&s.mean[..w]).zip(&self.q2.w) {
@@ -432,6 +514,30 @@ impl QNet {
             *o = q;
         }
         s.h = h;
+    }
+}
+
+/// [`QNet::forward`]'s arguments, for `pulp`'s dispatch: its `with_simd` is compiled once per
+/// instruction set with [`QNet::forward_any`] inlined.
+struct Forward<'a> {
+    net: &'a QNet,
+    x: &'a [f32],
+    n: usize,
+    sources: &'a [u32],
+    targets: &'a [u32],
+    edges: &'a [f32],
+    wanted: &'a [usize],
+    out: &'a mut [f32],
+    s: &'a mut Scratch,
+}
+
+impl pulp::WithSimd for Forward<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let Forward { net, x, n, sources, targets, edges, wanted, out, s } = self;
+        net.forward_any(simd, x, n, sources, targets, edges, wanted, out, s);
     }
 }
 
@@ -463,4 +569,84 @@ fn compose(first: &Dense, second: &Dense, second_bias: bool) -> Dense {
         })
         .collect();
     Dense { input: i, output: o, w, b }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`gemm`] on the widest instruction set of this CPU (what the forward pass runs).
+    struct Gemm<'a> {
+        x: &'a [f32],
+        rows: usize,
+        k: usize,
+        w: &'a [f32],
+        cols: usize,
+        bias: Option<&'a [f32]>,
+        out: &'a mut [f32],
+    }
+
+    impl pulp::WithSimd for Gemm<'_> {
+        type Output = ();
+
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, simd: S) {
+            gemm(simd, self.x, self.rows, self.k, self.w, self.cols, self.bias, self.out);
+        }
+    }
+
+    fn values(count: usize, seed: u32) -> Vec<f32> {
+        (0..count as u32).map(|i| ((i.wrapping_mul(2_654_435_761).wrapping_add(seed) >> 8) % 2001) as f32 / 1000.0 - 1.0).collect()
+    }
+
+    #[test]
+    fn gemm_equals_the_plain_product_on_every_tile_and_tail_shape() {
+        // rows around the 4-row tiles, columns around the two-vector tiles of 8 and 16 lanes
+        // (and tails past them), with and without bias, on this CPU's SIMD path and the scalar one
+        for rows in [1, 3, 4, 5, 9] {
+            for k in [1, 7, 32, 190] {
+                for cols in [1, 5, 16, 32, 33, 64, 100, 128] {
+                    let (x, w, b) = (values(rows * k, 1), values(k * cols, 2), values(cols, 3));
+                    for bias in [None, Some(&b[..])] {
+                        let want: Vec<f64> = (0..rows * cols)
+                            .map(|i| {
+                                let (r, c) = (i / cols, i % cols);
+                                let sum: f64 = (0..k).map(|j| f64::from(x[r * k + j]) * f64::from(w[j * cols + c])).sum();
+                                sum + bias.map_or(0.0, |b| f64::from(b[c]))
+                            })
+                            .collect();
+                        let mut simd = vec![f32::NAN; rows * cols];
+                        pulp::Arch::new().dispatch(Gemm { x: &x, rows, k, w: &w, cols, bias, out: &mut simd });
+                        let mut scalar = vec![f32::NAN; rows * cols];
+                        gemm(pulp::Scalar::new(), &x, rows, k, &w, cols, bias, &mut scalar);
+                        for (path, got) in [("simd", &simd), ("scalar", &scalar)] {
+                            for (i, (g, v)) in got.iter().zip(&want).enumerate() {
+                                let err = (f64::from(*g) - v).abs();
+                                assert!(err <= 1e-5 * (k as f64), "{path} rows {rows} k {k} cols {cols} bias {}: [{i}] {g} vs {v}", bias.is_some());
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn exp_is_within_a_few_ulp_of_the_library() {
+        // the softmax's range: scores clamped at SCORE_CLAMP above, anything below
+        let mut worst = 0.0f64;
+        let mut x = -80.0f32;
+        while x <= SCORE_CLAMP {
+            let (got, want) = (f64::from(exp(x)), f64::from(x).exp());
+            worst = worst.max((got - want).abs() / want);
+            x += 0.013;
+        }
+        assert!(worst <= 4.0 * f64::from(f32::EPSILON), "relative error {worst}");
+        assert_eq!(exp(0.0), 1.0);
+        // far below the range: tiny and finite, never NaN or negative
+        for x in [-88.0f32, -100.0, -1e6, f32::MIN] {
+            let v = exp(x);
+            assert!((0.0..1e-37).contains(&v), "exp({x}) = {v}");
+        }
+    }
 }
