@@ -136,6 +136,10 @@ def _q_parser(sub) -> None:
         help="states per assembly scored for the ranking quality (default 2000)",
     )
     q.add_argument(
+        "--train-eval-states", type=int, default=None,
+        help="states per training assembly scored likewise (default: --eval-states; 0 skips them)",
+    )
+    q.add_argument(
         "--aggregation", choices=["scatter", "dense"], default="dense",
         help="aggregation ops in the ONNX file (default dense)",
     )
@@ -268,7 +272,8 @@ def _q(args: argparse.Namespace) -> int:
     parity = export_q(model, args.out, features, args.objective, aggregation=args.aggregation, tolerance=args.parity_tolerance)
     _log(f"wrote {args.out} (ONNX matches PyTorch to {parity:.2g}, padded graphs included)")
     save_q_weights(model, str(args.out) + ".pt", features, args.objective)
-    train_rank = {a.name: ranking_quality(model, a, graphs, max_states=args.eval_states) for a in train_set}
+    train_states = args.eval_states if args.train_eval_states is None else args.train_eval_states
+    train_rank = {a.name: ranking_quality(model, a, graphs, max_states=train_states) for a in train_set} if train_states > 0 else {}
     held = {a.name: ranking_quality(model, a, graphs, max_states=args.eval_states) for a in test_set}
     for name, r in held.items():
         if r["accuracy"] is None:
