@@ -3,6 +3,10 @@
 //! ScatterND and the one-hot MatMul aggregations; and the shipped model (`shipped/...`, its own
 //! width and layers, buckets).
 //!
+//! The Q network's Rust forward pass per state (`q/...`): the width-32 fixture on a state graph of
+//! 40 and 70 parts, 8 nearest neighbours each plus the context node's edge, edge encodings
+//! precomputed as the search's pair cache holds them.
+//!
 //! `cargo bench -p asp-learn --bench infer`
 
 use std::hint::black_box;
@@ -61,5 +65,43 @@ fn infer(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, infer);
+fn q_forward(c: &mut Criterion) {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let model = asp_learn::GraphModel::open_kind(dir.join("random_q_access.onnx"), asp_learn::ModelKind::Q).unwrap();
+    let net = asp_learn::qnet::QNet::from_model(&model).unwrap();
+    let (node_dim, edge_dim, width) = (model.node_dim(), model.edge_dim(), net.width());
+    let mut group = c.benchmark_group("q");
+    for parts in [40usize, 70] {
+        let n = parts + 1; // the context node last
+        let mut x: Vec<f32> = (0..n * node_dim).map(|i| ((i * 37) % 101) as f32 / 101.0).collect();
+        for k in 0..n {
+            x[k * node_dim] = if k < parts { 1.0 } else { 0.0 };
+        }
+        let (mut sources, mut targets) = (Vec::new(), Vec::new());
+        for t in 0..parts as u32 {
+            for j in 1..=8 {
+                sources.push((t + j) % parts as u32);
+                targets.push(t);
+            }
+            sources.push(parts as u32);
+            targets.push(t);
+        }
+        let (mut edges, mut scratch) = (vec![0.0; sources.len() * width], Vec::new());
+        for (k, out) in edges.chunks_exact_mut(width).enumerate() {
+            let row: Vec<f32> = (0..edge_dim).map(|i| ((i * 13 + k * 7) % 97) as f32 / 97.0).collect();
+            net.encode_edge(&row, out, &mut scratch);
+        }
+        let wanted: Vec<usize> = (0..parts).collect();
+        let (mut out, mut s) = (vec![0.0; parts], asp_learn::qnet::Scratch::default());
+        group.bench_function(format!("width{width}/parts{parts}"), |b| {
+            b.iter(|| {
+                net.forward(black_box(&x), n, &sources, &targets, &edges, &wanted, &mut out, &mut s);
+                black_box(out[0])
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, infer, q_forward);
 criterion_main!(benches);
