@@ -124,9 +124,10 @@ fn pair<S: Simd>(v: &[f32]) -> [S::f32s; 2] {
     [v[0], v[1]]
 }
 
-/// `e^x` for `x <= SCORE_CLAMP` (Cephes' `expf` polynomial after reduction by `ln 2`; within
-/// 2 ulp of the correctly rounded value; 0 below `-87`). Branch-free, so loops of it vectorise,
-/// where the C library's `expf` is a call per element.
+/// `e^x` for `x <= SCORE_CLAMP` (Cephes' `expf` polynomial after reduction by `ln 2`; within a
+/// few ulp of the correctly rounded value; `x` is clamped to `[-87, 88]`, so far below the
+/// range it gives `e^-87`, not 0). Branch-free, so loops of it vectorise, where the C library's
+/// `expf` is a call per element.
 #[inline(always)]
 fn exp(x: f32) -> f32 {
     const LOG2E: f32 = std::f32::consts::LOG2_E;
