@@ -256,7 +256,7 @@ pub struct Hemisphere {
 impl Hemisphere {
     /// Samples `resolution × resolution` directions (odd, 3..=15) around `up`.
     pub fn new(resolution: usize, up: Axis) -> Result<Self> {
-        if !(3..=MAX_RESOLUTION).contains(&resolution) || resolution % 2 == 0 {
+        if !(3..=MAX_RESOLUTION).contains(&resolution) || resolution.is_multiple_of(2) {
             return Err(GeomError::config(format!(
                 "distance map resolution must be odd and within 3..={MAX_RESOLUTION}, got {resolution}"
             )));
@@ -451,7 +451,7 @@ impl MapConfigBuilder {
     pub fn build(self) -> Result<MapConfig> {
         let c = self.config;
         let r = c.resolution;
-        if !(3..=MAX_RESOLUTION).contains(&r) || r % 2 == 0 {
+        if !(3..=MAX_RESOLUTION).contains(&r) || r.is_multiple_of(2) {
             return Err(GeomError::config(format!(
                 "distance map resolution must be odd and within 3..={MAX_RESOLUTION}, got {r}"
             )));

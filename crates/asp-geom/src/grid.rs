@@ -622,7 +622,7 @@ impl Solver<'_> {
         let mut next = vec![0i32; width];
         while head < links.len() {
             self.expanded += 1;
-            if self.states >= self.config.max_states || (self.expanded % 1024 == 0 && (self.stop)()) {
+            if self.states >= self.config.max_states || (self.expanded.is_multiple_of(1024) && (self.stop)()) {
                 return Bfs::Budget;
             }
             let offsets: Vec<Cell> = arena[head * width..(head + 1) * width].chunks(3).map(|c| [c[0], c[1], c[2]]).collect();

@@ -57,6 +57,7 @@ impl Dense {
 /// multiply-adds, so each load of a row of `W` serves four rows of `x`; columns past the last
 /// whole tile (all of them without SIMD) are summed one by one.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn gemm<S: Simd>(simd: S, x: &[f32], rows: usize, k: usize, w: &[f32], cols: usize, bias: Option<&[f32]>, out: &mut [f32]) {
     let tile = 2 * lanes::<S>();
     // without SIMD (one lane) every column takes the plain loop below: a scalar mul_add would be
@@ -144,7 +145,7 @@ fn exp(x: f32) -> f32 {
     p = p * r + 8.333_452e-3;
     p = p * r + 4.166_579_6e-2;
     p = p * r + 1.666_666_5e-1;
-    p = p * r + 5.000_000_1e-1;
+    p = p * r + 0.5;
     let y = p * r * r + r + 1.0;
     // 2^k from the integer in t's mantissa (k in -126..=127 after the clamp)
     // (wrapping u32 arithmetic is the two's complement of k + 127, and has no overflow check

@@ -143,7 +143,7 @@ impl AssemblyGraph {
     ) -> Result<AssemblyGraph> {
         config.validate()?;
         let (nd, ed) = (config.node_dim(), config.edge_dim());
-        if nodes.len() % nd != 0 {
+        if !nodes.len().is_multiple_of(nd) {
             return Err(GeomError::config(format!(
                 "graph nodes hold {} floats, not a multiple of node_dim {nd}",
                 nodes.len()

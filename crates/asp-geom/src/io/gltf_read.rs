@@ -465,7 +465,7 @@ fn bake(local: &LocalMesh, world: &DMat4, scale: f64) -> Mesh {
 fn triangulate(mode: Mode, indices: &[u32]) -> Res<Vec<[u32; 3]>> {
     let n = indices.len();
     let triangles: Vec<[u32; 3]> = match mode {
-        Mode::Triangles if n % 3 != 0 => {
+        Mode::Triangles if !n.is_multiple_of(3) => {
             return Err(format!("{n} triangle indices is not a multiple of 3"));
         }
         Mode::Triangles => {

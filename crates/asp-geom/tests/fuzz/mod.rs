@@ -49,10 +49,10 @@ fn split_glb(glb: &[u8]) -> (Vec<u8>, Vec<u8>) {
 
 /// A GLB container around `json` and `bin`, every length right.
 fn glb(mut json: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + json.len() + if bin.is_empty() { 0 } else { 8 + bin.len() };
