@@ -22,6 +22,12 @@ PUMP = "tests/data/pump"
 _SECONDS = re.compile(r'("(?:seconds|map_seconds|search_seconds|load|world|search|path_planner)": )[-+0-9.eE]+')
 
 
+#: First lines of a child Python script that tests Ctrl-C with ``_thread.interrupt_main``: Python's
+#: own SIGINT handler, also when the test run was started with SIGINT ignored (a background job of
+#: a non-interactive shell), where the child would inherit the ignoring and the interrupt do nothing.
+CTRL_C_HANDLER = "import signal\nsignal.signal(signal.SIGINT, signal.default_int_handler)\n"
+
+
 def need(module: str, install: str):
     """Imports an optional test dependency, or skips the test module without it, unless the
     environment variable ``ASP_TEST_REQUIRE`` (comma-separated top-level names) lists it: there a

@@ -8,14 +8,14 @@ import threading
 import time
 
 import asp
-from conftest import PUMP, ROOT, _asp_command
+from conftest import CTRL_C_HANDLER, PUMP, ROOT, _asp_command
 
 CUBE81 = "tests/data/cube81"
 
 # cube81 one piece at a time: no piece can leave along a straight line, and the path planner is
 # tried on each of the 81 pieces in turn (seconds; the search checks for Ctrl-C between calls)
 SLOW = dict(subassemblies=False, rrt_time=0.05)
-INTERRUPTED = f"""
+INTERRUPTED = CTRL_C_HANDLER + f"""
 import _thread, threading, time, asp
 a = asp.load({str(ROOT / CUBE81)!r}, unit="mm", up="z")
 threading.Timer(0.3, _thread.interrupt_main).start()
@@ -44,7 +44,7 @@ def test_ctrl_c_interrupts_a_search():
 # more episodes than it can run in the time limit. Not the pump: without subassemblies its
 # optimiser proves in well under a second that no complete sequence exists (its locked core),
 # which on an idle machine ended the run before the signal came.
-OPTIMISING = """
+OPTIMISING = CTRL_C_HANDLER + """
 import _thread, sys, threading, time, asp
 a = asp.load(sys.argv[1])
 threading.Timer(1.0, _thread.interrupt_main).start()

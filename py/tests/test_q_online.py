@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import _asp_command, need, without_seconds
+from conftest import CTRL_C_HANDLER, _asp_command, need, without_seconds
 
 torch = need("torch", "asp.train needs torch (pip install ./py[train])")
 
@@ -159,7 +159,7 @@ def test_bench_mcts_prints_the_four_settings_and_the_cli_points_to_it(cube: Path
 
 
 def test_ctrl_c_stops_a_stepped_search(cube: Path, tmp_path: Path) -> None:
-    script = f"""
+    script = CTRL_C_HANDLER + f"""
 import _thread, threading, time, asp
 s = asp.load({str(cube)!r}).search(objective="access", episodes=10**9, budget=10**9, resolution=5)
 threading.Timer(1.0, _thread.interrupt_main).start()
