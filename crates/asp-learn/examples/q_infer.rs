@@ -93,16 +93,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             if actions.is_empty() || done >= states {
                 break;
             }
-            let t = Instant::now();
-            builder.build(&mut state, direction_history(&problem, &memory), &actions, &mut graph);
-            let built = t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let scores = if search_only {
-                Vec::new()
-            } else {
-                q.model().score(&graph.x, graph.num_nodes(), &graph.edge_index, graph.num_edges(), &graph.edge_attr)?
-            };
-            let scored = t.elapsed().as_secs_f64();
+            let (mut built, mut scored, mut scores) = (0.0, 0.0, Vec::new());
+            if !search_only {
+                let t = Instant::now();
+                builder.build(&mut state, direction_history(&problem, &memory), &actions, &mut graph);
+                built = t.elapsed().as_secs_f64();
+                let t = Instant::now();
+                scores = q.model().score(&graph.x, graph.num_nodes(), &graph.edge_index, graph.num_edges(), &graph.edge_attr)?;
+                scored = t.elapsed().as_secs_f64();
+            }
             values.resize(actions.len(), 0.0);
             let t = Instant::now();
             worker.q_values(&mut PolicyContext { state: &mut state, memory: &memory, problem: &problem }, &actions, &mut values)?;
@@ -112,7 +111,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let r = f64::from(scores[k]).max(asp_learn::qfunction::MIN_Q);
                 worst = worst.max((v - r).abs() / r.abs().max(1.0));
             }
-            let e = by_size.entry(graph.num_nodes() - 1).or_default();
+            let e = by_size.entry(state.present().len()).or_default();
             *e = (e.0 + 1, e.1 + built, e.2 + scored, e.3 + search);
             done += 1;
             seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
