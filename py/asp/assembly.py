@@ -139,6 +139,7 @@ class Assembly:
         threads: Optional[int] = None,
         time_limit: Optional[float] = None,
         exploration: float = math.sqrt(0.5),
+        polish: float = 0.25,
         resolution: int = 9,
         d_max: Optional[float] = None,
         support: str = "below",
@@ -189,6 +190,9 @@ class Assembly:
         :param threads: optimiser threads (default: all cores).
         :param time_limit: optimiser wall-time limit, seconds.
         :param exploration: exploration constant of UCT / MOUCB.
+        :param polish: local search over the answer's sequences (block moves of 1-3 removals
+            around every sequence the search finds) may take this share of the search's work;
+            0 turns it off.
         :param resolution: distance map resolution N_M (odd, 3 to 15).
         :param d_max: distance map cap, model units (default the diagonal).
         :param support: the optimiser's gravity check, ``below`` or ``contact``.
@@ -235,6 +239,7 @@ class Assembly:
             "threads": threads,
             "time_limit": time_limit,
             "exploration": exploration,
+            "polish": polish,
             "resolution": resolution,
             "d_max": d_max,
             "support": support,

@@ -42,6 +42,23 @@ def test_optimised_plan_json_is_the_clis(root, asp_cli):
     assert plan.trace_csv is not None and plan.trace_csv.count("\n") >= 2
 
 
+def test_local_search_share_is_the_clis_polish_flag(root, asp_cli):
+    flags = ["--objective", "access", "--episodes", "40", "--threads", "1", "--seed", "2", "--polish", "0"]
+    code, out, err = asp_cli("plan", LACK, "--up", "z", "--json", *flags)
+    assert code == 0, err
+    a = asp.load(LACK, up="z")
+    off = a.plan(objective="access", episodes=40, threads=1, seed=2, polish=0)
+    assert without_seconds(off.json) == without_seconds(out)
+    assert off.optimisation["polish"] == 0 and off.optimisation["polished"] == 0
+    on = a.plan(objective="access", episodes=40, threads=1, seed=2)
+    assert on.optimisation["polish"] == 0.25
+    # the same tree search; the local search keeps the best sequence or finds a better one
+    assert on.optimisation["iterations"] == off.optimisation["iterations"]
+    assert on.optimisation["values"][0] >= off.optimisation["values"][0]
+    with pytest.raises(asp.ConfigError, match="local search share"):
+        a.plan(objective="access", episodes=5, polish=-1.0)
+
+
 def test_no_plan_pump_explains_what_holds_what(root, asp_cli):
     a = asp.load(PUMP, unit="mm", up="z")
     # single parts only: body, back lid, the two large screws through both, and the shaft and

@@ -48,6 +48,9 @@ pub struct MctsArgs {
     /// Exploration constant c of UCT / MOUCB.
     #[arg(long, default_value_t = std::f64::consts::FRAC_1_SQRT_2)]
     pub exploration: f64,
+    /// The local search's share of each search's work (`asp plan --polish`; 0: off).
+    #[arg(long, value_name = "SHARE", default_value_t = asp_search::search::DEFAULT_POLISH)]
+    pub polish: f64,
     /// Distance map resolution N_M.
     #[arg(long, default_value_t = asp_geom::distmap::DEFAULT_RESOLUTION)]
     pub resolution: usize,
@@ -130,6 +133,7 @@ pub fn run(a: &MctsArgs) -> anyhow::Result<std::process::ExitCode> {
         budget: a.budget,
         threads: Some(a.threads),
         exploration: a.exploration,
+        polish: a.polish,
         resolution: a.resolution,
         d_max: a.d_max,
         support: match a.support {

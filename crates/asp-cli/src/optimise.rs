@@ -53,6 +53,10 @@ pub struct OptimiseArgs {
     /// Exploration constant c of UCT / MOUCB.
     #[arg(long, default_value_t = std::f64::consts::FRAC_1_SQRT_2, help_heading = "Optimisation")]
     pub exploration: f64,
+    /// Local search over the answer's sequences: block moves of 1-3 removals around every
+    /// sequence the search finds, taking at most this share of the search's work (0: off).
+    #[arg(long, value_name = "SHARE", default_value_t = asp_search::search::DEFAULT_POLISH, help_heading = "Optimisation")]
+    pub polish: f64,
     /// Distance map resolution N_M (odd, 3 to 15): N_M × N_M directions on the half sphere.
     #[arg(long, default_value_t = asp_geom::distmap::DEFAULT_RESOLUTION, help_heading = "Optimisation")]
     pub resolution: usize,
@@ -141,6 +145,7 @@ impl OptimiseArgs {
             threads: self.threads,
             time_limit: self.time_limit,
             exploration: self.exploration,
+            polish: self.polish,
             resolution: self.resolution,
             d_max: self.d_max,
             support: match self.support {

@@ -1627,6 +1627,23 @@ impl<'m> MapState<'m> {
         }
     }
 
+    /// Whether `i` is a feasible removal: present, not fixed, collision-free, and leaving a
+    /// stable state (one part of [`MapState::feasible_actions`]).
+    pub fn can_remove(&mut self, i: usize) -> bool {
+        if i >= self.maps.n || !self.present.contains(i) || self.fixed.contains(i) || !self.is_collision_free(i) {
+            return false;
+        }
+        self.counters.gravity_tests += 1;
+        let stable = match self.maps.support {
+            Support::Below => !self.holding.contains(i),
+            Support::ContactGraph => self.removal_keeps_stable(i),
+        };
+        if !stable {
+            self.counters.unsupported += 1;
+        }
+        stable
+    }
+
     /// Whether every present part stands (by the maps' [`Support`] rule).
     pub fn is_stable(&self) -> bool {
         self.maps.stability(&self.present()) == Stability::Stable

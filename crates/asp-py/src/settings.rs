@@ -30,7 +30,7 @@ pub const DEFAULT_PHYSICS_THRESHOLD: f64 = 0.01;
 pub const ORDER_NAMES: [&str; 5] = ["given", "shuffled", "random", "bookkeeping", "gnn"];
 
 /// The keywords of [`plan_settings`], in the order of `asp.Assembly.plan`'s signature.
-pub const PLAN_KEYS: [&str; 30] = [
+pub const PLAN_KEYS: [&str; 31] = [
     "order",
     "model",
     "bookkeeping",
@@ -55,6 +55,7 @@ pub const PLAN_KEYS: [&str; 30] = [
     "threads",
     "time_limit",
     "exploration",
+    "polish",
     "resolution",
     "d_max",
     "support",
@@ -235,6 +236,7 @@ fn optimise_settings(k: &Keywords<'_, '_>) -> Result<Option<OptimiseSettings>, E
         threads: k.count("threads")?,
         time_limit: k.positive("time_limit")?,
         exploration: k.number("exploration")?.unwrap_or(d.exploration),
+        polish: k.number("polish")?.unwrap_or(d.polish),
         resolution,
         d_max: k.positive("d_max")?,
         support,
@@ -367,6 +369,7 @@ pub fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("threads", o.threads)?;
     d.set_item("time_limit", o.time_limit)?;
     d.set_item("exploration", o.exploration)?;
+    d.set_item("polish", o.polish)?;
     d.set_item("resolution", o.resolution)?;
     d.set_item("d_max", o.d_max)?;
     d.set_item("support", "below")?;

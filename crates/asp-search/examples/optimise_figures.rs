@@ -124,7 +124,50 @@ fn main() {
                 println!("{name}: {} parts ({removable} removable), all distance maps in {best:.3} s (best of 5)", a.len());
             }
         }
-        other => eprintln!("unknown mode '{other}' (speed, hv, exact, small, maps)"),
+        "sweep" => {
+            // exact fronts once, then Pareto-MCTS for SECONDS on THREADS with each exploration
+            // constant and local search share of two lists:
+            // `sweep SIZE COUNT SECONDS THREADS c1,c2,... share1,share2,...`
+            let size: usize = arg(1, "4").parse().expect("size");
+            let count: u64 = arg(2, "3").parse().expect("count");
+            let time = Duration::from_secs_f64(arg(3, "10").parse().expect("seconds"));
+            let threads: usize = arg(4, "1").parse().expect("threads");
+            let cs: Vec<f64> = arg(5, "0.7071").split(',').map(|c| c.parse().expect("exploration")).collect();
+            let shares: Vec<f64> = arg(6, "0.25").split(',').map(|c| c.parse().expect("local search share")).collect();
+            let cubes: Vec<_> = (0..count)
+                .map(|seed| {
+                    let cube = soma_cube(size, seed);
+                    let (mdp, _) = mdp(&cube);
+                    let t = Instant::now();
+                    let exact = exact_front(&mdp, 5_000_000).expect("exact front");
+                    println!("cube {seed}: exact front {} points, {} states in {:.2} s", exact.solutions.len(), exact.states, t.elapsed().as_secs_f64());
+                    (seed, mdp, exact)
+                })
+                .collect();
+            for (c, share) in cs.iter().flat_map(|&c| shares.iter().map(move |&s| (c, s))) {
+                let mut fractions = Vec::new();
+                for (seed, mdp, exact) in &cubes {
+                    let reference: Vec<f64> = exact.worst.iter().map(|w| w - 1e-3 * w.abs().max(1.0)).collect();
+                    let out = ParetoMcts::builder()
+                        .seed(*seed)
+                        .threads(threads)
+                        .reference(reference.clone())
+                        .episodes(usize::MAX)
+                        .time_limit(time)
+                        .exploration(c)
+                        .polish(share)
+                        .build()
+                        .expect("settings")
+                        .solve(mdp)
+                        .expect("search");
+                    let f = out.value / exact.hypervolume(&reference);
+                    println!("  c {c}, polish {share}: cube {seed}: HV fraction {f:.4}, {} episodes, {} nodes, {} polish steps, {} polished, {} iterations + {} rollout steps", out.stats.episodes, out.stats.tree_nodes, out.stats.polish_steps, out.stats.polished, out.stats.iterations, out.stats.rollout_steps);
+                    fractions.push(f);
+                }
+                summary(&fractions);
+            }
+        }
+        other => eprintln!("unknown mode '{other}' (speed, hv, exact, sweep, small, maps)"),
     }
 }
 

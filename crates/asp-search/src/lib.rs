@@ -16,6 +16,7 @@ pub mod ordering;
 pub mod pareto;
 pub mod pipeline;
 pub mod policy;
+pub mod polish;
 pub mod problem;
 pub mod qgraph;
 pub mod report;

@@ -170,6 +170,9 @@ pub struct OptimiseSettings {
     pub time_limit: Option<f64>,
     /// Exploration constant of UCT / MOUCB.
     pub exploration: f64,
+    /// The share of the search's work its local search over the answer's sequences may take
+    /// ([`crate::search::SearchBuilder::polish`]; 0: none).
+    pub polish: f64,
     /// Distance map resolution N_M.
     pub resolution: usize,
     /// Cap of the distance maps, model units (default the model's diagonal).
@@ -194,6 +197,7 @@ impl Default for OptimiseSettings {
             threads: None,
             time_limit: None,
             exploration: std::f64::consts::FRAC_1_SQRT_2,
+            polish: crate::search::DEFAULT_POLISH,
             resolution: asp_geom::distmap::DEFAULT_RESOLUTION,
             d_max: None,
             support: Support::Below,
@@ -501,6 +505,7 @@ pub fn optimise_problem(
                 .threads(threads)
                 .seed(settings.seed)
                 .exploration(o.exploration)
+                .polish(o.polish)
                 .record_transitions(stepped && record);
             if let Some(t) = o.time_limit {
                 b = b.time_limit(Duration::from_secs_f64(positive("the time limit", t)?));
@@ -555,6 +560,8 @@ pub fn optimise_problem(
         episodes: s.episodes,
         iterations: s.iterations,
         tree_nodes: s.tree_nodes,
+        polish: o.polish,
+        polished: s.polished,
         budget: o.budget,
         threads: s.threads,
         seed: settings.seed,

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.6";
+pub const FORMAT_VERSION: &str = "1.7";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -413,6 +413,12 @@ pub struct OptimisationEntry {
     pub iterations: u64,
     /// Tree nodes built (all threads).
     pub tree_nodes: u64,
+    /// The local search's share of the search's work (0: none; format 1.7).
+    #[serde(default)]
+    pub polish: f64,
+    /// Sequences the local search added to the threads' answers (format 1.7).
+    #[serde(default)]
+    pub polished: u64,
     /// Iterations per search step.
     pub budget: usize,
     /// Threads.

@@ -62,6 +62,7 @@ use crate::hypervolume::ParetoFront;
 use crate::mdp::{FilterCount, FilterCounts, Mdp, MAX_OBJECTIVES};
 use crate::objective::StepKind;
 use crate::policy::{rng_for, Policy, PolicyContext, PolicyWorker, RandomPolicy, SearchRng};
+use crate::polish::{Ended, Polisher};
 use asp_geom::distmap::MapState;
 use asp_geom::{Motion, PartSet};
 use std::collections::HashMap;
@@ -80,6 +81,8 @@ pub const DEFAULT_EPISODES: usize = 1000;
 pub const DEFAULT_EXPLORATION: f64 = std::f64::consts::FRAC_1_SQRT_2;
 /// Default cap on tree nodes per thread; beyond it iterations roll out without expanding.
 pub const DEFAULT_MAX_NODES: usize = 1_000_000;
+/// Default share of a search's work its local search may take ([`SearchBuilder::polish`]).
+pub const DEFAULT_POLISH: f64 = 0.25;
 /// Default cap on recorded transitions ([`SearchBuilder::record_transitions_limit`]).
 pub const DEFAULT_RECORD_LIMIT: usize = 1_000_000;
 
@@ -102,6 +105,7 @@ pub struct SearchSettings {
     pub(crate) record: bool,
     pub(crate) record_limit: usize,
     pub(crate) lazy_filters: bool,
+    pub(crate) polish: f64,
 }
 
 /// Stops running searches from another thread (Ctrl-C from Python, a caller's deadline): each
@@ -146,6 +150,7 @@ impl Default for SearchSettings {
             record: false,
             record_limit: DEFAULT_RECORD_LIMIT,
             lazy_filters: true,
+            polish: DEFAULT_POLISH,
         }
     }
 }
@@ -202,6 +207,10 @@ impl SearchSettings {
     /// Whether rollouts ask the problem's filters lazily ([`SearchBuilder::lazy_filters`]).
     pub fn lazy_filters(&self) -> bool {
         self.lazy_filters
+    }
+    /// The share of the search's work its local search may take (0: none).
+    pub fn polish(&self) -> f64 {
+        self.polish
     }
 }
 
@@ -321,6 +330,17 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
         self
     }
 
+    /// The local search over the answer's sequences ([`crate::polish`]): every complete sequence
+    /// that enters a thread's archive is improved by block moves, with at most `share` map steps
+    /// of local search per step of the tree search while the search runs (default
+    /// [`DEFAULT_POLISH`]; 0 turns it off). When the episodes are done (not at a time limit or a
+    /// stop), the thread searches on until no archived sequence is left unsearched or its local
+    /// search has done as much work as its tree search. Deterministic for a seed like the rest.
+    pub fn polish(mut self, share: f64) -> Self {
+        self.settings.polish = share;
+        self
+    }
+
     /// The most transitions recorded (default 1,000,000, ≥ 1), split among the threads like the
     /// episodes; a thread that reaches its share stops recording and the outcome says so
     /// ([`SearchOutcome::transitions_capped`]).
@@ -361,6 +381,9 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
                 "the prior weight must be finite and >= 0, got {}",
                 s.prior_weight
             )));
+        }
+        if !(s.polish.is_finite() && s.polish >= 0.0) {
+            return Err(SearchError::config(format!("the local search share must be finite and >= 0, got {}", s.polish)));
         }
         if let Some(r) = &s.reference {
             if r.iter().any(|v| !v.is_finite()) {
@@ -486,6 +509,13 @@ pub struct SearchStats {
     /// recording included.
     #[serde(default)]
     pub filter_checks: u64,
+    /// Work of the local search over the answer's sequences ([`crate::polish`]), in map steps
+    /// (all threads).
+    #[serde(default)]
+    pub polish_steps: u64,
+    /// Sequences the local search added to the threads' archives (some were later dominated).
+    #[serde(default)]
+    pub polished: u64,
 }
 
 /// The result of a search.
@@ -910,6 +940,8 @@ struct Worker<'p, V: Variant> {
     abort: &'p StopToken,
     /// The recording, when the settings ask for it.
     record: Option<Recorder>,
+    /// The local search, when the settings ask for one.
+    polisher: Option<Polisher<'p>>,
 }
 
 impl<'p, V: Variant> Worker<'p, V> {
@@ -1009,6 +1041,7 @@ impl<'p, V: Variant> Worker<'p, V> {
                 actions: Vec::with_capacity(n),
                 counts: problem.filter_counts(),
             }),
+            polisher: (settings.polish > 0.0).then(|| Polisher::new(problem)),
         };
         Ok(worker)
     }
@@ -1385,6 +1418,9 @@ impl<'p, V: Variant> Worker<'p, V> {
         if complete {
             self.bounds.update(&ret[..m]);
             let seq = &self.sequence;
+            if let Some(p) = &mut self.polisher {
+                p.seed(&ret[..m], seq);
+            }
             if self.archive.insert(&ret[..m], || seq.clone()) {
                 self.archive_changed = true;
                 let seconds = self.start.elapsed().as_secs_f64();
@@ -1459,7 +1495,7 @@ impl<'p, V: Variant> Worker<'p, V> {
     }
 
     /// Publishes the archive to the shared front and the trace.
-    fn sync(&mut self, shared: &Mutex<Shared>, reference: &[f64], start: Instant, iterations: u64) {
+    fn sync(&mut self, shared: &Mutex<Shared>, reference: &[f64], start: Instant, iterations: u64, episode: bool) {
         let mut s = shared.lock().unwrap_or_else(|e| e.into_inner());
         // the improvements inside the episode first, each as it was found
         for (point, seconds, at) in std::mem::take(&mut self.found) {
@@ -1479,7 +1515,9 @@ impl<'p, V: Variant> Worker<'p, V> {
                 s.trace.push(point);
             }
         }
-        s.episodes += 1;
+        if episode {
+            s.episodes += 1;
+        }
         s.iterations += iterations;
         if self.archive_changed {
             for (p, _) in self.archive.iter() {
@@ -1549,8 +1587,12 @@ impl<'p, V: Variant> Worker<'p, V> {
             }
             if !self.stopped {
                 self.stats.episodes += 1;
+                self.polish(false);
             }
-            self.sync(shared, reference, start, self.stats.iterations - before);
+            self.sync(shared, reference, start, self.stats.iterations - before, true);
+        }
+        if self.error.is_none() && !self.should_stop() && self.polish(true) {
+            self.sync(shared, reference, start, 0, false);
         }
         if let Some(h) = hook {
             let report = self.report(shared, start, &mut last, true);
@@ -1559,6 +1601,45 @@ impl<'p, V: Variant> Worker<'p, V> {
             }
         }
         self.finish();
+    }
+
+    /// Local search around the archive's sequences not searched yet ([`crate::polish`]), while
+    /// its work stays within its share of the tree search's (`last`: up to as much work as the
+    /// tree search, when the episodes are done). Returns whether it added anything.
+    fn polish(&mut self, last: bool) -> bool {
+        let Some(mut polisher) = self.polisher.take() else { return false };
+        let work = self.stats.iterations + self.stats.rollout_steps;
+        let cap = if last { work as f64 * self.settings.polish.max(1.0) } else { work as f64 * self.settings.polish };
+        let (deadline, stop, abort) = (self.deadline, self.settings.stop.as_ref(), self.abort);
+        let should_stop = || {
+            deadline.is_some_and(|d| Instant::now() >= d) || stop.is_some_and(StopToken::is_stopped) || abort.is_stopped()
+        };
+        let mut added = 0u64;
+        while (polisher.steps as f64) < cap {
+            let Some((seq, seed)) = polisher.queue.pop() else { break };
+            if !seed && !self.archive.iter().any(|(_, s)| *s == seq) {
+                continue; // dominated since the local search found it
+            }
+            let (found, start) = (&mut self.found, self.start);
+            let ended = polisher.search_around(
+                &seq,
+                &mut self.archive,
+                |values| {
+                    added += 1;
+                    found.push((values.to_vec(), start.elapsed().as_secs_f64(), u64::MAX));
+                },
+                |_| should_stop(),
+            );
+            if ended == Ended::Stopped {
+                polisher.queue.push((seq, seed));
+                break;
+            }
+        }
+        self.stats.polish_steps = polisher.steps;
+        self.stats.polished += added;
+        self.archive_changed |= added > 0;
+        self.polisher = Some(polisher);
+        added > 0
     }
 
     /// Ends the run with a plug-in's (or the hook's) error.
@@ -1797,6 +1878,8 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings, hook: Op
         stats.failed_collision += s.failed_collision;
         stats.failed_gravity += s.failed_gravity;
         stats.tree_nodes += s.tree_nodes;
+        stats.polish_steps += s.polish_steps;
+        stats.polished += s.polished;
         stats.exhausted |= s.exhausted;
         stats.stopped |= s.stopped;
         filtered.add(f);

@@ -134,7 +134,8 @@ fn objectives_learn_which_step_of_the_search_calls_them() {
     let maps = maps(&cube, 5);
     let counter = Arc::new(KindCounter::default());
     let p = Mdp::new(maps, vec![counter.clone()]).unwrap().with_assembly(Arc::new(cube)).with_seed(3);
-    let out = Mcts::builder().episodes(30).seed(2).build().unwrap().solve(&p).unwrap();
+    // without the local search, whose moves are replay steps too (below)
+    let out = Mcts::builder().episodes(30).seed(2).polish(0.0).build().unwrap().solve(&p).unwrap();
     // one expansion step per new edge (no edge without an expansion) and per iteration at most
     let expansions = counter.expansion.load(Ordering::Relaxed);
     assert!(expansions > 0 && expansions <= out.stats.iterations, "{expansions} vs {}", out.stats.iterations);
@@ -145,6 +146,15 @@ fn objectives_learn_which_step_of_the_search_calls_them() {
     let pathlen = problem(p.maps_arc(), "pathlen");
     let best = out.best().unwrap();
     assert!(close(pathlen.evaluate(&best.sequence).unwrap().0[0], best.values[0]));
+    // the local search evaluates its moves by replay steps, never as expansions or simulations
+    let before = (counter.expansion.load(Ordering::Relaxed), counter.simulation.load(Ordering::Relaxed), counter.replay.load(Ordering::Relaxed));
+    let polished = Mcts::builder().episodes(30).seed(2).build().unwrap().solve(&p).unwrap();
+    assert!(polished.stats.polish_steps > 0);
+    assert_eq!(counter.expansion.load(Ordering::Relaxed) - before.0, expansions);
+    assert_eq!(counter.simulation.load(Ordering::Relaxed) - before.1, polished.stats.rollout_steps);
+    let replayed: usize = polished.solutions.iter().map(|s| s.sequence.len()).sum();
+    assert!(counter.replay.load(Ordering::Relaxed) - before.2 > replayed as u64);
+    assert!(polished.best().unwrap().values[0] >= best.values[0]);
 }
 
 #[test]
