@@ -154,7 +154,6 @@ impl OptimiseArgs {
             },
             extensions,
             policy,
-            ..OptimiseSettings::default()
         }))
     }
 }
