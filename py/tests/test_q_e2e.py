@@ -68,10 +68,11 @@ def exact(qg: "asp.QGraphs") -> tuple[float, dict]:
 
 def episodes_to_reach(asp_cmd: list, model: Path, optimum: float, seed: int, flags: list, cwd: Path) -> tuple[int, float]:
     """The episode at which a search first reaches ``optimum`` (``CAP + 1``: not within ``CAP``)
-    and the best total it reached, in units of d_max."""
+    and the best total it reached, in units of d_max. The local search over the answer is off: it
+    would improve either search's sequences, and this compares the rollout policies."""
     trace = cwd / f"trace_{seed}_{len(flags)}.csv"
     r = run(asp_cmd + ["plan", str(model), "--objective", "access", "--threads", "1", "--seed", str(seed),
-                       "--episodes", str(CAP), "--trace", str(trace), "--json", "--quiet"] + flags, cwd)
+                       "--episodes", str(CAP), "--trace", str(trace), "--json", "--quiet", "--polish", "0"] + flags, cwd)
     d_max = json.loads(r.stdout)["optimisation"]["d_max"]
     rows = list(csv.DictReader(trace.open()))
     best = max(float(row["value"]) / d_max for row in rows)
