@@ -45,9 +45,10 @@ pub(crate) struct Polisher<'p> {
     rewards: Vec<f64>,
     running: Vec<f64>,
     counts: FilterCounts,
-    /// Sequences not searched around yet (the last found first), and whether each is a seed
-    /// (searched around even when the archive no longer holds it).
-    pub queue: Vec<(Vec<u16>, bool)>,
+    /// Sequences not searched around yet (the last found first), whether each is a seed
+    /// (searched around even when the archive no longer holds it), and the position its search
+    /// goes on from.
+    pub queue: Vec<(Vec<u16>, bool, usize)>,
     /// The front of the search's own sequences: each that enters it seeds a local search.
     seeds: ParetoFront<()>,
     /// Work so far, in map steps (a removal, or a copy of the state).
@@ -59,8 +60,9 @@ pub(crate) struct Polisher<'p> {
 pub(crate) enum Ended {
     /// Every neighbour was tried.
     Done,
-    /// `stop` said to stop; the sequence's remaining neighbours were not tried.
-    Stopped,
+    /// `stop` said to stop; the neighbours from this position on were not tried (pass it as
+    /// `from` to go on).
+    Stopped(usize),
 }
 
 impl<'p> Polisher<'p> {
@@ -92,8 +94,18 @@ impl<'p> Polisher<'p> {
     /// would otherwise crowd out the variety the search brings.
     pub fn seed(&mut self, values: &[f64], seq: &[u16]) {
         if self.seeds.insert(values, || ()) {
-            self.queue.push((seq.to_vec(), true));
+            self.queue.push((seq.to_vec(), true, 0));
         }
+    }
+
+    /// The removals the local search put to the problem's feasibility filters so far.
+    pub fn checks(&self) -> u64 {
+        self.counts.checks()
+    }
+
+    /// Its filters' rejections and checks, by reason.
+    pub fn counts(&self) -> &FilterCounts {
+        &self.counts
     }
 
     /// Whether `part` is a feasible removal of `state` with `memory` (a replay step).
@@ -129,15 +141,17 @@ impl<'p> Polisher<'p> {
         self.base.is_complete()
     }
 
-    /// Searches the neighbours of `seq` (a complete sequence in `archive`), adding to `archive`
-    /// every neighbour it keeps and queueing it; `found` is told each one's values. `stop` is
-    /// asked between neighbours.
+    /// Searches the neighbours of `seq` (a complete sequence) whose first change is at position
+    /// `from` or later, adding to `archive` every neighbour it keeps and queueing it; `found` is
+    /// told each one's values. `stop` is asked between neighbours, with the work so far (map
+    /// steps and filter checks).
     pub fn search_around(
         &mut self,
         seq: &[u16],
+        from: usize,
         archive: &mut ParetoFront<Vec<u16>>,
         mut found: impl FnMut(&[f64]),
-        mut stop: impl FnMut(u64) -> bool,
+        mut stop: impl FnMut(u64, u64) -> bool,
     ) -> Ended {
         let len = seq.len();
         if len < 2 || !self.replay(seq) {
@@ -146,14 +160,20 @@ impl<'p> Polisher<'p> {
         let w = self.w;
         let problem = self.problem;
         self.base.reset(&asp_geom::PartSet::full(problem.maps().num_parts()));
-        for lo in 0..len - 1 {
+        for lo in 0..from.min(len - 1) {
+            self.memory.clear();
+            self.memory.extend_from_slice(&self.memories[lo * w..(lo + 1) * w]);
+            problem.step(&mut self.base, &mut self.memory, seq[lo] as usize, StepKind::Replay, &mut self.rewards);
+            self.steps += 1;
+        }
+        for lo in from..len - 1 {
             // moves whose first changed position is `lo`: a block starting at `lo` moved later,
             // or a block starting after `lo` moved to `lo`
             for block in 1..=MAX_BLOCK.min(len - lo - 1) {
                 for to in lo + 1..=len - block {
                     // later: seq[lo..lo+block] goes to position `to` of the rest
-                    if stop(self.steps) {
-                        return Ended::Stopped;
+                    if stop(self.steps, self.counts.checks()) {
+                        return Ended::Stopped(lo);
                     }
                     self.neighbour.clear();
                     self.neighbour.extend_from_slice(&seq[..lo]);
@@ -224,7 +244,7 @@ impl<'p> Polisher<'p> {
         let neighbour = &self.neighbour;
         if archive.insert(&self.running, || neighbour.clone()) {
             found(&self.running);
-            self.queue.push((self.neighbour.clone(), false));
+            self.queue.push((self.neighbour.clone(), false, 0));
         }
     }
 }

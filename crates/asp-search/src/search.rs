@@ -331,9 +331,10 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
     }
 
     /// The local search over the answer's sequences ([`crate::polish`]): every complete sequence
-    /// that enters a thread's archive is improved by block moves, with at most `share` map steps
-    /// of local search per step of the tree search while the search runs (default
-    /// [`DEFAULT_POLISH`]; 0 turns it off). When the episodes are done (not at a time limit or a
+    /// that enters a thread's front of sampled sequences is improved by block moves, with at
+    /// most `share` map steps of local search per step of the tree search, and `share` filter
+    /// checks per check of the tree search, while the search runs (default [`DEFAULT_POLISH`];
+    /// 0 turns it off). When the episodes are done (not at a time limit or a
     /// stop), the thread searches on until no archived sequence is left unsearched or its local
     /// search has done as much work as its tree search. Deterministic for a seed like the rest.
     pub fn polish(mut self, share: f64) -> Self {
@@ -506,7 +507,7 @@ pub struct SearchStats {
     #[serde(default)]
     pub replay_failures: u64,
     /// Removals put to the problem's feasibility filters (all threads; [`FilterCounts::checks`]),
-    /// recording included.
+    /// recording and the local search included.
     #[serde(default)]
     pub filter_checks: u64,
     /// Work of the local search over the answer's sequences ([`crate::polish`]), in map steps
@@ -1608,30 +1609,39 @@ impl<'p, V: Variant> Worker<'p, V> {
     /// tree search, when the episodes are done). Returns whether it added anything.
     fn polish(&mut self, last: bool) -> bool {
         let Some(mut polisher) = self.polisher.take() else { return false };
-        let work = self.stats.iterations + self.stats.rollout_steps;
-        let cap = if last { work as f64 * self.settings.polish.max(1.0) } else { work as f64 * self.settings.polish };
+        // its work in both of the search's currencies: map steps, and checks by the problem's
+        // feasibility filters (a robot's plans a path; they cost far more than a step)
+        let share = if last { self.settings.polish.max(1.0) } else { self.settings.polish };
+        let cap = (self.stats.iterations + self.stats.rollout_steps) as f64 * share;
+        let check_cap = self.filtered.checks() as f64 * share;
+        let filters = !self.problem.filters().is_empty();
+        let over_checks = move |checks: u64| filters && checks as f64 >= check_cap;
+        let over = move |steps: u64, checks: u64| steps as f64 >= cap || over_checks(checks);
         let (deadline, stop, abort) = (self.deadline, self.settings.stop.as_ref(), self.abort);
         let should_stop = || {
             deadline.is_some_and(|d| Instant::now() >= d) || stop.is_some_and(StopToken::is_stopped) || abort.is_stopped()
         };
         let mut added = 0u64;
-        while (polisher.steps as f64) < cap {
-            let Some((seq, seed)) = polisher.queue.pop() else { break };
+        while !over(polisher.steps, polisher.checks()) {
+            let Some((seq, seed, from)) = polisher.queue.pop() else { break };
             if !seed && !self.archive.iter().any(|(_, s)| *s == seq) {
                 continue; // dominated since the local search found it
             }
             let (found, start) = (&mut self.found, self.start);
             let ended = polisher.search_around(
                 &seq,
+                from,
                 &mut self.archive,
                 |values| {
                     added += 1;
                     found.push((values.to_vec(), start.elapsed().as_secs_f64(), u64::MAX));
                 },
-                |_| should_stop(),
+                // map steps are cheap: a search around a sequence may finish past their limit
+                // (it stays deterministic); filter checks may not be
+                |_, checks| over_checks(checks) || should_stop(),
             );
-            if ended == Ended::Stopped {
-                polisher.queue.push((seq, seed));
+            if let Ended::Stopped(at) = ended {
+                polisher.queue.push((seq, seed, at));
                 break;
             }
         }
@@ -1679,6 +1689,9 @@ impl<'p, V: Variant> Worker<'p, V> {
 
     /// The statistics and the graph's answers at the end of a run.
     fn finish(&mut self) {
+        if let Some(p) = &self.polisher {
+            self.filtered.add(p.counts());
+        }
         self.stats.tree_nodes = self.tree.nodes.len() as u64;
         self.stats.exhausted = self.root_finished();
         let c = self.sim.counters();
