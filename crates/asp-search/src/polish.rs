@@ -1,13 +1,15 @@
 //! Local search over the answer's sequences (Pareto local search, after Paquete et al.): every
-//! complete sequence that enters a search thread's archive is taken apart by *block moves* —
+//! complete sequence that enters a search thread's front of sampled sequences (its seeds) is
+//! taken apart by *block moves* —
 //! a run of one to [`MAX_BLOCK`] consecutive removals moved earlier or later in the sequence —
 //! and every feasible neighbour the archive keeps (it is not dominated) is searched in turn.
 //!
 //! Random rollouts find the sequences of a front's crowded middle; they rarely find the ones
 //! that need many removals in a coordinated order, e.g. all removals along one direction kept
 //! together for the direction-change objective. A block move is one step there. On random
-//! 4×4×4 Soma cubes (access, direction changes) local search from a 10-s Pareto-MCTS front
-//! raised its share of the exact front's hypervolume from 0.83 to 0.90-0.95 in under 0.5 s.
+//! 4×4×4 Soma cubes (access, direction changes) it lifts a 10-s Pareto-MCTS run from 0.83 to
+//! 0.92-0.97 of the exact front's hypervolume, with 5-7 % of the search's work
+//! (docs/benchmarks.md, "Local search over the answer").
 //!
 //! A neighbour is evaluated from where it departs from its sequence: the state after the
 //! common prefix is kept, only the moved window is replayed, and past the window the replay
@@ -16,7 +18,7 @@
 //! (the premise of [`crate::exact`] too). Steps are [`StepKind::Replay`] steps: what the local
 //! search finds replays.
 //!
-//! Its work is counted in map steps and kept to a share of the search's own
+//! Its work is counted in map steps and filter checks and kept to a share of the search's own
 //! ([`crate::search::SearchBuilder::polish`]), so the search stays deterministic for a seed.
 
 use crate::hypervolume::ParetoFront;
