@@ -1634,10 +1634,7 @@ impl<'m> MapState<'m> {
             return false;
         }
         self.counters.gravity_tests += 1;
-        let stable = match self.maps.support {
-            Support::Below => !self.holding.contains(i),
-            Support::ContactGraph => self.removal_keeps_stable(i),
-        };
+        let stable = self.removal_keeps_stable(i);
         if !stable {
             self.counters.unsupported += 1;
         }

@@ -415,9 +415,7 @@ impl Mdp {
         if part >= maps.num_parts() || !state.contains(part) {
             return Some("is not present".into());
         }
-        let mut actions = Vec::new();
-        state.feasible_actions(&mut actions);
-        if !actions.contains(&part) {
+        if !state.can_remove(part) {
             return Some(
                 if maps.is_fixed(part) {
                     "is fixed"

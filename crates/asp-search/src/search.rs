@@ -334,9 +334,9 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
     /// that enters a thread's front of sampled sequences is improved by block moves, with at
     /// most `share` map steps of local search per step of the tree search, and `share` filter
     /// checks per check of the tree search, while the search runs (default [`DEFAULT_POLISH`];
-    /// 0 turns it off). When the episodes are done (not at a time limit or a
-    /// stop), the thread searches on until no archived sequence is left unsearched or its local
-    /// search has done as much work as its tree search. Deterministic for a seed like the rest.
+    /// 0 turns it off). When the episodes are done (not at a time limit or a stop), the thread
+    /// searches on until no sequence is left to search around or its local search has done as
+    /// much work as its tree search. Deterministic for a seed like the rest.
     pub fn polish(mut self, share: f64) -> Self {
         self.settings.polish = share;
         self
