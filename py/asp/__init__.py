@@ -20,6 +20,7 @@ from asp.graph import Graph
 from asp.qgraphs import QGraphs
 from asp.result import ORDERS, Plan
 from asp.search import Episode, Search
+from asp.settings import PlanSettings
 
 __all__ = [
     "Assembly",
@@ -32,6 +33,7 @@ __all__ = [
     "PLAN_FORMAT_VERSION",
     "Part",
     "Plan",
+    "PlanSettings",
     "QGraphs",
     "Search",
     "__version__",

@@ -4,7 +4,6 @@ in one call."""
 from __future__ import annotations
 
 import inspect
-import math
 import os
 from dataclasses import dataclass
 from typing import Any, Iterable, Optional, Sequence, Tuple, Union
@@ -14,6 +13,7 @@ from asp.errors import ConfigError
 from asp.graph import Graph
 from asp.qgraphs import QGraphs
 from asp.result import Plan
+from asp.settings import Order, Overlaps, QUse, Stability, Support, given
 
 __all__ = ["Assembly", "Part", "load", "plan"]
 
@@ -115,96 +115,121 @@ class Assembly:
     def plan(
         self,
         *,
-        order: str = "given",
-        model: Optional[str] = None,
-        bookkeeping: bool = False,
-        seed: int = 0,
+        order: Optional[Order] = None,
+        model: Optional[PathLike] = None,
+        bookkeeping: Optional[bool] = None,
+        seed: Optional[int] = None,
         tolerance: Optional[float] = None,
         contact_distance: Optional[float] = None,
-        normals: int = 10,
-        sphere_directions: int = 0,
-        overlaps: str = "strict",
-        stability: str = "contact",
-        physics_threshold: float = 0.01,
-        path_planner: bool = True,
-        subassemblies: bool = True,
-        rrt_iterations: int = 2000,
-        rrt_time: float = 5.0,
+        normals: Optional[int] = None,
+        sphere_directions: Optional[int] = None,
+        overlaps: Optional[Overlaps] = None,
+        stability: Optional[Stability] = None,
+        physics_threshold: Optional[float] = None,
+        path_planner: Optional[bool] = None,
+        subassemblies: Optional[bool] = None,
+        grid: Optional[bool] = None,
+        rrt_iterations: Optional[int] = None,
+        rrt_time: Optional[float] = None,
         max_tests: Optional[int] = None,
-        timeout: Optional[float] = 60.0,
+        timeout: Optional[float] = None,
         objective: Union[str, Sequence[str], None] = None,
-        pareto: bool = False,
-        episodes: int = 1000,
-        budget: int = 5,
+        pareto: Optional[bool] = None,
+        episodes: Optional[int] = None,
+        budget: Optional[int] = None,
         threads: Optional[int] = None,
         time_limit: Optional[float] = None,
-        exploration: float = math.sqrt(0.5),
-        polish: float = 0.25,
-        resolution: int = 9,
+        exploration: Optional[float] = None,
+        polish: Optional[float] = None,
+        resolution: Optional[int] = None,
         d_max: Optional[float] = None,
-        support: str = "below",
-        q: Union[str, Sequence[str], None] = None,
-        epsilon: float = 0.2,
-        q_use: str = "rollouts",
+        support: Optional[Support] = None,
+        q: Union[PathLike, Sequence[PathLike], None] = None,
+        epsilon: Optional[float] = None,
+        q_use: Optional[QUse] = None,
+        robot: Optional[str] = None,
+        robot_base: Union[str, Sequence[float], None] = None,
+        drop_off: Union[str, Sequence[float], None] = None,
+        replans: Optional[int] = None,
+        grippers: Optional[int] = None,
     ) -> Plan:
         """Plans an assembly sequence: the pipeline of ``asp plan``, with the same settings under
         the flags' names (``--max-tests`` is ``max_tests``, ``--no-path-planner`` is
-        ``path_planner=False``). Lengths are in model units.
+        ``path_planner=False``). Lengths are in model units. A setting left out (``None``) takes
+        its default (``asp._asp.default_settings()``); a setting of the other search (``timeout``
+        with ``objective``, ``time_limit`` without) raises :class:`ConfigError` naming the one that
+        applies.
 
-        :param order: part ordering of the depth-first search: ``given`` (the model's order),
-            ``shuffled`` (one order drawn from ``seed`` and kept: the thesis' vanilla AbD),
-            ``random`` (a fresh order in every state), ``bookkeeping`` (``given`` with
-            bookkeeping), ``gnn`` (the learned ordering).
-        :param model: the removability model (ONNX) of ``order="gnn"`` (default: the model
-            shipped with asp).
+        The feasibility search (without ``objective``):
+
+        :param order: part ordering: ``given`` (default, the model's order), ``shuffled`` (one
+            order drawn from ``seed`` and kept: the thesis' vanilla AbD), ``random`` (a fresh order
+            in every state), ``bookkeeping`` (``given`` with bookkeeping), ``gnn`` (the learned
+            ordering).
+        :param model: the removability model (ONNX) of ``order="gnn"`` (default: the shipped one).
         :param bookkeeping: skip retesting a part until one of its blockers is gone.
-        :param seed: seed of every random choice.
+        :param normals: clustered surface-normal directions tried besides the six axes (10).
+        :param sphere_directions: extra removal directions sampled evenly on the sphere (0).
+        :param stability: ``contact`` (default: linked through contacts to a base part) or
+            ``physics`` (rapier3d simulation).
+        :param physics_threshold: physics stability: how far (fraction of the diagonal) a part
+            may move (0.01).
+        :param path_planner: try the RRT path planner when no straight line works (True).
+        :param subassemblies: let groups of parts leave together as one rigid subassembly when
+            no single part can (True).
+        :param grid: plan voxel models by grid moves (True).
+        :param rrt_iterations: path planner iterations per call (2000).
+        :param rrt_time: path planner wall-time cap per call, seconds (5).
+        :param max_tests: stop after this many removal tests (status ``budget_exhausted``).
+        :param timeout: stop after this many seconds with the best partial plan (default 60; 0
+            for no limit).
+        :param grippers: grippers in all: up to N-1 placed parts may be held (1).
+
+        Both searches:
+
+        :param seed: seed of every random choice (0).
         :param tolerance: contact tolerance (default 1e-4 × the model's diagonal).
         :param contact_distance: parts closer than this touch, for stability (default 1e-3 × the
             diagonal).
-        :param normals: clustered surface-normal directions tried besides the six axes.
-        :param sphere_directions: extra removal directions sampled evenly on the sphere.
         :param overlaps: parts that overlap in the input (press fits, dowels, screws, slop; warned
             once per pair with the measured depth, listed in the plan's ``overlaps``):
-            ``strict`` (they separate only along motions that enter no new material of each
-            other), ``lenient`` (shrink one of them; ignore pairs no shrinking separates) or
+            ``strict`` (default: they separate only along motions that enter no new material of
+            each other), ``lenient`` (shrink one of them; ignore pairs no shrinking separates) or
             ``error`` (raise :class:`LoadError` on pairs no shrinking separates).
-        :param stability: ``contact`` (linked through contacts to a base part) or ``physics``
-            (rapier3d simulation).
-        :param physics_threshold: physics stability: how far (fraction of the diagonal) a part
-            may move.
-        :param path_planner: try the RRT path planner when no straight line works.
-        :param subassemblies: let groups of parts leave together as one rigid subassembly when
-            no single part can (each planned on its own base; ``--no-subassemblies`` is
-            ``subassemblies=False``).
-        :param rrt_iterations: path planner iterations per call.
-        :param rrt_time: path planner wall-time cap per call, seconds.
-        :param max_tests: stop after this many removal tests (status ``budget_exhausted``).
-        :param timeout: stop after this many seconds (status ``budget_exhausted`` with the
-            best partial plan); ``None`` for no limit.
+        :param robot: a robot arm that must carry every removal out: ``panda`` (the shipped arm)
+            or a URDF file.
+        :param robot_base: the robot base's position ``(x, y, z)`` in model units (default: on
+            the floor in front of the model).
+        :param drop_off: where removed parts are put down, ``(x, y, z)``.
+        :param replans: path plans per grasp, the shortest kept (4).
+
+        The optimiser (with ``objective``):
+
         :param objective: optimise instead (MCTS on distance maps): ``access``, ``dirchange``,
-            ``pathlen``, comma-separated or a list; several need ``pareto=True``.
+            ``pathlen``, ``robot-path`` (with ``robot``), comma-separated or a list; several need
+            ``pareto=True``.
         :param pareto: Pareto-MCTS over the objectives.
-        :param episodes: MCTS episodes.
-        :param budget: MCTS iterations per step.
+        :param episodes: MCTS episodes (1000).
+        :param budget: MCTS iterations per step (5).
         :param threads: optimiser threads (default: all cores).
         :param time_limit: optimiser wall-time limit, seconds.
-        :param exploration: exploration constant of UCT / MOUCB.
+        :param exploration: exploration constant of UCT / MOUCB (1/√2).
         :param polish: local search over the answer's sequences (block moves of 1-3 removals
-            around every sequence the search finds) may take this share of the search's work;
-            0 turns it off.
-        :param resolution: distance map resolution N_M (odd, 3 to 15).
+            around every sequence the search finds) may take this share of the search's work
+            (0.25); 0 turns it off.
+        :param resolution: distance map resolution N_M (odd, 3 to 15; 9).
         :param d_max: distance map cap, model units (default the diagonal).
-        :param support: the optimiser's gravity check, ``below`` or ``contact``.
+        :param support: the optimiser's gravity check, ``below`` (default) or ``contact``.
         :param q: learned Q-functions (ONNX files of ``python -m asp.train q``), one per objective
             in ``objective``'s order (a comma-separated string or a list): rollouts take the
             removal with the largest Q-value (the product for several objectives) instead of a
             random one, except with probability ``epsilon`` (thesis 5.4.5, 6.4.4).
-        :param epsilon: probability of a random removal in a rollout (or expansion) guided by ``q``.
-        :param q_use: where ``q`` guides: ``rollouts`` (the thesis: one evaluation per rollout
-            step), ``expansions`` (the Q-values of every state the search adds order its
+        :param epsilon: probability of a random removal where ``q`` guides (0.2).
+        :param q_use: where ``q`` guides: ``rollouts`` (default, the thesis: one evaluation per
+            rollout step), ``expansions`` (the Q-values of every state the search adds order its
             expansions, rollouts stay random: one evaluation per node) or ``both``.
-        :raises ConfigError: a setting is unknown, of the wrong type or out of range.
+        :raises ConfigError: a setting is unknown, of the wrong type, out of range or of the
+            other search.
         :raises LoadError: the model cannot be planned as given (parts overlapping beyond
             repair, ...).
         :raises KeyboardInterrupt: Ctrl-C while planning or optimising (checked every 50 ms; a
@@ -212,41 +237,7 @@ class Assembly:
 
         The GIL is released while planning.
         """
-        if isinstance(objective, (list, tuple)):
-            objective = list(objective)
-        settings = {
-            "order": order,
-            "model": None if model is None else str(model),
-            "bookkeeping": bookkeeping,
-            "seed": seed,
-            "tolerance": tolerance,
-            "contact_distance": contact_distance,
-            "normals": normals,
-            "sphere_directions": sphere_directions,
-            "overlaps": overlaps,
-            "stability": stability,
-            "physics_threshold": physics_threshold,
-            "path_planner": path_planner,
-            "subassemblies": subassemblies,
-            "rrt_iterations": rrt_iterations,
-            "rrt_time": rrt_time,
-            "max_tests": max_tests,
-            "timeout": timeout,
-            "objective": objective,
-            "pareto": pareto,
-            "episodes": episodes,
-            "budget": budget,
-            "threads": threads,
-            "time_limit": time_limit,
-            "exploration": exploration,
-            "polish": polish,
-            "resolution": resolution,
-            "d_max": d_max,
-            "support": support,
-            "q": q if q is None or isinstance(q, str) else ",".join(os.fspath(m) for m in q),
-            "epsilon": epsilon,
-            "q_use": q_use,
-        }
+        settings = given({k: v for k, v in locals().items() if k != "self"})
         json, found, trace = self._native.plan(settings)
         return Plan(json, found, trace)
 
@@ -259,7 +250,8 @@ class Assembly:
         :param record: record each episode's transitions (the ``asp-transitions`` records).
         :param settings: the keywords of :meth:`plan` (``objective`` required; ``threads`` is 1,
             ``episodes`` the most episodes, ``time_limit`` the wall time from the first episode,
-            ``q`` the first episodes' Q models).
+            ``q`` the first episodes' Q models; ``epsilon`` and ``q_use`` are also those of
+            :meth:`Search.set_q`).
         :raises ConfigError: no objective, or a bad setting (as :meth:`plan`).
         :raises TypeError: an unknown keyword.
 
@@ -267,21 +259,17 @@ class Assembly:
         """
         from asp.search import Search
 
-        bound = inspect.signature(Assembly.plan).bind(self, **settings)
-        bound.apply_defaults()
-        kw = dict(bound.arguments)
-        del kw["self"]
+        inspect.signature(Assembly.plan).bind(self, **settings)  # unknown keywords: TypeError
+        kw = given(settings)
         if kw.get("objective") is None:
             raise ConfigError("objective: a search needs objectives")
-        if isinstance(kw["objective"], (list, tuple)):
-            kw["objective"] = list(kw["objective"])
-        if kw.get("model") is not None:
-            kw["model"] = str(kw["model"])
-        q = kw.get("q")
-        if q is not None and not isinstance(q, str):
-            kw["q"] = ",".join(os.fspath(m) for m in q)
         kw["threads"] = 1
-        return Search(self._native.search(kw, record), kw)
+        native = dict(kw)
+        if native.get("q") is None:
+            # without Q models now, ε and q_use are the later set_q's defaults
+            native.pop("epsilon", None)
+            native.pop("q_use", None)
+        return Search(self._native.search(native, record), kw)
 
     def graph(
         self,

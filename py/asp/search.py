@@ -101,8 +101,8 @@ class Search:
             paths = [p.strip() for p in paths[0].split(",") if p.strip()]
         self._native.set_q(
             [os.fspath(p) for p in paths],
-            self._settings["epsilon"] if epsilon is None else epsilon,
-            self._settings["q_use"] if q_use is None else q_use,
+            self._settings.get("epsilon") if epsilon is None else epsilon,
+            self._settings.get("q_use") if q_use is None else q_use,
         )
 
     def result(self) -> Plan:

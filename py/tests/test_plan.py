@@ -128,12 +128,22 @@ def test_budget_exhausted_is_a_status(root):
 
 def test_defaults_are_the_librarys():
     import inspect
+    import typing
 
-    from asp import _asp
+    from asp import _asp, settings
 
     defaults = _asp.default_settings()
-    plan = {k: p.default for k, p in inspect.signature(asp.Assembly.plan).parameters.items() if k != "self"}
+    plan = inspect.signature(asp.Assembly.plan).parameters
     graph = {k: p.default for k, p in inspect.signature(asp.Assembly.graph).parameters.items()
              if k not in ("self", "present")}
-    assert {**plan, **graph} == defaults
-    assert set(asp.ORDERS) == {"given", "shuffled", "random", "bookkeeping", "gnn"}
+    # every plan keyword is a setting of the request, left to its default by None
+    assert set(plan) - {"self"} == set(defaults) - {"radius_bins", "degree", "points_per_part"}
+    assert all(p.default is None for k, p in plan.items() if k != "self")
+    assert set(typing.get_type_hints(settings.PlanSettings)) == set(plan) - {"self"}
+    assert {k: v for k, v in graph.items() if v is not None} == {k: defaults[k] for k in graph if graph[k] is not None}
+    # the closed sets are the library's, in its order
+    choices = _asp.choices()
+    for name, literal in [("order", settings.Order), ("overlaps", settings.Overlaps), ("stability", settings.Stability),
+                          ("support", settings.Support), ("q_use", settings.QUse)]:
+        assert list(typing.get_args(literal)) == choices[name], name
+    assert asp.ORDERS == tuple(choices["order"])

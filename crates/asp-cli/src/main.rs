@@ -6,11 +6,12 @@ mod bench_mcts;
 mod flags;
 mod gen;
 mod learn;
-mod optimise;
 mod output;
 mod plot;
-mod view;
+mod request;
 mod robot;
+mod text;
+mod view;
 
 use flags::{Cli, Command};
 use std::process::ExitCode;
@@ -20,7 +21,11 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            let geom = match e.downcast_ref::<asp_search::SearchError>() {
+            let search = match e.downcast_ref::<asp_app::AppError>() {
+                Some(asp_app::AppError::Search(s)) => Some(s),
+                _ => e.downcast_ref::<asp_search::SearchError>(),
+            };
+            let geom = match search {
                 Some(asp_search::SearchError::Geom(g)) => Some(g),
                 _ => e.downcast_ref::<asp_geom::GeomError>(),
             };

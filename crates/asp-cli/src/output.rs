@@ -1,106 +1,23 @@
 //! `asp plan`: load, plan, print the table, write the JSON.
 
-use crate::flags::{ModelArgs, OrderArg, OverlapsArg, PlanArgs, StabilityArg};
+use crate::flags::PlanArgs;
 use anyhow::{bail, Context};
-use asp_geom::math::Axis;
-use asp_geom::Units;
-use asp_search::pipeline::{self, PlanSettings, StabilitySetting};
-use asp_search::report::{AssemblyStep, MotionEntry, PlanReport};
+use asp_app::pipeline::{self, PlanSettings};
 use asp_search::Progress;
 use asp_search::{StopReason, StopToken};
 use std::collections::BTreeSet;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::{Arc, OnceLock};
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-pub(crate) fn positive(name: &str, v: f64) -> anyhow::Result<f64> {
-    if v > 0.0 && v.is_finite() {
-        Ok(v)
-    } else {
-        bail!("--{name} must be a positive number, got {v}")
-    }
-}
-
-/// The pipeline's loading and testing settings from the flags (flag names in the errors).
-pub(crate) fn model_settings(args: &ModelArgs) -> anyhow::Result<PlanSettings> {
-    let unit = match &args.unit {
-        Some(u) => Some(Units::parse(u).with_context(|| format!("--unit: unknown unit '{u}' (use m, cm, mm, in, ft or a number of metres)"))?),
-        None => None,
-    };
-    let up = match &args.up {
-        Some(a) => Some(Axis::parse(a).with_context(|| format!("--up: '{a}' is not an axis (use x, y, z, -x, -y, -z)"))?),
-        None => None,
-    };
-    let check = |name: &str, v: Option<f64>| v.map(|v| positive(name, v)).transpose();
-    Ok(PlanSettings {
-        unit,
-        up,
-        fixed: args.fixed.clone(),
-        tolerance: check("tolerance", args.tolerance)?,
-        contact_distance: check("contact-distance", args.contact_distance)?,
-        normals: args.normals,
-        sphere_directions: args.sphere_directions,
-        overlaps: if args.ignore_overlapping {
-            asp_geom::OverlapPolicy::Lenient
-        } else {
-            match args.overlaps {
-                OverlapsArg::Strict => asp_geom::OverlapPolicy::Strict,
-                OverlapsArg::Lenient => asp_geom::OverlapPolicy::Lenient,
-                OverlapsArg::Error => asp_geom::OverlapPolicy::Error,
-            }
-        },
-        stability: match args.stability {
-            StabilityArg::Contact => StabilitySetting::Contact,
-            StabilityArg::Physics => {
-                StabilitySetting::Physics { threshold: positive("physics-threshold", args.physics_threshold)? }
-            }
-        },
-        path_planner: !args.no_path_planner,
-        subassemblies: !args.no_subassemblies,
-        grid: !args.no_grid,
-        rrt_iterations: args.rrt_iterations,
-        rrt_time: positive("rrt-time", args.rrt_time)?,
-        ..PlanSettings::default()
-    })
-}
-
-/// The pipeline's settings of `asp plan`.
+/// The pipeline's settings of `asp plan`: the flags given, over the `--settings` file.
 pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
-    let timeout = match args.timeout {
-        t if t == 0.0 => None,
-        t => Some(positive("timeout", t)?),
-    };
-    let robot = crate::robot::setup(args)?;
-    let extensions: Vec<Arc<dyn asp_search::MdpExtension>> = match &robot {
-        Some(r) => vec![Arc::new(asp_robot::RobotExtension::new(r.clone())) as Arc<dyn asp_search::MdpExtension>],
-        None => Vec::new(),
-    };
-    let optimise = args.optimise.settings(extensions)?;
-    let grippers = args.robot.grippers;
-    if grippers == 0 {
-        bail!("--grippers must be at least 1");
-    }
-    if grippers > 1 && optimise.is_some() {
-        bail!("--grippers works with the feasibility search only, not with --objective");
-    }
-    let checker_extension: Option<Arc<dyn asp_search::pipeline::CheckerExtension>> =
-        if optimise.is_none() && (robot.is_some() || grippers > 1) {
-            Some(Arc::new(asp_robot::CellSetup { robot: robot.clone(), grippers }) as Arc<dyn asp_search::pipeline::CheckerExtension>)
-        } else {
-            None
-        };
-    Ok(PlanSettings {
-        order: crate::learn::order_source(args.order, args.onnx.as_deref())?,
-        bookkeeping: args.bookkeeping || args.order == OrderArg::Bookkeeping,
-        seed: args.seed,
-        max_tests: args.max_tests,
-        timeout,
-        optimise,
-        checker_extension,
-        ..model_settings(&args.load)?
-    })
+    let mut map = crate::flags::Map::new();
+    args.put(&mut map);
+    let request = crate::request::request(map, args.settings.as_deref())?;
+    crate::request::resolve(&request)
 }
 
 /// How one model's run ended, worst last: the process exits with the worst.
@@ -282,7 +199,7 @@ fn plan_one(
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
-    let mut result = result?;
+    let mut result = result.map_err(crate::request::cli_error)?;
     if let Some(t) = result.report.stats.timings.as_mut() {
         t.load = load_seconds;
     }
@@ -312,9 +229,9 @@ fn plan_one(
         if separate {
             writeln!(stdout)?;
         }
-        write_table(stdout, report)?;
+        crate::text::write_table(stdout, report)?;
         if let Some(summary) = &report.optimisation {
-            crate::optimise::write_summary(stdout, summary, report.pareto_front.as_deref())?;
+            crate::text::write_summary(stdout, summary, report.pareto_front.as_deref())?;
         }
     }
     stdout.flush()?;
@@ -343,140 +260,3 @@ fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
     Some(bar)
 }
 
-/// The human-readable plan: a header, the assembly sequence, and the explanation when stuck.
-pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
-    let s = &r.stats;
-    writeln!(
-        out,
-        "{}: {} in {:.3} s — {} removal tests ({} failed by collision, {} by gravity), {} path planner calls",
-        r.model,
-        r.status.replace('_', " "),
-        s.seconds,
-        s.removal_tests,
-        s.failed_collision,
-        s.failed_gravity,
-        s.path_planner_calls
-    )?;
-    let width = r.parts.iter().map(|p| p.name.len()).max().unwrap_or(4).max(4);
-    let fixed: Vec<&str> = r.parts.iter().filter(|p| p.fixed).map(|p| p.name.as_str()).collect();
-    if !fixed.is_empty() {
-        writeln!(out, "base (fixed): {}", fixed.join(", "))?;
-    } else if r.grid.is_some() {
-        writeln!(out, "base: none (taken apart in the hand, no gravity; the last part goes down first along -{})", r.up.trim_start_matches(['+', '-']))?;
-    } else {
-        writeln!(out, "base: ground plane under the lowest point (up {})", r.up)?;
-    }
-    if let Some(g) = &r.grid {
-        let first = g.first_separation_moves.map_or("-".to_string(), |m| m.to_string());
-        writeln!(
-            out,
-            "grid plan ({}): cells of {:.4} x {:.4} x {:.4} {}, {} states in {:.3} s, {first} moves before the first separation",
-            g.reason.replace('_', " "),
-            g.cell[0],
-            g.cell[1],
-            g.cell[2],
-            r.units,
-            g.states,
-            g.seconds
-        )?;
-    }
-    if let Some(o) = &r.overlaps {
-        writeln!(out, "overlapping in the input ({} pairs, policy {}):", o.pairs.len(), o.policy)?;
-        for p in &o.pairs {
-            let bound = if p.gross { "more than " } else { "" };
-            writeln!(out, "  {} / {}: {}, {bound}{:.4} deep, {}", p.names[0], p.names[1], p.kind, p.depth, p.handling)?;
-        }
-    }
-    if !r.assembly_sequence.is_empty() {
-        write_steps(out, r, &r.assembly_sequence, width, "")?;
-    }
-    if !r.partial_assembly_sequence.is_empty() {
-        let remaining = r.remaining.as_ref().map_or(0, Vec::len);
-        writeln!(
-            out,
-            "partial plan: {} steps; in assembly order onto the {remaining} parts that stay:",
-            r.partial_assembly_sequence.len()
-        )?;
-        write_steps(out, r, &r.partial_assembly_sequence, width, "")?;
-    }
-    if let Some(robot) = &r.robot {
-        writeln!(out, "robot {}: total path length {:.3} {}", robot.name, robot.total_path_length, r.units)?;
-    }
-    if !r.explanation.is_empty() {
-        writeln!(out, "stuck with {} parts left; none can leave:", r.explanation.len())?;
-        for e in &r.explanation {
-            let others: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
-            let why = match e.reason.as_str() {
-                "blocked" => format!("blocked by {}", others.join(", ")),
-                "unsupported" => format!("would leave {} unsupported", others.join(", ")),
-                _ => "can leave, but every state after that is a dead end".into(),
-            };
-            writeln!(out, "  {:<width$}  {why}", e.name)?;
-        }
-    }
-    if r.status == "budget_exhausted" {
-        match r.stats.stopped_by.as_deref() {
-            Some("interrupted") => writeln!(out, "interrupted (Ctrl-C) before a plan was found; the best partial plan so far is above")?,
-            _ => writeln!(out, "the budget ran out (--max-tests / --timeout) before a plan was found")?,
-        }
-    }
-    Ok(())
-}
-
-/// Assembly steps as table rows; a subassembly's own steps follow it, indented.
-fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], width: usize, indent: &str) -> std::io::Result<()> {
-    let name = |i: usize| r.parts.get(i).map_or("?", |p| p.name.as_str());
-    let label = |step: &AssemblyStep| match &step.subassembly {
-        None => step.name.clone(),
-        Some(g) => format!("{} + {} more (subassembly)", step.name, g.parts.len() - 1),
-    };
-    let width = sequence.iter().map(|s| label(s).len()).fold(width, usize::max);
-    if indent.is_empty() {
-        writeln!(out, "{:>4}  {:<width$}  motion (insertion, {})", "step", "part", r.units)?;
-    }
-    for (k, step) in sequence.iter().enumerate() {
-        let motion = match &step.motion {
-            MotionEntry::Linear { direction: d, distance } => {
-                format!("straight along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
-            }
-            MotionEntry::Path { poses, .. } => format!("path of {} poses", poses.len()),
-            MotionEntry::Screw { direction: d, distance, .. } => {
-                format!("screw along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
-            }
-        };
-        let robot = step.robot.as_ref().map_or(String::new(), |rs| {
-            format!("; robot path {:.3}", rs.path_length)
-        });
-        let robot = if step.held.is_empty() {
-            robot
-        } else {
-            format!("{robot}; holding {}", step.held.iter().map(|&p| name(p)).collect::<Vec<_>>().join(", "))
-        };
-        writeln!(out, "{indent}{:>4}  {:<width$}  {motion}{robot}", k + 1, label(step))?;
-        if let Some(g) = &step.subassembly {
-            let inner = format!("{indent}      ");
-            let members: Vec<&str> = g.parts.iter().map(|&p| name(p)).collect();
-            let how = match g.status.as_str() {
-                "found" => "built on its base in this order:".to_string(),
-                "no_plan" => "cannot be taken apart (it goes in as one unit):".to_string(),
-                "unplanned" => "not planned".to_string(),
-                other => format!("{} before its own plan was found; the parts that come off:", other.replace('_', " ")),
-            };
-            writeln!(out, "{inner}subassembly {} on base {}: {how}", members.join(", "), step.name)?;
-            write_steps(out, r, &g.assembly_sequence, width.saturating_sub(6), &inner)?;
-            for e in &g.explanation {
-                let others: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
-                writeln!(out, "{inner}  {} {} {}", e.name, e.reason.replace('_', " "), others.join(", "))?;
-            }
-        }
-        if !step.moves.is_empty() {
-            writeln!(out, "{indent}      then {} moves:", step.moves.len())?;
-        }
-        for m in &step.moves {
-            let t = m.translation;
-            let parts: Vec<&str> = m.parts.iter().map(|&p| name(p)).collect();
-            writeln!(out, "{indent}        move {} by ({:+.4}, {:+.4}, {:+.4})", parts.join(" + "), t[0], t[1], t[2])?;
-        }
-    }
-    Ok(())
-}

@@ -9,4 +9,4 @@ pub mod qnet;
 pub use error::{LearnError, Result};
 pub use model::{GraphModel, ModelKind, RemovabilityModel, ShapePolicy};
 pub use ordering::{GnnFactory, GnnOrdering, GnnSource, SHIPPED_MODEL};
-pub use qfunction::{epsilon_greedy, OnnxQ};
+pub use qfunction::{epsilon_greedy, epsilon_greedy_models, open_q_models, OnnxQ};

@@ -255,20 +255,32 @@ impl QWorker for OnnxQWorker<'_> {
 /// objective in `objectives`' order (each model's `asp.objective` must be that objective), for
 /// maps with `directions` directions, evaluated where `uses` says (rollouts, expansions or both).
 pub fn epsilon_greedy(paths: &[impl AsRef<Path>], objectives: &[&str], epsilon: f64, directions: usize, uses: QUse) -> Result<Arc<dyn Policy>> {
-    let label = |p: &dyn AsRef<Path>| p.as_ref().display().to_string();
+    let models = open_q_models(paths, objectives)?;
+    epsilon_greedy_models(&models, objectives, epsilon, directions, uses)
+}
+
+/// The Q models at `paths`, one per objective in `objectives`' order, opened and checked to be
+/// Q models (their objectives and directions are checked by [`epsilon_greedy_models`], when the
+/// maps are known).
+pub fn open_q_models(paths: &[impl AsRef<Path>], objectives: &[&str]) -> Result<Vec<Arc<GraphModel>>> {
     if paths.len() != objectives.len() {
-        let names = paths.iter().map(|p| label(p)).collect::<Vec<_>>().join(",");
+        let names = paths.iter().map(|p| p.as_ref().display().to_string()).collect::<Vec<_>>().join(",");
         return Err(LearnError::Mismatch {
             path: names,
             mismatch: format!("{} Q models for {} objectives ({}): give one per objective, in their order", paths.len(), objectives.len(), objectives.join(",")),
         });
     }
-    let mut qs: Vec<Arc<dyn QFunction>> = Vec::with_capacity(paths.len());
-    for (path, objective) in paths.iter().zip(objectives) {
-        let q = OnnxQ::load(path, directions)?;
+    paths.iter().map(|p| GraphModel::open_kind(p, ModelKind::Q).map(Arc::new)).collect()
+}
+
+/// [`epsilon_greedy`] over models opened by [`open_q_models`].
+pub fn epsilon_greedy_models(models: &[Arc<GraphModel>], objectives: &[&str], epsilon: f64, directions: usize, uses: QUse) -> Result<Arc<dyn Policy>> {
+    let mut qs: Vec<Arc<dyn QFunction>> = Vec::with_capacity(models.len());
+    for (model, objective) in models.iter().zip(objectives) {
+        let q = OnnxQ::new(model.clone(), directions)?;
         if q.objective() != *objective {
             return Err(LearnError::Mismatch {
-                path: label(path),
+                path: model.path().to_string(),
                 mismatch: format!("estimates objective '{}', but its place in the list is that of '{objective}'", q.objective()),
             });
         }

@@ -7,7 +7,7 @@ use crate::search::PySearch;
 use crate::settings::GraphSettings;
 use crate::{run, settings};
 use asp_geom::{AssemblyGraph, PartSet, World};
-use asp_search::pipeline::{self, PlanSettings};
+use asp_app::pipeline;
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};
 use std::path::PathBuf;
@@ -57,12 +57,8 @@ impl PyAssembly {
 #[pyfunction]
 #[pyo3(signature = (path, unit=None, up=None, fixed=Vec::new()))]
 pub fn load(py: Python<'_>, path: PathBuf, unit: Option<&str>, up: Option<&str>, fixed: Vec<String>) -> PyResult<PyAssembly> {
-    let settings = PlanSettings {
-        unit: unit.map(settings::unit).transpose().map_err(|e| e.into_py(py))?,
-        up: up.map(settings::axis).transpose().map_err(|e| e.into_py(py))?,
-        fixed,
-        ..PlanSettings::default()
-    };
+    let request = asp_app::PlanRequest { unit: unit.map(String::from), up: up.map(String::from), fixed, ..Default::default() };
+    let settings = asp_app::resolve(&request).map_err(|e| Error::from(e).into_py(py))?;
     let assembly = py.detach(|| pipeline::load(&path, &settings)).map_err(|e| Error::from(e).into_py(py))?;
     Ok(PyAssembly { inner: Arc::new(assembly), graph: Mutex::new(None) })
 }

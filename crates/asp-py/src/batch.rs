@@ -10,9 +10,9 @@ use crate::settings;
 use asp_gen::batch::{self, Batch, Generator};
 use asp_gen::manifest::ManifestEntry;
 use asp_gen::{GenError, ProfileParams};
-use asp_search::bench::{self, BenchRow};
-use asp_search::collect::{self, CollectSettings, CollectedModel, ModelItem};
-use asp_search::pipeline::PlanSettings;
+use asp_app::bench::{self, BenchRow};
+use asp_app::collect::{self, CollectSettings, CollectedModel, ModelItem};
+use asp_app::PlanSettings;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::{Path, PathBuf};
@@ -103,12 +103,13 @@ pub fn model_items(py: Python<'_>, paths: Vec<PathBuf>) -> PyResult<Vec<(String,
 
 /// Plan settings from `asp.Assembly.plan`'s keywords and `asp.load`'s.
 fn model_settings(dict: &Bound<'_, PyDict>, unit: Option<&str>, up: Option<&str>, fixed: Vec<String>) -> Result<PlanSettings, Error> {
-    Ok(PlanSettings {
-        unit: unit.map(settings::unit).transpose()?,
-        up: up.map(settings::axis).transpose()?,
+    let request = asp_app::PlanRequest {
+        unit: unit.map(String::from),
+        up: up.map(String::from),
         fixed,
-        ..settings::plan_settings(dict)?
-    })
+        ..settings::request(dict, false)?
+    };
+    Ok(asp_app::resolve(&request)?)
 }
 
 fn collect_settings(runs: usize, seed: u64, max_tests: Option<u64>, timeout: Option<f64>, plan: PlanSettings) -> CollectSettings {
@@ -179,8 +180,7 @@ pub fn bench_item(
 ) -> PyResult<String> {
     let settings = model_settings(settings, unit, up, fixed).map_err(|e| e.into_py(py))?;
     let list = methods.unwrap_or_else(|| bench::default_methods(model.is_some()).to_string());
-    let gnn = || settings::ordering("gnn", model.as_deref()).map(|(source, _)| source);
-    let methods = bench::parse_methods(&list, &gnn).map_err(|e| e.into_py(py))?;
+    let methods = bench::parse_methods(&list, model.as_deref().map(Path::new)).map_err(|e| Error::from(e).into_py(py))?;
     let rows = py
         .detach(|| bench::bench_model(Path::new(&path), &name, &settings, &methods, orderings))
         .map_err(|e| Error::from(e).into_py(py))?;
@@ -205,12 +205,12 @@ pub fn bench_table(py: Python<'_>, rows: Vec<String>) -> PyResult<String> {
 /// settings that train during the search and prints them through this.
 #[pyfunction]
 pub fn mcts_table(py: Python<'_>, rows: Vec<String>) -> PyResult<(String, String)> {
-    let mut all: Vec<asp_search::bench_mcts::MctsRow> = Vec::new();
+    let mut all: Vec<asp_app::bench_mcts::MctsRow> = Vec::new();
     for r in &rows {
-        let part: Vec<asp_search::bench_mcts::MctsRow> = serde_json::from_str(r).map_err(|e| json_error("benchmark rows", e).into_py(py))?;
+        let part: Vec<asp_app::bench_mcts::MctsRow> = serde_json::from_str(r).map_err(|e| json_error("benchmark rows", e).into_py(py))?;
         all.extend(part);
     }
     let mut table = Vec::new();
-    asp_search::bench_mcts::write_table(&mut table, &all).expect("writing to memory");
-    Ok((String::from_utf8_lossy(&table).into_owned(), asp_search::bench_mcts::csv(&all)))
+    asp_app::bench_mcts::write_table(&mut table, &all).expect("writing to memory");
+    Ok((String::from_utf8_lossy(&table).into_owned(), asp_app::bench_mcts::csv(&all)))
 }

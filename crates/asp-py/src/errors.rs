@@ -94,6 +94,18 @@ impl From<SearchError> for Error {
     }
 }
 
+impl From<asp_app::AppError> for Error {
+    fn from(e: asp_app::AppError) -> Self {
+        match e {
+            // the keys are Python's keyword names already
+            asp_app::AppError::Setting { .. } => Error::config(e.render(&|k: &str| k.to_string())),
+            asp_app::AppError::Search(s) => s.into(),
+            e @ (asp_app::AppError::Learn(_) | asp_app::AppError::Robot(_)) => Error::config(e.to_string()),
+            e => Error { kind: Kind::Other, message: e.to_string(), path: None },
+        }
+    }
+}
+
 impl From<asp_gen::GenError> for Error {
     fn from(e: asp_gen::GenError) -> Self {
         match e {

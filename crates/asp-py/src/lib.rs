@@ -4,7 +4,7 @@
 //! arrays. This is the only crate of the workspace that depends on pyo3.
 //!
 //! - [`assembly`]: `load` and the `Assembly` handle (owns its data);
-//! - [`settings`]: Python keywords into [`asp_search::pipeline::PlanSettings`], order names;
+//! - [`settings`]: Python keywords into the plan request ([`asp_app::PlanRequest`]);
 //! - [`qgraphs`]: the `asp-q/1` graphs of optimiser states (`Assembly.q_graphs`);
 //! - [`run`]: the pipeline with the GIL released, interruptible by Ctrl-C;
 //! - [`search`]: the stepped optimiser run of `Assembly.search` (online Q-learning);
@@ -28,10 +28,29 @@ fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     settings::default_settings(py)
 }
 
-/// The part orderings `order=` accepts.
+/// The part orderings `order=` accepts (the catalogue's).
 #[pyfunction]
 fn order_names() -> Vec<&'static str> {
-    settings::ORDER_NAMES.to_vec()
+    settings::order_names()
+}
+
+/// The names of each closed setting (`order`, `overlaps`, `stability`, `support`, `q_use`), in
+/// the order the docs list them: what `asp.settings`' `Literal` types must list.
+#[pyfunction]
+fn choices() -> std::collections::BTreeMap<&'static str, Vec<&'static str>> {
+    use asp_app::request::{Choice, Overlaps, QUse, Stability, Support};
+    fn names<T: Choice>() -> Vec<&'static str> {
+        T::CHOICES.iter().map(|(_, n, _)| *n).collect()
+    }
+    [
+        ("order", settings::order_names()),
+        ("overlaps", names::<Overlaps>()),
+        ("stability", names::<Stability>()),
+        ("support", names::<Support>()),
+        ("q_use", names::<QUse>()),
+    ]
+    .into_iter()
+    .collect()
 }
 
 /// asp's native module (private: use the `asp` package).
@@ -43,6 +62,7 @@ fn asp_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(assembly::load, m)?)?;
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(order_names, m)?)?;
+    m.add_function(wrap_pyfunction!(choices, m)?)?;
     m.add_class::<assembly::PyAssembly>()?;
     m.add_class::<qgraphs::PyQGraphs>()?;
     m.add_class::<search::PySearch>()?;

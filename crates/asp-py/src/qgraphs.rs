@@ -8,7 +8,7 @@ use crate::assembly::GraphBuffers;
 use crate::settings;
 use asp_geom::distmap::{DirMask, MapState};
 use asp_geom::PartSet;
-use asp_search::pipeline::{self, OptimiserProblem};
+use asp_app::pipeline::{self, OptimiserProblem};
 use asp_search::qgraph::{QGraph, QGraphBuilder};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};

@@ -14,7 +14,7 @@
 
 use crate::errors::Error;
 use asp_geom::Assembly;
-use asp_search::pipeline::{self, PlanResult, PlanSettings};
+use asp_app::pipeline::{self, PlanResult, PlanSettings};
 use asp_search::StopToken;
 use pyo3::prelude::*;
 use std::panic;

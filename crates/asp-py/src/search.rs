@@ -1,5 +1,5 @@
 //! `asp._asp.Search`: the stepped optimiser run of `asp.Assembly.search`
-//! ([`asp_search::stepped::SteppedSearch`]): episodes on demand, each returning its transitions
+//! ([`asp_app::stepped::SteppedSearch`]): episodes on demand, each returning its transitions
 //! as the lines of `transitions.jsonl`, Q models swapped in between episodes, and the plan at the
 //! end. Every wait releases the GIL and looks at Python's signals every [`SIGNAL_INTERVAL`] as
 //! `Assembly.plan` does: a Ctrl-C stops the running episode, ends the search and raises.
@@ -7,8 +7,9 @@
 use crate::errors::Error;
 use crate::run::SIGNAL_INTERVAL;
 use crate::settings;
-use asp_search::collect_q;
-use asp_search::stepped::{Poll, SteppedSearch};
+use asp_app::collect_q;
+use asp_app::stepped::{Poll, SteppedSearch};
+use asp_app::catalogue::{PolicySource, QPolicy, DEFAULT_EPSILON};
 use asp_search::QUse;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -24,8 +25,6 @@ pub type EpisodeTuple = (String, u64, u64, f64, f64, usize, bool, bool, bool, bo
 #[pyclass(frozen, module = "asp._asp", name = "Search")]
 pub struct PySearch {
     inner: Mutex<Option<SteppedSearch>>,
-    objectives: Vec<String>,
-    directions: usize,
     index: String,
     /// Swaps counted when the result was taken.
     swaps: AtomicUsize,
@@ -48,9 +47,7 @@ impl PySearch {
             .detach(|| SteppedSearch::start_assembly(assembly, &path, &plan, record).map_err(Error::from))
             .map_err(|e| e.into_py(py))?;
         let index = serde_json::to_string(search.index()).expect("the index serialises");
-        let objectives = search.index().objectives.clone();
-        let directions = search.problem().maps().num_directions();
-        Ok(PySearch { inner: Mutex::new(Some(search)), objectives, directions, index, swaps: AtomicUsize::new(0) })
+        Ok(PySearch { inner: Mutex::new(Some(search)), index, swaps: AtomicUsize::new(0) })
     }
 
     fn lock(&self) -> MutexGuard<'_, Option<SteppedSearch>> {
@@ -135,21 +132,24 @@ impl PySearch {
     }
 
     /// Swaps in the ε-greedy policy over the Q models at `paths` (one per objective, in their
-    /// order) from the next episode on.
-    #[pyo3(signature = (paths, epsilon=0.2, q_use="rollouts"))]
-    fn set_q(&self, py: Python<'_>, paths: Vec<PathBuf>, epsilon: f64, q_use: &str) -> PyResult<()> {
-        let uses: QUse = q_use.parse().map_err(|e: asp_search::SearchError| Error::config(format!("q_use: {e}")).into_py(py))?;
-        let names: Vec<&str> = self.objectives.iter().map(String::as_str).collect();
-        let policy = py
-            .detach(|| asp_learn::epsilon_greedy(&paths, &names, epsilon, self.directions, uses))
-            .map_err(|e| Error::config(format!("q: {e}")).into_py(py))?;
-        match self.lock().as_mut() {
-            Some(search) => {
-                search.set_policy(policy);
-                Ok(())
-            }
-            None => Err(Error::config("the search has ended and its result was taken").into_py(py)),
-        }
+    /// order) from the next episode on (`epsilon` and `q_use` default as in `Assembly.plan`).
+    #[pyo3(signature = (paths, epsilon=None, q_use=None))]
+    fn set_q(&self, py: Python<'_>, paths: Vec<PathBuf>, epsilon: Option<f64>, q_use: Option<&str>) -> PyResult<()> {
+        let uses = match q_use {
+            None => QUse::default(),
+            Some(u) => u.parse().map_err(|e: asp_search::SearchError| Error::config(format!("q_use: {e}")).into_py(py))?,
+        };
+        let mut guard = self.lock();
+        let Some(search) = guard.as_mut() else {
+            return Err(Error::config("the search has ended and its result was taken").into_py(py));
+        };
+        let objectives = search.problem().objective_names();
+        let objectives: Vec<&str> = objectives.iter().map(String::as_str).collect();
+        let q = QPolicy::new(&paths, &objectives, epsilon.unwrap_or(DEFAULT_EPSILON), uses).map_err(|e| Error::from(e).into_py(py))?;
+        let problem = search.problem();
+        let policy = py.detach(|| q.prepare(problem)).map_err(|e| Error::from(e).into_py(py))?;
+        search.set_policy(policy);
+        Ok(())
     }
 
     /// Ends the search (after the episode running) and returns `(plan_json, found, trace_csv)`

@@ -23,7 +23,7 @@ use asp_geom::math::{Pose, Vec3};
 use asp_geom::{Assembly, Checker, FeasibilityChecker, Motion, PartSet, World, WorldConfig};
 use asp_search::mdp::{ActionFilter, MdpExtension, ModelContext, Verdict};
 use asp_search::objective::{Objective, StepContext, StepKind};
-use asp_search::pipeline::CheckerExtension;
+use asp_search::CheckerExtension;
 use asp_search::report::{RobotEntry, RobotReport, RobotStepEntry};
 use asp_search::{Mdp, PathLength, PlanOutcome, SearchError};
 

@@ -1,9 +1,6 @@
 #![doc = include_str!("../README.md")]
 
-pub mod bench;
-pub mod bench_mcts;
-pub mod collect;
-pub mod collect_q;
+pub mod checker_extension;
 pub mod dfs;
 pub mod error;
 pub mod exact;
@@ -14,15 +11,14 @@ pub mod mdp;
 pub mod objective;
 pub mod ordering;
 pub mod pareto;
-pub mod pipeline;
 pub mod policy;
 pub mod polish;
 pub mod problem;
 pub mod qgraph;
 pub mod report;
 pub mod search;
-pub mod stepped;
 
+pub use checker_extension::CheckerExtension;
 pub use dfs::Dfs;
 pub use error::{Result, SearchError};
 pub use mcts::Mcts;

@@ -1,6 +1,5 @@
 //! Integration tests of asp-search (one binary; modules in subfolders).
 
-mod collect;
 mod conformance;
 mod exact;
 mod fasteners;
@@ -13,6 +12,4 @@ mod pareto;
 mod qgraph;
 mod real;
 mod seams;
-mod stepped;
-mod transitions;
 mod verify;

@@ -342,8 +342,9 @@ def bench_mcts(
                     if setting in ("vanilla", "pretrained"):
                         plan = assembly.plan(
                             objective=objectives, pareto=len(objectives) > 1, seed=run, threads=1, time_limit=last,
-                            episodes=10**12, budget=base.budget, resolution=base.resolution, epsilon=base.epsilon,
-                            q_use=base.q_use, q=list(q) if setting == "pretrained" else None, **(base.search or {}),
+                            episodes=10**12, budget=base.budget, resolution=base.resolution,
+                            **({"q": list(q), "epsilon": base.epsilon, "q_use": base.q_use} if setting == "pretrained" else {}),
+                            **(base.search or {}),
                         )
                         trace, done = _trace_of(plan.trace_csv or "")
                     else:

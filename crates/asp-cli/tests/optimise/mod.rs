@@ -281,5 +281,60 @@ fn q_models_are_checked_before_the_search() {
     let o = asp(&["plan", m, "--objective", "access", "--q", "no/such.onnx"]);
     assert!(stderr(&o).contains("no/such.onnx: cannot read"), "{}", stderr(&o));
     let o = asp(&["plan", m, "--objective", "access", "--q", removability, "--epsilon", "1.5"]);
-    assert!(stderr(&o).contains("--epsilon must be in [0, 1], got 1.5"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--epsilon: must be in [0, 1], got 1.5"), "{}", stderr(&o));
+}
+
+/// Issue 23: a setting of the other search is an error naming the one that applies, before any
+/// work (`--timeout 10` on an MCTS run used to be ignored while the run went on for its whole
+/// episode budget); one line, exit 2, nothing written.
+#[test]
+fn issue_23_settings_of_the_other_search_are_refused_naming_what_applies() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = jenga(dir.path());
+    let m = model.to_str().unwrap();
+    let out = dir.path().join("plan.json");
+    let o_ = out.to_str().unwrap();
+    for (args, expected) in [
+        (
+            vec!["plan", m, "--objective", "access", "--timeout", "10", "--out", o_],
+            "error: --timeout: applies to the feasibility search only (without --objective); the optimiser's limit is --time-limit",
+        ),
+        (
+            vec!["plan", m, "--time-limit", "10", "--out", o_],
+            "error: --time-limit: applies to the optimiser only (with --objective); the feasibility search's limit is --timeout",
+        ),
+        (vec!["plan", m, "--objective", "access", "--order", "random", "--out", o_], "error: --order: applies to the feasibility search only (without --objective)"),
+        (vec!["plan", m, "--episodes", "5", "--out", o_], "error: --episodes: applies to the optimiser only (with --objective)"),
+        (vec!["plan", m, "--physics-threshold", "0.1", "--out", o_], "error: --physics-threshold: needs --stability physics"),
+        (vec!["plan", m, "--drop-off", "1,2", "--out", o_], "error: --drop-off: must be three finite numbers x,y,z"),
+    ] {
+        let o = asp(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert_eq!(stderr(&o).trim_end(), expected, "{args:?}");
+        assert!(!out.exists(), "{args:?} wrote a plan");
+    }
+}
+
+/// The plan request as a file: `--settings` gives the keys, flags on the command line win, and
+/// the plan is the one the same flags give.
+#[test]
+fn a_settings_file_plans_like_its_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = jenga(dir.path());
+    let m = model.to_str().unwrap();
+    let settings = dir.path().join("settings.json");
+    std::fs::write(&settings, r#"{"objective": "access", "episodes": 30, "threads": 1, "seed": 5}"#).unwrap();
+    let (a, b) = (dir.path().join("a.json"), dir.path().join("b.json"));
+    let o = asp(&["plan", m, "--settings", settings.to_str().unwrap(), "--seed", "6", "--out", a.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let o = asp(&["plan", m, "--objective", "access", "--episodes", "30", "--threads", "1", "--seed", "6", "--out", b.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let (a, b) = (json(&a), json(&b));
+    assert_eq!(a["optimisation"]["seed"], 6);
+    assert_eq!(a["disassembly_sequence"], b["disassembly_sequence"]);
+    assert_eq!(a["optimisation"]["values"], b["optimisation"]["values"]);
+    std::fs::write(&settings, r#"{"episode": 30}"#).unwrap();
+    let o = asp(&["plan", m, "--settings", settings.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("settings.json: episode: unknown setting (did you mean episodes?)"), "{}", stderr(&o));
 }

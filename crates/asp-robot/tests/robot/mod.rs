@@ -2,8 +2,8 @@ mod fk;
 mod grasp;
 mod ik;
 mod load;
+mod recheck;
 mod removal;
-mod search;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

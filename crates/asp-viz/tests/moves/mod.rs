@@ -5,7 +5,7 @@
 use asp_geom::grid::VoxelModel;
 use asp_geom::math::Vec3;
 use asp_geom::puzzles;
-use asp_search::pipeline::{plan_assembly, PlanSettings};
+use asp_app::pipeline::{plan_assembly, PlanSettings};
 use asp_viz::{Scene, MOVE_TIME};
 use std::path::Path;
 

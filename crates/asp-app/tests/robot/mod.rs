@@ -8,10 +8,12 @@ use asp_geom::fixtures::{assemble, box_part};
 use asp_geom::math::{Axis, Pose, Rot, Vec3};
 use asp_geom::{Assembly, Grasp, PartSet, World, WorldConfig};
 use asp_robot::{CellSetup, RobotCell, RobotExtension, RobotRemoval, RobotSetup};
-use asp_search::pipeline::{plan_assembly, OptimiseSettings, PlanSettings, StabilitySetting};
+use asp_app::pipeline::{plan_assembly, OptimiseSettings, PlanSettings, StabilitySetting};
 use asp_search::report::PlanReport;
 
-use super::removal::recheck;
+#[path = "../../../asp-robot/tests/robot/recheck.rs"]
+mod recheck;
+use recheck::recheck;
 
 /// Four blocks on a fixed plate in front of the robot: two side by side, one on each.
 fn blocks() -> Assembly {
@@ -172,9 +174,9 @@ fn the_beam_plans_under_physics_with_held_parts() {
     let base = PlanSettings { stability: StabilitySetting::Physics { threshold: 0.01 }, ..PlanSettings::default() };
     let with = |grippers: usize| {
         let settings = PlanSettings { checker_extension: Some(Arc::new(CellSetup { robot: None, grippers })), ..base.clone() };
-        asp_search::pipeline::plan_file(&path, &settings, None).unwrap()
+        asp_app::pipeline::plan_file(&path, &settings, None).unwrap()
     };
-    let one = asp_search::pipeline::plan_file(&path, &base, None).unwrap();
+    let one = asp_app::pipeline::plan_file(&path, &base, None).unwrap();
     assert!(one.found(), "{:?}", one.report.explanation);
     assert!(one.report.assembly_sequence.iter().any(|s| s.subassembly.is_some()), "one gripper needs a subassembly");
     let two = with(2);
@@ -210,7 +212,7 @@ fn stacks() -> Assembly {
 /// best sequence and value, the removals put to the filter, and the robot's path searches.
 fn robot_search(lazy: bool) -> (Vec<usize>, f64, u64, u64) {
     use asp_search::mdp::{MdpExtension, ModelContext};
-    use asp_search::pipeline::optimiser_problem;
+    use asp_app::pipeline::optimiser_problem;
     use asp_search::Mcts;
     let assembly = Arc::new(stacks());
     let ext = Arc::new(RobotExtension::new(RobotSetup::panda()));

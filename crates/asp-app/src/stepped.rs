@@ -9,8 +9,8 @@
 //! with one thread (a test holds it to that).
 //!
 //! ```no_run
-//! # use asp_search::stepped::{SteppedSearch, Poll};
-//! # use asp_search::pipeline::{OptimiseSettings, PlanSettings};
+//! # use asp_app::stepped::{SteppedSearch, Poll};
+//! # use asp_app::pipeline::{OptimiseSettings, PlanSettings};
 //! # use std::path::Path;
 //! let o = OptimiseSettings { objectives: "access".into(), ..OptimiseSettings::default() };
 //! let plan = PlanSettings { optimise: Some(o), ..PlanSettings::default() };
@@ -25,11 +25,11 @@
 
 use crate::collect::ModelItem;
 use crate::collect_q::{self, TransitionsIndex};
-use crate::error::{Result, SearchError};
-use crate::mdp::Mdp;
+use crate::error::{AppError, Result};
+use asp_search::Mdp;
 use crate::pipeline::{self, OptimiseSettings, PlanResult, PlanSettings};
-use crate::policy::Policy;
-use crate::search::{EpisodeEnd, Next, StopToken};
+use asp_search::Policy;
+use asp_search::{EpisodeEnd, Next, StopToken};
 use std::path::Path;
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
 use std::sync::Arc;
@@ -90,7 +90,7 @@ impl SteppedSearch {
     /// [`start`](Self::start) on a loaded assembly (`path` names it in the index).
     pub fn start_assembly(assembly: Arc<asp_geom::Assembly>, path: &Path, settings: &PlanSettings, record: bool) -> Result<Self> {
         let Some(o) = settings.optimise.clone() else {
-            return Err(SearchError::config("a stepped search needs objectives (the optimiser's settings)"));
+            return Err(AppError::config("a stepped search needs objectives (the optimiser's settings)"));
         };
         let count = o.objectives.split(',').filter(|s| !s.trim().is_empty()).count();
         let o = OptimiseSettings { pareto: o.pareto || count > 1, threads: Some(1), ..o };
@@ -109,14 +109,14 @@ impl SteppedSearch {
                 // the first command starts the first episode (or ends the search before it)
                 let o = match inbox.recv() {
                     Ok(Next::Continue) => o,
-                    Ok(Next::Policy(p)) => OptimiseSettings { policy: Some(p), ..o },
+                    Ok(Next::Policy(p)) => OptimiseSettings { policy: Some(Arc::new(crate::catalogue::FixedPolicy(p))), ..o },
                     Ok(Next::Stop) | Err(_) => {
-                        let _ = outbox.send(Message::Done(Box::new(Err(SearchError::config("the stepped search ended before its first episode")))));
+                        let _ = outbox.send(Message::Done(Box::new(Err(AppError::config("the stepped search ended before its first episode")))));
                         return;
                     }
                 };
                 let reports = outbox.clone();
-                let mut hook = move |end: EpisodeEnd| -> Result<Next> {
+                let mut hook = move |end: EpisodeEnd| -> asp_search::Result<Next> {
                     let last = end.finished;
                     if reports.send(Message::Episode(end)).is_err() {
                         return Ok(Next::Stop); // the handle is gone
@@ -129,10 +129,10 @@ impl SteppedSearch {
                 let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                     pipeline::optimise_problem(assembly, &settings, &o, problem, Some(&mut hook), record)
                 }))
-                .unwrap_or_else(|_| Err(SearchError::plugin("stepped search", "panicked")));
+                .unwrap_or_else(|_| Err(AppError::plugin("stepped search", "panicked")));
                 let _ = outbox.send(Message::Done(Box::new(result)));
             })
-            .map_err(|e| SearchError::config(format!("cannot start the search thread: {e}")))?;
+            .map_err(|e| AppError::config(format!("cannot start the search thread: {e}")))?;
         Ok(SteppedSearch {
             commands,
             messages,
@@ -183,7 +183,7 @@ impl SteppedSearch {
     /// Starts the next episode without waiting for it ([`poll`](Self::poll) for its end).
     pub fn request_episode(&mut self) -> Result<()> {
         if self.ended {
-            return Err(SearchError::config("the search has ended: no more episodes"));
+            return Err(AppError::config("the search has ended: no more episodes"));
         }
         if self.waiting {
             return Ok(());
@@ -211,7 +211,7 @@ impl SteppedSearch {
             Err(RecvTimeoutError::Timeout) => Ok(Poll::Pending),
             Err(RecvTimeoutError::Disconnected) => {
                 self.ended = true;
-                self.result = Some(Err(SearchError::plugin("stepped search", "its thread ended without an answer")));
+                self.result = Some(Err(AppError::plugin("stepped search", "its thread ended without an answer")));
                 Ok(Poll::Done)
             }
             Ok(Message::Episode(end)) => {
@@ -226,7 +226,7 @@ impl SteppedSearch {
                 self.result = Some(*result);
                 match failed {
                     // a plug-in's error surfaces at once (and again from finish)
-                    Some(message) => Err(SearchError::plugin("stepped search", message)),
+                    Some(message) => Err(AppError::plugin("stepped search", message)),
                     None => Ok(Poll::Done),
                 }
             }
@@ -240,7 +240,7 @@ impl SteppedSearch {
             match self.poll(Duration::from_secs(3600))? {
                 Poll::Pending => {}
                 Poll::Episode(end) => return Ok(end),
-                Poll::Done => return Err(SearchError::config("the search has ended: no more episodes")),
+                Poll::Done => return Err(AppError::config("the search has ended: no more episodes")),
             }
         }
     }
@@ -269,7 +269,7 @@ impl SteppedSearch {
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
-        self.result.take().unwrap_or_else(|| Err(SearchError::config("the search has not ended (or its answer was taken)")))
+        self.result.take().unwrap_or_else(|| Err(AppError::config("the search has not ended (or its answer was taken)")))
     }
 }
 

@@ -10,9 +10,11 @@
 
 use crate::bench::MeanStd;
 use crate::pipeline::{self, OptimiseSettings, PlanSettings};
-use crate::policy::{Policy, RandomPolicy};
-use crate::search::SearchOutcome;
-use crate::{Mcts, ParetoMcts, Result, SearchError};
+use crate::catalogue::{FixedPolicy, PolicySource};
+use asp_search::RandomPolicy;
+use asp_search::SearchOutcome;
+use asp_search::{Mcts, ParetoMcts};
+use crate::error::{AppError, Result};
 use serde::Serialize;
 use std::path::Path;
 use std::sync::Arc;
@@ -24,13 +26,13 @@ pub struct MctsSetting {
     /// The column's name (`vanilla`, `pretrained`, ...).
     pub name: String,
     /// The policy.
-    pub policy: Arc<dyn Policy>,
+    pub policy: Arc<dyn PolicySource>,
 }
 
 impl MctsSetting {
     /// The vanilla setting: uniformly random rollouts.
     pub fn vanilla() -> Self {
-        MctsSetting { name: "vanilla".into(), policy: Arc::new(RandomPolicy) }
+        MctsSetting { name: "vanilla".into(), policy: Arc::new(FixedPolicy(Arc::new(RandomPolicy))) }
     }
 }
 
@@ -76,15 +78,15 @@ pub fn bench_model(
     runs: usize,
 ) -> Result<Vec<MctsRow>> {
     if runs == 0 {
-        return Err(SearchError::config("the number of runs must be at least 1"));
+        return Err(AppError::config("the number of runs must be at least 1"));
     }
     let Some(&last) = checkpoints.last() else {
-        return Err(SearchError::config("no checkpoint given"));
+        return Err(AppError::config("no checkpoint given"));
     };
     if checkpoints.iter().any(|t| !(t.is_finite() && *t > 0.0)) || checkpoints.windows(2).any(|w| w[0] >= w[1]) {
-        return Err(SearchError::config(format!("checkpoints must be positive and increasing, got {checkpoints:?}")));
+        return Err(AppError::config(format!("checkpoints must be positive and increasing, got {checkpoints:?}")));
     }
-    crate::objective::check_objective_names(&o.objectives, &o.extensions)?;
+    asp_search::objective::check_objective_names(&o.objectives, &o.extensions)?;
     let pareto = o.pareto || o.objectives.split(',').filter(|s| !s.trim().is_empty()).count() > 1;
     let assembly = Arc::new(pipeline::load(path, plan)?);
     let o = OptimiseSettings { pareto, ..o.clone() };
@@ -93,6 +95,7 @@ pub fn bench_model(
     let measure = if pareto { "hypervolume".to_string() } else { o.objectives.trim().to_string() };
     let mut rows = Vec::new();
     for setting in settings {
+        let policy = setting.policy.prepare(&problem.mdp)?;
         let mut per_checkpoint = vec![Vec::with_capacity(runs); checkpoints.len()];
         let mut episodes = Vec::with_capacity(runs);
         for run in 0..runs {
@@ -105,7 +108,7 @@ pub fn bench_model(
                         .seed(run as u64)
                         .exploration(o.exploration)
                         .time_limit(Duration::from_secs_f64(last))
-                        .policy(setting.policy.clone());
+                        .policy(policy.clone());
                     if let Some(stop) = &plan.cancel {
                         b = b.stop_token(stop.clone());
                     }

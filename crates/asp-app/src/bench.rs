@@ -6,10 +6,11 @@
 //! Each run gets a fresh collision world (built outside the timer), so every method pays for its
 //! own first tests of each part: cached blocking rows would otherwise favour later runs.
 
-use crate::ordering::{BuiltinOrder, OrderingSource};
+use asp_search::OrderingSource;
 use crate::pipeline::{self, PlanSettings};
-use crate::problem::Problem;
-use crate::{Planner, Result, SearchError, Status};
+use asp_search::Problem;
+use asp_search::{Planner, Status};
+use crate::error::{AppError, Result};
 use asp_geom::Checker;
 use serde::Serialize;
 use std::path::Path;
@@ -37,13 +38,11 @@ pub fn default_methods(learned: bool) -> &'static str {
     }
 }
 
-/// The methods of a comma-separated list: `vanilla` (shuffled), `bk` (vanilla with
-/// bookkeeping), `random`, `given`, `gnn`, each optionally `+bk`. `gnn` makes the learned
-/// ordering, called only when the list names it.
-pub fn parse_methods<E: From<SearchError>>(
-    list: &str,
-    gnn: &dyn Fn() -> std::result::Result<Arc<dyn OrderingSource>, E>,
-) -> std::result::Result<Vec<Method>, E> {
+/// The methods of a comma-separated list: `vanilla` (the catalogue's `shuffled`), `bk` (vanilla
+/// with bookkeeping), or any ordering of the catalogue ([`crate::catalogue::ORDERINGS`]: `random`,
+/// `given`, `gnn`, ...), each optionally `+bk`. An ordering that reads a model (`gnn`) gets
+/// `model` (the shipped one when `None`), loaded only when the list names it.
+pub fn parse_methods(list: &str, model: Option<&Path>) -> Result<Vec<Method>> {
     let mut out = Vec::new();
     for name in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let (base, bookkeeping) = match name.strip_suffix("+bk") {
@@ -51,20 +50,15 @@ pub fn parse_methods<E: From<SearchError>>(
             None if name == "bk" => ("vanilla", true),
             None => (name, false),
         };
-        let order: Arc<dyn OrderingSource> = match base {
-            "vanilla" | "shuffled" => Arc::new(BuiltinOrder::Shuffled),
-            "random" => Arc::new(BuiltinOrder::Random),
-            "given" => Arc::new(BuiltinOrder::Given),
-            "gnn" => gnn()?,
-            other => {
-                let message = format!("unknown method '{other}' (vanilla, bk, random, given, gnn, each optionally +bk)");
-                return Err(SearchError::config(message).into());
-            }
-        };
-        out.push(Method { name: name.to_string(), order, bookkeeping });
+        let entry = crate::catalogue::ordering(if base == "vanilla" { "shuffled" } else { base }).map_err(|_| {
+            let names: Vec<&str> = crate::catalogue::ORDERINGS.iter().map(|o| o.name).collect();
+            AppError::config(format!("unknown method '{base}' (vanilla, bk, {}, each optionally +bk)", names.join(", ")))
+        })?;
+        let order = (entry.build)(if entry.takes_model { model } else { None })?;
+        out.push(Method { name: name.to_string(), order, bookkeeping: bookkeeping || entry.bookkeeping });
     }
     if out.is_empty() {
-        return Err(SearchError::config(format!("the method list '{list}' names no method")).into());
+        return Err(AppError::config(format!("the method list '{list}' names no method")));
     }
     Ok(out)
 }
@@ -126,7 +120,7 @@ pub struct BenchRow {
 /// the methods) and summarises each. `settings` give the model's loading and testing.
 pub fn bench_model(path: &Path, name: &str, settings: &PlanSettings, methods: &[Method], orderings: usize) -> Result<Vec<BenchRow>> {
     if orderings == 0 {
-        return Err(SearchError::config("the number of orderings must be at least 1"));
+        return Err(AppError::config("the number of orderings must be at least 1"));
     }
     let assembly = pipeline::load(path, settings)?;
     let world_config = pipeline::world_config(&assembly, settings)?;
@@ -202,15 +196,17 @@ mod tests {
 
     #[test]
     fn method_lists_parse_and_bad_names_are_errors() {
-        let no_gnn = || -> Result<Arc<dyn OrderingSource>> { Err(SearchError::config("no model here")) };
-        let methods = parse_methods(default_methods(false), &no_gnn).unwrap();
+        let methods = parse_methods(default_methods(false), None).unwrap();
         let names: Vec<(&str, bool)> = methods.iter().map(|m| (m.name.as_str(), m.bookkeeping)).collect();
         assert_eq!(names, [("vanilla", false), ("bk", true), ("random", false), ("random+bk", true)]);
-        let err = parse_methods("vanilla,gnn+bk", &no_gnn).err().unwrap();
-        assert!(err.to_string().contains("no model here"), "{err}");
-        let err = parse_methods("vanilla,fastest", &no_gnn).err().unwrap();
+        assert_eq!(methods[0].order.name(), "shuffled");
+        let err = parse_methods("vanilla,gnn+bk", Some(Path::new("/no/such/model.onnx"))).err().unwrap();
+        assert!(err.to_string().contains("/no/such/model.onnx"), "{err}");
+        let gnn = parse_methods("gnn+bk", None).unwrap();
+        assert_eq!((gnn[0].order.name().as_str(), gnn[0].bookkeeping), ("gnn", true));
+        let err = parse_methods("vanilla,fastest", None).err().unwrap();
         assert!(err.to_string().contains("unknown method 'fastest'"), "{err}");
-        assert!(parse_methods(" , ", &no_gnn).is_err());
+        assert!(parse_methods(" , ", None).is_err());
     }
 
     #[test]

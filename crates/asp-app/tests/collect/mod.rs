@@ -2,7 +2,7 @@
 //! reproducibility (format: docs/learning.md).
 
 use asp_geom::{Checker, CheckerConfig, FeasibilityChecker, MotionKind, Outcome, PartSet, World, WorldConfig};
-use asp_search::collect::{collect, CollectSettings};
+use asp_app::collect::{collect, CollectSettings};
 use std::path::{Path, PathBuf};
 
 fn model(dir: &Path, seed: u64) -> PathBuf {
@@ -78,6 +78,6 @@ fn data_set_files_labels_and_reproducibility() {
 
 #[test]
 fn models_with_one_name_in_two_folders_get_distinct_names() {
-    let names = asp_search::collect::unique_names(&[PathBuf::from("a/x.glb"), PathBuf::from("b/x.glb"), PathBuf::from("b/y.glb")]);
+    let names = asp_app::collect::unique_names(&[PathBuf::from("a/x.glb"), PathBuf::from("b/x.glb"), PathBuf::from("b/y.glb")]);
     assert_eq!(names, ["a_x", "b_x", "y"]);
 }

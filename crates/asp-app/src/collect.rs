@@ -8,10 +8,11 @@
 //! straight candidate direction and the rest stays stable) or not. Runs go in parallel; the
 //! output depends only on the models, the settings and the seed.
 
-use crate::ordering::BuiltinOrder;
+use asp_search::BuiltinOrder;
 use crate::pipeline::{self, PlanSettings};
-use crate::problem::{Budget, Problem};
-use crate::{Dfs, Result, SearchError};
+use asp_search::{Budget, Problem};
+use asp_search::{Dfs};
+use crate::error::{AppError, Result};
 use asp_geom::graph::{AssemblyGraph, GraphConfig};
 use asp_geom::{FeasibilityChecker, MotionKind, Outcome, PartSet};
 use rayon::prelude::*;
@@ -142,13 +143,13 @@ pub fn model_paths(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
         }
     }
     if out.is_empty() {
-        return Err(SearchError::config("no models given"));
+        return Err(AppError::config("no models given"));
     }
     Ok(out)
 }
 
-pub(crate) fn io_error(path: &Path, e: std::io::Error) -> SearchError {
-    SearchError::Geom(asp_geom::GeomError::Io { path: path.to_path_buf(), source: e })
+pub(crate) fn io_error(path: &Path, e: std::io::Error) -> AppError {
+    AppError::from(asp_geom::GeomError::Io { path: path.to_path_buf(), source: e })
 }
 
 /// The name of a model: its file stem, or its folder's name.
@@ -176,14 +177,14 @@ pub fn unique_names(models: &[PathBuf]) -> Vec<String> {
 
 /// The seed of run `run` of the model at position `model` in a collection with base seed `base`.
 pub(crate) fn seed_of(base: u64, model: usize, run: usize) -> u64 {
-    crate::ordering::state_seed(base, &PartSet::empty(0), ((model as u64) << 32) | run as u64)
+    asp_search::ordering::state_seed(base, &PartSet::empty(0), ((model as u64) << 32) | run as u64)
 }
 
 /// Collects the data set of `models` into `out` (created; existing files of the format are
 /// overwritten). `progress` is called after each model with its name and entry.
 pub fn collect(models: &[PathBuf], out: &Path, settings: &CollectSettings, progress: &(dyn Fn(&CollectedModel) + Sync)) -> Result<Collected> {
     if settings.runs == 0 {
-        return Err(SearchError::config("the number of runs must be at least 1"));
+        return Err(AppError::config("the number of runs must be at least 1"));
     }
     settings.graph.validate()?;
     std::fs::create_dir_all(out).map_err(|e| io_error(out, e))?;
@@ -256,7 +257,7 @@ pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
 /// and the seed, so models can be collected in any order or on other machines (`asp.batch`).
 pub fn collect_model(item: &ModelItem, out: &Path, settings: &CollectSettings) -> Result<CollectedModel> {
     if settings.runs == 0 {
-        return Err(SearchError::config("the number of runs must be at least 1"));
+        return Err(AppError::config("the number of runs must be at least 1"));
     }
     settings.graph.validate()?;
     let (path, m, name, dir) = (item.path.as_path(), item.index, item.name.as_str(), item.dir.as_str());
@@ -279,7 +280,7 @@ pub fn collect_model(item: &ModelItem, out: &Path, settings: &CollectSettings) -
             let mut states = Vec::new();
             let mut visit = |s: &PartSet| states.push(s.clone());
             let outcome = dfs.solve_visiting(&Problem::full(&checker), &budget, Some(&mut visit));
-            (states, outcome.status == crate::Status::Found)
+            (states, outcome.status == asp_search::Status::Found)
         })
         .collect();
     let lines: Vec<Vec<StateLine>> = runs

@@ -6,16 +6,18 @@
 //! that name the setting, not a command-line flag. Every step is also public on its own, so a
 //! caller that plans many times on one model (data collection, benchmarks) builds the world once.
 
-use crate::mdp::{MdpExtension, ModelContext};
-use crate::objective::resolve_objectives;
-use crate::policy::Policy;
-use crate::ordering::{BuiltinOrder, OrderingSource};
-use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
-use crate::grid::GridRun;
+use asp_search::{CheckerExtension, MdpExtension, ModelContext};
+use asp_search::objective::resolve_objectives;
+use crate::catalogue::PolicySource;
+use asp_search::{BuiltinOrder, OrderingSource};
+use asp_search::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
+use asp_search::grid::GridRun;
 use asp_geom::grid::{GridConfig, VoxelModel};
-use crate::report::{GridEntry, OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
-use crate::search::{EpisodeHook, SearchOutcome, SearchStatus, StopToken, DEFAULT_BUDGET, DEFAULT_EPISODES};
-use crate::{Dfs, Mcts, Mdp, ParetoMcts, Planner, Result, SearchError};
+use asp_search::report::{GridEntry, OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
+use asp_search::search::{DEFAULT_BUDGET, DEFAULT_EPISODES};
+use asp_search::{EpisodeHook, SearchOutcome, SearchStatus, StopToken};
+use asp_search::{Dfs, Mcts, Mdp, ParetoMcts, Planner};
+use crate::error::{AppError, Result};
 use asp_geom::distmap::{DistanceMaps, MapConfig, Support};
 use asp_geom::io::LoadOptions;
 use asp_geom::math::Axis;
@@ -77,7 +79,7 @@ pub struct PlanSettings {
     pub path_planner: bool,
     /// Let groups of parts leave together as rigid subassemblies when no single part can.
     pub subassemblies: bool,
-    /// Plan voxel models by moves of parts and groups on their grid ([`crate::grid`]) when
+    /// Plan voxel models by moves of parts and groups on their grid ([`asp_search::grid`]) when
     /// several parts must move in turn before anything can leave, or when the depth-first
     /// search finds no plan.
     pub grid: bool,
@@ -97,20 +99,6 @@ pub struct PlanSettings {
     pub cancel: Option<StopToken>,
     /// Wraps the depth-first search's checker (e.g. a robot that must also take each part out).
     pub checker_extension: Option<Arc<dyn CheckerExtension>>,
-}
-
-/// Decorates the feasibility planner's checker: [`CheckerExtension::solve`] builds its
-/// checker on the collision-world checker, lets the search run on it, and describes the
-/// outcome's steps (a robot's grasps and paths).
-pub trait CheckerExtension: Send + Sync + std::fmt::Debug {
-    /// Builds the decorated checker on `checker`, calls `search` with it, and returns the
-    /// search's outcome with the extension's report (or `None`).
-    fn solve(
-        &self,
-        checker: &Checker,
-        seed: u64,
-        search: &mut dyn FnMut(&dyn asp_geom::FeasibilityChecker) -> PlanOutcome,
-    ) -> Result<(PlanOutcome, Option<crate::report::RobotReport>)>;
 }
 
 impl Default for PlanSettings {
@@ -171,7 +159,7 @@ pub struct OptimiseSettings {
     /// Exploration constant of UCT / MOUCB.
     pub exploration: f64,
     /// The share of the search's work its local search over the answer's sequences may take
-    /// ([`crate::search::SearchBuilder::polish`]; 0: none).
+    /// ([`asp_search::search::SearchBuilder::polish`]; 0: none).
     pub polish: f64,
     /// Distance map resolution N_M.
     pub resolution: usize,
@@ -182,9 +170,9 @@ pub struct OptimiseSettings {
     /// Objectives and feasibility filters beyond the built-in ones (e.g. a robot's); their
     /// objective names may appear in `objectives`.
     pub extensions: Vec<Arc<dyn MdpExtension>>,
-    /// The rollout and expansion policy (default: uniformly random; e.g. ε-greedy over learned
-    /// Q-functions, which asp-learn builds).
-    pub policy: Option<Arc<dyn Policy>>,
+    /// The rollout and expansion policy, made for the problem (default: uniformly random; e.g.
+    /// ε-greedy over learned Q-functions, [`crate::catalogue::QPolicy`]).
+    pub policy: Option<Arc<dyn PolicySource>>,
 }
 
 impl Default for OptimiseSettings {
@@ -197,7 +185,7 @@ impl Default for OptimiseSettings {
             threads: None,
             time_limit: None,
             exploration: std::f64::consts::FRAC_1_SQRT_2,
-            polish: crate::search::DEFAULT_POLISH,
+            polish: asp_search::search::DEFAULT_POLISH,
             resolution: asp_geom::distmap::DEFAULT_RESOLUTION,
             d_max: None,
             support: Support::Below,
@@ -229,7 +217,7 @@ fn positive(name: &str, v: f64) -> Result<f64> {
     if v > 0.0 && v.is_finite() {
         Ok(v)
     } else {
-        Err(SearchError::config(format!("{name} must be a positive number, got {v}")))
+        Err(AppError::config(format!("{name} must be a positive number, got {v}")))
     }
 }
 
@@ -379,7 +367,7 @@ pub fn plan_assembly(
 /// What every feasibility plan's report carries besides its steps: the overlapping pairs and
 /// where the time went (loading is timed by the caller).
 fn finish_report(report: &mut PlanReport, world: &asp_geom::World, outcome: &PlanOutcome, world_seconds: f64) {
-    report.overlaps = crate::report::OverlapsEntry::of(world);
+    report.overlaps = asp_search::report::OverlapsEntry::of(world);
     report.stats.timings = Some(Timings {
         load: 0.0,
         world: world_seconds,
@@ -435,9 +423,9 @@ pub struct OptimiserProblem {
 /// (built-in or from the extensions), the extensions' filters, and `settings.seed` as the
 /// problem's seed. Several objectives need `o.pareto`.
 pub fn optimiser_problem(assembly: &Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<OptimiserProblem> {
-    crate::objective::check_objective_names(&o.objectives, &o.extensions)?;
+    asp_search::objective::check_objective_names(&o.objectives, &o.extensions)?;
     if o.objectives.split(',').filter(|s| !s.trim().is_empty()).count() > 1 && !o.pareto {
-        return Err(SearchError::config(format!(
+        return Err(AppError::config(format!(
             "objectives {}: several objectives need a Pareto search (or give one objective)",
             o.objectives
         )));
@@ -477,7 +465,7 @@ pub fn optimise(assembly: Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSe
 }
 
 /// [`optimise`] on a problem built by [`optimiser_problem`], episode by episode on one thread
-/// when a `hook` is given ([`crate::Mcts::solve_stepped`]: it sees each episode's transitions,
+/// when a `hook` is given ([`asp_search::Mcts::solve_stepped`]: it sees each episode's transitions,
 /// recorded when `record` is set, and may swap the policy between episodes). The one search loop and report of `asp plan
 /// --objective`, the stepped search of `asp.Assembly.search` and the online Q-learning.
 pub fn optimise_problem(
@@ -492,6 +480,7 @@ pub fn optimise_problem(
     let maps = mdp.maps_arc().clone();
     let model = ModelContext { assembly: &assembly, maps: &maps, seed: settings.seed };
     let stepped = hook.is_some();
+    let policy = o.policy.as_ref().map(|p| p.prepare(&mdp)).transpose()?;
     let threads = match (&hook, o.threads) {
         (Some(_), _) => 1,
         (None, Some(t)) => t,
@@ -513,7 +502,7 @@ pub fn optimise_problem(
             if let Some(stop) = &settings.cancel {
                 b = b.stop_token(stop.clone());
             }
-            if let Some(policy) = &o.policy {
+            if let Some(policy) = &policy {
                 b = b.policy(policy.clone());
             }
             b.build()?

@@ -5,19 +5,21 @@
 //! For every model the distance maps, objectives and filters are built as the optimiser builds
 //! them ([`pipeline::optimiser_problem`]); one search per model (MCTS for one objective,
 //! Pareto-MCTS for several) runs `episodes` episodes on one thread with recording on
-//! ([`crate::search::SearchBuilder::record_transitions`]), its seed derived from the base seed
+//! ([`asp_search::search::SearchBuilder::record_transitions`]), its seed derived from the base seed
 //! and the model's position. Models go in parallel; the output depends only on the models, the
 //! settings and the seed. The index records, per model, the keyword arguments of `asp.load`
 //! and `Assembly.q_graphs` that rebuild the same maps, so the Python trainer computes each
 //! transition's state graphs with the search's own Rust code.
 
 use crate::collect::{self, io_error, ModelItem};
-use crate::mdp::Mdp;
-use crate::objective::StepKind;
+use asp_search::Mdp;
+use asp_search::StepKind;
 use crate::pipeline::{self, OptimiseSettings, PlanSettings};
-use crate::qgraph::{direction_history, QGraphConfig};
-use crate::search::{Transition, DEFAULT_RECORD_LIMIT};
-use crate::{Mcts, ParetoMcts, Result, SearchError};
+use asp_search::qgraph::{direction_history, QGraphConfig};
+use asp_search::search::DEFAULT_RECORD_LIMIT;
+use asp_search::Transition;
+use asp_search::{Mcts, ParetoMcts};
+use crate::error::{AppError, Result};
 use asp_geom::distmap::Support;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -171,15 +173,15 @@ fn history(problem: &Mdp, memory: &[u64]) -> Vec<usize> {
 /// Checks the settings that do not depend on a model.
 fn checked(settings: &TransitionSettings) -> Result<()> {
     if settings.optimise.episodes == 0 {
-        return Err(SearchError::config("episodes must be at least 1"));
+        return Err(AppError::config("episodes must be at least 1"));
     }
     if settings.optimise.budget == 0 {
-        return Err(SearchError::config("the search budget must be at least 1"));
+        return Err(AppError::config("the search budget must be at least 1"));
     }
     if settings.limit == 0 {
-        return Err(SearchError::config("the transitions limit must be at least 1"));
+        return Err(AppError::config("the transitions limit must be at least 1"));
     }
-    crate::objective::check_objective_names(&settings.optimise.objectives, &settings.optimise.extensions)
+    Ok(asp_search::objective::check_objective_names(&settings.optimise.objectives, &settings.optimise.extensions)?)
 }
 
 /// Collects the transitions of `models` into `out` (created; files of the format are
@@ -193,7 +195,7 @@ pub fn collect_transitions(
 ) -> Result<TransitionsIndex> {
     checked(settings)?;
     if models.is_empty() {
-        return Err(SearchError::config("no models given"));
+        return Err(AppError::config("no models given"));
     }
     std::fs::create_dir_all(out).map_err(|e| io_error(out, e))?;
     let collected: Vec<Result<(TransitionsModel, QGraphConfig, Vec<String>)>> = collect::model_items(models)
@@ -208,7 +210,7 @@ pub fn collect_transitions(
     let (_, graph, objectives) = collected.first().cloned().expect("at least one model");
     for (entry, g, o) in &collected {
         if *g != graph || *o != objectives {
-            return Err(SearchError::config(format!(
+            return Err(AppError::config(format!(
                 "model {}: its state graphs ({}, objectives {}) differ from the first model's ({}, objectives {})",
                 entry.model,
                 g.features(),
@@ -274,7 +276,7 @@ fn problem_entry(problem: &Mdp) -> Result<(Vec<[f64; 2]>, QGraphConfig, Vec<Stri
     let mut reward_ranges = Vec::with_capacity(problem.num_objectives());
     for objective in problem.objectives() {
         let Some((lo, hi)) = objective.reward_range(maps) else {
-            return Err(SearchError::config(format!(
+            return Err(AppError::config(format!(
                 "objective '{}' has no reward range, so its rewards cannot be normalised for learning",
                 objective.name()
             )));

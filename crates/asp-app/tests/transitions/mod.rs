@@ -1,14 +1,14 @@
 //! Transitions recorded by the MCTS (`SearchBuilder::record_transitions`) and the
-//! `asp-transitions` data set (`asp_search::collect_q`, docs/learning.md): recording changes no
+//! `asp-transitions` data set (`asp_app::collect_q`, docs/learning.md): recording changes no
 //! answer, every transition replays through `Mdp::step`, the cap holds, the files are what the
 //! format says and rebuild the same maps.
 
 use crate::fixtures::{maps, problem, soma};
 use asp_geom::distmap::MapState;
 use asp_geom::PartSet;
-use asp_search::collect_q::{collect_transitions, TransitionSettings};
+use asp_app::collect_q::{collect_transitions, TransitionSettings};
 use asp_search::objective::DirHistory;
-use asp_search::pipeline::{OptimiseSettings, PlanSettings};
+use asp_app::pipeline::{OptimiseSettings, PlanSettings};
 use asp_search::{Mcts, Mdp, ParetoMcts, SearchOutcome, StepKind, Transition};
 use std::path::{Path, PathBuf};
 
@@ -263,7 +263,7 @@ fn the_data_set_has_the_documented_files_and_rebuilds_the_maps() {
                                "tolerance": 1e-5, "contact_distance": null, "overlaps": "strict"})
         );
         // the maps rebuilt from the entry's arguments, as Python rebuilds them
-        let load: asp_search::collect_q::LoadArgs = serde_json::from_value(entry["load"].clone()).unwrap();
+        let load: asp_app::collect_q::LoadArgs = serde_json::from_value(entry["load"].clone()).unwrap();
         let plan = PlanSettings {
             unit: load.unit.as_deref().map(|u| asp_geom::Units::parse(u).unwrap()),
             up: load.up.as_deref().map(|a| asp_geom::math::Axis::parse(a).unwrap()),
@@ -271,14 +271,14 @@ fn the_data_set_has_the_documented_files_and_rebuilds_the_maps() {
             tolerance: entry["maps"]["tolerance"].as_f64(),
             ..PlanSettings::default()
         };
-        let assembly = std::sync::Arc::new(asp_search::pipeline::load(Path::new(entry["model"].as_str().unwrap()), &plan).unwrap());
+        let assembly = std::sync::Arc::new(asp_app::pipeline::load(Path::new(entry["model"].as_str().unwrap()), &plan).unwrap());
         let o = OptimiseSettings {
             objectives: entry["maps"]["objective"].as_str().unwrap().into(),
             pareto: true,
             resolution: entry["maps"]["resolution"].as_u64().unwrap() as usize,
             ..OptimiseSettings::default()
         };
-        let p = asp_search::pipeline::optimiser_problem(&assembly, &plan, &o).unwrap().mdp;
+        let p = asp_app::pipeline::optimiser_problem(&assembly, &plan, &o).unwrap().mdp;
         let n = p.maps().num_parts();
         assert_eq!(entry["parts"].as_u64().unwrap() as usize, n);
         assert_eq!(entry["removable"].as_u64().unwrap() as usize, p.removals());

@@ -4,9 +4,9 @@
 
 use crate::fixtures::{maps, problem, soma};
 use asp_geom::distmap::MapState;
-use asp_search::pipeline::{self, OptimiseSettings, PlanSettings};
+use asp_app::pipeline::{self, OptimiseSettings, PlanSettings};
 use asp_search::policy::{argmax, EpsilonGreedy, ImmediateReward, Policy};
-use asp_search::stepped::SteppedSearch;
+use asp_app::stepped::SteppedSearch;
 use asp_search::{EpisodeEnd, Mcts, Mdp, Next, ParetoMcts, SearchOutcome, StepKind, Transition};
 use std::sync::Arc;
 

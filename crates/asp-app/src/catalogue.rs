@@ -1,0 +1,269 @@
+//! The catalogue: the one place where each named part ordering, objective, rollout policy and
+//! robot meets its implementation and its one line of help. The command line's `--help`, its
+//! accepted values, Python's `order_names()` and the error messages all read these tables, so a
+//! new ordering is its implementation plus one entry in [`ORDERINGS`]:
+//!
+//! ```text
+//! OrderingEntry {
+//!     name: "widest-first",
+//!     help: "parts by decreasing width",
+//!     bookkeeping: false,
+//!     takes_model: false,
+//!     build: |_model| Ok(Arc::new(my_crate::WidestFirst)),
+//! },
+//! ```
+
+use crate::error::{AppError, Result};
+use asp_search::{BuiltinOrder, Mdp, OrderingSource, Policy};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// A named part ordering of the depth-first search (`order`).
+#[derive(Clone, Copy, Debug)]
+pub struct OrderingEntry {
+    /// The name `order` takes.
+    pub name: &'static str,
+    /// One line of help.
+    pub help: &'static str,
+    /// Whether the name implies bookkeeping on top of the ordering.
+    pub bookkeeping: bool,
+    /// Whether it reads a model file (`model`).
+    pub takes_model: bool,
+    /// Builds the ordering (with the model file, when it takes one and one is given).
+    pub build: fn(model: Option<&Path>) -> Result<Arc<dyn OrderingSource>>,
+}
+
+/// The part orderings, in the order the docs list them; the first is the default.
+pub const ORDERINGS: &[OrderingEntry] = &[
+    OrderingEntry {
+        name: "given",
+        help: "the model's part order",
+        bookkeeping: false,
+        takes_model: false,
+        build: |_| Ok(Arc::new(BuiltinOrder::Given)),
+    },
+    OrderingEntry {
+        name: "shuffled",
+        help: "one random order drawn from the seed at the start and kept (the thesis' vanilla AbD)",
+        bookkeeping: false,
+        takes_model: false,
+        build: |_| Ok(Arc::new(BuiltinOrder::Shuffled)),
+    },
+    OrderingEntry {
+        name: "random",
+        help: "a fresh random order in every state (from the seed and the state)",
+        bookkeeping: false,
+        takes_model: false,
+        build: |_| Ok(Arc::new(BuiltinOrder::Random)),
+    },
+    OrderingEntry {
+        name: "bookkeeping",
+        help: "the given order with bookkeeping: a blocked part is retested only after a blocker is gone",
+        bookkeeping: true,
+        takes_model: false,
+        build: |_| Ok(Arc::new(BuiltinOrder::Given)),
+    },
+    OrderingEntry {
+        name: "gnn",
+        help: "parts in order of the removability a graph neural network predicts (`model`), predicted again after each removal (thesis 3.5.3)",
+        bookkeeping: false,
+        takes_model: true,
+        build: |model| {
+            Ok(Arc::new(match model {
+                Some(p) => asp_learn::GnnSource::load(p, asp_geom::graph::GraphConfig::default())?,
+                None => asp_learn::GnnSource::shipped()?,
+            }))
+        },
+    },
+];
+
+/// The ordering called `name`, or an error listing the names.
+pub fn ordering(name: &str) -> Result<&'static OrderingEntry> {
+    ORDERINGS.iter().find(|o| o.name == name).ok_or_else(|| {
+        AppError::setting("order", format!("unknown order '{name}' (use {})", ORDERINGS.iter().map(|o| o.name).collect::<Vec<_>>().join(", ")))
+    })
+}
+
+/// Where an objective comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ObjectiveSource {
+    /// Built into the optimiser (`asp_search::objective::objective_by_name`).
+    BuiltIn,
+    /// Provided by the robot's extension (`asp_robot::RobotExtension`): needs `robot`.
+    Robot,
+}
+
+/// A named objective of the optimiser (`objective`).
+#[derive(Clone, Copy, Debug)]
+pub struct ObjectiveEntry {
+    /// The name `objective` takes.
+    pub name: &'static str,
+    /// One line of help.
+    pub help: &'static str,
+    /// Where its implementation comes from.
+    pub source: ObjectiveSource,
+}
+
+/// The objectives, in the order the docs list them.
+pub const OBJECTIVES: &[ObjectiveEntry] = &[
+    ObjectiveEntry {
+        name: "access",
+        help: "accessibility of each part as it leaves (thesis 6.15), maximised",
+        source: ObjectiveSource::BuiltIn,
+    },
+    ObjectiveEntry {
+        name: "dirchange",
+        help: "shared removal directions: fewer direction changes (thesis 6.16)",
+        source: ObjectiveSource::BuiltIn,
+    },
+    ObjectiveEntry {
+        name: "pathlen",
+        help: "straight-line removal path length, minimised",
+        source: ObjectiveSource::BuiltIn,
+    },
+    ObjectiveEntry {
+        name: asp_robot::ROBOT_PATH,
+        help: "the robot arm's total joint-space path (thesis 5.3), minimised; needs `robot`",
+        source: ObjectiveSource::Robot,
+    },
+];
+
+/// A robot the catalogue names (`robot`; any other value is a URDF file).
+#[derive(Clone, Copy, Debug)]
+pub struct RobotEntry {
+    /// The name `robot` takes.
+    pub name: &'static str,
+    /// One line of help.
+    pub help: &'static str,
+    /// Builds the robot.
+    pub build: fn() -> asp_robot::Robot,
+}
+
+/// The shipped robots.
+pub const ROBOTS: &[RobotEntry] =
+    &[RobotEntry { name: "panda", help: "the shipped Franka-Panda-like arm", build: asp_robot::Robot::panda }];
+
+/// The robot `name` stands for: a catalogue robot, else a URDF file.
+pub fn robot(name: &str) -> Result<asp_robot::Robot> {
+    match ROBOTS.iter().find(|r| r.name == name) {
+        Some(r) => Ok((r.build)()),
+        None => Ok(asp_robot::Robot::from_urdf_file(Path::new(name))?),
+    }
+}
+
+/// A rollout and expansion policy of the optimiser, made for one problem: the problem tells
+/// what a policy must know of it (the learned Q-functions' direction count is the maps').
+pub trait PolicySource: Send + Sync + std::fmt::Debug {
+    /// A short name for reports (`random`, `q`).
+    fn name(&self) -> &str;
+    /// The policy for `mdp`.
+    fn prepare(&self, mdp: &Mdp) -> Result<Arc<dyn Policy>>;
+}
+
+/// A named rollout policy (`q` selects the learned one).
+#[derive(Clone, Copy, Debug)]
+pub struct PolicyEntry {
+    /// The name.
+    pub name: &'static str,
+    /// One line of help.
+    pub help: &'static str,
+}
+
+/// The rollout policies, in the order the docs list them; the first is the default.
+pub const POLICIES: &[PolicyEntry] = &[
+    PolicyEntry { name: "random", help: "uniformly random rollouts and expansions (the thesis' vanilla MCTS)" },
+    PolicyEntry {
+        name: "q",
+        help: "ε-greedy over learned Q-functions (`q`, one ONNX file per objective; thesis 5.4.5, 6.4.4), where `q_use` says",
+    },
+];
+
+/// The probability of a random removal where learned Q-functions guide (thesis 5.4.5: 0.2).
+pub const DEFAULT_EPSILON: f64 = 0.2;
+
+/// The ε-greedy policy over learned Q-functions, one per objective of the problem in its order.
+/// The files are opened and checked to be Q models when it is made; their objectives and
+/// direction counts are checked against the problem in [`PolicySource::prepare`].
+#[derive(Clone, Debug)]
+pub struct QPolicy {
+    /// The Q models, one per objective.
+    models: Vec<Arc<asp_learn::GraphModel>>,
+    /// The probability of a random removal.
+    epsilon: f64,
+    /// Where the Q-values guide.
+    uses: asp_search::QUse,
+}
+
+impl QPolicy {
+    /// A policy over the Q models at `paths`, one per objective of `objectives` in their order,
+    /// with ε checked to be in [0, 1].
+    pub fn new(paths: &[PathBuf], objectives: &[&str], epsilon: f64, uses: asp_search::QUse) -> Result<Self> {
+        if !(0.0..=1.0).contains(&epsilon) {
+            return Err(AppError::setting("epsilon", format!("must be in [0, 1], got {epsilon}")));
+        }
+        let models = asp_learn::open_q_models(paths, objectives).map_err(|e| AppError::setting("q", e.to_string()))?;
+        Ok(QPolicy { models, epsilon, uses })
+    }
+}
+
+impl PolicySource for QPolicy {
+    fn name(&self) -> &str {
+        "q"
+    }
+
+    fn prepare(&self, mdp: &Mdp) -> Result<Arc<dyn Policy>> {
+        let names = mdp.objective_names();
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        let directions = mdp.maps().num_directions();
+        asp_learn::epsilon_greedy_models(&self.models, &names, self.epsilon, directions, self.uses)
+            .map_err(|e| AppError::setting("q", e.to_string()))
+    }
+}
+
+/// A policy that is the same for every problem (a caller's own).
+#[derive(Clone, Debug)]
+pub struct FixedPolicy(pub Arc<dyn Policy>);
+
+impl PolicySource for FixedPolicy {
+    fn name(&self) -> &str {
+        "fixed"
+    }
+
+    fn prepare(&self, _mdp: &Mdp) -> Result<Arc<dyn Policy>> {
+        Ok(self.0.clone())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_objective_is_catalogued_and_every_entry_resolves() {
+        for name in asp_search::objective::OBJECTIVE_NAMES {
+            assert!(OBJECTIVES.iter().any(|o| o.name == name && o.source == ObjectiveSource::BuiltIn), "{name}");
+        }
+        let robot = asp_robot::RobotExtension::new(asp_robot::RobotSetup::panda());
+        let provided = asp_search::MdpExtension::objective_names(&robot);
+        for o in OBJECTIVES {
+            match o.source {
+                ObjectiveSource::BuiltIn => assert!(asp_search::objective::objective_by_name(o.name).is_ok(), "{}", o.name),
+                ObjectiveSource::Robot => assert!(provided.iter().any(|p| p == o.name), "{}", o.name),
+            }
+        }
+    }
+
+    #[test]
+    fn orderings_build_by_name_and_unknown_names_list_the_known() {
+        for o in ORDERINGS.iter().filter(|o| !o.takes_model) {
+            let source = (o.build)(None).unwrap();
+            assert_eq!(source.name(), if o.name == "bookkeeping" { "given" } else { o.name });
+        }
+        let gnn = ordering("gnn").unwrap();
+        assert_eq!((gnn.build)(None).unwrap().name(), "gnn");
+        let e = ordering("sideways").unwrap_err().to_string();
+        assert_eq!(e, "order: unknown order 'sideways' (use given, shuffled, random, bookkeeping, gnn)");
+        assert!(robot("panda").is_ok());
+        assert!(robot("/no/such/robot.urdf").unwrap_err().to_string().contains("/no/such/robot.urdf"));
+    }
+}

@@ -1,0 +1,409 @@
+//! The plan request: every setting of a planning run as plain data, serde-(de)serialisable.
+//!
+//! A request says what its user asked for and nothing more: every field is optional, and a
+//! field left out takes the default of the search it belongs to. The defaults live in one place,
+//! [`crate::resolve`] (reading the library constants), and [`PlanRequest::defaults`] lists them.
+//! The keys are the Python keywords of `asp.Assembly.plan` and, with `-` for `_`, the flags of
+//! `asp plan` (`max_tests` is `--max-tests`; the switches `path_planner`, `subassemblies` and
+//! `grid` are `--no-path-planner`, ...). A setting that does not apply to the chosen search (an
+//! optimiser setting without `objective`, a feasibility-search setting with one) is an error
+//! naming the setting that does, never silently ignored.
+//!
+//! ```
+//! use asp_app::PlanRequest;
+//! let r = PlanRequest::from_json(r#"{"objective": "access,dirchange", "pareto": true, "episodes": 50}"#).unwrap();
+//! assert_eq!(r.objective.as_deref(), Some(&["access".to_string(), "dirchange".to_string()][..]));
+//! let e = PlanRequest::from_json(r#"{"episode": 50}"#).unwrap_err();
+//! assert_eq!(e.to_string(), "episode: unknown setting (did you mean `episodes`?)");
+//! ```
+
+use crate::error::{AppError, Result};
+use serde::{Deserialize, Deserializer, Serialize};
+use std::path::PathBuf;
+
+/// A closed set of named values (`overlaps`, `stability`, `support`, `q_use`): the names with
+/// one line of help each, for `--help`, Python's `Literal`s and error messages.
+pub trait Choice: Sized + Copy + 'static {
+    /// Every value with its name and its one-line help, in the order the docs list them.
+    const CHOICES: &'static [(Self, &'static str, &'static str)];
+
+    /// The value called `name`.
+    fn parse(name: &str) -> Option<Self> {
+        Self::CHOICES.iter().find(|(_, n, _)| *n == name).map(|(v, _, _)| *v)
+    }
+
+    /// The names, comma-separated (for messages).
+    fn names() -> String {
+        Self::CHOICES.iter().map(|(_, n, _)| *n).collect::<Vec<_>>().join(", ")
+    }
+}
+
+macro_rules! choice {
+    ($(#[$meta:meta])* $name:ident { $($(#[$vmeta:meta])* $variant:ident = $text:literal : $help:literal,)+ }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+        #[serde(rename_all = "kebab-case")]
+        pub enum $name {
+            $($(#[$vmeta])* #[serde(rename = $text)] $variant,)+
+        }
+
+        impl Choice for $name {
+            const CHOICES: &'static [(Self, &'static str, &'static str)] = &[$(($name::$variant, $text, $help),)+];
+        }
+
+        impl $name {
+            /// The value's name.
+            pub fn name(self) -> &'static str {
+                Self::CHOICES.iter().find(|(v, _, _)| *v == self).map(|(_, n, _)| *n).unwrap_or("?")
+            }
+        }
+    };
+}
+
+choice!(
+    /// What to do with parts that overlap in the input (press fits, dowels, screws, slop).
+    Overlaps {
+        /// Separate only along motions that enter no new material of each other.
+        Strict = "strict": "an overlapping pair separates only along motions that enter no new material of each other (a dowel leaves along its axis, never sideways)",
+        /// Shrink one part of the pair; ignore pairs no shrinking separates.
+        Lenient = "lenient": "shrink one part of the pair in their tests; ignore pairs no shrinking separates",
+        /// Shrink small overlaps; an error on pairs no shrinking separates.
+        Error = "error": "shrink small overlaps; stop with an error on pairs no shrinking separates",
+    }
+);
+
+choice!(
+    /// The stability criterion of the feasibility search.
+    Stability {
+        /// Linked through contacts to a fixed part.
+        Contact = "contact": "every part linked through contacts to a fixed part",
+        /// Simulated under gravity.
+        Physics = "physics": "simulate what remains under gravity (rapier3d); unstable when a part moves more than `physics_threshold`",
+    }
+);
+
+choice!(
+    /// The optimiser's gravity check on the distance maps.
+    Support {
+        /// A part or the floor directly beneath each part.
+        Below = "below": "every part rests on a part or the floor directly beneath it (thesis 6.3.2)",
+        /// Linked through contacts.
+        Contact = "contact": "every part linked through contacts to a fixed part or the floor",
+    }
+);
+
+choice!(
+    /// Where learned Q-functions guide the optimiser.
+    QUse {
+        /// ε-greedy rollouts.
+        Rollouts = "rollouts": "ε-greedy rollouts (thesis: one evaluation per rollout step)",
+        /// Q-ordered expansions, random rollouts.
+        Expansions = "expansions": "the Q-values of each state the search adds order its expansions; rollouts stay random (one evaluation per node)",
+        /// Both.
+        Both = "both": "ε-greedy rollouts and Q-ordered expansions",
+    }
+);
+
+/// Every setting of a planning run (see the module documentation). Lengths are in model units.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PlanRequest {
+    // --- loading (the CLI and batches; Python's `asp.load`) ---
+    /// The unit of the model's coordinates: `m`, `cm`, `mm`, `in`, `ft` or metres per unit
+    /// (default: what the file says, else metres).
+    pub unit: Option<String>,
+    /// The up axis: `x`, `y`, `z`, `-x`, `-y`, `-z` (default: what the file says, else +y for
+    /// glTF, +z for OBJ/STL).
+    pub up: Option<String>,
+    /// Base parts that stay in place, by name, on top of those the file marks as fixed.
+    pub fixed: Vec<String>,
+
+    // --- the removal test ---
+    /// Contact tolerance: motions may push a part this deep into another (default 1e-4 × the
+    /// model's diagonal).
+    pub tolerance: Option<f64>,
+    /// Parts closer than this are in contact for stability (default 1e-3 × the diagonal).
+    pub contact_distance: Option<f64>,
+    /// Clustered surface-normal directions tried besides the six axes (feasibility search).
+    pub normals: Option<usize>,
+    /// Extra removal directions sampled evenly on the sphere (feasibility search).
+    pub sphere_directions: Option<usize>,
+    /// Parts that overlap in the input.
+    pub overlaps: Option<Overlaps>,
+    /// The feasibility search's stability criterion.
+    pub stability: Option<Stability>,
+    /// Physics stability: how far (fraction of the model's diagonal) a part may move.
+    pub physics_threshold: Option<f64>,
+    /// Try the path planner when no straight line works (`--no-path-planner`: false).
+    pub path_planner: Option<bool>,
+    /// Let groups of parts leave together as rigid subassemblies (`--no-subassemblies`: false).
+    pub subassemblies: Option<bool>,
+    /// Plan voxel models by grid moves (`--no-grid`: false).
+    pub grid: Option<bool>,
+    /// Path planner iterations per call.
+    pub rrt_iterations: Option<usize>,
+    /// Path planner wall-time cap per call, seconds.
+    pub rrt_time: Option<f64>,
+
+    // --- the feasibility search ---
+    /// The part ordering, by its catalogue name (`given`, `shuffled`, `random`, `bookkeeping`,
+    /// `gnn`).
+    pub order: Option<String>,
+    /// The removability model (ONNX) of `order = "gnn"` (default: the shipped one).
+    pub model: Option<PathBuf>,
+    /// Bookkeeping on top of the ordering.
+    pub bookkeeping: Option<bool>,
+    /// Seed of every random choice (both searches).
+    pub seed: Option<u64>,
+    /// Stop after this many removal tests.
+    pub max_tests: Option<u64>,
+    /// Stop after this many seconds with the best partial plan (0: no limit; default 60).
+    pub timeout: Option<f64>,
+
+    // --- the optimiser (present when `objective` is) ---
+    /// Optimise for these objectives (a comma-separated string or a list).
+    #[serde(deserialize_with = "names")]
+    pub objective: Option<Vec<String>>,
+    /// Search the Pareto front (several objectives need it).
+    pub pareto: Option<bool>,
+    /// MCTS episodes.
+    pub episodes: Option<usize>,
+    /// MCTS iterations per step of an episode.
+    pub budget: Option<usize>,
+    /// Optimiser threads (default: all cores).
+    pub threads: Option<usize>,
+    /// Optimiser wall-time limit, seconds.
+    pub time_limit: Option<f64>,
+    /// Exploration constant of UCT / MOUCB.
+    pub exploration: Option<f64>,
+    /// The local search's share of the search's work (0: off).
+    pub polish: Option<f64>,
+    /// Distance map resolution N_M (odd, 3 to 15).
+    pub resolution: Option<usize>,
+    /// Distance map cap (default: the model's diagonal).
+    pub d_max: Option<f64>,
+    /// The optimiser's gravity check.
+    pub support: Option<Support>,
+    /// Learned Q-functions (ONNX), one per objective in `objective`'s order (a comma-separated
+    /// string or a list).
+    #[serde(deserialize_with = "paths")]
+    pub q: Option<Vec<PathBuf>>,
+    /// The probability of a random removal where `q` guides.
+    pub epsilon: Option<f64>,
+    /// Where `q` guides.
+    pub q_use: Option<QUse>,
+
+    // --- the robot (both searches) ---
+    /// A robot arm that must carry every removal out: a catalogue name (`panda`) or a URDF file.
+    pub robot: Option<String>,
+    /// The robot base's position `[x, y, z]` (or `"x,y,z"`), model frame.
+    #[serde(deserialize_with = "point")]
+    pub robot_base: Option<[f64; 3]>,
+    /// Where the gripper puts removed parts down, `[x, y, z]` (or `"x,y,z"`).
+    #[serde(deserialize_with = "point")]
+    pub drop_off: Option<[f64; 3]>,
+    /// Path plans per grasp (`k`), the shortest kept.
+    pub replans: Option<usize>,
+    /// Grippers in all: up to N-1 placed parts may be held (feasibility search).
+    pub grippers: Option<usize>,
+}
+
+/// The keys that belong to loading a model (`asp.load` in Python, not `Assembly.plan`).
+pub const LOAD_KEYS: [&str; 3] = ["unit", "up", "fixed"];
+
+impl PlanRequest {
+    /// Every key of a request, in declaration order.
+    pub fn keys() -> Vec<String> {
+        match serde_json::to_value(PlanRequest::default()) {
+            Ok(serde_json::Value::Object(map)) => map.keys().cloned().collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// A request from a JSON object. An unknown key, or a value of the wrong type, is an
+    /// [`AppError::Setting`] naming the key.
+    pub fn from_json(text: &str) -> Result<PlanRequest> {
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| AppError::setting("request", format!("not JSON: {e}")))?;
+        PlanRequest::from_value(value)
+    }
+
+    /// A request from a JSON value (an object of settings; `null` values are left out).
+    pub fn from_value(value: serde_json::Value) -> Result<PlanRequest> {
+        let serde_json::Value::Object(map) = value else {
+            return Err(AppError::setting("request", "settings must be an object of key: value"));
+        };
+        let keys = PlanRequest::keys();
+        let mut request = serde_json::Map::new();
+        for (key, v) in map {
+            if !keys.contains(&key) {
+                let hint = keys
+                    .iter()
+                    .filter(|k| k.starts_with(key.get(..3).unwrap_or(&key)) || key.starts_with(k.as_str()))
+                    .min_by_key(|k| k.len().abs_diff(key.len()));
+                return Err(AppError::setting(
+                    &key,
+                    match hint {
+                        Some(h) => format!("unknown setting (did you mean `{h}`?)"),
+                        None => "unknown setting".into(),
+                    },
+                ));
+            }
+            if v.is_null() {
+                continue;
+            }
+            // one key at a time, so that a type error names its key
+            let mut one = serde_json::Map::new();
+            one.insert(key.clone(), v.clone());
+            serde_json::from_value::<PlanRequest>(serde_json::Value::Object(one))
+                .map_err(|e| AppError::setting(&key, type_message(&e.to_string())))?;
+            request.insert(key, v);
+        }
+        serde_json::from_value(serde_json::Value::Object(request)).map_err(|e| AppError::setting("request", e.to_string()))
+    }
+
+    /// The request as JSON (only the settings given).
+    pub fn to_json(&self) -> String {
+        let mut value = serde_json::to_value(self).unwrap_or_default();
+        if let serde_json::Value::Object(map) = &mut value {
+            map.retain(|k, v| !v.is_null() && !(k == "fixed" && v.as_array().is_some_and(Vec::is_empty)));
+        }
+        value.to_string()
+    }
+
+    /// Whether the request asks for the optimiser.
+    pub fn optimises(&self) -> bool {
+        self.objective.is_some()
+    }
+
+    /// The settings given, by key.
+    pub fn given(&self) -> Vec<&'static str> {
+        let mut keys = Vec::new();
+        macro_rules! given {
+            ($($field:ident),+) => {$(if self.$field.is_some() { keys.push(stringify!($field)); })+};
+        }
+        given!(
+            unit, up, tolerance, contact_distance, normals, sphere_directions, overlaps, stability, physics_threshold,
+            path_planner, subassemblies, grid, rrt_iterations, rrt_time, order, model, bookkeeping, seed, max_tests,
+            timeout, objective, pareto, episodes, budget, threads, time_limit, exploration, polish, resolution, d_max,
+            support, q, epsilon, q_use, robot, robot_base, drop_off, replans, grippers
+        );
+        if !self.fixed.is_empty() {
+            keys.push("fixed");
+        }
+        keys
+    }
+}
+
+/// serde's words for a type error, without its position and in ours where we can.
+fn type_message(serde: &str) -> String {
+    let text = serde.split(" at line ").next().unwrap_or(serde);
+    match text.strip_prefix("invalid type: ").or_else(|| text.strip_prefix("invalid value: ")) {
+        Some(rest) => match rest.split_once(", expected ") {
+            Some((got, want)) => format!("must be {}, got {got}", want_words(want)),
+            None => text.to_string(),
+        },
+        None => match text.strip_prefix("unknown variant ") {
+            Some(rest) => format!("unknown value {}", rest.replace(", expected one of", " (use").replace(", expected", " (use") + ")"),
+            None => text.to_string(),
+        },
+    }
+}
+
+fn want_words(serde: &str) -> &str {
+    match serde {
+        "u64" | "usize" | "u32" => "a non-negative integer",
+        "f64" | "f32" => "a number",
+        "a boolean" => "true or false",
+        other => other,
+    }
+}
+
+/// A comma-separated string or a list of strings, as a list (blank names dropped).
+fn names<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<String>>, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum OneOrMany {
+        One(String),
+        Many(Vec<String>),
+    }
+    let split = |s: &str| s.split(',').map(str::trim).filter(|n| !n.is_empty()).map(String::from).collect::<Vec<_>>();
+    Ok(match Option::<OneOrMany>::deserialize(d)
+        .map_err(|_| serde::de::Error::custom("must be a comma-separated string or a list of strings"))?
+    {
+        None => None,
+        Some(OneOrMany::One(s)) => Some(split(&s)),
+        Some(OneOrMany::Many(v)) => Some(v.iter().flat_map(|s| split(s)).collect()),
+    })
+}
+
+/// [`names`] as paths.
+fn paths<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<PathBuf>>, D::Error> {
+    Ok(names(d)?.map(|v| v.into_iter().map(PathBuf::from).collect()))
+}
+
+/// Three numbers, as a list or as `"x,y,z"`.
+fn point<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<[f64; 3]>, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Point {
+        Text(String),
+        List(Vec<f64>),
+    }
+    let bad = || serde::de::Error::custom("must be three finite numbers x,y,z");
+    let v: Vec<f64> = match Option::<Point>::deserialize(d).map_err(|_| bad())? {
+        None => return Ok(None),
+        Some(Point::List(v)) => v,
+        Some(Point::Text(s)) => s.split(',').map(|x| x.trim().parse::<f64>()).collect::<std::result::Result<_, _>>().map_err(|_| bad())?,
+    };
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Some([x, y, z])),
+        _ => Err(bad()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_are_every_field_and_json_round_trips() {
+        let keys = PlanRequest::keys();
+        assert_eq!(keys.len(), 40, "{keys:?}");
+        assert!(keys.iter().any(|k| k == "time_limit") && keys.iter().any(|k| k == "robot_base"));
+        let r = PlanRequest {
+            objective: Some(vec!["access".into()]),
+            q_use: Some(QUse::Both),
+            overlaps: Some(Overlaps::Lenient),
+            robot_base: Some([1.0, 2.0, 3.0]),
+            fixed: vec!["base".into()],
+            ..PlanRequest::default()
+        };
+        assert_eq!(PlanRequest::from_json(&r.to_json()).unwrap(), r);
+        assert_eq!(r.given(), vec!["overlaps", "objective", "q_use", "robot_base", "fixed"]);
+    }
+
+    #[test]
+    fn bad_settings_name_their_key() {
+        let e = |json: &str| PlanRequest::from_json(json).unwrap_err().to_string();
+        assert_eq!(e(r#"{"seed": "x"}"#), "seed: must be a non-negative integer, got string \"x\"");
+        assert_eq!(e(r#"{"seed": -1}"#), "seed: must be a non-negative integer, got integer `-1`");
+        assert!(e(r#"{"overlaps": "loose"}"#).starts_with("overlaps: unknown value `loose` (use `strict`"), "{}", e(r#"{"overlaps": "loose"}"#));
+        assert_eq!(e(r#"{"robot_base": "1,2"}"#), "robot_base: must be three finite numbers x,y,z");
+        assert_eq!(e(r#"{"colour": 1}"#), "colour: unknown setting");
+        assert_eq!(e(r#"{"timeouts": 1}"#), "timeouts: unknown setting (did you mean `timeout`?)");
+        assert_eq!(e("[1]"), "request: settings must be an object of key: value");
+    }
+
+    #[test]
+    fn lists_come_as_strings_or_lists_and_nulls_are_left_out() {
+        let r = PlanRequest::from_json(r#"{"objective": ["access", "dirchange"], "q": "a.onnx, b.onnx", "robot_base": "1, 2, 3", "timeout": null}"#).unwrap();
+        assert_eq!(r.objective, Some(vec!["access".to_string(), "dirchange".to_string()]));
+        assert_eq!(r.q, Some(vec![PathBuf::from("a.onnx"), PathBuf::from("b.onnx")]));
+        assert_eq!(r.robot_base, Some([1.0, 2.0, 3.0]));
+        assert_eq!(r.timeout, None);
+        assert_eq!(Overlaps::parse("error"), Some(Overlaps::Error));
+        assert_eq!(QUse::names(), "rollouts, expansions, both");
+        assert_eq!(Support::Below.name(), "below");
+    }
+}

@@ -1,0 +1,342 @@
+//! From a [`PlanRequest`] to the pipeline's [`PlanSettings`]: every default filled in (this is
+//! the one place they are chosen, from the library constants), every value checked, every
+//! name looked up in the catalogue, and every setting checked to apply to the search the
+//! request asks for. Errors are [`AppError::Setting`]s naming the key.
+
+use crate::catalogue::{self, QPolicy, DEFAULT_EPSILON};
+use crate::error::{AppError, Result};
+use crate::pipeline::{OptimiseSettings, PlanSettings, StabilitySetting, DEFAULT_TIMEOUT};
+use crate::request::{Overlaps, PlanRequest, QUse, Stability, Support};
+use asp_geom::math::{Axis, Vec3};
+use asp_geom::Units;
+use asp_search::search::{DEFAULT_BUDGET, DEFAULT_EPISODES, DEFAULT_EXPLORATION, DEFAULT_POLISH};
+use asp_search::MdpExtension;
+use serde_json::{json, Value};
+use std::sync::Arc;
+
+/// The physics stability threshold when none is given: the simulation's own default (a part
+/// that moves more than 1 % of the model's diagonal has fallen).
+pub fn default_physics_threshold() -> f64 {
+    asp_geom::PhysicsConfig::default().displacement_fraction as f64
+}
+
+/// The settings only the feasibility (depth-first) search reads, with what the optimiser has
+/// instead (if anything).
+const FEASIBILITY_ONLY: &[(&str, &str)] = &[
+    ("normals", ""),
+    ("sphere_directions", ""),
+    ("stability", "the optimiser's gravity check is `support`"),
+    ("physics_threshold", ""),
+    ("path_planner", ""),
+    ("subassemblies", ""),
+    ("grid", ""),
+    ("rrt_iterations", ""),
+    ("rrt_time", ""),
+    ("order", ""),
+    ("model", ""),
+    ("bookkeeping", ""),
+    ("max_tests", ""),
+    ("timeout", "the optimiser's limit is `time_limit`"),
+    ("grippers", ""),
+];
+
+/// The settings only the optimiser reads, with what the feasibility search has instead.
+const OPTIMISER_ONLY: &[(&str, &str)] = &[
+    ("pareto", ""),
+    ("episodes", ""),
+    ("budget", ""),
+    ("threads", ""),
+    ("time_limit", "the feasibility search's limit is `timeout`"),
+    ("exploration", ""),
+    ("polish", ""),
+    ("resolution", ""),
+    ("d_max", ""),
+    ("support", "the feasibility search's criterion is `stability`"),
+    ("q", ""),
+    ("epsilon", ""),
+    ("q_use", ""),
+];
+
+/// Each setting does something in the search the request asks for.
+fn check_applies(r: &PlanRequest) -> Result<()> {
+    let given = r.given();
+    let (table, search, switch) = if r.optimises() {
+        (FEASIBILITY_ONLY, "the feasibility search", "without `objective`")
+    } else {
+        (OPTIMISER_ONLY, "the optimiser", "with `objective`")
+    };
+    for (key, instead) in table {
+        if given.contains(key) {
+            let mut reason = format!("applies to {search} only ({switch})");
+            if !instead.is_empty() {
+                reason.push_str("; ");
+                reason.push_str(instead);
+            }
+            return Err(AppError::setting(*key, reason));
+        }
+    }
+    let needs = |key: &str, on: bool, what: &str| -> Result<()> {
+        if given.contains(&key) && !on {
+            return Err(AppError::setting(key, format!("needs {what}")));
+        }
+        Ok(())
+    };
+    needs("physics_threshold", r.stability == Some(Stability::Physics), "`stability` physics")?;
+    needs("epsilon", r.q.is_some(), "learned Q-functions (`q`)")?;
+    needs("q_use", r.q.is_some(), "learned Q-functions (`q`)")?;
+    for key in ["robot_base", "drop_off", "replans"] {
+        needs(key, r.robot.is_some(), "a robot (`robot`)")?;
+    }
+    Ok(())
+}
+
+fn positive(key: &str, v: Option<f64>) -> Result<Option<f64>> {
+    match v {
+        Some(x) if !(x > 0.0 && x.is_finite()) => Err(AppError::setting(key, format!("must be a positive number, got {x}"))),
+        v => Ok(v),
+    }
+}
+
+fn at_least_one(key: &str, v: Option<usize>) -> Result<Option<usize>> {
+    match v {
+        Some(0) => Err(AppError::setting(key, "must be at least 1")),
+        v => Ok(v),
+    }
+}
+
+/// The unit of `unit` (`m`, `mm`, ... or metres per unit).
+pub fn unit(name: &str) -> Result<Units> {
+    Units::parse(name).ok_or_else(|| AppError::setting("unit", format!("unknown unit '{name}' (use m, cm, mm, in, ft or a number of metres)")))
+}
+
+/// The axis of `up` (`x`, `-z`, ...).
+pub fn axis(name: &str) -> Result<Axis> {
+    Axis::parse(name).ok_or_else(|| AppError::setting("up", format!("'{name}' is not an axis (use x, y, z, -x, -y, -z)")))
+}
+
+/// The pipeline's settings of `request` (see the module documentation). The cancel token and
+/// progress are the caller's: set [`PlanSettings::cancel`] on the result.
+pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
+    check_applies(r)?;
+    let d = PlanSettings::default();
+    let robot = robot(r)?;
+    let grippers = at_least_one("grippers", r.grippers)?.unwrap_or(1);
+    let extensions: Vec<Arc<dyn MdpExtension>> = match &robot {
+        Some(setup) => vec![Arc::new(asp_robot::RobotExtension::new(setup.clone())) as Arc<dyn MdpExtension>],
+        None => Vec::new(),
+    };
+    let optimise = optimise(r, extensions)?;
+    let checker_extension: Option<Arc<dyn asp_search::CheckerExtension>> =
+        (optimise.is_none() && (robot.is_some() || grippers > 1)).then(|| {
+            Arc::new(asp_robot::CellSetup { robot: robot.clone(), grippers }) as Arc<dyn asp_search::CheckerExtension>
+        });
+    let order_name = r.order.as_deref().unwrap_or(catalogue::ORDERINGS[0].name);
+    let entry = catalogue::ordering(order_name)?;
+    if r.model.is_some() && !entry.takes_model {
+        return Err(AppError::setting("model", format!("the removability model of `order` gnn; it has no effect with `order` {order_name}")));
+    }
+    let order = (entry.build)(r.model.as_deref()).map_err(|e| match (&r.model, e) {
+        (Some(_), e) => AppError::setting("model", e.to_string()),
+        (None, e) => e,
+    })?;
+    let stability = match r.stability.unwrap_or(Stability::Contact) {
+        Stability::Contact => StabilitySetting::Contact,
+        Stability::Physics => StabilitySetting::Physics {
+            threshold: positive("physics_threshold", r.physics_threshold)?.unwrap_or_else(default_physics_threshold),
+        },
+    };
+    let timeout = match r.timeout {
+        None => Some(DEFAULT_TIMEOUT),
+        Some(t) if t == 0.0 => None,
+        t => positive("timeout", t)?,
+    };
+    Ok(PlanSettings {
+        unit: r.unit.as_deref().map(unit).transpose()?,
+        up: r.up.as_deref().map(axis).transpose()?,
+        fixed: r.fixed.clone(),
+        tolerance: positive("tolerance", r.tolerance)?,
+        contact_distance: positive("contact_distance", r.contact_distance)?,
+        normals: r.normals.unwrap_or(d.normals),
+        sphere_directions: r.sphere_directions.unwrap_or(d.sphere_directions),
+        overlaps: match r.overlaps.unwrap_or(Overlaps::Strict) {
+            Overlaps::Strict => asp_geom::OverlapPolicy::Strict,
+            Overlaps::Lenient => asp_geom::OverlapPolicy::Lenient,
+            Overlaps::Error => asp_geom::OverlapPolicy::Error,
+        },
+        stability,
+        order,
+        bookkeeping: r.bookkeeping.unwrap_or(false) || entry.bookkeeping,
+        seed: r.seed.unwrap_or(0),
+        path_planner: r.path_planner.unwrap_or(d.path_planner),
+        subassemblies: r.subassemblies.unwrap_or(d.subassemblies),
+        grid: r.grid.unwrap_or(d.grid),
+        rrt_iterations: at_least_one("rrt_iterations", r.rrt_iterations)?.unwrap_or(d.rrt_iterations),
+        rrt_time: positive("rrt_time", r.rrt_time)?.unwrap_or(d.rrt_time),
+        max_tests: r.max_tests,
+        timeout,
+        optimise,
+        cancel: None,
+        checker_extension,
+    })
+}
+
+/// The robot of the request, if any.
+fn robot(r: &PlanRequest) -> Result<Option<asp_robot::RobotSetup>> {
+    let Some(name) = &r.robot else { return Ok(None) };
+    let robot = catalogue::robot(name).map_err(|e| AppError::setting("robot", e.to_string()))?;
+    let replans = at_least_one("replans", r.replans)?.unwrap_or(asp_robot::RemovalConfig::default().replans);
+    let to_vec = |p: [f64; 3]| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+    Ok(Some(asp_robot::RobotSetup {
+        robot,
+        base: r.robot_base.map(to_vec),
+        drop_off: r.drop_off.map(to_vec),
+        config: asp_robot::RemovalConfig { replans, ..Default::default() },
+    }))
+}
+
+/// The optimiser's settings, `None` without `objective`.
+fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<Option<OptimiseSettings>> {
+    let Some(names) = &r.objective else { return Ok(None) };
+    if names.is_empty() {
+        return Err(AppError::setting("objective", "no objective given"));
+    }
+    let list = names.join(",");
+    if names.iter().any(|n| n == asp_robot::ROBOT_PATH) && extensions.is_empty() {
+        return Err(AppError::setting("objective", format!("{list}: robot-path needs a robot (`robot` panda or a URDF file)")));
+    }
+    asp_search::objective::check_objective_names(&list, &extensions).map_err(|e| AppError::setting("objective", e.to_string()))?;
+    let pareto = r.pareto.unwrap_or(false);
+    if names.len() > 1 && !pareto {
+        return Err(AppError::setting("objective", format!("{list}: several objectives need `pareto` (or give one objective)")));
+    }
+    let policy = match &r.q {
+        None => None,
+        Some(paths) => {
+            let uses = match r.q_use.unwrap_or(QUse::Rollouts) {
+                QUse::Rollouts => asp_search::QUse::Rollouts,
+                QUse::Expansions => asp_search::QUse::Expansions,
+                QUse::Both => asp_search::QUse::Both,
+            };
+            let objectives: Vec<&str> = names.iter().map(String::as_str).collect();
+            let q = QPolicy::new(paths, &objectives, r.epsilon.unwrap_or(DEFAULT_EPSILON), uses)?;
+            Some(Arc::new(q) as Arc<dyn catalogue::PolicySource>)
+        }
+    };
+    let polish = r.polish.unwrap_or(DEFAULT_POLISH);
+    if !(polish >= 0.0 && polish.is_finite()) {
+        return Err(AppError::setting("polish", format!("must be a share of the search's work (0 or more), got {polish}")));
+    }
+    let exploration = r.exploration.unwrap_or(DEFAULT_EXPLORATION);
+    if !(exploration >= 0.0 && exploration.is_finite()) {
+        return Err(AppError::setting("exploration", format!("must be 0 or more, got {exploration}")));
+    }
+    Ok(Some(OptimiseSettings {
+        objectives: list,
+        pareto,
+        episodes: at_least_one("episodes", r.episodes)?.unwrap_or(DEFAULT_EPISODES),
+        budget: at_least_one("budget", r.budget)?.unwrap_or(DEFAULT_BUDGET),
+        threads: at_least_one("threads", r.threads)?,
+        time_limit: positive("time_limit", r.time_limit)?,
+        exploration,
+        polish,
+        resolution: r.resolution.unwrap_or(asp_geom::distmap::DEFAULT_RESOLUTION),
+        d_max: positive("d_max", r.d_max)?,
+        support: match r.support.unwrap_or(Support::Below) {
+            Support::Below => asp_geom::distmap::Support::Below,
+            Support::Contact => asp_geom::distmap::Support::ContactGraph,
+        },
+        extensions,
+        policy,
+    }))
+}
+
+/// Every setting's default, by key, as the searches use them (`null`: none, or derived from the
+/// model: the tolerance is 1e-4 × its diagonal, the threads all cores). Python's
+/// `asp._asp.default_settings()` and the docs show these.
+pub fn defaults() -> serde_json::Map<String, Value> {
+    let d = PlanSettings::default();
+    let values = json!({
+        "unit": null, "up": null, "fixed": [],
+        "tolerance": null, "contact_distance": null, "normals": d.normals, "sphere_directions": d.sphere_directions,
+        "overlaps": Overlaps::Strict.name(), "stability": Stability::Contact.name(),
+        "physics_threshold": default_physics_threshold(), "path_planner": d.path_planner,
+        "subassemblies": d.subassemblies, "grid": d.grid, "rrt_iterations": d.rrt_iterations, "rrt_time": d.rrt_time,
+        "order": catalogue::ORDERINGS[0].name, "model": null, "bookkeeping": false, "seed": 0,
+        "max_tests": null, "timeout": DEFAULT_TIMEOUT,
+        "objective": null, "pareto": false, "episodes": DEFAULT_EPISODES, "budget": DEFAULT_BUDGET,
+        "threads": null, "time_limit": null, "exploration": DEFAULT_EXPLORATION, "polish": DEFAULT_POLISH,
+        "resolution": asp_geom::distmap::DEFAULT_RESOLUTION, "d_max": null, "support": Support::Below.name(),
+        "q": null, "epsilon": DEFAULT_EPSILON, "q_use": QUse::Rollouts.name(),
+        "robot": null, "robot_base": null, "drop_off": null,
+        "replans": asp_robot::RemovalConfig::default().replans, "grippers": 1,
+    });
+    match values {
+        Value::Object(map) => map,
+        _ => serde_json::Map::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(json: &str) -> String {
+        resolve(&PlanRequest::from_json(json).unwrap()).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn defaults_name_every_key_once() {
+        let keys = PlanRequest::keys();
+        let defaults = defaults();
+        assert_eq!(defaults.keys().cloned().collect::<std::collections::BTreeSet<_>>(), keys.into_iter().collect());
+    }
+
+    #[test]
+    fn an_empty_request_is_the_pipelines_default() {
+        let s = resolve(&PlanRequest::default()).unwrap();
+        let d = PlanSettings::default();
+        assert_eq!((s.normals, s.seed, s.timeout, s.bookkeeping, s.grid), (d.normals, d.seed, d.timeout, d.bookkeeping, d.grid));
+        assert_eq!(s.order.name(), "given");
+        assert!(s.optimise.is_none() && s.checker_extension.is_none());
+        let o = resolve(&PlanRequest::from_json(r#"{"objective": "access"}"#).unwrap()).unwrap().optimise.unwrap();
+        let od = OptimiseSettings::default();
+        assert_eq!((o.episodes, o.budget, o.polish, o.resolution, o.exploration), (od.episodes, od.budget, od.polish, od.resolution, od.exploration));
+    }
+
+    #[test]
+    fn settings_of_the_other_search_are_errors_naming_what_applies() {
+        assert_eq!(
+            err(r#"{"objective": "access", "timeout": 10}"#),
+            "timeout: applies to the feasibility search only (without `objective`); the optimiser's limit is `time_limit`"
+        );
+        assert_eq!(
+            err(r#"{"time_limit": 10}"#),
+            "time_limit: applies to the optimiser only (with `objective`); the feasibility search's limit is `timeout`"
+        );
+        assert_eq!(err(r#"{"physics_threshold": 0.1}"#), "physics_threshold: needs `stability` physics");
+        assert_eq!(err(r#"{"objective": "access", "epsilon": 0.1}"#), "epsilon: needs learned Q-functions (`q`)");
+        assert_eq!(err(r#"{"drop_off": [0, 0, 1]}"#), "drop_off: needs a robot (`robot`)");
+        assert_eq!(err(r#"{"objective": "access", "grippers": 2}"#), "grippers: applies to the feasibility search only (without `objective`)");
+    }
+
+    #[test]
+    fn values_are_checked_with_the_key() {
+        assert_eq!(err(r#"{"timeout": -1}"#), "timeout: must be a positive number, got -1");
+        assert!(resolve(&PlanRequest::from_json(r#"{"timeout": 0}"#).unwrap()).unwrap().timeout.is_none());
+        assert_eq!(err(r#"{"order": "sideways"}"#), "order: unknown order 'sideways' (use given, shuffled, random, bookkeeping, gnn)");
+        assert_eq!(err(r#"{"model": "m.onnx"}"#), "model: the removability model of `order` gnn; it has no effect with `order` given");
+        assert!(err(r#"{"order": "gnn", "model": "/no/such.onnx"}"#).starts_with("model: ") );
+        assert_eq!(err(r#"{"objective": "access,dirchange"}"#), "objective: access,dirchange: several objectives need `pareto` (or give one objective)");
+        assert!(err(r#"{"objective": "speed"}"#).starts_with("objective: unknown objective 'speed'"));
+        assert!(err(r#"{"objective": "robot-path"}"#).contains("robot-path needs a robot"));
+        assert_eq!(err(r#"{"objective": "access", "q": "a.onnx", "epsilon": 1.5}"#), "epsilon: must be in [0, 1], got 1.5");
+        assert!(err(r#"{"objective": "access", "q": "/no/such/q.onnx"}"#).starts_with("q: /no/such/q.onnx"));
+        assert!(err(r#"{"objective": "access", "q": "a.onnx,b.onnx"}"#).contains("2 Q models for 1 objectives"));
+        assert_eq!(err(r#"{"unit": "furlong"}"#), "unit: unknown unit 'furlong' (use m, cm, mm, in, ft or a number of metres)");
+        assert_eq!(err(r#"{"grippers": 0}"#), "grippers: must be at least 1");
+        let s = resolve(&PlanRequest::from_json(r#"{"order": "bookkeeping"}"#).unwrap()).unwrap();
+        assert!(s.bookkeeping && s.order.name() == "given");
+        let s = resolve(&PlanRequest::from_json(r#"{"robot": "panda", "grippers": 2}"#).unwrap()).unwrap();
+        assert!(s.checker_extension.is_some());
+    }
+}

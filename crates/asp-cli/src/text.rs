@@ -1,0 +1,181 @@
+//! The plan as text: the table of `asp plan` and the optimiser's summary under it.
+
+use asp_search::report::{AssemblyStep, MotionEntry, OptimisationEntry, ParetoEntry, PlanReport};
+use std::io::Write;
+
+/// The human-readable plan: a header, the assembly sequence, and the explanation when stuck.
+pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
+    let s = &r.stats;
+    writeln!(
+        out,
+        "{}: {} in {:.3} s — {} removal tests ({} failed by collision, {} by gravity), {} path planner calls",
+        r.model,
+        r.status.replace('_', " "),
+        s.seconds,
+        s.removal_tests,
+        s.failed_collision,
+        s.failed_gravity,
+        s.path_planner_calls
+    )?;
+    let width = r.parts.iter().map(|p| p.name.len()).max().unwrap_or(4).max(4);
+    let fixed: Vec<&str> = r.parts.iter().filter(|p| p.fixed).map(|p| p.name.as_str()).collect();
+    if !fixed.is_empty() {
+        writeln!(out, "base (fixed): {}", fixed.join(", "))?;
+    } else if r.grid.is_some() {
+        writeln!(out, "base: none (taken apart in the hand, no gravity; the last part goes down first along -{})", r.up.trim_start_matches(['+', '-']))?;
+    } else {
+        writeln!(out, "base: ground plane under the lowest point (up {})", r.up)?;
+    }
+    if let Some(g) = &r.grid {
+        let first = g.first_separation_moves.map_or("-".to_string(), |m| m.to_string());
+        writeln!(
+            out,
+            "grid plan ({}): cells of {:.4} x {:.4} x {:.4} {}, {} states in {:.3} s, {first} moves before the first separation",
+            g.reason.replace('_', " "),
+            g.cell[0],
+            g.cell[1],
+            g.cell[2],
+            r.units,
+            g.states,
+            g.seconds
+        )?;
+    }
+    if let Some(o) = &r.overlaps {
+        writeln!(out, "overlapping in the input ({} pairs, policy {}):", o.pairs.len(), o.policy)?;
+        for p in &o.pairs {
+            let bound = if p.gross { "more than " } else { "" };
+            writeln!(out, "  {} / {}: {}, {bound}{:.4} deep, {}", p.names[0], p.names[1], p.kind, p.depth, p.handling)?;
+        }
+    }
+    if !r.assembly_sequence.is_empty() {
+        write_steps(out, r, &r.assembly_sequence, width, "")?;
+    }
+    if !r.partial_assembly_sequence.is_empty() {
+        let remaining = r.remaining.as_ref().map_or(0, Vec::len);
+        writeln!(
+            out,
+            "partial plan: {} steps; in assembly order onto the {remaining} parts that stay:",
+            r.partial_assembly_sequence.len()
+        )?;
+        write_steps(out, r, &r.partial_assembly_sequence, width, "")?;
+    }
+    if let Some(robot) = &r.robot {
+        writeln!(out, "robot {}: total path length {:.3} {}", robot.name, robot.total_path_length, r.units)?;
+    }
+    if !r.explanation.is_empty() {
+        writeln!(out, "stuck with {} parts left; none can leave:", r.explanation.len())?;
+        for e in &r.explanation {
+            let others: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
+            let why = match e.reason.as_str() {
+                "blocked" => format!("blocked by {}", others.join(", ")),
+                "unsupported" => format!("would leave {} unsupported", others.join(", ")),
+                _ => "can leave, but every state after that is a dead end".into(),
+            };
+            writeln!(out, "  {:<width$}  {why}", e.name)?;
+        }
+    }
+    if r.status == "budget_exhausted" {
+        match r.stats.stopped_by.as_deref() {
+            Some("interrupted") => writeln!(out, "interrupted (Ctrl-C) before a plan was found; the best partial plan so far is above")?,
+            _ => writeln!(out, "the budget ran out (--max-tests / --timeout) before a plan was found")?,
+        }
+    }
+    Ok(())
+}
+
+/// Assembly steps as table rows; a subassembly's own steps follow it, indented.
+fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], width: usize, indent: &str) -> std::io::Result<()> {
+    let name = |i: usize| r.parts.get(i).map_or("?", |p| p.name.as_str());
+    let label = |step: &AssemblyStep| match &step.subassembly {
+        None => step.name.clone(),
+        Some(g) => format!("{} + {} more (subassembly)", step.name, g.parts.len() - 1),
+    };
+    let width = sequence.iter().map(|s| label(s).len()).fold(width, usize::max);
+    if indent.is_empty() {
+        writeln!(out, "{:>4}  {:<width$}  motion (insertion, {})", "step", "part", r.units)?;
+    }
+    for (k, step) in sequence.iter().enumerate() {
+        let motion = match &step.motion {
+            MotionEntry::Linear { direction: d, distance } => {
+                format!("straight along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
+            }
+            MotionEntry::Path { poses, .. } => format!("path of {} poses", poses.len()),
+            MotionEntry::Screw { direction: d, distance, .. } => {
+                format!("screw along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
+            }
+        };
+        let robot = step.robot.as_ref().map_or(String::new(), |rs| {
+            format!("; robot path {:.3}", rs.path_length)
+        });
+        let robot = if step.held.is_empty() {
+            robot
+        } else {
+            format!("{robot}; holding {}", step.held.iter().map(|&p| name(p)).collect::<Vec<_>>().join(", "))
+        };
+        writeln!(out, "{indent}{:>4}  {:<width$}  {motion}{robot}", k + 1, label(step))?;
+        if let Some(g) = &step.subassembly {
+            let inner = format!("{indent}      ");
+            let members: Vec<&str> = g.parts.iter().map(|&p| name(p)).collect();
+            let how = match g.status.as_str() {
+                "found" => "built on its base in this order:".to_string(),
+                "no_plan" => "cannot be taken apart (it goes in as one unit):".to_string(),
+                "unplanned" => "not planned".to_string(),
+                other => format!("{} before its own plan was found; the parts that come off:", other.replace('_', " ")),
+            };
+            writeln!(out, "{inner}subassembly {} on base {}: {how}", members.join(", "), step.name)?;
+            write_steps(out, r, &g.assembly_sequence, width.saturating_sub(6), &inner)?;
+            for e in &g.explanation {
+                let others: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
+                writeln!(out, "{inner}  {} {} {}", e.name, e.reason.replace('_', " "), others.join(", "))?;
+            }
+        }
+        if !step.moves.is_empty() {
+            writeln!(out, "{indent}      then {} moves:", step.moves.len())?;
+        }
+        for m in &step.moves {
+            let t = m.translation;
+            let parts: Vec<&str> = m.parts.iter().map(|&p| name(p)).collect();
+            writeln!(out, "{indent}        move {} by ({:+.4}, {:+.4}, {:+.4})", parts.join(" + "), t[0], t[1], t[2])?;
+        }
+    }
+    Ok(())
+}
+
+/// Prints the Pareto front (or the best value) under the plan table.
+pub fn write_summary(
+    out: &mut impl std::io::Write,
+    summary: &OptimisationEntry,
+    front: Option<&[ParetoEntry]>,
+) -> std::io::Result<()> {
+    let names = summary.objectives.join(", ");
+    writeln!(
+        out,
+        "{}: {} episodes, {} iterations in {:.3} s ({} threads){}",
+        summary.method.replace('_', "-"),
+        summary.episodes,
+        summary.iterations,
+        summary.search_seconds,
+        summary.threads,
+        if summary.exhaustive { "; the search space was exhausted: the answer is exact" } else { "" }
+    )?;
+    match front {
+        Some(front) => {
+            writeln!(
+                out,
+                "Pareto front ({names}): {} sequences, hypervolume {:.6}",
+                front.len(),
+                summary.hypervolume.unwrap_or(0.0)
+            )?;
+            for (k, e) in front.iter().enumerate() {
+                let v: Vec<String> = e.objectives.iter().map(|x| format!("{x:.4}")).collect();
+                writeln!(out, "{:>4}  ({})  removal order {:?}", k + 1, v.join(", "), e.disassembly_sequence)?;
+            }
+        }
+        None => {
+            let v: Vec<String> = summary.values.iter().map(|x| format!("{x:.4}")).collect();
+            writeln!(out, "best {names}: {}", v.join(", "))?;
+        }
+    }
+    Ok(())
+}
+

@@ -1,0 +1,100 @@
+//! The independent re-check of a robot removal, shared by asp-robot's tests and asp-app's (which
+//! include this file by path): no robot code is trusted by it.
+
+use asp_geom::math::{Pose, Vec3};
+use asp_geom::{PartSet, World};
+use asp_robot::{RobotCell, RobotRemoval};
+use parry3d::query::{self, PointQuery};
+use parry3d::shape::TriMesh;
+
+/// Points on the edges of every triangle of `mesh` displaced by `pose`, every `step` metres.
+fn edge_points(mesh: &TriMesh, pose: &Pose, step: f32) -> Vec<Vec3> {
+    let v = mesh.vertices();
+    let mut out = Vec::new();
+    for t in mesh.indices() {
+        for k in 0..3 {
+            let (a, b) = (v[t[k] as usize], v[t[(k + 1) % 3] as usize]);
+            let n = ((b - a).length() / step).ceil().max(1.0) as usize;
+            for i in 0..=n {
+                out.push(pose.transform_point(a.lerp(b, i as f32 / n as f32)));
+            }
+        }
+    }
+    out
+}
+
+/// How deep `x` lies inside the closed mesh (0 outside).
+fn depth_inside(mesh: &TriMesh, x: Vec3) -> f32 {
+    let p = mesh.project_local_point(x, true);
+    if p.is_inside {
+        (p.point - x).length().max(1e-9)
+    } else {
+        0.0
+    }
+}
+
+/// Re-checks a robot removal independently of the planner: the trajectory's joints are sampled
+/// so that no joint moves more than 0.5 mrad between samples; at each sample every link and
+/// finger shape (unshrunk) must not penetrate a part still present (nor the floor) by more
+/// than `allowed` metres (parry `contact`), and the held part's edge points must not lie more
+/// than `allowed` inside another part, nor theirs inside it. Returns the first violation.
+pub fn recheck(world: &World, cell: &RobotCell, part: usize, present: &PartSet, r: &RobotRemoval, allowed: f32) -> Result<(), String> {
+    let robot = &cell.robot;
+    let obstacles: Vec<usize> = world.with_fixed(present).iter().filter(|&q| q != part).collect();
+    // the part is held as it was at the first configuration (the grasp)
+    let grasp = robot.tool_pose(&r.joints[0]);
+    let base_shapes = robot.links()[0].shapes.len();
+    let floor = parry3d::shape::HalfSpace::new(cell.up);
+    let floor_pose = Pose::from_translation(cell.up * cell.floor);
+    let held = world.mesh(part);
+    for (w, pair) in r.joints.windows(2).enumerate() {
+        let (a, b) = (&pair[0], &pair[1]);
+        let max_step = a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        let n = (max_step / 5e-4).ceil().max(1.0) as usize;
+        for i in 0..=n {
+            let t = i as f64 / n as f64;
+            let q: Vec<f64> = a.iter().zip(b).map(|(x, y)| x + (y - x) * t).collect();
+            if !robot.within_limits(&q) {
+                return Err(format!("segment {w} sample {i}: outside the joint limits"));
+            }
+            for (k, (link_pose, shape)) in robot.collision_shapes(&q, r.grasp.width).iter().enumerate() {
+                let (pose, s) = shape.world(link_pose);
+                if k >= base_shapes {
+                    if let Ok(Some(c)) = query::contact(&floor_pose, &floor, &pose, &*s, 0.0) {
+                        if c.dist < -allowed {
+                            return Err(format!("segment {w} sample {i}: shape {k} {} below the floor", -c.dist));
+                        }
+                    }
+                }
+                for &o in &obstacles {
+                    if k < base_shapes && world.ground() == Some(o) {
+                        continue;
+                    }
+                    if let Ok(Some(c)) = query::contact(&pose, &*s, &Pose::IDENTITY, world.mesh(o), 0.0) {
+                        if c.dist < -allowed {
+                            return Err(format!("segment {w} sample {i}: robot shape {k} penetrates part {o} by {}", -c.dist));
+                        }
+                    }
+                    if depth_inside(world.mesh(o), pose.translation) > allowed {
+                        return Err(format!("segment {w} sample {i}: robot shape {k} inside part {o}"));
+                    }
+                }
+            }
+            let displacement = robot.tool_pose(&q) * grasp.inverse();
+            if i % 4 == 0 || i == n {
+                let inv = displacement.inverse();
+                for &o in &obstacles {
+                    let om = world.mesh(o);
+                    if edge_points(held, &displacement, 0.004).iter().any(|&x| depth_inside(om, x) > allowed) {
+                        return Err(format!("segment {w} sample {i}: the held part enters part {o}"));
+                    }
+                    if edge_points(om, &Pose::IDENTITY, 0.004).iter().any(|&x| depth_inside(held, inv.transform_point(x)) > allowed) {
+                        return Err(format!("segment {w} sample {i}: part {o} enters the held part"));
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+

@@ -1,0 +1,73 @@
+"""The vocabulary of planning settings: the closed sets as ``Literal`` types and every setting of
+:meth:`asp.Assembly.plan` as a :class:`PlanSettings` ``TypedDict``.
+
+The settings are the keys of asp's plan request (the Rust crate ``asp-app``), the same as the
+command line's flags with ``_`` for ``-``. Their defaults and accepted values live there, once:
+``asp._asp.default_settings()`` and ``asp._asp.choices()`` read them, and a test holds these
+types to them.
+"""
+
+from __future__ import annotations
+
+from typing import List, Literal, Sequence, Tuple, TypedDict, Union
+
+__all__ = ["Order", "Overlaps", "PlanSettings", "QUse", "Stability", "Support", "given"]
+
+#: Part orderings of the depth-first search (``order=``).
+Order = Literal["given", "shuffled", "random", "bookkeeping", "gnn"]
+#: What to do with parts that overlap in the input (``overlaps=``).
+Overlaps = Literal["strict", "lenient", "error"]
+#: The feasibility search's stability criterion (``stability=``).
+Stability = Literal["contact", "physics"]
+#: The optimiser's gravity check (``support=``).
+Support = Literal["below", "contact"]
+#: Where learned Q-functions guide the optimiser (``q_use=``).
+QUse = Literal["rollouts", "expansions", "both"]
+
+
+class PlanSettings(TypedDict, total=False):
+    """Every keyword of :meth:`asp.Assembly.plan` (each optional; see its documentation)."""
+
+    tolerance: float
+    contact_distance: float
+    normals: int
+    sphere_directions: int
+    overlaps: Overlaps
+    stability: Stability
+    physics_threshold: float
+    path_planner: bool
+    subassemblies: bool
+    grid: bool
+    rrt_iterations: int
+    rrt_time: float
+    order: Order
+    model: str
+    bookkeeping: bool
+    seed: int
+    max_tests: int
+    timeout: float
+    objective: Union[str, Sequence[str]]
+    pareto: bool
+    episodes: int
+    budget: int
+    threads: int
+    time_limit: float
+    exploration: float
+    polish: float
+    resolution: int
+    d_max: float
+    support: Support
+    q: Union[str, Sequence[str]]
+    epsilon: float
+    q_use: QUse
+    robot: str
+    robot_base: Union[str, Tuple[float, float, float], List[float]]
+    drop_off: Union[str, Tuple[float, float, float], List[float]]
+    replans: int
+    grippers: int
+
+
+def given(settings: dict) -> dict:
+    """The settings that were given (``None`` means "the default": left out)."""
+    return {k: v for k, v in settings.items() if v is not None}
+
