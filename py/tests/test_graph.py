@@ -73,7 +73,7 @@ def test_graph_is_deterministic_and_cached(lack):
     ({"present": [-1]}, "no part -1"),
     ({"degree": 100}, "degree"),
     ({"radius_bins": 0}, "radius"),
-    ({"contact_distance": -1.0}, "contact_distance must be a positive number"),
+    ({"contact_distance": -1.0}, "contact_distance: must be a positive number"),
 ])
 def test_bad_graph_settings_are_config_errors(lack, kwargs, words):
     with pytest.raises(asp.ConfigError, match=words):

@@ -55,7 +55,7 @@ def test_local_search_share_is_the_clis_polish_flag(root, asp_cli):
     # the same tree search; the local search keeps the best sequence or finds a better one
     assert on.optimisation["iterations"] == off.optimisation["iterations"]
     assert on.optimisation["values"][0] >= off.optimisation["values"][0]
-    with pytest.raises(asp.ConfigError, match="local search share"):
+    with pytest.raises(asp.ConfigError, match="polish: must be a share of the search"):
         a.plan(objective="access", episodes=5, polish=-1.0)
 
 

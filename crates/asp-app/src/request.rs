@@ -298,15 +298,30 @@ impl PlanRequest {
 /// serde's words for a type error, without its position and in ours where we can.
 fn type_message(serde: &str) -> String {
     let text = serde.split(" at line ").next().unwrap_or(serde);
-    match text.strip_prefix("invalid type: ").or_else(|| text.strip_prefix("invalid value: ")) {
-        Some(rest) => match rest.split_once(", expected ") {
-            Some((got, want)) => format!("must be {}, got {got}", want_words(want)),
-            None => text.to_string(),
-        },
-        None => match text.strip_prefix("unknown variant ") {
-            Some(rest) => format!("unknown value {}", rest.replace(", expected one of", " (use").replace(", expected", " (use") + ")"),
-            None => text.to_string(),
-        },
+    if let Some(rest) = text.strip_prefix("invalid type: ").or_else(|| text.strip_prefix("invalid value: ")) {
+        if let Some((got, want)) = rest.split_once(", expected ") {
+            return format!("must be {}, got {}", want_words(want), got_words(got));
+        }
+    }
+    if let Some(rest) = text.strip_prefix("unknown variant ") {
+        if let Some((got, want)) = rest.split_once(", expected ") {
+            let names: Vec<&str> = want.trim_start_matches("one of ").split(", ").map(|n| n.trim_matches('`')).collect();
+            return format!("unknown value '{}' (use {})", got.trim_matches('`'), names.join(", "));
+        }
+    }
+    text.replace('`', "'")
+}
+
+/// The value serde saw, as a user wrote it (`integer `-1`` is -1, `string "x"` is 'x').
+fn got_words(serde: &str) -> String {
+    for prefix in ["integer ", "floating point ", "boolean "] {
+        if let Some(v) = serde.strip_prefix(prefix) {
+            return v.trim_matches('`').to_string();
+        }
+    }
+    match serde.strip_prefix("string ") {
+        Some(s) => format!("'{}'", s.trim_matches('"')),
+        None => serde.replace('`', ""),
     }
 }
 
@@ -386,9 +401,11 @@ mod tests {
     #[test]
     fn bad_settings_name_their_key() {
         let e = |json: &str| PlanRequest::from_json(json).unwrap_err().to_string();
-        assert_eq!(e(r#"{"seed": "x"}"#), "seed: must be a non-negative integer, got string \"x\"");
-        assert_eq!(e(r#"{"seed": -1}"#), "seed: must be a non-negative integer, got integer `-1`");
-        assert!(e(r#"{"overlaps": "loose"}"#).starts_with("overlaps: unknown value `loose` (use `strict`"), "{}", e(r#"{"overlaps": "loose"}"#));
+        assert_eq!(e(r#"{"seed": "x"}"#), "seed: must be a non-negative integer, got 'x'");
+        assert_eq!(e(r#"{"seed": -1}"#), "seed: must be a non-negative integer, got -1");
+        assert_eq!(e(r#"{"bookkeeping": "yes"}"#), "bookkeeping: must be true or false, got 'yes'");
+        assert_eq!(e(r#"{"tolerance": "small"}"#), "tolerance: must be a number, got 'small'");
+        assert_eq!(e(r#"{"overlaps": "loose"}"#), "overlaps: unknown value 'loose' (use strict, lenient, error)");
         assert_eq!(e(r#"{"robot_base": "1,2"}"#), "robot_base: must be three finite numbers x,y,z");
         assert_eq!(e(r#"{"colour": 1}"#), "colour: unknown setting");
         assert_eq!(e(r#"{"timeouts": 1}"#), "timeouts: unknown setting (did you mean `timeout`?)");

@@ -37,13 +37,13 @@ fn to_json(key: &str, v: &Bound<'_, PyAny>) -> Result<Value, Error> {
         if let Ok(u) = v.extract::<u64>() {
             return Ok(Value::from(u));
         }
-        return Err(Error::config(format!("{key} is out of range")));
+        return Err(Error::config(format!("{key}: out of range")));
     }
     if v.is_instance_of::<PyFloat>() {
         let x = v.extract::<f64>().unwrap_or(f64::NAN);
         return serde_json::Number::from_f64(x)
             .map(Value::Number)
-            .ok_or_else(|| Error::config(format!("{key} must be a finite number, got {x}")));
+            .ok_or_else(|| Error::config(format!("{key}: must be a finite number, got {x}")));
     }
     if let Ok(s) = v.cast::<PyString>() {
         return Ok(Value::String(s.to_string()));
