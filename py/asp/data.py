@@ -29,6 +29,8 @@ from typing import Iterator
 
 import numpy as np
 
+from .errors import AspError
+
 __all__ = [
     "FORMAT",
     "VERSION",
@@ -46,8 +48,9 @@ FORMAT = "asp-removability"
 VERSION = 1
 
 
-class DataError(ValueError):
-    """A data set file is missing, malformed or inconsistent (one line: file and cause)."""
+class DataError(AspError, ValueError):
+    """A data set file is missing, malformed or inconsistent (one line: file and cause); also a
+    :class:`ValueError`."""
 
 
 def _fail(path: os.PathLike | str, message: str) -> DataError:

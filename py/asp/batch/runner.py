@@ -20,12 +20,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, TextIO
 
+from ..errors import AspError
 from .jobs import Item, Job, run_chunk, run_item
 
 JOURNAL_DIR = ".asp-batch"
 
 
-class BatchError(Exception):
+class BatchError(AspError):
     """A batch cannot start or finish: its folder holds another job, Ray is missing, ..."""
 
 

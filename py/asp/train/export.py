@@ -24,6 +24,7 @@ import numpy as np
 import onnx
 import torch
 
+from ..errors import AspError
 from .gnn import RemovabilityGNN
 
 __all__ = [
@@ -44,8 +45,8 @@ PARITY_SIZES = ((7, 0), (53, 212), (131, 610))
 CASE_SIZES = ((3, 0), (9, 24), (19, 60))
 
 
-class ExportError(RuntimeError):
-    """The exported file does not reproduce the PyTorch model."""
+class ExportError(AspError, RuntimeError):
+    """The exported file does not reproduce the PyTorch model (also a :class:`RuntimeError`)."""
 
 
 def random_graph(n: int, e: int, node_dim: int, edge_dim: int, rng: np.random.Generator):
