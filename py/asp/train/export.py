@@ -1,4 +1,5 @@
-"""ONNX export of a :class:`~asp.train.gnn.RemovabilityGNN` as docs/learning.md specifies.
+"""ONNX export of a :class:`~asp.train.gnn.RemovabilityGNN` (or any model built on the shared
+:class:`~asp.train.encoder.GraphEncoder`, as the Q network is) as docs/learning.md specifies.
 
 The file has opset 17, inputs ``x`` float32 ``[n, node_dim]``, ``edge_index`` int64 ``[2, e]``,
 ``edge_attr`` float32 ``[e, edge_dim]``, output ``removability`` float32 ``[n]`` with ``n`` and
@@ -25,7 +26,7 @@ import onnx
 import torch
 
 from ..errors import AspError
-from .gnn import RemovabilityGNN
+from .encoder import EncodedModel
 
 __all__ = [
     "OPSET", "INPUT_NAMES", "OUTPUT_NAME", "ExportError", "export_onnx", "pad_graph", "parity_check", "run_onnx",
@@ -87,7 +88,7 @@ def run_onnx(path: os.PathLike | str, x: np.ndarray, edge_index: np.ndarray, edg
     return np.asarray(session.run(None, feeds)[0])
 
 
-def _like_training(model: RemovabilityGNN, x: np.ndarray, edge_attr: np.ndarray, rng: np.random.Generator):
+def _like_training(model: EncodedModel, x: np.ndarray, edge_attr: np.ndarray, rng: np.random.Generator):
     """Attributes drawn where the model's training data lay: each column within three standard
     deviations of its training mean (in the model's ``log1p`` space, mapped back), the contract's
     ranges kept (descriptor entries in [0, 1], flags 0/1, cosines in [-1, 1]). Far outside that, a
@@ -107,10 +108,9 @@ def _like_training(model: RemovabilityGNN, x: np.ndarray, edge_attr: np.ndarray,
         out[:, v.shape[1] - 2 :] = v[:, v.shape[1] - 2 :] if flags else np.clip(out[:, v.shape[1] - 2 :], lo, hi)
         return out.astype(np.float32)
 
-    if not hasattr(model, "node_mean"):
-        return x, edge_attr
-    x = draw(x, model.node_log_mask, model.node_mean, model.node_std, flags=True)
-    edge_attr = draw(edge_attr, model.edge_log_mask, model.edge_mean, model.edge_std, flags=False)
+    encoder = model.encoder
+    x = draw(x, encoder.node_log_mask, encoder.node_mean, encoder.node_std, flags=True)
+    edge_attr = draw(edge_attr, encoder.edge_log_mask, encoder.edge_mean, encoder.edge_std, flags=False)
     return x, edge_attr
 
 
@@ -129,7 +129,7 @@ def pad_graph(x: np.ndarray, edge_index: np.ndarray, edge_attr: np.ndarray, node
 
 
 def parity_check(
-    model: RemovabilityGNN,
+    model: EncodedModel,
     path: os.PathLike | str,
     seed: int = 12345,
     tolerance: float = 1e-5,
@@ -174,7 +174,7 @@ def parity_check(
 
 
 def export_onnx(
-    model: RemovabilityGNN,
+    model: EncodedModel,
     path: os.PathLike | str,
     features: str,
     aggregation: str | None = None,
@@ -246,7 +246,7 @@ def _f32(v: float) -> float:
     return float(np.format_float_positional(np.float32(v), unique=True, trim="-"))
 
 
-def write_parity_cases(model: RemovabilityGNN, path: os.PathLike | str, features: str, seed: int = 4242) -> None:
+def write_parity_cases(model: EncodedModel, path: os.PathLike | str, features: str, seed: int = 4242) -> None:
     """Write graphs drawn like the model's training inputs (:data:`CASE_SIZES`) with the PyTorch
     outputs, as JSON (``features``, ``node_dim``, ``edge_dim``, ``cases`` of ``n``, ``e``, ``x``,
     ``edge_index``, ``edge_attr``, ``removability``), so another runtime (asp-learn's tests on the
