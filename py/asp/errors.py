@@ -5,7 +5,7 @@ folder cannot be read, or its content cannot be planned as given) or a :class:`C
 setting is unknown, of the wrong type or out of range). A search that finds no plan is not an
 error: its :class:`asp.Plan` has ``status == "no_plan"``. The errors of the optional parts are
 :class:`AspError` too, each also an instance of the builtin class it used to be:
-:class:`asp.data.DataError` (a data set is malformed; a :class:`ValueError`),
+:class:`asp.datasets.DataError` (a data set is malformed; a :class:`ValueError`),
 :class:`asp.train.ExportError` (an exported ONNX file does not reproduce its model; a
 :class:`RuntimeError`) and :class:`asp.batch.BatchError` (a batch cannot start or finish).
 """

@@ -499,3 +499,27 @@ def test_a_data_set_larger_than_the_buffer_streams_through_it(tmp_path):
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(DataError, match=re.escape(f"{path}:20: 'rewards' must be a list of 2 numbers")):
         train_q(train_set, node_dim, edge_dim, config, FakeGraphs())
+
+
+def test_online_and_offline_training_share_one_set_of_learning_settings():
+    _torch()
+    from dataclasses import fields
+
+    import asp
+    from asp.train.online import OnlineConfig
+    from asp.train.q import QConfig, QLearning
+
+    shared = [f.name for f in fields(QLearning)]
+    assert {"batch", "buffer", "lr", "seed", "layers", "width", "threads", "target_sync"} <= set(shared)
+    for cls in (QConfig, OnlineConfig):
+        assert issubclass(cls, QLearning)
+        assert [f.name for f in fields(cls)][: len(shared)] == shared
+    # one default each, the online batch excepted (the thesis' 5 transitions per step)
+    offline, online = QConfig(), OnlineConfig(objective="access")
+    assert {k: v for k, v in online.learning().items() if k != "batch"} == {k: v for k, v in offline.learning().items() if k != "batch"}
+    assert (offline.batch, online.batch) == (128, 5)
+    # the online settings become the learner's QConfig as they are
+    tuned = OnlineConfig(objective="access", lr=0.5, width=7, target_sync=3)
+    assert QConfig(**tuned.learning()).learning() == tuned.learning()
+    with pytest.raises(asp.ConfigError, match="objective"):
+        OnlineConfig()

@@ -31,7 +31,7 @@ import statistics
 import sys
 from pathlib import Path
 
-from ..data import DataError
+from ..datasets import DataError
 from ..errors import AspError
 from .export import ExportError, export_onnx, write_parity_cases
 from .trainer import AssemblyData, TrainConfig, evaluate, load_assemblies, train

@@ -32,8 +32,9 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from ..qdata import DataError, TransitionDataset
-from .q import BindingGraphs, DeepQLearner, QAssembly, QConfig, export_q, load_q_weights, save_q_weights
+from ..datasets.transitions import DataError, TransitionDataset
+from ..errors import ConfigError
+from .q import BindingGraphs, DeepQLearner, QAssembly, QConfig, QLearning, export_q, load_q_weights, save_q_weights
 
 __all__ = ["OnlineConfig", "OnlineResult", "run_online", "bench_mcts", "SETTINGS", "values_at"]
 
@@ -42,11 +43,15 @@ SETTINGS = ("vanilla", "online", "pretrained", "retrained")
 
 
 @dataclass(frozen=True)
-class OnlineConfig:
-    """Settings of a search that trains its Q-functions after each episode."""
+class OnlineConfig(QLearning):
+    """Settings of a search that trains its Q-functions after each episode: the deep Q-learning
+    hyper-parameters of :class:`~asp.train.q.QLearning` (each objective ``k``'s network seeded with
+    ``seed + k``; ``seed`` also seeds the search), and the search's."""
 
-    objective: str
-    """Objectives, comma-separated (one network each; several run Pareto-MCTS)."""
+    batch: int = 5
+    """Transitions per step (the thesis: 5; offline training's default is larger)."""
+    objective: str = ""
+    """Objectives, comma-separated (one network each; several run Pareto-MCTS); required."""
     seconds: Optional[float] = None
     """Wall time of the search (training between episodes included); ``None``: ``episodes`` only."""
     episodes: int = 1_000_000
@@ -56,22 +61,10 @@ class OnlineConfig:
     retrained setting."""
     steps_per_episode: int = 20
     """Deep Q-learning steps after each episode (the thesis: 20 for 5×5 cubes)."""
-    batch: int = 5
-    """Transitions per step (the thesis: 5)."""
-    buffer: int = 10_000
-    """Replay buffer capacity (the thesis: 10,000)."""
-    lr: float = 1e-3
-    target_sync: int = 100
-    layers: int = 3
-    width: int = 64
-    seed: int = 0
-    """Seeds the search and the networks (objective ``k``'s network: ``seed + k``)."""
     epsilon: float = 0.2
     q_use: str = "rollouts"
     budget: int = 5
     resolution: int = 9
-    threads: int = 1
-    """PyTorch threads (reproducible for one count)."""
     aggregation: str = "dense"
     parity_tolerance: float = 1e-5
     search: Optional[dict] = None
@@ -79,6 +72,10 @@ class OnlineConfig:
     keep_models: bool = False
     """Keep every episode's models (``models/<episode>_q_<objective>.onnx``: the ones swapped in
     after that episode), not only the last."""
+
+    def __post_init__(self) -> None:
+        if not self.objective.strip(" ,"):
+            raise ConfigError("OnlineConfig: objective must name at least one objective")
 
 
 @dataclass
@@ -163,11 +160,7 @@ def run_online(
     torch.set_num_threads(config.threads)
     learners = []
     for k, objective in enumerate(objectives):
-        qc = QConfig(
-            steps=max(config.steps_per_episode, 1), batch=config.batch, buffer=config.buffer, lr=config.lr,
-            seed=config.seed + k, layers=config.layers, width=config.width, threads=config.threads,
-            target_sync=config.target_sync,
-        )
+        qc = QConfig(**{**config.learning(), "seed": config.seed + k}, steps=max(config.steps_per_episode, 1))
         learners.append((QAssembly(source, data.objective_index(objective)), DeepQLearner(data.node_dim, data.edge_dim, qc, graphs, networks[k] if networks else None)))
     paths = [out / f"q_{o}.onnx" for o in objectives]
     lines_path = source.transitions_path
@@ -189,7 +182,7 @@ def run_online(
             episodes = e.episodes
             lines = e.transitions_jsonl
             lines_file.write(lines)
-            parsed = [source._parse(line, transitions + i + 1) for i, line in enumerate(lines.splitlines()) if line.strip()]
+            parsed = [source.parse(line, transitions + i + 1) for i, line in enumerate(lines.splitlines()) if line.strip()]
             transitions += len(parsed)
             trace.append((time.monotonic() - started, e.value, e.episodes))
             if e.finished:

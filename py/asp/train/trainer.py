@@ -16,7 +16,7 @@ from typing import Callable, Iterable, Sequence
 import numpy as np
 import torch
 
-from ..data import Assembly, DataError, RemovabilityDataset
+from ..datasets.removability import Assembly, DataError, RemovabilityDataset
 from .gnn import RemovabilityGNN
 
 __all__ = ["TrainConfig", "StateRecord", "AssemblyData", "load_assemblies", "train", "evaluate", "Batch", "make_batch"]

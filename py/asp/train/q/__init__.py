@@ -18,7 +18,7 @@ asp-learn appends, so padding changes no real output (docs/learning.md, "Q model
 batch (graphs concatenated with offsets) ``hbar`` is pooled per graph.
 
 Deep Q-learning (:func:`train_q`): transitions stream in from ``asp-transitions`` data sets
-(:mod:`asp.qdata`) into a replay buffer (10,000 by default; a data set that fits
+(:mod:`asp.datasets.transitions`) into a replay buffer (10,000 by default; a data set that fits
 is read once, a larger one streams through it, round robin over the assemblies, ``batch / 8`` new
 transitions per step, so each is sampled about eight times while it is in the buffer); every step
 samples a batch uniformly, and regresses ``Q(s, a)`` on ``y = r~ + max_{a' in next_actions} Q_target(s', a')``
@@ -38,10 +38,10 @@ tests use :func:`synthetic_q_graph`-style fakes).
 from __future__ import annotations
 
 # the data-set names the module used to import (``asp.train.q.TransitionDataset`` keeps working)
-from ...qdata import DataError as DataError
-from ...qdata import Transition as Transition
-from ...qdata import TransitionAssembly as TransitionAssembly
-from ...qdata import TransitionDataset as TransitionDataset
+from ...datasets.transitions import DataError as DataError
+from ...datasets.transitions import Transition as Transition
+from ...datasets.transitions import TransitionAssembly as TransitionAssembly
+from ...datasets.transitions import TransitionDataset as TransitionDataset
 from .evaluate import ranking_quality
 from .export import PARITY_PADDING, PARITY_PARTS, export_q, load_q_weights, parity_graphs, save_q_weights
 from .graphs import (
@@ -53,13 +53,14 @@ from .graphs import (
     parse_q_features,
     synthetic_q_graph,
 )
-from .learner import DeepQLearner, QConfig, config_dict, train_q
+from .learner import DeepQLearner, QConfig, QLearning, config_dict, train_q
 from .network import MIN_STD, QNetwork
 from .replay import QAssembly, ReplayBuffer, open_q_assemblies
 
 __all__ = [
     "QNetwork",
     "QConfig",
+    "QLearning",
     "QAssembly",
     "GraphSource",
     "BindingGraphs",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from ...qdata import Transition
+from ...datasets.transitions import Transition
 from .graphs import GraphCache, GraphSource, _positions
 from .network import QNetwork
 from .replay import QAssembly, _run

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ...qdata import DataError
+from ...datasets.transitions import DataError
 from ..export import export_onnx
 from .graphs import parse_q_features, synthetic_q_graph
 from .network import QNetwork

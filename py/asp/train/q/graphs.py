@@ -11,7 +11,7 @@ from typing import Any, Callable, Protocol
 
 import numpy as np
 
-from ...qdata import DataError, TransitionAssembly
+from ...datasets.transitions import DataError, TransitionAssembly
 
 __all__ = ["GraphLike", "GraphSource", "SyntheticGraph", "parse_q_features", "synthetic_q_graph", "BindingGraphs", "GraphCache"]
 

@@ -6,30 +6,27 @@ from __future__ import annotations
 import copy
 import math
 import time
-from dataclasses import asdict, dataclass
-from typing import Callable, Sequence
+from dataclasses import asdict, dataclass, fields
+from typing import Any, Callable, Sequence
 
 import numpy as np
 import torch
 from torch import nn
 
-from ...qdata import DataError, Transition
+from ...datasets.transitions import DataError, Transition
 from ..trainer import _seed_everything
 from .graphs import GraphCache, GraphSource, _positions
 from .network import QNetwork
 from .replay import QAssembly, ReplayBuffer, _Record, _run, _stream
 
-__all__ = ["QConfig", "DeepQLearner", "train_q", "config_dict"]
+__all__ = ["QLearning", "QConfig", "DeepQLearner", "train_q", "config_dict"]
 
 
 @dataclass(frozen=True)
-class QConfig:
-    """Deep Q-learning hyper-parameters."""
+class QLearning:
+    """The deep Q-learning hyper-parameters that offline training (:class:`QConfig`) and the
+    online settings (:class:`asp.train.online.OnlineConfig`) share."""
 
-    steps: int = 2000
-    """Gradient steps (at most)."""
-    seconds: float | None = None
-    """Stop after this many seconds of training (checked after every step)."""
     batch: int = 128
     """Transitions per step."""
     buffer: int = 10_000
@@ -46,6 +43,20 @@ class QConfig:
     """PyTorch CPU threads (results are reproducible for one thread count)."""
     target_sync: int = 100
     """Steps between copies of the trained network into the target network."""
+
+    def learning(self) -> dict[str, Any]:
+        """The :class:`QLearning` fields of these settings, as keywords (of :class:`QConfig`)."""
+        return {f.name: getattr(self, f.name) for f in fields(QLearning)}
+
+
+@dataclass(frozen=True)
+class QConfig(QLearning):
+    """Deep Q-learning hyper-parameters: :class:`QLearning`'s, and how long and on what to train."""
+
+    steps: int = 2000
+    """Gradient steps (at most)."""
+    seconds: float | None = None
+    """Stop after this many seconds of training (checked after every step)."""
     loss: str = "huber"
     """``"huber"`` (smooth L1, delta 1) or ``"mse"``."""
     cache: int = 512

@@ -11,7 +11,7 @@ import numpy as np
 import torch
 from torch import Tensor
 
-from ...qdata import DataError, Transition, TransitionAssembly, TransitionDataset
+from ...datasets.transitions import DataError, Transition, TransitionAssembly, TransitionDataset
 from .graphs import GraphLike
 from .network import QNetwork
 
