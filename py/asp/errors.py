@@ -12,8 +12,6 @@ error: its :class:`asp.Plan` has ``status == "no_plan"``. The errors of the opti
 
 from __future__ import annotations
 
-from typing import Optional
-
 __all__ = ["AspError", "LoadError", "ConfigError"]
 
 
@@ -29,7 +27,7 @@ class LoadError(AspError):
     folder.
     """
 
-    def __init__(self, message: str, path: Optional[str] = None) -> None:
+    def __init__(self, message: str, path: str | None = None) -> None:
         super().__init__(message)
         #: The model file or folder the error is about.
         self.path = path

@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
 
 from conftest import need
-
 
 torch = need("torch", "asp.train needs PyTorch (pip install torch)")
 onnx = need("onnx", "the ONNX export needs the onnx package")

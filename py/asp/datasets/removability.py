@@ -24,9 +24,10 @@ Example::
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import numpy as np
 
@@ -222,7 +223,7 @@ class RemovabilityDataset:
     """The assemblies, in index order."""
 
     @classmethod
-    def open(cls, root: os.PathLike | str) -> "RemovabilityDataset":
+    def open(cls, root: os.PathLike | str) -> RemovabilityDataset:
         """Open and validate a data set folder (index, graphs, array shapes; states stream later)."""
         root = Path(root)
         index_path = root / "index.json"

@@ -28,9 +28,10 @@ import json
 import math
 import os
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import numpy as np
 
@@ -253,7 +254,7 @@ class TransitionDataset:
         return self.root / "index.json"
 
     @classmethod
-    def open(cls, root: os.PathLike | str) -> "TransitionDataset":
+    def open(cls, root: os.PathLike | str) -> TransitionDataset:
         """Open and validate a data set folder (its index; the transitions are read when streamed)."""
         root = Path(root)
         path = root / "index.json"

@@ -12,6 +12,7 @@
 
 Command line: ``python -m asp.train removability DATA_DIR... --out model.onnx`` (see ``--help``).
 """
+from __future__ import annotations
 
 from .encoder import GraphEncoder
 from .export import ExportError, export_onnx, parity_check

@@ -83,7 +83,9 @@ def _online_flags(o) -> None:
     o.add_argument("--width", type=int, default=64, help="hidden width of a new network (default 64)")
     o.add_argument("--threads", type=int, default=1, help="PyTorch CPU threads (default 1)")
     o.add_argument("--epsilon", type=float, default=0.2, help="probability of a random removal in a guided rollout (default 0.2)")
-    o.add_argument("--q-use", choices=["rollouts", "expansions", "both"], default="rollouts", help="where the Q models guide (default rollouts)")
+    o.add_argument(
+        "--q-use", choices=["rollouts", "expansions", "both"], default="rollouts", help="where the Q models guide (default rollouts)"
+    )
     o.add_argument("--budget", type=int, default=5, help="MCTS iterations per step (default 5)")
     o.add_argument("--resolution", type=int, default=9, help="distance map resolution (default 9)")
     o.add_argument("--unit", help="the model's unit (mm, ...), as asp plan --unit")
@@ -248,7 +250,7 @@ def _removability(args: argparse.Namespace) -> int:
 
 
 def _q(args: argparse.Namespace) -> int:
-    from .q import QConfig, config_dict, export_q, open_q_assemblies, ranking_quality, save_q_weights, train_q, BindingGraphs
+    from .q import BindingGraphs, QConfig, config_dict, export_q, open_q_assemblies, ranking_quality, save_q_weights, train_q
 
     assemblies, features, node_dim, edge_dim = open_q_assemblies(args.data, args.objective)
     by_name = {a.name: a for a in assemblies}
@@ -357,7 +359,8 @@ def _bench_mcts(args: argparse.Namespace) -> int:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     args = _parser().parse_args(argv)
-    for flag in ("epochs", "batch", "layers", "width", "threads", "steps", "buffer", "target_sync", "eval_states", "episodes", "runs", "budget"):
+    counts = ("epochs", "batch", "layers", "width", "threads", "steps", "buffer", "target_sync", "eval_states", "episodes")
+    for flag in counts + ("runs", "budget"):
         value = getattr(args, flag, None)
         if value is not None and value < 1:
             print(f"error: --{flag.replace('_', '-')} must be at least 1", file=sys.stderr)

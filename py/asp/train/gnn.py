@@ -12,8 +12,8 @@ statistics.
 
 from __future__ import annotations
 
-from torch import Tensor, nn
 import torch
+from torch import Tensor, nn
 
 from .encoder import AGGREGATIONS, EPS, SCORE_CLAMP, EncodedModel, GraphEncoder
 

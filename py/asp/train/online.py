@@ -26,9 +26,10 @@ import math
 import os
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable, Optional, Sequence
+from typing import Callable
 
 import numpy as np
 
@@ -52,11 +53,11 @@ class OnlineConfig(QLearning):
     """Transitions per step (the thesis: 5; offline training's default is larger)."""
     objective: str = ""
     """Objectives, comma-separated (one network each; several run Pareto-MCTS); required."""
-    seconds: Optional[float] = None
+    seconds: float | None = None
     """Wall time of the search (training between episodes included); ``None``: ``episodes`` only."""
     episodes: int = 1_000_000
     """The most episodes."""
-    q: Optional[Sequence[str]] = None
+    q: Sequence[str] | None = None
     """Pretrained Q models (ONNX, with their ``.pt`` weights beside them), one per objective: the
     retrained setting."""
     steps_per_episode: int = 20
@@ -67,7 +68,7 @@ class OnlineConfig(QLearning):
     resolution: int = 9
     aggregation: str = "dense"
     parity_tolerance: float = 1e-5
-    search: Optional[dict] = None
+    search: dict | None = None
     """Further keywords of :meth:`asp.Assembly.plan` (``exploration``, ``d_max``, ``support``, ...)."""
     keep_models: bool = False
     """Keep every episode's models (``models/<episode>_q_<objective>.onnx``: the ones swapped in
@@ -82,7 +83,7 @@ class OnlineConfig(QLearning):
 class OnlineResult:
     """What :func:`run_online` did."""
 
-    plan: "object"
+    plan: object
     """The :class:`asp.Plan` of the search."""
     episodes: int
     swaps: int
@@ -107,16 +108,17 @@ def run_online(
     model: str | os.PathLike,
     out: str | os.PathLike,
     config: OnlineConfig,
-    load: Optional[dict] = None,
-    log: Optional[Callable[[str], None]] = _log_stderr,
+    load: dict | None = None,
+    log: Callable[[str], None] | None = _log_stderr,
     record_transitions: bool = True,
 ) -> OnlineResult:
     """Runs the search of ``model`` with its Q-functions trained after every episode; writes to
     ``out``: ``plan.json``, ``trace.csv``, the final models ``q_<objective>.onnx`` (with their
     ``.pt`` weights), ``transitions/`` (the episodes' transitions as an ``asp-transitions`` data
     set) and ``online.json`` (settings and counts)."""
-    import asp
     import torch
+
+    import asp
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -161,7 +163,8 @@ def run_online(
     learners = []
     for k, objective in enumerate(objectives):
         qc = QConfig(**{**config.learning(), "seed": config.seed + k}, steps=max(config.steps_per_episode, 1))
-        learners.append((QAssembly(source, data.objective_index(objective)), DeepQLearner(data.node_dim, data.edge_dim, qc, graphs, networks[k] if networks else None)))
+        learner = DeepQLearner(data.node_dim, data.edge_dim, qc, graphs, networks[k] if networks else None)
+        learners.append((QAssembly(source, data.objective_index(objective)), learner))
     paths = [out / f"q_{o}.onnx" for o in objectives]
     lines_path = source.transitions_path
     transitions = 0
@@ -198,8 +201,10 @@ def run_online(
                     losses.append(learner.step())
             exported = False
             if all(learner.steps > 0 or not learner.fresh for _, learner in learners):
-                for (q_assembly, learner), path, objective in zip(learners, paths, objectives):
-                    export_q(learner.model, path, data.features, objective, aggregation=config.aggregation, tolerance=config.parity_tolerance)
+                for (_, learner), path, objective in zip(learners, paths, objectives):
+                    export_q(
+                        learner.model, path, data.features, objective, aggregation=config.aggregation, tolerance=config.parity_tolerance
+                    )
                     if config.keep_models:
                         (out / "models").mkdir(exist_ok=True)
                         (out / "models" / f"{e.episodes}_{path.name}").write_bytes(path.read_bytes())
@@ -295,11 +300,11 @@ def bench_mcts(
     settings: Sequence[str],
     checkpoints: Sequence[float],
     runs: int = 1,
-    q: Optional[Sequence[str]] = None,
-    config: Optional[OnlineConfig] = None,
-    load: Optional[dict] = None,
-    work: Optional[Path] = None,
-    log: Optional[Callable[[str], None]] = _log_stderr,
+    q: Sequence[str] | None = None,
+    config: OnlineConfig | None = None,
+    load: dict | None = None,
+    work: Path | None = None,
+    log: Callable[[str], None] | None = _log_stderr,
 ) -> tuple[str, str, list[dict]]:
     """Each setting of :data:`SETTINGS` named in ``settings`` searches each model for the last
     checkpoint's wall time, ``runs`` times (seeds 0, 1, ...); returns ``asp bench mcts``'s table,

@@ -98,7 +98,9 @@ def load_q_weights(path: Path | str) -> tuple[QNetwork, str, str]:
     """The network :func:`save_q_weights` wrote, with its features and objective."""
     try:
         saved = torch.load(str(path), map_location="cpu", weights_only=True)
-        model = QNetwork(saved["node_dim"], saved["edge_dim"], width=saved["width"], layers=saved["layers"], aggregation=saved["aggregation"])
+        model = QNetwork(
+            saved["node_dim"], saved["edge_dim"], width=saved["width"], layers=saved["layers"], aggregation=saved["aggregation"]
+        )
         model.load_state_dict(saved["state_dict"])
     except FileNotFoundError:
         raise DataError(f"{path}: file not found (python -m asp.train q writes the weights beside the ONNX model)") from None

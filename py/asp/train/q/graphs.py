@@ -83,7 +83,7 @@ def synthetic_q_graph(
         x[:n, 2] = np.asarray(fixed, dtype=bool)[present]
     x[:n, 3] = np.isin(present, actions)
     for k in range(8):
-        corner = np.stack([boxes[present, 1 if k & 1 else 0, 0], boxes[present, 1 if k & 2 else 0, 1], boxes[present, 1 if k & 4 else 0, 2]], 1)
+        corner = np.stack([boxes[present, 1 if k & (1 << axis) else 0, axis] for axis in range(3)], 1)
         x[:n, 4 + 3 * k : 7 + 3 * k] = (corner - centre_all) / diag
     if maps is None:
         rng = rng or np.random.default_rng(0)
