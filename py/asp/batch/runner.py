@@ -282,8 +282,9 @@ def _run_ray(job: Job, todo: list[Item], out: str, address: str, workers: int | 
             while chunks and len(pending) < 2 * slots:
                 chunk = chunks.pop()
                 pending[task.remote(job.kind, spec, [i.payload for i in chunk], out)] = chunk
-            ready, _ = ray.wait(list(pending), num_returns=1)
-            for ref in ready:
+            # (not `ready`: that is the callback of this function's arguments)
+            finished_refs, _ = ray.wait(list(pending), num_returns=1)
+            for ref in finished_refs:
                 chunk = pending.pop(ref)
                 try:
                     results = ray.get(ref)

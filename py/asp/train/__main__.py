@@ -30,11 +30,15 @@ import re
 import statistics
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from ..datasets import DataError
 from ..errors import AspError
 from .export import ExportError, export_onnx, write_parity_cases
 from .trainer import AssemblyData, TrainConfig, evaluate, load_assemblies, train
+
+if TYPE_CHECKING:
+    from .online import OnlineConfig
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -72,7 +76,7 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _online_flags(o) -> None:
+def _online_flags(o: argparse.ArgumentParser) -> None:
     o.add_argument("--objective", required=True, metavar="LIST", help="objectives, comma-separated (several: Pareto-MCTS)")
     o.add_argument("--steps-per-episode", type=int, default=20, help="deep Q-learning steps after each episode (default 20)")
     o.add_argument("--batch", type=int, default=5, help="transitions per step (default 5, the thesis')")
@@ -96,7 +100,7 @@ def _online_flags(o) -> None:
     )
 
 
-def _online_parsers(sub) -> None:
+def _online_parsers(sub: argparse._SubParsersAction) -> None:
     o = sub.add_parser("q-online", help="optimise with Q-functions trained after each episode (thesis 6.5)")
     o.add_argument("model", metavar="MODEL", help="the model to plan (.glb, .gltf or a folder of OBJ/STL parts)")
     o.add_argument("--out", type=Path, required=True, help="folder for plan.json, trace.csv, the models and the transitions")
@@ -116,7 +120,7 @@ def _online_parsers(sub) -> None:
     _online_flags(b)
 
 
-def _q_parser(sub) -> None:
+def _q_parser(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser("q", help="learn the Q-function of one objective by deep Q-learning (thesis 5.4.4, 6.4.4)")
     q.add_argument("data", nargs="+", metavar="DATA_DIR", help="asp-transitions data set folders")
     q.add_argument("--objective", required=True, metavar="NAME", help="the objective of the data sets to learn")
@@ -302,7 +306,7 @@ def _q(args: argparse.Namespace) -> int:
     return 0
 
 
-def _online_config(args: argparse.Namespace, **more):
+def _online_config(args: argparse.Namespace, **more: Any) -> OnlineConfig:
     from .online import OnlineConfig
 
     return OnlineConfig(

@@ -56,12 +56,12 @@ class _ScatterAdd(torch.autograd.Function):
     """``zeros(n, c).index_add(0, index, values)``, exported as ONNX ``ScatterND(add)``."""
 
     @staticmethod
-    def forward(ctx: Any, values: Tensor, index: Tensor, zeros: Tensor) -> Tensor:  # type: ignore[override]
+    def forward(ctx: Any, values: Tensor, index: Tensor, zeros: Tensor) -> Tensor:
         ctx.save_for_backward(index)
         return zeros.index_add(0, index, values)
 
     @staticmethod
-    def backward(ctx: Any, grad: Tensor) -> tuple[Tensor, None, None]:  # type: ignore[override]
+    def backward(ctx: Any, grad: Tensor) -> tuple[Tensor, None, None]:
         (index,) = ctx.saved_tensors
         return grad.index_select(0, index), None, None
 
@@ -178,7 +178,7 @@ class GraphEncoder(nn.Module):
         if onehot is not None:
             return torch.matmul(onehot.transpose(0, 1), values)
         zeros = torch.zeros((n, values.shape[1]), dtype=values.dtype, device=values.device)
-        return _ScatterAdd.apply(values, target, zeros)  # type: ignore[no-any-return]
+        return _ScatterAdd.apply(values, target, zeros)
 
     def _aggregate(self, m: Tensor, target: Tensor, onehot: Tensor | None, inv_count: Tensor, n: int, tau: Tensor) -> Tensor:
         score = m * tau
@@ -263,7 +263,7 @@ class EncodedModel(nn.Module):
 
     def embed(self, x: Tensor, edge_index: Tensor, edge_attr: Tensor) -> Tensor:
         """The node embeddings ``[n, width]`` (the encoder's output, before the head)."""
-        return self.encoder(x, edge_index, edge_attr)  # type: ignore[no-any-return]
+        return self.encoder(x, edge_index, edge_attr)
 
 
 #: The top-level names in a :class:`GraphEncoder`'s state dict.

@@ -50,7 +50,7 @@ class ExportError(AspError, RuntimeError):
     """The exported file does not reproduce the PyTorch model (also a :class:`RuntimeError`)."""
 
 
-def random_graph(n: int, e: int, node_dim: int, edge_dim: int, rng: np.random.Generator):
+def random_graph(n: int, e: int, node_dim: int, edge_dim: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A random state graph ``(x, edge_index, edge_attr)`` as NumPy arrays.
 
     Attributes lie where real ones do (docs/learning.md): descriptor entries in [0, 1], flag-like
@@ -83,12 +83,16 @@ def run_onnx(path: os.PathLike | str, x: np.ndarray, edge_index: np.ndarray, edg
     except ImportError:
         from onnx.reference import ReferenceEvaluator
 
-        return np.asarray(ReferenceEvaluator(str(path)).run(None, feeds)[0])
+        outputs = ReferenceEvaluator(str(path)).run(None, feeds)
+        assert isinstance(outputs, list)  # a dict only with intermediate=True
+        return np.asarray(outputs[0])
     session = onnxruntime.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     return np.asarray(session.run(None, feeds)[0])
 
 
-def _like_training(model: EncodedModel, x: np.ndarray, edge_attr: np.ndarray, rng: np.random.Generator):
+def _like_training(
+    model: EncodedModel, x: np.ndarray, edge_attr: np.ndarray, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray]:
     """Attributes drawn where the model's training data lay: each column within three standard
     deviations of its training mean (in the model's ``log1p`` space, mapped back), the contract's
     ranges kept (descriptor entries in [0, 1], flags 0/1, cosines in [-1, 1]). Far outside that, a
@@ -96,13 +100,13 @@ def _like_training(model: EncodedModel, x: np.ndarray, edge_attr: np.ndarray, rn
     between PyTorch and an ONNX runtime by more than the parity tolerance, on inputs asp never
     produces."""
 
-    def draw(v: np.ndarray, mask, mean, std, flags: bool) -> np.ndarray:
+    def draw(v: np.ndarray, mask: torch.Tensor, mean: torch.Tensor, std: torch.Tensor, flags: bool) -> np.ndarray:
         if v.shape[0] == 0:
             return v
-        mask, mean, std = (t.detach().cpu().numpy() for t in (mask, mean, std))
+        log_cols, mu, sigma = (t.detach().cpu().numpy() for t in (mask, mean, std))
         z = np.clip(rng.standard_normal(v.shape), -3.0, 3.0)
-        w = mean + std * z
-        out = np.where(mask, np.expm1(np.maximum(w, 0.0)), w)
+        w = mu + sigma * z
+        out = np.where(log_cols, np.expm1(np.maximum(w, 0.0)), w)
         lo, hi = (0.0, 1.0) if flags else (-1.0, 1.0)
         out[:, : v.shape[1] - 2] = np.clip(out[:, : v.shape[1] - 2], 0.0, 1.0)
         out[:, v.shape[1] - 2 :] = v[:, v.shape[1] - 2 :] if flags else np.clip(out[:, v.shape[1] - 2 :], lo, hi)
@@ -114,7 +118,9 @@ def _like_training(model: EncodedModel, x: np.ndarray, edge_attr: np.ndarray, rn
     return x, edge_attr
 
 
-def pad_graph(x: np.ndarray, edge_index: np.ndarray, edge_attr: np.ndarray, nodes: int, edges: int):
+def pad_graph(
+    x: np.ndarray, edge_index: np.ndarray, edge_attr: np.ndarray, nodes: int, edges: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The graph as asp-learn pads it to a size bucket: ``nodes`` zero rows appended to ``x`` and
     ``edges`` self-loop edges with zero attributes on the first padding node (so ``nodes >= 1``
     when ``edges > 0``). A model's outputs for the real nodes must not change."""

@@ -54,7 +54,7 @@ class RemovabilityGNN(EncodedModel):
 
     def logits(self, x: Tensor, edge_index: Tensor, edge_attr: Tensor) -> Tensor:
         """Pre-sigmoid removability ``[n]``."""
-        return self.head(self.embed(x, edge_index, edge_attr)).squeeze(1)  # type: ignore[no-any-return]
+        return self.head(self.embed(x, edge_index, edge_attr)).squeeze(1)
 
     def forward(self, x: Tensor, edge_index: Tensor, edge_attr: Tensor) -> Tensor:
         """Removability ``[n]`` in (0, 1)."""

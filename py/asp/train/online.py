@@ -29,13 +29,16 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
 from ..datasets.transitions import DataError, TransitionDataset
 from ..errors import ConfigError
 from .q import BindingGraphs, DeepQLearner, QAssembly, QConfig, QLearning, export_q, load_q_weights, save_q_weights
+
+if TYPE_CHECKING:
+    from ..result import Plan
 
 __all__ = ["OnlineConfig", "OnlineResult", "run_online", "bench_mcts", "SETTINGS", "values_at"]
 
@@ -83,7 +86,7 @@ class OnlineConfig(QLearning):
 class OnlineResult:
     """What :func:`run_online` did."""
 
-    plan: object
+    plan: Plan
     """The :class:`asp.Plan` of the search."""
     episodes: int
     swaps: int
@@ -129,10 +132,10 @@ def run_online(
     if pretrained and len(pretrained) != len(objectives):
         raise DataError(f"{len(pretrained)} Q models for {len(objectives)} objectives ({', '.join(objectives)}): give one per objective")
     networks = []
-    for path, objective in zip(pretrained, objectives):
-        net, features, trained_for = load_q_weights(str(path) + ".pt")
+    for q_path, objective in zip(pretrained, objectives):
+        net, features, trained_for = load_q_weights(str(q_path) + ".pt")
         if trained_for != objective:
-            raise DataError(f"{path}.pt: estimates '{trained_for}', its place in --q is that of '{objective}'")
+            raise DataError(f"{q_path}.pt: estimates '{trained_for}', its place in --q is that of '{objective}'")
         networks.append(net)
 
     assembly = asp.load(model, **(load or {}))
@@ -341,11 +344,11 @@ def bench_mcts(
                         plan = assembly.plan(
                             objective=objectives, pareto=len(objectives) > 1, seed=run, threads=1, time_limit=last,
                             episodes=10**12, budget=base.budget, resolution=base.resolution, epsilon=base.epsilon,
-                            q_use=base.q_use, q=list(q) if setting == "pretrained" else None, **(base.search or {}),
+                            q_use=base.q_use, q=list(q or []) if setting == "pretrained" else None, **(base.search or {}),
                         )
                         trace, done = _trace_of(plan.trace_csv or "")
                     else:
-                        c = replace(base, objective=objective, seconds=last, seed=run, q=list(q) if setting == "retrained" else None)
+                        c = replace(base, objective=objective, seconds=last, seed=run, q=list(q or []) if setting == "retrained" else None)
                         r = run_online(path, scratch / f"{name}-{setting}-{run}", c, load=load, log=None)
                         plan = r.plan
                         trace, done = _trace_of(plan.trace_csv or "")

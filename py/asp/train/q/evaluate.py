@@ -68,8 +68,8 @@ def ranking_quality(
     for b in range(0, len(scored), batch):
         chunk = scored[b : b + batch]
         gs = [cache(source.assembly, e["t"].present, e["t"].actions, e["t"].history) for e in chunk]
-        q, offsets = _run(model, gs)
-        q = q.numpy()
+        q_tensor, offsets = _run(model, gs)
+        q = q_tensor.numpy()
         for e, g, off in zip(chunk, gs, offsets):
             acts = np.array(sorted(e["returns"]), dtype=np.int64)
             returns = np.array([e["returns"][int(a)] for a in acts])

@@ -7,22 +7,36 @@ from __future__ import annotations
 import re
 from collections import OrderedDict
 from dataclasses import dataclass
-from typing import Any, Callable, Protocol
+from typing import TYPE_CHECKING, Any, Callable, Protocol
 
 import numpy as np
 
 from ...datasets.transitions import DataError, TransitionAssembly
 
+if TYPE_CHECKING:
+    from ...qgraphs import QGraphs
+
 __all__ = ["GraphLike", "GraphSource", "SyntheticGraph", "parse_q_features", "synthetic_q_graph", "BindingGraphs", "GraphCache"]
 
 
 class GraphLike(Protocol):
-    """What a graph source returns (``asp.Graph`` is one)."""
+    """What a graph source returns (``asp.Graph`` is one): four read-only arrays."""
 
-    nodes: np.ndarray
-    x: np.ndarray
-    edge_index: np.ndarray
-    edge_attr: np.ndarray
+    @property
+    def nodes(self) -> np.ndarray:
+        """int64 ``[n]``: the part of each node, -1 for the context node."""
+
+    @property
+    def x(self) -> np.ndarray:
+        """float32 ``[n, node_dim]``."""
+
+    @property
+    def edge_index(self) -> np.ndarray:
+        """int64 ``[2, e]``."""
+
+    @property
+    def edge_attr(self) -> np.ndarray:
+        """float32 ``[e, edge_dim]``."""
 
 
 GraphSource = Callable[[TransitionAssembly, np.ndarray, np.ndarray, np.ndarray], GraphLike]
@@ -134,7 +148,7 @@ class BindingGraphs:
         self.features, self.node_dim, self.edge_dim = features, node_dim, edge_dim
         self._maps: dict[str, Any] = {}
 
-    def _q_graphs(self, a: TransitionAssembly):
+    def _q_graphs(self, a: TransitionAssembly) -> QGraphs:
         if a.name in self._maps:
             return self._maps[a.name]
         import asp

@@ -109,7 +109,7 @@ class DeepQLearner:
                 raise ValueError(f"{name} must be at least 1")
         if config.loss not in ("huber", "mse"):
             raise ValueError(f"loss must be 'huber' or 'mse', not {config.loss!r}")
-        _seed_everything(config)
+        _seed_everything(config.seed, config.threads)
         self.config = config
         self.rng = np.random.default_rng(config.seed)
         self.graphs = GraphCache(graph_source, node_dim, edge_dim, capacity=config.cache)

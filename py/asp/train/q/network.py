@@ -54,4 +54,4 @@ class QNetwork(EncodedModel):
             sums = torch.zeros((count, h.shape[1]), dtype=h.dtype).index_add(0, batch, w * h)
             weights = torch.zeros((count, 1), dtype=h.dtype).index_add(0, batch, w)
             pooled = (sums / torch.clamp(weights, min=1.0)).index_select(0, batch)
-        return self.phi_q(torch.cat([h, pooled], dim=1)).squeeze(1)  # type: ignore[no-any-return]
+        return self.phi_q(torch.cat([h, pooled], dim=1)).squeeze(1)
