@@ -3,12 +3,14 @@
 Every error of asp is an :class:`AspError`; bad input is a :class:`LoadError` (the model file or
 folder cannot be read, or its content cannot be planned as given) or a :class:`ConfigError` (a
 setting is unknown, of the wrong type or out of range). A search that finds no plan is not an
-error: its :class:`asp.Plan` has ``status == "no_plan"``.
+error: its :class:`asp.Plan` has ``status == "no_plan"``. The errors of the optional parts are
+:class:`AspError` too, each also an instance of the builtin class it used to be:
+:class:`asp.datasets.DataError` (a data set is malformed; a :class:`ValueError`),
+:class:`asp.train.ExportError` (an exported ONNX file does not reproduce its model; a
+:class:`RuntimeError`) and :class:`asp.batch.BatchError` (a batch cannot start or finish).
 """
 
 from __future__ import annotations
-
-from typing import Optional
 
 __all__ = ["AspError", "LoadError", "ConfigError"]
 
@@ -25,7 +27,7 @@ class LoadError(AspError):
     folder.
     """
 
-    def __init__(self, message: str, path: Optional[str] = None) -> None:
+    def __init__(self, message: str, path: str | None = None) -> None:
         super().__init__(message)
         #: The model file or folder the error is about.
         self.path = path

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Tuple
 
 import numpy as np
 
@@ -50,7 +49,7 @@ class Graph:
         return int(self.edge_attr.shape[1])
 
     @classmethod
-    def _from_native(cls, raw: Tuple[bytearray, bytearray, bytearray, bytearray, int, int, str]) -> "Graph":
+    def _from_native(cls, raw: tuple[bytearray, bytearray, bytearray, bytearray, int, int, str]) -> Graph:
         """From ``asp._asp.Assembly.graph``'s little-endian buffers (writable arrays, no copy)."""
         nodes, x, edge_index, edge_attr, node_dim, edge_dim, features = raw
         n = len(nodes) // 8

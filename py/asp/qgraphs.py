@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from typing import Iterable, List, Optional, Tuple
+from collections.abc import Iterable
 
 from asp import _asp
 from asp.graph import Graph
@@ -19,7 +19,7 @@ class QGraphs:
     carries the ``dirchange`` history; see ``docs/learning.md`` for every column.
     """
 
-    def __init__(self, native: "_asp.QGraphs") -> None:
+    def __init__(self, native: _asp.QGraphs) -> None:
         self._native = native
 
     @property
@@ -53,16 +53,16 @@ class QGraphs:
         return self._native.removable
 
     @property
-    def objectives(self) -> Tuple[str, ...]:
+    def objectives(self) -> tuple[str, ...]:
         """The objectives' names."""
         return tuple(self._native.objectives)
 
     @property
-    def reward_ranges(self) -> Tuple[Optional[Tuple[float, float]], ...]:
+    def reward_ranges(self) -> tuple[tuple[float, float] | None, ...]:
         """Each objective's per-step reward range ``(lo, hi)`` on these maps (``None``: none)."""
         return tuple(self._native.reward_ranges)
 
-    def feasible_actions(self, present: Iterable[int]) -> List[int]:
+    def feasible_actions(self, present: Iterable[int]) -> list[int]:
         """The parts removable from the state ``present`` on the maps (collision-free along some
         direction, not fixed, the rest supported), ascending."""
         return list(self._native.feasible_actions([int(p) for p in present]))

@@ -9,7 +9,7 @@ import re
 import shutil
 import subprocess
 from pathlib import Path
-from typing import Callable, List, Tuple
+from typing import Callable
 
 import pytest
 
@@ -51,7 +51,7 @@ def root(monkeypatch: pytest.MonkeyPatch) -> Path:
     return ROOT
 
 
-def _asp_command() -> List[str]:
+def _asp_command() -> list[str]:
     env = os.environ.get("ASP_BIN")
     if env:
         return [env]
@@ -65,11 +65,11 @@ def _asp_command() -> List[str]:
 
 
 @pytest.fixture
-def asp_cli(root: Path) -> Callable[..., Tuple[int, str, str]]:
+def asp_cli(root: Path) -> Callable[..., tuple[int, str, str]]:
     """Runs ``asp ARGS...`` in the repository root: ``(exit code, stdout, stderr)``."""
     command = _asp_command()
 
-    def run(*args: str) -> Tuple[int, str, str]:
+    def run(*args: str) -> tuple[int, str, str]:
         p = subprocess.run(command + list(args), cwd=root, capture_output=True, text=True, timeout=600)
         return p.returncode, p.stdout, p.stderr
 

@@ -3,6 +3,7 @@
 Needs the `asp` binary (`$ASP_BIN`, else target/debug/asp or target/release/asp of this
 checkout) and `pip install mcap`; skips with the reason when either is missing.
 """
+from __future__ import annotations
 
 import json
 import os

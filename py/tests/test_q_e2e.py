@@ -39,7 +39,7 @@ def run(cmd: list, cwd: Path) -> subprocess.CompletedProcess:
     return r
 
 
-def exact(qg: "asp.QGraphs") -> tuple[float, dict]:
+def exact(qg: asp.QGraphs) -> tuple[float, dict]:
     """The best total accessibility (in units of d_max) and each first removal's best total."""
     d = qg.directions
     fixed = {p for p in range(qg.num_parts) if qg.graph([p]).x[0, 2] == 1.0}

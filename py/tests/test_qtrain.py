@@ -193,7 +193,10 @@ def test_reader_rejects_bad_json_and_wrong_counts(tmp_path):
         (lambda i: i.update(version=2), r"asp-transitions version 2 is not supported"),
         (lambda i: i.update(objectives=[]), r"'objectives' must be a non-empty list"),
         (lambda i: i.update(objectives=["a", "a"]), r"'objectives' names an objective twice"),
-        (lambda i: i["assemblies"][0].update(reward_ranges=[[0, 1]]), r"assemblies\[0\]: 'reward_ranges' must hold one \[lo, hi\] pair per objective \(2\)"),
+        (
+            lambda i: i["assemblies"][0].update(reward_ranges=[[0, 1]]),
+            r"assemblies\[0\]: 'reward_ranges' must hold one \[lo, hi\] pair per objective \(2\)",
+        ),
         (lambda i: i["assemblies"][0].update(reward_ranges=[[1, 0], [0, 1]]), r"reward range of 'bonus' must be finite with lo <= hi"),
         (lambda i: i["assemblies"][0].update(load="unit=1"), r"assemblies\[0\]: 'load' must be an object"),
         (lambda i: i["assemblies"][0].pop("model"), r"assemblies\[0\]: 'model' must be a string"),
@@ -244,7 +247,8 @@ def _model(seed: int = 0):
     torch.manual_seed(seed)
     model = QNetwork(NODE_DIM, EDGE_DIM, width=32, layers=2).eval()
     gs = [_graph(p, 100 + p) for p in (3, 7, 12)]
-    model.fit_normalisation(torch.from_numpy(np.concatenate([g.x for g in gs])), torch.from_numpy(np.concatenate([g.edge_attr for g in gs])))
+    nodes, edges = np.concatenate([g.x for g in gs]), np.concatenate([g.edge_attr for g in gs])
+    model.fit_normalisation(torch.from_numpy(nodes), torch.from_numpy(edges))
     return model
 
 
@@ -366,7 +370,7 @@ def test_training_is_reproducible(tmp_path):
     b, sb, *_ = _train(tmp_path / "2", steps=12)
     c, *_ = _train(tmp_path / "3", steps=12, seed=1)
     assert sa["steps"] == 12 and sa["loss_curve"] == sb["loss_curve"]
-    for (k, va), vb, vc in zip(a.state_dict().items(), b.state_dict().values(), c.state_dict().values()):
+    for (k, va), vb, _vc in zip(a.state_dict().items(), b.state_dict().values(), c.state_dict().values()):
         assert torch.equal(va, vb), k
     assert any(not torch.equal(va, vc) for va, vc in zip(a.state_dict().values(), c.state_dict().values()))
 
@@ -408,7 +412,7 @@ def test_ranking_quality_chains_transitions_into_returns(tmp_path):
     spec = bonus_assembly("a", 3, 0, seed=0)
 
     def step(e, present, action, reward, next_actions):
-        rest = [p for p in present if p != action]
+        [p for p in present if p != action]
         return {"episode": e, "kind": "simulation", "present": present, "history": [], "actions": present, "action": action,
                 "rewards": [reward, 0.0], "next_history": [], "next_actions": next_actions, "complete": not next_actions}
 
@@ -499,3 +503,27 @@ def test_a_data_set_larger_than_the_buffer_streams_through_it(tmp_path):
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(DataError, match=re.escape(f"{path}:20: 'rewards' must be a list of 2 numbers")):
         train_q(train_set, node_dim, edge_dim, config, FakeGraphs())
+
+
+def test_online_and_offline_training_share_one_set_of_learning_settings():
+    _torch()
+    from dataclasses import fields
+
+    import asp
+    from asp.train.online import OnlineConfig
+    from asp.train.q import QConfig, QLearning
+
+    shared = [f.name for f in fields(QLearning)]
+    assert {"batch", "buffer", "lr", "seed", "layers", "width", "threads", "target_sync"} <= set(shared)
+    for cls in (QConfig, OnlineConfig):
+        assert issubclass(cls, QLearning)
+        assert [f.name for f in fields(cls)][: len(shared)] == shared
+    # one default each, the online batch excepted (the thesis' 5 transitions per step)
+    offline, online = QConfig(), OnlineConfig(objective="access")
+    assert {k: v for k, v in online.learning().items() if k != "batch"} == {k: v for k, v in offline.learning().items() if k != "batch"}
+    assert (offline.batch, online.batch) == (128, 5)
+    # the online settings become the learner's QConfig as they are
+    tuned = OnlineConfig(objective="access", lr=0.5, width=7, target_sync=3)
+    assert QConfig(**tuned.learning()).learning() == tuned.learning()
+    with pytest.raises(asp.ConfigError, match="objective"):
+        OnlineConfig()

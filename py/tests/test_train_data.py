@@ -9,7 +9,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-
 from asp.data import DataError, RemovabilityDataset, induced_subgraph  # noqa: E402
 
 
@@ -50,7 +49,9 @@ def write_dataset(root: Path, assemblies: list[dict], node_dim: int, edge_dim: i
     return root
 
 
-def stacks_assembly(name: str, rng: np.random.Generator, columns: int, max_height: int, runs: int, node_dim: int = 10, edge_dim: int = 6) -> dict:
+def stacks_assembly(
+    name: str, rng: np.random.Generator, columns: int, max_height: int, runs: int, node_dim: int = 10, edge_dim: int = 6
+) -> dict:
     """A learnable synthetic assembly: columns of stacked blocks on a fixed base (part 0).
 
     A block is removable exactly when no present block sits on it, which a GNN sees in the
@@ -75,7 +76,7 @@ def stacks_assembly(name: str, rng: np.random.Generator, columns: int, max_heigh
             link(p, cell[(c + 1, k)], 0.0)  # side contact
     nodes = np.concatenate([rng.gamma(2.0, 0.5, (len(parts), node_dim - 2)), np.zeros((len(parts), 2))], axis=1)
     nodes[0, -2] = 1.0  # fixed
-    for (c, k), p in cell.items():
+    for (_, k), p in cell.items():
         nodes[p, -1] = 1.0 if k == 0 else 0.0  # on_base
     on_top = {p: cell.get((c, k + 1)) for (c, k), p in cell.items()}
     states = []
@@ -87,7 +88,8 @@ def stacks_assembly(name: str, rng: np.random.Generator, columns: int, max_heigh
             states.append({"run": run, "step": step, "present": sorted(present), "removable": removable})
             present.remove(int(rng.choice(removable)))
             step += 1
-    return {"name": name, "parts": parts, "edges": edges, "nodes": nodes, "edge_attr": np.asarray(attrs).reshape(-1, edge_dim), "states": states}
+    edge_attr = np.asarray(attrs).reshape(-1, edge_dim)
+    return {"name": name, "parts": parts, "edges": edges, "nodes": nodes, "edge_attr": edge_attr, "states": states}
 
 
 def write_stacks_dataset(root: Path, names: list[str], seed: int = 0, runs: int = 4) -> Path:

@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
 
 from conftest import need
-
 
 torch = need("torch", "asp.train needs PyTorch (pip install torch)")
 onnx = need("onnx", "the ONNX export needs the onnx package")
@@ -93,7 +91,7 @@ def test_dense_and_scatter_aggregations_agree():
 def test_large_scores_stay_finite():
     model = _model()
     with torch.no_grad():
-        model.temperature.fill_(1e4)  # a huge temperature: exp would overflow without the shift/clamp
+        model.encoder.temperature.fill_(1e4)  # a huge temperature: exp would overflow without the shift/clamp
         y = model(*_graph(20, 80))
     assert torch.isfinite(y).all()
 
@@ -109,8 +107,8 @@ def test_gradients_reach_every_parameter():
 
 def test_normalisation_is_baked_in():
     model = _model()
-    assert float(model.node_std[0]) != 1.0 and float(model.node_mean[0]) != 0.0
-    assert set(dict(model.named_buffers())) >= {"node_mean", "node_std", "edge_mean", "edge_std"}
+    assert float(model.encoder.node_std[0]) != 1.0 and float(model.encoder.node_mean[0]) != 0.0
+    assert set(dict(model.named_buffers())) >= {f"encoder.{b}" for b in ("node_mean", "node_std", "edge_mean", "edge_std")}
 
 
 @pytest.mark.parametrize("aggregation", ["scatter", "dense"])
@@ -168,10 +166,73 @@ def test_parity_holds_with_small_descriptor_entries(tmp_path):
     export_onnx(model, path, "test/1 a=1", check=False)
     with torch.no_grad():
         expected = model(torch.from_numpy(x), torch.from_numpy(ei), torch.from_numpy(ea)).numpy()
-        exact_log1p = torch.where(model.node_log_mask, torch.log1p(torch.from_numpy(x)), torch.from_numpy(x))
-        ours = torch.where(model.node_log_mask, torch.log(1.0 + torch.from_numpy(x)), torch.from_numpy(x))
+        exact_log1p = torch.where(model.encoder.node_log_mask, torch.log1p(torch.from_numpy(x)), torch.from_numpy(x))
+        ours = torch.where(model.encoder.node_log_mask, torch.log(1.0 + torch.from_numpy(x)), torch.from_numpy(x))
     # the inputs do exercise the difference between the two logs (with torch.log1p the outputs
     # differed by 5.8e-5)
     assert float((exact_log1p - ours).abs().max()) > 1e-9
     got = run_onnx(path, x, ei, ea)
     np.testing.assert_allclose(got, expected, rtol=0, atol=1e-5)
+
+
+# -- the shared graph encoder ---------------------------------------------------------------------
+def _q_model(seed: int = 0):
+    from asp.train.q import QNetwork
+
+    torch.manual_seed(seed)
+    model = QNetwork(NODE_DIM, EDGE_DIM, width=16, layers=2).eval()
+    rng = np.random.default_rng(seed)
+    x, _, a = random_graph(50, 200, NODE_DIM, EDGE_DIM, rng)
+    model.fit_normalisation(torch.from_numpy(x), torch.from_numpy(a))
+    return model
+
+
+def test_both_models_compose_the_shared_encoder():
+    from asp.train.encoder import GraphEncoder
+    from asp.train.q import MIN_STD
+
+    gnn, q = _model(), _q_model()
+    assert type(gnn.encoder) is GraphEncoder and type(q.encoder) is GraphEncoder
+    # the Q network is not a removability network with its head switched off
+    assert not isinstance(q, RemovabilityGNN) and not hasattr(q, "head") and not hasattr(q, "logits")
+    assert {k.split(".")[0] for k in q.state_dict()} == {"encoder", "phi_q"}
+    assert {k.split(".")[0] for k in gnn.state_dict()} == {"encoder", "head"}
+    # the shape a model reports is its encoder's (export and the weight files read it)
+    assert (q.node_dim, q.edge_dim, q.width, q.layers, q.aggregation) == (NODE_DIM, EDGE_DIM, 16, 2, "scatter")
+    # Q inputs are only standardised (no log1p), with stds floored at MIN_STD
+    assert not q.encoder.node_log_mask.any() and gnn.encoder.node_log_mask[: NODE_DIM - 2].all()
+    assert float(q.encoder.node_std.min()) >= MIN_STD and float(q.encoder.edge_std.min()) >= MIN_STD
+
+
+@pytest.mark.parametrize("make", [_model, _q_model], ids=["removability", "q"])
+def test_state_dicts_from_before_the_encoder_split_still_load(make):
+    # weights saved when the encoder's parameters sat on the model itself (``node_encoder.weight``,
+    # ``node_mean``, ...; e.g. a ``q.onnx.pt`` of python -m asp.train q) load into the new layout
+    trained = make(seed=3)
+    flat = {k[len("encoder."):] if k.startswith("encoder.") else k: v for k, v in trained.state_dict().items()}
+    assert "node_encoder.weight" in flat and "node_mean" in flat
+    fresh = make(seed=4)
+    g = _graph(15, 40)
+    with torch.no_grad():
+        assert not torch.equal(fresh(*g), trained(*g))
+        fresh.load_state_dict(flat)
+        torch.testing.assert_close(fresh(*g), trained(*g), rtol=0, atol=0)
+
+
+@pytest.mark.parametrize("make, kind, output", [(_model, "removability", "removability"), (_q_model, "q", "q")])
+def test_exported_graph_keeps_the_contract_names_and_shapes(tmp_path, make, kind, output):
+    # docs/learning.md: inputs x [n, node_dim], edge_index int64 [2, e], edge_attr [e, edge_dim],
+    # one output [n]; a Q model (no log1p) has no Log op, a removability model has
+    model = make(seed=1)
+    path = tmp_path / "m.onnx"
+    export_onnx(model, path, "test/1 a=1", kind=kind, output_name=output, check=False)
+    proto = onnx.load(str(path))
+
+    def dims(value):
+        return [d.dim_param or d.dim_value for d in value.type.tensor_type.shape.dim]
+
+    inputs = {i.name: dims(i) for i in proto.graph.input}
+    assert inputs == {"x": ["n", NODE_DIM], "edge_index": [2, "e"], "edge_attr": ["e", EDGE_DIM]}
+    assert [(o.name, dims(o)) for o in proto.graph.output] == [(output, ["n"])]
+    assert {p.key: p.value for p in proto.metadata_props}["asp.kind"] == kind
+    assert ("Log" in {n.op_type for n in proto.graph.node}) == (kind == "removability")

@@ -14,7 +14,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any, Dict, List, Optional
+from typing import Any
 
 from asp.errors import AspError
 
@@ -29,8 +29,8 @@ def _value(text: str) -> Any:
         return text
 
 
-def _pairs(pairs: Optional[List[str]], what: str) -> Dict[str, Any]:
-    out: Dict[str, Any] = {}
+def _pairs(pairs: list[str] | None, what: str) -> dict[str, Any]:
+    out: dict[str, Any] = {}
     for pair in pairs or []:
         key, sep, value = pair.partition("=")
         if not sep or not key:
@@ -142,7 +142,7 @@ def job_of(args: argparse.Namespace) -> Job:
                     models_dir=args.models_dir, settings=settings, load=load)
 
 
-def main(argv: Optional[List[str]] = None) -> int:
+def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         job = job_of(args)

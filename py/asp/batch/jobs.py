@@ -14,9 +14,10 @@ import abc
 import json
 import os
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any
 
 from asp import _asp
 
@@ -30,7 +31,7 @@ class Item:
     """One unit of work: its key (unique in the job, names its journal line) and payload."""
 
     key: str
-    payload: Dict[str, Any]
+    payload: dict[str, Any]
 
 
 def _write_atomic(path: Path, text: str) -> None:
@@ -40,7 +41,7 @@ def _write_atomic(path: Path, text: str) -> None:
     os.replace(tmp, path)
 
 
-def _models(paths: Sequence[os.PathLike | str]) -> List[Dict[str, Any]]:
+def _models(paths: Sequence[os.PathLike | str]) -> list[dict[str, Any]]:
     """The models of files and folders, named as a data set names them."""
     return [
         {"path": path, "index": index, "name": name, "dir": d}
@@ -56,26 +57,26 @@ class Job(abc.ABC):
     # whether :meth:`finish` runs when some items failed (their results are ``{"error": ...}``)
     finishes_with_failures: bool = False
 
-    def __init__(self, spec: Dict[str, Any]) -> None:
+    def __init__(self, spec: dict[str, Any]) -> None:
         self.spec = spec
 
     @abc.abstractmethod
-    def items(self) -> List[Item]:
+    def items(self) -> list[Item]:
         """The job's items, in a fixed order."""
 
-    def done(self, out: Path, item: Item, result: Dict[str, Any]) -> bool:
+    def done(self, out: Path, item: Item, result: dict[str, Any]) -> bool:
         """Whether a journaled item is still done (its output files exist)."""
         return all((out / f).is_file() for f in result.get("files", []))
 
-    def describe(self, item: Item, result: Dict[str, Any]) -> str:
+    def describe(self, item: Item, result: dict[str, Any]) -> str:
         """One line of progress for an item that succeeded."""
         return item.key
 
     @abc.abstractmethod
-    def finish(self, out: Path, results: Dict[str, Dict[str, Any]]) -> str:
+    def finish(self, out: Path, results: dict[str, dict[str, Any]]) -> str:
         """Writes what needs every item (manifest, index, summary); returns the closing line."""
 
-    def record(self) -> Dict[str, Any]:
+    def record(self) -> dict[str, Any]:
         """The job record of the journal: a resumed batch must have the same one."""
         return {"format": JOURNAL_FORMAT, "version": JOURNAL_VERSION, "kind": self.kind, "spec": self.spec}
 
@@ -90,18 +91,18 @@ class GenJob(Job):
 
     kind = "gen"
 
-    def __init__(self, generator: Dict[str, Any], count: int, seed: int = 0, preset: Optional[str] = None) -> None:
+    def __init__(self, generator: dict[str, Any], count: int, seed: int = 0, preset: str | None = None) -> None:
         if count < 1:
             raise ValueError(f"count must be at least 1, got {count}")
         canonical = json.loads(_asp.generator_canonical(json.dumps(generator)))
         super().__init__({"generator": canonical, "preset": preset, "count": int(count), "seed": int(seed)})
 
     @staticmethod
-    def soma(size: int = 5, cell: float = 0.05, **kw: Any) -> "GenJob":
+    def soma(size: int = 5, cell: float = 0.05, **kw: Any) -> GenJob:
         return GenJob({"kind": "soma", "size": size, "cell": cell}, **kw)
 
     @staticmethod
-    def profiles(preset: Optional[str] = None, overrides: Optional[Dict[str, Any]] = None, **kw: Any) -> "GenJob":
+    def profiles(preset: str | None = None, overrides: dict[str, Any] | None = None, **kw: Any) -> GenJob:
         params = json.loads(_asp.profile_preset(preset or "single-layer"))
         for key, value in (overrides or {}).items():
             if key not in params:
@@ -109,17 +110,17 @@ class GenJob(Job):
             params[key] = value
         return GenJob({"kind": "profiles", **params}, preset=preset, **kw)
 
-    def items(self) -> List[Item]:
+    def items(self) -> list[Item]:
         return [Item(str(i), {"index": i}) for i in range(self.spec["count"])]
 
-    def describe(self, item: Item, result: Dict[str, Any]) -> str:
+    def describe(self, item: Item, result: dict[str, Any]) -> str:
         entry = result["entry"]
         passed = all(
             entry["checks"][k] for k in ("contact_linked", "straight_line_disassemblable", "stable_order_found")
         )
         return f"{entry['file']}: {entry['parts']} parts{'' if passed else ', failed its checks'}"
 
-    def finish(self, out: Path, results: Dict[str, Dict[str, Any]]) -> str:
+    def finish(self, out: Path, results: dict[str, dict[str, Any]]) -> str:
         s = self.spec
         entries = [json.dumps(results[str(i)]["entry"]) for i in range(s["count"])]
         manifest = json.loads(
@@ -130,7 +131,7 @@ class GenJob(Job):
         return f"wrote {manifest['count']} assemblies and manifest.json to {out}{note}"
 
 
-def _gen(spec: Dict[str, Any], payload: Dict[str, Any], out: str) -> Dict[str, Any]:
+def _gen(spec: dict[str, Any], payload: dict[str, Any], out: str) -> dict[str, Any]:
     entry = json.loads(
         _asp.gen_item(json.dumps(spec["generator"]), payload["index"], spec["count"], spec["seed"], out)
     )
@@ -145,11 +146,11 @@ def _gen(spec: Dict[str, Any], payload: Dict[str, Any], out: str) -> Dict[str, A
 class LoadSettings:
     """``asp.load``'s settings, the same for every model of a batch."""
 
-    unit: Optional[str] = None
-    up: Optional[str] = None
-    fixed: List[str] = field(default_factory=list)
+    unit: str | None = None
+    up: str | None = None
+    fixed: list[str] = field(default_factory=list)
 
-    def as_dict(self) -> Dict[str, Any]:
+    def as_dict(self) -> dict[str, Any]:
         return {"unit": self.unit, "up": self.up, "fixed": list(self.fixed)}
 
 
@@ -161,8 +162,8 @@ class PlanJob(Job):
     kind = "plan"
     finishes_with_failures = True  # the summary lists the models that failed, with the error
 
-    def __init__(self, models: Sequence[os.PathLike | str], settings: Optional[Dict[str, Any]] = None,
-                 load: Optional[LoadSettings] = None) -> None:
+    def __init__(self, models: Sequence[os.PathLike | str], settings: dict[str, Any] | None = None,
+                 load: LoadSettings | None = None) -> None:
         settings = dict(settings or {})
         defaults = _asp.default_settings()
         unknown = sorted(set(settings) - set(defaults))
@@ -174,14 +175,14 @@ class PlanJob(Job):
             "load": (load or LoadSettings()).as_dict(),
         })
 
-    def items(self) -> List[Item]:
+    def items(self) -> list[Item]:
         return [Item(m["name"], m) for m in self.spec["models"]]
 
-    def describe(self, item: Item, result: Dict[str, Any]) -> str:
+    def describe(self, item: Item, result: dict[str, Any]) -> str:
         return (f"{item.key}: {result['status']}, {result['steps']} steps, "
                 f"{result['removal_tests']} removal tests, {result['seconds']:.2f} s")
 
-    def finish(self, out: Path, results: Dict[str, Dict[str, Any]]) -> str:
+    def finish(self, out: Path, results: dict[str, dict[str, Any]]) -> str:
         rows = [{"name": i.key, "source": i.payload["path"], **results[i.key]} for i in self.items()]
         summary = {"format": "asp-batch-plans", "version": 1, "settings": self.spec["settings"],
                    "load": self.spec["load"], "plans": rows}
@@ -192,7 +193,7 @@ class PlanJob(Job):
         return f"{found} of {len(rows)} models planned{errors}; plans and summary.json in {out}"
 
 
-def _plan(spec: Dict[str, Any], payload: Dict[str, Any], out: str) -> Dict[str, Any]:
+def _plan(spec: dict[str, Any], payload: dict[str, Any], out: str) -> dict[str, Any]:
     import asp
 
     load = spec["load"]
@@ -228,8 +229,8 @@ class CollectJob(Job):
     kind = "collect"
 
     def __init__(self, models: Sequence[os.PathLike | str], runs: int = 20, seed: int = 0,
-                 max_tests: Optional[int] = 20_000, timeout: Optional[float] = 60.0,
-                 settings: Optional[Dict[str, Any]] = None, load: Optional[LoadSettings] = None) -> None:
+                 max_tests: int | None = 20_000, timeout: float | None = 60.0,
+                 settings: dict[str, Any] | None = None, load: LoadSettings | None = None) -> None:
         if runs < 1:
             raise ValueError(f"runs must be at least 1, got {runs}")
         super().__init__({
@@ -242,18 +243,18 @@ class CollectJob(Job):
             "load": (load or LoadSettings()).as_dict(),
         })
 
-    def items(self) -> List[Item]:
+    def items(self) -> list[Item]:
         return [Item(m["name"], m) for m in self.spec["models"]]
 
-    def done(self, out: Path, item: Item, result: Dict[str, Any]) -> bool:
+    def done(self, out: Path, item: Item, result: dict[str, Any]) -> bool:
         d = out / item.payload["dir"]
         return all((d / f).is_file() for f in ("graph.json", "nodes.npy", "edge_attr.npy", "states.jsonl"))
 
-    def describe(self, item: Item, result: Dict[str, Any]) -> str:
+    def describe(self, item: Item, result: dict[str, Any]) -> str:
         e = result["entry"]
         return f"{item.key}: {e['parts']} parts, {e['states']} states ({e['runs_found']} of {self.spec['runs']} runs complete)"
 
-    def finish(self, out: Path, results: Dict[str, Dict[str, Any]]) -> str:
+    def finish(self, out: Path, results: dict[str, dict[str, Any]]) -> str:
         entries = [json.dumps(results[i.key]["entry"]) for i in self.items()]
         index = json.loads(_asp.collect_index(str(out), self.spec["runs"], self.spec["seed"], entries))
         states = sum(a["states"] for a in index["assemblies"])
@@ -261,7 +262,7 @@ class CollectJob(Job):
                 f"{index['features']} ({index['node_dim']} node, {index['edge_dim']} edge attributes)")
 
 
-def _collect(spec: Dict[str, Any], payload: Dict[str, Any], out: str) -> Dict[str, Any]:
+def _collect(spec: dict[str, Any], payload: dict[str, Any], out: str) -> dict[str, Any]:
     load = spec["load"]
     entry = _asp.collect_item(
         payload["path"], payload["index"], payload["name"], payload["dir"], out, spec["runs"], spec["seed"],
@@ -282,9 +283,9 @@ class BenchJob(Job):
 
     kind = "bench"
 
-    def __init__(self, models: Sequence[os.PathLike | str], orderings: int = 10, methods: Optional[str] = None,
-                 model: Optional[str] = None, models_dir: Optional[str] = None,
-                 settings: Optional[Dict[str, Any]] = None, load: Optional[LoadSettings] = None) -> None:
+    def __init__(self, models: Sequence[os.PathLike | str], orderings: int = 10, methods: str | None = None,
+                 model: str | None = None, models_dir: str | None = None,
+                 settings: dict[str, Any] | None = None, load: LoadSettings | None = None) -> None:
         if orderings < 1:
             raise ValueError(f"orderings must be at least 1, got {orderings}")
         if model and models_dir:
@@ -299,15 +300,15 @@ class BenchJob(Job):
             "load": (load or LoadSettings()).as_dict(),
         })
 
-    def items(self) -> List[Item]:
+    def items(self) -> list[Item]:
         return [Item(m["name"], m) for m in self.spec["models"]]
 
-    def describe(self, item: Item, result: Dict[str, Any]) -> str:
+    def describe(self, item: Item, result: dict[str, Any]) -> str:
         rows = result["rows"]
         best = min(rows, key=lambda r: r["removal_tests"]["mean"])
         return f"{item.key}: {len(rows)} methods, fewest tests {best['method']} ({best['removal_tests']['mean']:.1f})"
 
-    def finish(self, out: Path, results: Dict[str, Dict[str, Any]]) -> str:
+    def finish(self, out: Path, results: dict[str, dict[str, Any]]) -> str:
         rows = [row for i in self.items() for row in results[i.key]["rows"]]
         _write_atomic(out / "bench.json", json.dumps(rows, indent=2) + "\n")
         table = _asp.bench_table([json.dumps(rows)])
@@ -315,7 +316,7 @@ class BenchJob(Job):
         return table.rstrip("\n") + f"\n(rows in {out / 'bench.json'})"
 
 
-def _bench(spec: Dict[str, Any], payload: Dict[str, Any], out: str) -> Dict[str, Any]:
+def _bench(spec: dict[str, Any], payload: dict[str, Any], out: str) -> dict[str, Any]:
     load = spec["load"]
     model = spec["model"]
     if spec["models_dir"]:
@@ -332,7 +333,7 @@ def _bench(spec: Dict[str, Any], payload: Dict[str, Any], out: str) -> Dict[str,
 _RUNNERS = {"gen": _gen, "plan": _plan, "collect": _collect, "bench": _bench}
 
 
-def run_item(kind: str, spec: Dict[str, Any], payload: Dict[str, Any], out: str) -> Dict[str, Any]:
+def run_item(kind: str, spec: dict[str, Any], payload: dict[str, Any], out: str) -> dict[str, Any]:
     """Runs one item of a job of ``kind`` (in this process: a serial loop or a Ray worker).
     asp's own errors (a model that does not load, bad settings) become ``{"error": message}``:
     one bad model does not stop a batch."""
@@ -344,6 +345,6 @@ def run_item(kind: str, spec: Dict[str, Any], payload: Dict[str, Any], out: str)
         return {"error": str(e)}
 
 
-def run_chunk(kind: str, spec: Dict[str, Any], payloads: List[Dict[str, Any]], out: str) -> List[Dict[str, Any]]:
+def run_chunk(kind: str, spec: dict[str, Any], payloads: list[dict[str, Any]], out: str) -> list[dict[str, Any]]:
     """:func:`run_item` of several items in turn (one Ray task)."""
     return [run_item(kind, spec, p, out) for p in payloads]

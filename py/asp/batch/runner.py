@@ -18,14 +18,15 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, TextIO
+from typing import Any, Callable, TextIO
 
+from ..errors import AspError
 from .jobs import Item, Job, run_chunk, run_item
 
 JOURNAL_DIR = ".asp-batch"
 
 
-class BatchError(Exception):
+class BatchError(AspError):
     """A batch cannot start or finish: its folder holds another job, Ray is missing, ..."""
 
 
@@ -37,7 +38,7 @@ class Outcome:
     total: int
     ran: int = 0
     skipped: int = 0
-    failed: Dict[str, str] = field(default_factory=dict)
+    failed: dict[str, str] = field(default_factory=dict)
     seconds: float = 0.0
     startup_seconds: float = 0.0
     summary: str = ""
@@ -78,7 +79,7 @@ class Journal:
             tmp.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
             os.replace(tmp, job_file)
         self.path = self.dir / "done.jsonl"
-        self.done: Dict[str, Dict[str, Any]] = {}
+        self.done: dict[str, dict[str, Any]] = {}
         if self.path.is_file():
             with open(self.path, encoding="utf-8") as f:
                 for line in f:
@@ -87,9 +88,9 @@ class Journal:
                         self.done[entry["key"]] = entry["result"]
                     except (ValueError, KeyError, TypeError):
                         continue  # a line torn by a kill: that item runs again
-        self._file: Optional[TextIO] = None
+        self._file: TextIO | None = None
 
-    def add(self, key: str, result: Dict[str, Any]) -> None:
+    def add(self, key: str, result: dict[str, Any]) -> None:
         if self._file is None:
             self._file = open(self.path, "a", encoding="utf-8")
         self._file.write(json.dumps({"key": key, "result": result}) + "\n")
@@ -156,7 +157,7 @@ class Progress:
             self.stream.flush()
 
 
-def run(job: Job, out: os.PathLike | str, ray: Optional[str] = "local", workers: Optional[int] = None,
+def run(job: Job, out: os.PathLike | str, ray: str | None = "local", workers: int | None = None,
         fresh: bool = False, quiet: bool = False, stream: TextIO = sys.stderr) -> Outcome:
     """Runs ``job`` into folder ``out``: every item not done before, then the job's closing files.
 
@@ -182,7 +183,7 @@ def run(job: Job, out: os.PathLike | str, ray: Optional[str] = "local", workers:
         progress.message(f"{out}: {outcome.skipped} of {len(items)} items done before, {len(todo)} to go")
     started = time.perf_counter()
 
-    def finished(item: Item, result: Dict[str, Any]) -> None:
+    def finished(item: Item, result: dict[str, Any]) -> None:
         if "error" in result:
             outcome.failed[item.key] = result["error"]
             progress(f"{item.key}: failed")
@@ -244,8 +245,8 @@ def chunk_size(items: int, slots: int) -> int:
 WORKER_ENV = {"RAYON_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 
 
-def _run_ray(job: Job, todo: List[Item], out: str, address: str, workers: Optional[int],
-             finished: Callable[[Item, Dict[str, Any]], None], ready: Callable[[], None]) -> float:
+def _run_ray(job: Job, todo: list[Item], out: str, address: str, workers: int | None,
+             finished: Callable[[Item, dict[str, Any]], None], ready: Callable[[], None]) -> float:
     """Runs the items as Ray tasks; returns the seconds spent starting or joining Ray."""
     started = time.perf_counter()
     ray = _ray_module()
@@ -274,15 +275,16 @@ def _run_ray(job: Job, todo: List[Item], out: str, address: str, workers: Option
         size = chunk_size(len(todo), slots)
         chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
         chunks.reverse()
-        pending: Dict[Any, List[Item]] = {}
+        pending: dict[Any, list[Item]] = {}
         # a bounded number of tasks in flight (twice the CPUs that run them): a batch of 100,000
         # assemblies does not become 100,000 tasks at once, and results are journaled as they come
         while chunks or pending:
             while chunks and len(pending) < 2 * slots:
                 chunk = chunks.pop()
                 pending[task.remote(job.kind, spec, [i.payload for i in chunk], out)] = chunk
-            ready, _ = ray.wait(list(pending), num_returns=1)
-            for ref in ready:
+            # (not `ready`: that is the callback of this function's arguments)
+            finished_refs, _ = ray.wait(list(pending), num_returns=1)
+            for ref in finished_refs:
                 chunk = pending.pop(ref)
                 try:
                     results = ray.get(ref)

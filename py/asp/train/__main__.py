@@ -30,11 +30,15 @@ import re
 import statistics
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from ..data import DataError
+from ..datasets import DataError
 from ..errors import AspError
 from .export import ExportError, export_onnx, write_parity_cases
 from .trainer import AssemblyData, TrainConfig, evaluate, load_assemblies, train
+
+if TYPE_CHECKING:
+    from .online import OnlineConfig
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -72,7 +76,7 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _online_flags(o) -> None:
+def _online_flags(o: argparse.ArgumentParser) -> None:
     o.add_argument("--objective", required=True, metavar="LIST", help="objectives, comma-separated (several: Pareto-MCTS)")
     o.add_argument("--steps-per-episode", type=int, default=20, help="deep Q-learning steps after each episode (default 20)")
     o.add_argument("--batch", type=int, default=5, help="transitions per step (default 5, the thesis')")
@@ -83,7 +87,9 @@ def _online_flags(o) -> None:
     o.add_argument("--width", type=int, default=64, help="hidden width of a new network (default 64)")
     o.add_argument("--threads", type=int, default=1, help="PyTorch CPU threads (default 1)")
     o.add_argument("--epsilon", type=float, default=0.2, help="probability of a random removal in a guided rollout (default 0.2)")
-    o.add_argument("--q-use", choices=["rollouts", "expansions", "both"], default="rollouts", help="where the Q models guide (default rollouts)")
+    o.add_argument(
+        "--q-use", choices=["rollouts", "expansions", "both"], default="rollouts", help="where the Q models guide (default rollouts)"
+    )
     o.add_argument("--budget", type=int, default=5, help="MCTS iterations per step (default 5)")
     o.add_argument("--resolution", type=int, default=9, help="distance map resolution (default 9)")
     o.add_argument("--unit", help="the model's unit (mm, ...), as asp plan --unit")
@@ -94,7 +100,7 @@ def _online_flags(o) -> None:
     )
 
 
-def _online_parsers(sub) -> None:
+def _online_parsers(sub: argparse._SubParsersAction) -> None:
     o = sub.add_parser("q-online", help="optimise with Q-functions trained after each episode (thesis 6.5)")
     o.add_argument("model", metavar="MODEL", help="the model to plan (.glb, .gltf or a folder of OBJ/STL parts)")
     o.add_argument("--out", type=Path, required=True, help="folder for plan.json, trace.csv, the models and the transitions")
@@ -114,7 +120,7 @@ def _online_parsers(sub) -> None:
     _online_flags(b)
 
 
-def _q_parser(sub) -> None:
+def _q_parser(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser("q", help="learn the Q-function of one objective by deep Q-learning (thesis 5.4.4, 6.4.4)")
     q.add_argument("data", nargs="+", metavar="DATA_DIR", help="asp-transitions data set folders")
     q.add_argument("--objective", required=True, metavar="NAME", help="the objective of the data sets to learn")
@@ -248,7 +254,7 @@ def _removability(args: argparse.Namespace) -> int:
 
 
 def _q(args: argparse.Namespace) -> int:
-    from .q import QConfig, config_dict, export_q, open_q_assemblies, ranking_quality, save_q_weights, train_q, BindingGraphs
+    from .q import BindingGraphs, QConfig, config_dict, export_q, open_q_assemblies, ranking_quality, save_q_weights, train_q
 
     assemblies, features, node_dim, edge_dim = open_q_assemblies(args.data, args.objective)
     by_name = {a.name: a for a in assemblies}
@@ -300,7 +306,7 @@ def _q(args: argparse.Namespace) -> int:
     return 0
 
 
-def _online_config(args: argparse.Namespace, **more):
+def _online_config(args: argparse.Namespace, **more: Any) -> OnlineConfig:
     from .online import OnlineConfig
 
     return OnlineConfig(
@@ -357,7 +363,8 @@ def _bench_mcts(args: argparse.Namespace) -> int:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     args = _parser().parse_args(argv)
-    for flag in ("epochs", "batch", "layers", "width", "threads", "steps", "buffer", "target_sync", "eval_states", "episodes", "runs", "budget"):
+    counts = ("epochs", "batch", "layers", "width", "threads", "steps", "buffer", "target_sync", "eval_states", "episodes")
+    for flag in counts + ("runs", "budget"):
         value = getattr(args, flag, None)
         if value is not None and value < 1:
             print(f"error: --{flag.replace('_', '-')} must be at least 1", file=sys.stderr)

@@ -1,4 +1,5 @@
-"""ONNX export of a :class:`~asp.train.gnn.RemovabilityGNN` as docs/learning.md specifies.
+"""ONNX export of a :class:`~asp.train.gnn.RemovabilityGNN` (or any model built on the shared
+:class:`~asp.train.encoder.GraphEncoder`, as the Q network is) as docs/learning.md specifies.
 
 The file has opset 17, inputs ``x`` float32 ``[n, node_dim]``, ``edge_index`` int64 ``[2, e]``,
 ``edge_attr`` float32 ``[e, edge_dim]``, output ``removability`` float32 ``[n]`` with ``n`` and
@@ -17,14 +18,15 @@ from __future__ import annotations
 import copy
 import os
 import warnings
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Iterable
 
 import numpy as np
 import onnx
 import torch
 
-from .gnn import RemovabilityGNN
+from ..errors import AspError
+from .encoder import EncodedModel
 
 __all__ = [
     "OPSET", "INPUT_NAMES", "OUTPUT_NAME", "ExportError", "export_onnx", "pad_graph", "parity_check", "run_onnx",
@@ -44,11 +46,11 @@ PARITY_SIZES = ((7, 0), (53, 212), (131, 610))
 CASE_SIZES = ((3, 0), (9, 24), (19, 60))
 
 
-class ExportError(RuntimeError):
-    """The exported file does not reproduce the PyTorch model."""
+class ExportError(AspError, RuntimeError):
+    """The exported file does not reproduce the PyTorch model (also a :class:`RuntimeError`)."""
 
 
-def random_graph(n: int, e: int, node_dim: int, edge_dim: int, rng: np.random.Generator):
+def random_graph(n: int, e: int, node_dim: int, edge_dim: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A random state graph ``(x, edge_index, edge_attr)`` as NumPy arrays.
 
     Attributes lie where real ones do (docs/learning.md): descriptor entries in [0, 1], flag-like
@@ -81,12 +83,16 @@ def run_onnx(path: os.PathLike | str, x: np.ndarray, edge_index: np.ndarray, edg
     except ImportError:
         from onnx.reference import ReferenceEvaluator
 
-        return np.asarray(ReferenceEvaluator(str(path)).run(None, feeds)[0])
+        outputs = ReferenceEvaluator(str(path)).run(None, feeds)
+        assert isinstance(outputs, list)  # a dict only with intermediate=True
+        return np.asarray(outputs[0])
     session = onnxruntime.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     return np.asarray(session.run(None, feeds)[0])
 
 
-def _like_training(model: RemovabilityGNN, x: np.ndarray, edge_attr: np.ndarray, rng: np.random.Generator):
+def _like_training(
+    model: EncodedModel, x: np.ndarray, edge_attr: np.ndarray, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray]:
     """Attributes drawn where the model's training data lay: each column within three standard
     deviations of its training mean (in the model's ``log1p`` space, mapped back), the contract's
     ranges kept (descriptor entries in [0, 1], flags 0/1, cosines in [-1, 1]). Far outside that, a
@@ -94,26 +100,27 @@ def _like_training(model: RemovabilityGNN, x: np.ndarray, edge_attr: np.ndarray,
     between PyTorch and an ONNX runtime by more than the parity tolerance, on inputs asp never
     produces."""
 
-    def draw(v: np.ndarray, mask, mean, std, flags: bool) -> np.ndarray:
+    def draw(v: np.ndarray, mask: torch.Tensor, mean: torch.Tensor, std: torch.Tensor, flags: bool) -> np.ndarray:
         if v.shape[0] == 0:
             return v
-        mask, mean, std = (t.detach().cpu().numpy() for t in (mask, mean, std))
+        log_cols, mu, sigma = (t.detach().cpu().numpy() for t in (mask, mean, std))
         z = np.clip(rng.standard_normal(v.shape), -3.0, 3.0)
-        w = mean + std * z
-        out = np.where(mask, np.expm1(np.maximum(w, 0.0)), w)
+        w = mu + sigma * z
+        out = np.where(log_cols, np.expm1(np.maximum(w, 0.0)), w)
         lo, hi = (0.0, 1.0) if flags else (-1.0, 1.0)
         out[:, : v.shape[1] - 2] = np.clip(out[:, : v.shape[1] - 2], 0.0, 1.0)
         out[:, v.shape[1] - 2 :] = v[:, v.shape[1] - 2 :] if flags else np.clip(out[:, v.shape[1] - 2 :], lo, hi)
         return out.astype(np.float32)
 
-    if not hasattr(model, "node_mean"):
-        return x, edge_attr
-    x = draw(x, model.node_log_mask, model.node_mean, model.node_std, flags=True)
-    edge_attr = draw(edge_attr, model.edge_log_mask, model.edge_mean, model.edge_std, flags=False)
+    encoder = model.encoder
+    x = draw(x, encoder.node_log_mask, encoder.node_mean, encoder.node_std, flags=True)
+    edge_attr = draw(edge_attr, encoder.edge_log_mask, encoder.edge_mean, encoder.edge_std, flags=False)
     return x, edge_attr
 
 
-def pad_graph(x: np.ndarray, edge_index: np.ndarray, edge_attr: np.ndarray, nodes: int, edges: int):
+def pad_graph(
+    x: np.ndarray, edge_index: np.ndarray, edge_attr: np.ndarray, nodes: int, edges: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The graph as asp-learn pads it to a size bucket: ``nodes`` zero rows appended to ``x`` and
     ``edges`` self-loop edges with zero attributes on the first padding node (so ``nodes >= 1``
     when ``edges > 0``). A model's outputs for the real nodes must not change."""
@@ -128,7 +135,7 @@ def pad_graph(x: np.ndarray, edge_index: np.ndarray, edge_attr: np.ndarray, node
 
 
 def parity_check(
-    model: RemovabilityGNN,
+    model: EncodedModel,
     path: os.PathLike | str,
     seed: int = 12345,
     tolerance: float = 1e-5,
@@ -173,7 +180,7 @@ def parity_check(
 
 
 def export_onnx(
-    model: RemovabilityGNN,
+    model: EncodedModel,
     path: os.PathLike | str,
     features: str,
     aggregation: str | None = None,
@@ -245,7 +252,7 @@ def _f32(v: float) -> float:
     return float(np.format_float_positional(np.float32(v), unique=True, trim="-"))
 
 
-def write_parity_cases(model: RemovabilityGNN, path: os.PathLike | str, features: str, seed: int = 4242) -> None:
+def write_parity_cases(model: EncodedModel, path: os.PathLike | str, features: str, seed: int = 4242) -> None:
     """Write graphs drawn like the model's training inputs (:data:`CASE_SIZES`) with the PyTorch
     outputs, as JSON (``features``, ``node_dim``, ``edge_dim``, ``cases`` of ``n``, ``e``, ``x``,
     ``edge_index``, ``edge_attr``, ``removability``), so another runtime (asp-learn's tests on the

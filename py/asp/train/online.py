@@ -26,14 +26,19 @@ import math
 import os
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable, Optional, Sequence
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from ..qdata import DataError, TransitionDataset
-from .q import BindingGraphs, DeepQLearner, QAssembly, QConfig, export_q, load_q_weights, save_q_weights
+from ..datasets.transitions import DataError, TransitionDataset
+from ..errors import ConfigError
+from .q import BindingGraphs, DeepQLearner, QAssembly, QConfig, QLearning, export_q, load_q_weights, save_q_weights
+
+if TYPE_CHECKING:
+    from ..result import Plan
 
 __all__ = ["OnlineConfig", "OnlineResult", "run_online", "bench_mcts", "SETTINGS", "values_at"]
 
@@ -42,50 +47,46 @@ SETTINGS = ("vanilla", "online", "pretrained", "retrained")
 
 
 @dataclass(frozen=True)
-class OnlineConfig:
-    """Settings of a search that trains its Q-functions after each episode."""
+class OnlineConfig(QLearning):
+    """Settings of a search that trains its Q-functions after each episode: the deep Q-learning
+    hyper-parameters of :class:`~asp.train.q.QLearning` (each objective ``k``'s network seeded with
+    ``seed + k``; ``seed`` also seeds the search), and the search's."""
 
-    objective: str
-    """Objectives, comma-separated (one network each; several run Pareto-MCTS)."""
-    seconds: Optional[float] = None
+    batch: int = 5
+    """Transitions per step (the thesis: 5; offline training's default is larger)."""
+    objective: str = ""
+    """Objectives, comma-separated (one network each; several run Pareto-MCTS); required."""
+    seconds: float | None = None
     """Wall time of the search (training between episodes included); ``None``: ``episodes`` only."""
     episodes: int = 1_000_000
     """The most episodes."""
-    q: Optional[Sequence[str]] = None
+    q: Sequence[str] | None = None
     """Pretrained Q models (ONNX, with their ``.pt`` weights beside them), one per objective: the
     retrained setting."""
     steps_per_episode: int = 20
     """Deep Q-learning steps after each episode (the thesis: 20 for 5×5 cubes)."""
-    batch: int = 5
-    """Transitions per step (the thesis: 5)."""
-    buffer: int = 10_000
-    """Replay buffer capacity (the thesis: 10,000)."""
-    lr: float = 1e-3
-    target_sync: int = 100
-    layers: int = 3
-    width: int = 64
-    seed: int = 0
-    """Seeds the search and the networks (objective ``k``'s network: ``seed + k``)."""
     epsilon: float = 0.2
     q_use: str = "rollouts"
     budget: int = 5
     resolution: int = 9
-    threads: int = 1
-    """PyTorch threads (reproducible for one count)."""
     aggregation: str = "dense"
     parity_tolerance: float = 1e-5
-    search: Optional[dict] = None
+    search: dict | None = None
     """Further keywords of :meth:`asp.Assembly.plan` (``exploration``, ``d_max``, ``support``, ...)."""
     keep_models: bool = False
     """Keep every episode's models (``models/<episode>_q_<objective>.onnx``: the ones swapped in
     after that episode), not only the last."""
+
+    def __post_init__(self) -> None:
+        if not self.objective.strip(" ,"):
+            raise ConfigError("OnlineConfig: objective must name at least one objective")
 
 
 @dataclass
 class OnlineResult:
     """What :func:`run_online` did."""
 
-    plan: "object"
+    plan: Plan
     """The :class:`asp.Plan` of the search."""
     episodes: int
     swaps: int
@@ -110,16 +111,17 @@ def run_online(
     model: str | os.PathLike,
     out: str | os.PathLike,
     config: OnlineConfig,
-    load: Optional[dict] = None,
-    log: Optional[Callable[[str], None]] = _log_stderr,
+    load: dict | None = None,
+    log: Callable[[str], None] | None = _log_stderr,
     record_transitions: bool = True,
 ) -> OnlineResult:
     """Runs the search of ``model`` with its Q-functions trained after every episode; writes to
     ``out``: ``plan.json``, ``trace.csv``, the final models ``q_<objective>.onnx`` (with their
     ``.pt`` weights), ``transitions/`` (the episodes' transitions as an ``asp-transitions`` data
     set) and ``online.json`` (settings and counts)."""
-    import asp
     import torch
+
+    import asp
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -130,10 +132,10 @@ def run_online(
     if pretrained and len(pretrained) != len(objectives):
         raise DataError(f"{len(pretrained)} Q models for {len(objectives)} objectives ({', '.join(objectives)}): give one per objective")
     networks = []
-    for path, objective in zip(pretrained, objectives):
-        net, features, trained_for = load_q_weights(str(path) + ".pt")
+    for q_path, objective in zip(pretrained, objectives):
+        net, features, trained_for = load_q_weights(str(q_path) + ".pt")
         if trained_for != objective:
-            raise DataError(f"{path}.pt: estimates '{trained_for}', its place in --q is that of '{objective}'")
+            raise DataError(f"{q_path}.pt: estimates '{trained_for}', its place in --q is that of '{objective}'")
         networks.append(net)
 
     assembly = asp.load(model, **(load or {}))
@@ -163,12 +165,9 @@ def run_online(
     torch.set_num_threads(config.threads)
     learners = []
     for k, objective in enumerate(objectives):
-        qc = QConfig(
-            steps=max(config.steps_per_episode, 1), batch=config.batch, buffer=config.buffer, lr=config.lr,
-            seed=config.seed + k, layers=config.layers, width=config.width, threads=config.threads,
-            target_sync=config.target_sync,
-        )
-        learners.append((QAssembly(source, data.objective_index(objective)), DeepQLearner(data.node_dim, data.edge_dim, qc, graphs, networks[k] if networks else None)))
+        qc = QConfig(**{**config.learning(), "seed": config.seed + k}, steps=max(config.steps_per_episode, 1))
+        learner = DeepQLearner(data.node_dim, data.edge_dim, qc, graphs, networks[k] if networks else None)
+        learners.append((QAssembly(source, data.objective_index(objective)), learner))
     paths = [out / f"q_{o}.onnx" for o in objectives]
     lines_path = source.transitions_path
     transitions = 0
@@ -189,7 +188,7 @@ def run_online(
             episodes = e.episodes
             lines = e.transitions_jsonl
             lines_file.write(lines)
-            parsed = [source._parse(line, transitions + i + 1) for i, line in enumerate(lines.splitlines()) if line.strip()]
+            parsed = [source.parse(line, transitions + i + 1) for i, line in enumerate(lines.splitlines()) if line.strip()]
             transitions += len(parsed)
             trace.append((time.monotonic() - started, e.value, e.episodes))
             if e.finished:
@@ -205,8 +204,10 @@ def run_online(
                     losses.append(learner.step())
             exported = False
             if all(learner.steps > 0 or not learner.fresh for _, learner in learners):
-                for (q_assembly, learner), path, objective in zip(learners, paths, objectives):
-                    export_q(learner.model, path, data.features, objective, aggregation=config.aggregation, tolerance=config.parity_tolerance)
+                for (_, learner), path, objective in zip(learners, paths, objectives):
+                    export_q(
+                        learner.model, path, data.features, objective, aggregation=config.aggregation, tolerance=config.parity_tolerance
+                    )
                     if config.keep_models:
                         (out / "models").mkdir(exist_ok=True)
                         (out / "models" / f"{e.episodes}_{path.name}").write_bytes(path.read_bytes())
@@ -302,11 +303,11 @@ def bench_mcts(
     settings: Sequence[str],
     checkpoints: Sequence[float],
     runs: int = 1,
-    q: Optional[Sequence[str]] = None,
-    config: Optional[OnlineConfig] = None,
-    load: Optional[dict] = None,
-    work: Optional[Path] = None,
-    log: Optional[Callable[[str], None]] = _log_stderr,
+    q: Sequence[str] | None = None,
+    config: OnlineConfig | None = None,
+    load: dict | None = None,
+    work: Path | None = None,
+    log: Callable[[str], None] | None = _log_stderr,
 ) -> tuple[str, str, list[dict]]:
     """Each setting of :data:`SETTINGS` named in ``settings`` searches each model for the last
     checkpoint's wall time, ``runs`` times (seeds 0, 1, ...); returns ``asp bench mcts``'s table,
@@ -343,12 +344,12 @@ def bench_mcts(
                         plan = assembly.plan(
                             objective=objectives, pareto=len(objectives) > 1, seed=run, threads=1, time_limit=last,
                             episodes=10**12, budget=base.budget, resolution=base.resolution,
-                            **({"q": list(q), "epsilon": base.epsilon, "q_use": base.q_use} if setting == "pretrained" else {}),
+                            **({"q": list(q or []), "epsilon": base.epsilon, "q_use": base.q_use} if setting == "pretrained" else {}),
                             **(base.search or {}),
                         )
                         trace, done = _trace_of(plan.trace_csv or "")
                     else:
-                        c = replace(base, objective=objective, seconds=last, seed=run, q=list(q) if setting == "retrained" else None)
+                        c = replace(base, objective=objective, seconds=last, seed=run, q=list(q or []) if setting == "retrained" else None)
                         r = run_online(path, scratch / f"{name}-{setting}-{run}", c, load=load, log=None)
                         plan = r.plan
                         trace, done = _trace_of(plan.trace_csv or "")

@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Callable, Iterable, Sequence
+from typing import Callable
 
 import numpy as np
 import torch
 
-from ..data import Assembly, DataError, RemovabilityDataset
+from ..datasets.removability import Assembly, DataError, RemovabilityDataset
 from .gnn import RemovabilityGNN
 
 __all__ = ["TrainConfig", "StateRecord", "AssemblyData", "load_assemblies", "train", "evaluate", "Batch", "make_batch"]
@@ -144,9 +145,9 @@ def make_batch(items: Iterable[tuple[AssemblyData, StateRecord]]) -> Batch:
     )
 
 
-def _seed_everything(config: TrainConfig) -> None:
-    torch.manual_seed(config.seed)
-    torch.set_num_threads(max(1, config.threads))
+def _seed_everything(seed: int, threads: int) -> None:
+    torch.manual_seed(seed)
+    torch.set_num_threads(max(1, threads))
     torch.use_deterministic_algorithms(True, warn_only=True)
 
 
@@ -164,7 +165,7 @@ def train(
     items = [(a, s) for a in assemblies for s in a.states if s.mask.any()]
     if not items:
         raise DataError("no labelled state to train on (" + ", ".join(a.name for a in assemblies) + ")")
-    _seed_everything(config)
+    _seed_everything(config.seed, config.threads)
     model = RemovabilityGNN(node_dim, edge_dim, width=config.width, layers=config.layers)
     nodes = np.concatenate([np.asarray(a.assembly.nodes) for a in assemblies])
     edges = np.concatenate([np.asarray(a.assembly.edge_attr) for a in assemblies])
