@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import inspect
 import os
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any, Iterable, Optional, Sequence, Tuple, Union
+from typing import TYPE_CHECKING, Any, Union
 
 from asp import _asp
 from asp.errors import ConfigError
@@ -14,6 +15,9 @@ from asp.graph import Graph
 from asp.qgraphs import QGraphs
 from asp.result import Plan
 from asp.settings import Order, Overlaps, QUse, Stability, Support, given
+
+if TYPE_CHECKING:
+    from asp.search import Search
 
 __all__ = ["Assembly", "Part", "load", "plan"]
 
@@ -33,10 +37,10 @@ class Part:
 def load(
     path: PathLike,
     *,
-    unit: Optional[str] = None,
-    up: Optional[str] = None,
+    unit: str | None = None,
+    up: str | None = None,
     fixed: Iterable[str] = (),
-) -> "Assembly":
+) -> Assembly:
     """Loads a model: a ``.glb``/``.gltf`` file, or a folder of ``.obj``/``.stl`` files (one part
     per file).
 
@@ -62,7 +66,7 @@ class Assembly:
 
     __slots__ = ("_native", "_parts")
 
-    def __init__(self, native: "_asp.Assembly") -> None:
+    def __init__(self, native: _asp.Assembly) -> None:
         """Wraps a native assembly; use :func:`load` to make one."""
         if not isinstance(native, _asp.Assembly):
             raise TypeError("use asp.load(path) to load an assembly")
@@ -70,7 +74,7 @@ class Assembly:
         self._parts = tuple(Part(i, name, fixed) for i, name, fixed in native.parts())
 
     @property
-    def parts(self) -> Tuple[Part, ...]:
+    def parts(self) -> tuple[Part, ...]:
         """The parts in file order (``parts[i].index == i``)."""
         return self._parts
 
@@ -95,7 +99,7 @@ class Assembly:
         return self._native.up
 
     @property
-    def warnings(self) -> Tuple[str, ...]:
+    def warnings(self) -> tuple[str, ...]:
         """Non-fatal problems found while loading, one line each, naming the part."""
         return tuple(self._native.warnings)
 
@@ -115,43 +119,43 @@ class Assembly:
     def plan(
         self,
         *,
-        order: Optional[Order] = None,
-        model: Optional[PathLike] = None,
-        bookkeeping: Optional[bool] = None,
-        seed: Optional[int] = None,
-        tolerance: Optional[float] = None,
-        contact_distance: Optional[float] = None,
-        normals: Optional[int] = None,
-        sphere_directions: Optional[int] = None,
-        overlaps: Optional[Overlaps] = None,
-        stability: Optional[Stability] = None,
-        physics_threshold: Optional[float] = None,
-        path_planner: Optional[bool] = None,
-        subassemblies: Optional[bool] = None,
-        grid: Optional[bool] = None,
-        rrt_iterations: Optional[int] = None,
-        rrt_time: Optional[float] = None,
-        max_tests: Optional[int] = None,
-        timeout: Optional[float] = None,
-        objective: Union[str, Sequence[str], None] = None,
-        pareto: Optional[bool] = None,
-        episodes: Optional[int] = None,
-        budget: Optional[int] = None,
-        threads: Optional[int] = None,
-        time_limit: Optional[float] = None,
-        exploration: Optional[float] = None,
-        polish: Optional[float] = None,
-        resolution: Optional[int] = None,
-        d_max: Optional[float] = None,
-        support: Optional[Support] = None,
-        q: Union[PathLike, Sequence[PathLike], None] = None,
-        epsilon: Optional[float] = None,
-        q_use: Optional[QUse] = None,
-        robot: Optional[str] = None,
-        robot_base: Union[str, Sequence[float], None] = None,
-        drop_off: Union[str, Sequence[float], None] = None,
-        replans: Optional[int] = None,
-        grippers: Optional[int] = None,
+        order: Order | None = None,
+        model: PathLike | None = None,
+        bookkeeping: bool | None = None,
+        seed: int | None = None,
+        tolerance: float | None = None,
+        contact_distance: float | None = None,
+        normals: int | None = None,
+        sphere_directions: int | None = None,
+        overlaps: Overlaps | None = None,
+        stability: Stability | None = None,
+        physics_threshold: float | None = None,
+        path_planner: bool | None = None,
+        subassemblies: bool | None = None,
+        grid: bool | None = None,
+        rrt_iterations: int | None = None,
+        rrt_time: float | None = None,
+        max_tests: int | None = None,
+        timeout: float | None = None,
+        objective: str | Sequence[str] | None = None,
+        pareto: bool | None = None,
+        episodes: int | None = None,
+        budget: int | None = None,
+        threads: int | None = None,
+        time_limit: float | None = None,
+        exploration: float | None = None,
+        polish: float | None = None,
+        resolution: int | None = None,
+        d_max: float | None = None,
+        support: Support | None = None,
+        q: PathLike | Sequence[PathLike] | None = None,
+        epsilon: float | None = None,
+        q_use: QUse | None = None,
+        robot: str | None = None,
+        robot_base: str | Sequence[float] | None = None,
+        drop_off: str | Sequence[float] | None = None,
+        replans: int | None = None,
+        grippers: int | None = None,
     ) -> Plan:
         """Plans an assembly sequence: the pipeline of ``asp plan``, with the same settings under
         the flags' names (``--max-tests`` is ``max_tests``, ``--no-path-planner`` is
@@ -241,7 +245,7 @@ class Assembly:
         json, found, trace = self._native.plan(settings)
         return Plan(json, found, trace)
 
-    def search(self, *, record: bool = True, **settings: Any) -> "Search":
+    def search(self, *, record: bool = True, **settings: Any) -> Search:
         """A stepped optimiser run: the search of :meth:`plan` with ``objective``, run episode by
         episode on one thread (its tree kept between episodes), with Q-functions swapped in
         between episodes — what the online settings of thesis 6.5 need
@@ -273,10 +277,10 @@ class Assembly:
 
     def graph(
         self,
-        present: Optional[Iterable[int]] = None,
+        present: Iterable[int] | None = None,
         *,
-        tolerance: Optional[float] = None,
-        contact_distance: Optional[float] = None,
+        tolerance: float | None = None,
+        contact_distance: float | None = None,
         overlaps: str = "strict",
         radius_bins: int = 8,
         degree: int = 8,
@@ -312,15 +316,15 @@ class Assembly:
     def q_graphs(
         self,
         *,
-        objective: Union[str, Sequence[str]],
+        objective: str | Sequence[str],
         resolution: int = 9,
-        d_max: Optional[float] = None,
+        d_max: float | None = None,
         support: str = "below",
-        tolerance: Optional[float] = None,
-        contact_distance: Optional[float] = None,
+        tolerance: float | None = None,
+        contact_distance: float | None = None,
         overlaps: str = "strict",
         neighbours: int = 8,
-    ) -> "QGraphs":
+    ) -> QGraphs:
         """The distance maps and optimisation problem of this model (as :meth:`plan` with
         ``objective`` builds them), as a :class:`QGraphs` that gives the graph of any optimiser
         state in the layout of a Q model's inputs (``docs/learning.md``, features ``asp-q/1``).
@@ -351,8 +355,8 @@ class Assembly:
 def plan(
     path: PathLike,
     *,
-    unit: Optional[str] = None,
-    up: Optional[str] = None,
+    unit: str | None = None,
+    up: str | None = None,
     fixed: Iterable[str] = (),
     **settings: Any,
 ) -> Plan:

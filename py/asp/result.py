@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json as _json
 import os
-from typing import Any, Dict, List, Optional, Tuple, Union
+from typing import Any
 
 from asp import _asp
 
@@ -12,7 +12,7 @@ __all__ = ["ORDERS", "Plan"]
 
 #: The part orderings ``order=`` accepts (``bookkeeping`` is ``given`` with bookkeeping; ``gnn``
 #: needs the learned-ordering crate).
-ORDERS: Tuple[str, ...] = tuple(_asp.order_names())
+ORDERS: tuple[str, ...] = tuple(_asp.order_names())
 
 
 class Plan:
@@ -25,11 +25,11 @@ class Plan:
 
     __slots__ = ("_json", "_found", "_trace", "_dict")
 
-    def __init__(self, json: str, found: bool, trace_csv: Optional[str] = None) -> None:
+    def __init__(self, json: str, found: bool, trace_csv: str | None = None) -> None:
         self._json = json
         self._found = bool(found)
         self._trace = trace_csv
-        self._dict: Dict[str, Any] = _json.loads(json)
+        self._dict: dict[str, Any] = _json.loads(json)
 
     @property
     def json(self) -> str:
@@ -46,7 +46,7 @@ class Plan:
         """``"found"``, ``"no_plan"`` or ``"budget_exhausted"``."""
         return self._dict["status"]
 
-    def to_dict(self) -> Dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """The plan JSON as a fresh dict (changing it does not change the plan)."""
         return _json.loads(self._json)
 
@@ -66,67 +66,67 @@ class Plan:
         return self._dict["up"]
 
     @property
-    def parts(self) -> List[Dict[str, Any]]:
+    def parts(self) -> list[dict[str, Any]]:
         """Every part: ``{"index", "name", "fixed"}``."""
         return self.to_dict()["parts"]
 
     @property
-    def assembly_sequence(self) -> List[Dict[str, Any]]:
+    def assembly_sequence(self) -> list[dict[str, Any]]:
         """One entry per non-fixed part in assembly order: ``{"part", "name", "motion"}``
         (empty unless found)."""
         return self.to_dict()["assembly_sequence"]
 
     @property
-    def disassembly_sequence(self) -> List[int]:
+    def disassembly_sequence(self) -> list[int]:
         """Part indices in removal order (when not found: the partial disassembly that got
         furthest)."""
         return list(self._dict["disassembly_sequence"])
 
     @property
-    def partial_assembly_sequence(self) -> List[Dict[str, Any]]:
+    def partial_assembly_sequence(self) -> list[dict[str, Any]]:
         """When not found: the parts that did come off, in assembly order onto
         :attr:`remaining`, entries as in :attr:`assembly_sequence` (empty when found)."""
         return self.to_dict().get("partial_assembly_sequence", [])
 
     @property
-    def remaining(self) -> Optional[List[int]]:
+    def remaining(self) -> list[int] | None:
         """When not found: the parts present where the partial disassembly stops (fixed parts
         included); ``None`` when found."""
         value = self._dict.get("remaining")
         return None if value is None else list(value)
 
     @property
-    def stats(self) -> Dict[str, Any]:
+    def stats(self) -> dict[str, Any]:
         """Removal tests, failures by collision and gravity, path planner calls, seconds."""
         return dict(self._dict["stats"])
 
     @property
-    def explanation(self) -> List[Dict[str, Any]]:
+    def explanation(self) -> list[dict[str, Any]]:
         """For ``no_plan``: each part of the deepest dead end, why it is stuck and which parts
         hold it (empty otherwise)."""
         return self.to_dict().get("explanation", [])
 
     @property
-    def warnings(self) -> List[str]:
+    def warnings(self) -> list[str]:
         """Non-fatal problems found in the model, one line each."""
         return list(self._dict.get("warnings", []))
 
     @property
-    def optimisation(self) -> Optional[Dict[str, Any]]:
+    def optimisation(self) -> dict[str, Any] | None:
         """For optimising runs (``objective=``): objectives, values and the search's settings."""
         return self.to_dict().get("optimisation")
 
     @property
-    def pareto_front(self) -> Optional[List[Dict[str, Any]]]:
+    def pareto_front(self) -> list[dict[str, Any]] | None:
         """For Pareto runs: every non-dominated sequence with its objective vector."""
         return self.to_dict().get("pareto_front")
 
     @property
-    def trace_csv(self) -> Optional[str]:
+    def trace_csv(self) -> str | None:
         """For optimising runs: the search's trace as CSV (what ``asp plan --trace`` writes)."""
         return self._trace
 
-    def write(self, path: Union[str, "os.PathLike[str]"]) -> None:
+    def write(self, path: str | os.PathLike[str]) -> None:
         """Writes the plan JSON to ``path`` (what ``asp plan --out`` writes)."""
         with open(path, "w", encoding="utf-8", newline="") as f:
             f.write(self._json)

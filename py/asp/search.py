@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Optional, Sequence, Union
 
 from asp import _asp
 from asp.result import Plan
@@ -58,7 +58,7 @@ class Search:
     ``KeyboardInterrupt`` (:meth:`result` then gives the plan of the episodes finished).
     """
 
-    def __init__(self, native: "_asp.Search", settings: dict) -> None:
+    def __init__(self, native: _asp.Search, settings: dict) -> None:
         self._native = native
         self._settings = settings
 
@@ -92,7 +92,7 @@ class Search:
         """
         return Episode(*self._native.episode())
 
-    def set_q(self, models: Union[str, Sequence[Union[str, "os.PathLike[str]"]]], epsilon: Optional[float] = None, q_use: Optional[str] = None) -> None:
+    def set_q(self, models: str | Sequence[str | os.PathLike[str]], epsilon: float | None = None, q_use: str | None = None) -> None:
         """Guides the episodes from the next one on by the ε-greedy policy over these Q models (ONNX
         files of ``python -m asp.train``, one per objective in their order). The files are read
         now. ``epsilon`` and ``q_use`` default to the search's settings."""

@@ -9,7 +9,8 @@ types to them.
 
 from __future__ import annotations
 
-from typing import List, Literal, Sequence, Tuple, TypedDict, Union
+from collections.abc import Sequence
+from typing import Literal, TypedDict
 
 __all__ = ["Order", "Overlaps", "PlanSettings", "QUse", "Stability", "Support", "given"]
 
@@ -46,7 +47,7 @@ class PlanSettings(TypedDict, total=False):
     seed: int
     max_tests: int
     timeout: float
-    objective: Union[str, Sequence[str]]
+    objective: str | Sequence[str]
     pareto: bool
     episodes: int
     budget: int
@@ -57,12 +58,12 @@ class PlanSettings(TypedDict, total=False):
     resolution: int
     d_max: float
     support: Support
-    q: Union[str, Sequence[str]]
+    q: str | Sequence[str]
     epsilon: float
     q_use: QUse
     robot: str
-    robot_base: Union[str, Tuple[float, float, float], List[float]]
-    drop_off: Union[str, Tuple[float, float, float], List[float]]
+    robot_base: str | tuple[float, float, float] | list[float]
+    drop_off: str | tuple[float, float, float] | list[float]
     replans: int
     grippers: int
 

@@ -30,10 +30,11 @@ import re
 import statistics
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, get_args
 
 from ..datasets import DataError
 from ..errors import AspError
+from ..settings import QUse
 from .export import ExportError, export_onnx, write_parity_cases
 from .trainer import AssemblyData, TrainConfig, evaluate, load_assemblies, train
 
@@ -86,9 +87,9 @@ def _online_flags(o: argparse.ArgumentParser) -> None:
     o.add_argument("--layers", type=int, default=3, help="GNN layers of a new network (default 3)")
     o.add_argument("--width", type=int, default=64, help="hidden width of a new network (default 64)")
     o.add_argument("--threads", type=int, default=1, help="PyTorch CPU threads (default 1)")
-    o.add_argument("--epsilon", type=float, default=0.2, help="probability of a random removal in a guided rollout (default 0.2)")
+    o.add_argument("--epsilon", type=float, help="probability of a random removal in a guided rollout (default: asp's, 0.2)")
     o.add_argument(
-        "--q-use", choices=["rollouts", "expansions", "both"], default="rollouts", help="where the Q models guide (default rollouts)"
+        "--q-use", choices=list(get_args(QUse)), help="where the Q models guide (default: asp's, rollouts)"
     )
     o.add_argument("--budget", type=int, default=5, help="MCTS iterations per step (default 5)")
     o.add_argument("--resolution", type=int, default=9, help="distance map resolution (default 9)")

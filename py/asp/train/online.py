@@ -35,6 +35,7 @@ import numpy as np
 
 from ..datasets.transitions import DataError, TransitionDataset
 from ..errors import ConfigError
+from ..settings import PlanSettings, QUse
 from .q import BindingGraphs, DeepQLearner, QAssembly, QConfig, QLearning, export_q, load_q_weights, save_q_weights
 
 if TYPE_CHECKING:
@@ -65,8 +66,10 @@ class OnlineConfig(QLearning):
     retrained setting."""
     steps_per_episode: int = 20
     """Deep Q-learning steps after each episode (the thesis: 20 for 5×5 cubes)."""
-    epsilon: float = 0.2
-    q_use: str = "rollouts"
+    epsilon: float | None = None
+    """The probability of a random removal in a guided rollout (``None``: asp's default, 0.2)."""
+    q_use: QUse | None = None
+    """Where the Q models guide (``None``: asp's default, ``rollouts``)."""
     budget: int = 5
     resolution: int = 9
     aggregation: str = "dense"
@@ -341,12 +344,16 @@ def bench_mcts(
                 map_seconds = 0.0
                 for run in range(runs):
                     if setting in ("vanilla", "pretrained"):
-                        plan = assembly.plan(
-                            objective=objectives, pareto=len(objectives) > 1, seed=run, threads=1, time_limit=last,
-                            episodes=10**12, budget=base.budget, resolution=base.resolution,
-                            **({"q": list(q or []), "epsilon": base.epsilon, "q_use": base.q_use} if setting == "pretrained" else {}),
-                            **(base.search or {}),
-                        )
+                        kw = PlanSettings(objective=objectives, pareto=len(objectives) > 1, seed=run, threads=1, time_limit=last,
+                                          episodes=10**12, budget=base.budget, resolution=base.resolution)
+                        if setting == "pretrained":
+                            kw["q"] = list(q or [])
+                            if base.epsilon is not None:
+                                kw["epsilon"] = base.epsilon
+                            if base.q_use is not None:
+                                kw["q_use"] = base.q_use
+                        kw.update(base.search or {})  # type: ignore[typeddict-item]
+                        plan = assembly.plan(**kw)
                         trace, done = _trace_of(plan.trace_csv or "")
                     else:
                         c = replace(base, objective=objective, seconds=last, seed=run, q=list(q or []) if setting == "retrained" else None)
