@@ -233,9 +233,27 @@ fn positive(name: &str, v: f64) -> Result<f64> {
     }
 }
 
-/// Loads the model at `path` with the settings' unit, up axis and fixed parts.
+/// Loads the model at `path` with the settings' unit, up axis and fixed parts; files outside
+/// the model's folder are refused and the default [`asp_geom::io::Limits`] hold.
 pub fn load(path: &Path, settings: &PlanSettings) -> Result<Assembly> {
-    let options = LoadOptions { unit: settings.unit.clone(), up: settings.up, fixed: settings.fixed.clone() };
+    load_with(path, settings, false, asp_geom::io::Limits::default())
+}
+
+/// [`load`] with files outside the model's folder allowed or not
+/// ([`LoadOptions::allow_outside_files`]) and the given caps on its size.
+pub fn load_with(
+    path: &Path,
+    settings: &PlanSettings,
+    allow_outside_files: bool,
+    limits: asp_geom::io::Limits,
+) -> Result<Assembly> {
+    let options = LoadOptions {
+        unit: settings.unit.clone(),
+        up: settings.up,
+        fixed: settings.fixed.clone(),
+        allow_outside_files,
+        limits,
+    };
     Ok(asp_geom::io::load(path, &options)?)
 }
 

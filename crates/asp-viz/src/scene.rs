@@ -49,7 +49,7 @@ pub fn load_model(report: &PlanReport, plan_path: &Path, model: Option<&Path>) -
     let up = Axis::parse(&report.up)
         .ok_or_else(|| VizError::input(plan_path, format!("'{}' is not an up axis", report.up)))?;
     let fixed = report.parts.iter().filter(|p| p.fixed).map(|p| p.name.clone()).collect();
-    let assembly = load(&path, &LoadOptions { unit: Some(unit), up: Some(up), fixed })?;
+    let assembly = load(&path, &LoadOptions { unit: Some(unit), up: Some(up), fixed, ..LoadOptions::default() })?;
     check_parts(&assembly, report, &path)?;
     Ok(assembly)
 }

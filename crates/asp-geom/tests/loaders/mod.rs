@@ -296,7 +296,7 @@ fn nested_nodes_give_world_coordinates_in_metres() {
     check_nested_scene(&load(&glb_path, &LoadOptions::default()).unwrap());
 
     // options override the file: metres and +Y, and more fixed parts
-    let options = LoadOptions { unit: Some(Units::metres()), up: Some(Axis::Y), fixed: vec!["tri".into()] };
+    let options = LoadOptions { unit: Some(Units::metres()), up: Some(Axis::Y), fixed: vec!["tri".into()], ..LoadOptions::default() };
     let assembly = load(&path, &options).unwrap();
     assert_eq!(assembly.up, Axis::Y);
     assert_points(&vertices(&assembly.parts[0]), &[[10.0, 0.0, 5.0], [10.0, 2.0, 5.0], [8.0, 0.0, 5.0]], 1.0);
@@ -316,6 +316,71 @@ fn gltf_with_an_external_bin_file() {
     std::fs::remove_file(dir.path().join("my parts.bin")).unwrap();
     assert_message(&load_error(&path), "external.gltf", "buffer file");
     assert_message(&load_error(&path), "my parts.bin", "is missing");
+}
+
+#[test]
+fn buffers_outside_the_model_folder_are_refused_unless_allowed() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    std::fs::create_dir_all(dir.path().join("other")).unwrap();
+    std::fs::create_dir(&model).unwrap();
+    let (fixture, content) = nested_scene();
+    std::fs::write(dir.path().join("other/secret.bin"), &fixture.bin).unwrap();
+    let secret = dir.path().join("other/secret.bin");
+    let cases = [
+        ("up.gltf", "../other/secret.bin".to_string(), "points outside the model's folder"),
+        ("absolute.gltf", secret.display().to_string(), "is an absolute path"),
+        ("file_uri.gltf", format!("file://{}", secret.display()), "is an absolute path"),
+    ];
+    for (name, uri, cause) in cases {
+        let path = model.join(name);
+        std::fs::write(&path, fixture.document(content.clone(), json!({"uri": uri})).to_string()).unwrap();
+        let message = load_error(&path);
+        assert_message(&message, name, cause);
+        assert_message(&message, &uri, "--allow-outside-files");
+        let allowed = LoadOptions { allow_outside_files: true, ..LoadOptions::default() };
+        check_nested_scene(&load(&path, &allowed).unwrap());
+    }
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(&secret, model.join("link.bin")).unwrap();
+        let path = model.join("link.gltf");
+        std::fs::write(&path, fixture.document(content.clone(), json!({"uri": "link.bin"})).to_string()).unwrap();
+        assert_message(&load_error(&path), "link.gltf", "points outside the model's folder");
+        // a folder of parts whose file is a symlink out
+        let parts = dir.path().join("parts");
+        std::fs::create_dir(&parts).unwrap();
+        std::fs::write(dir.path().join("outside.stl"), ascii_stl(&[[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]])).unwrap();
+        std::os::unix::fs::symlink(dir.path().join("outside.stl"), parts.join("a.stl")).unwrap();
+        assert_message(&load_error(&parts), "a.stl", "points outside the model's folder");
+    }
+}
+
+#[test]
+fn counts_past_the_caps_are_refused_before_reading() {
+    use asp_geom::io::Limits;
+    let dir = tempfile::tempdir().unwrap();
+    let (fixture, content) = nested_scene();
+    let path = write_gltf(dir.path(), "nested.gltf", &fixture, content);
+    let small = |max_triangles, max_parts| LoadOptions { limits: Limits { max_triangles, max_parts }, ..LoadOptions::default() };
+    assert_message(&load(&path, &small(1, 100)).unwrap_err().to_string(), "nested.gltf", "--max-triangles");
+    assert_message(&load(&path, &small(100, 1)).unwrap_err().to_string(), "nested.gltf", "--max-parts");
+    check_nested_scene(&load(&path, &small(100, 100)).unwrap());
+    // a binary STL header announcing more triangles than the cap
+    let stl = dir.path().join("big.stl");
+    std::fs::write(&stl, binary_stl(&[[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]; 3])).unwrap();
+    assert_message(&load(&stl, &small(2, 100)).unwrap_err().to_string(), "big.stl", "--max-triangles");
+}
+
+#[test]
+fn non_finite_transforms_name_the_node() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut f = Fixture::default();
+    let positions = f.positions(&TRIANGLE);
+    let mut content = single_mesh(positions, None);
+    content["nodes"][0]["scale"] = json!([1.0, 1e39, 1.0]);
+    let path = write_gltf(dir.path(), "inf.gltf", &f, content);
+    assert_message(&load_error(&path), "inf.gltf", "node 0 ('the_part'): its transform has NaN or infinite values");
 }
 
 #[test]
