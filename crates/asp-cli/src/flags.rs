@@ -86,6 +86,16 @@ pub struct ModelArgs {
     /// is the base.
     #[arg(long, num_args = 1.., value_name = "NAME")]
     pub fixed: Vec<String>,
+    /// Let the model (and a URDF) read files outside its folder: absolute paths, `..` that
+    /// climbs out, symlinks that point out (docs/security.md).
+    #[arg(long)]
+    pub allow_outside_files: bool,
+    /// Most triangles a model may have over all its parts [default: 20000000].
+    #[arg(long, value_name = "N")]
+    pub max_triangles: Option<usize>,
+    /// Most parts a model may have [default: 10000].
+    #[arg(long, value_name = "N")]
+    pub max_parts: Option<usize>,
     /// Contact tolerance in model units: motions may push a part this deep into another
     /// [default: 1e-4 × the model's diagonal].
     #[arg(long)]

@@ -66,6 +66,15 @@ pub(crate) fn model_settings(args: &ModelArgs) -> anyhow::Result<PlanSettings> {
     })
 }
 
+/// The loaders' caps from `--max-triangles` / `--max-parts`.
+pub(crate) fn limits(args: &ModelArgs) -> asp_geom::io::Limits {
+    let defaults = asp_geom::io::Limits::default();
+    asp_geom::io::Limits {
+        max_triangles: args.max_triangles.unwrap_or(defaults.max_triangles),
+        max_parts: args.max_parts.unwrap_or(defaults.max_parts),
+    }
+}
+
 /// The pipeline's settings of `asp plan`.
 pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
     let timeout = match args.timeout {
@@ -267,7 +276,7 @@ fn plan_one(
     separate: bool,
 ) -> anyhow::Result<Verdict> {
     let load_started = Instant::now();
-    let assembly = pipeline::load(model, settings)?;
+    let assembly = pipeline::load_with(model, settings, args.load.allow_outside_files, limits(&args.load))?;
     let load_seconds = load_started.elapsed().as_secs_f64();
     let for_mcap = args.mcap.as_ref().map(|_| assembly.clone());
     let bar = progress_bar(args.quiet || settings.optimise.is_some());

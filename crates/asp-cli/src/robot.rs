@@ -43,6 +43,12 @@ pub struct CheckArgs {
     /// Seed of the sampled configurations and of the IK restarts.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Where the URDF's `package://NAME/` meshes lie (repeatable).
+    #[arg(long, value_name = "NAME=DIR")]
+    pub package_path: Vec<String>,
+    /// Let the URDF name meshes outside its folder.
+    #[arg(long)]
+    pub allow_outside_files: bool,
 }
 
 /// The robot flags of `asp plan`.
@@ -69,6 +75,18 @@ pub struct PlanRobotArgs {
     /// (feasibility search only; the plan's steps say which parts are held).
     #[arg(long, default_value_t = 1, value_name = "N", help_heading = "Robot")]
     pub grippers: usize,
+    /// Where the URDF's `package://NAME/` meshes lie (repeatable).
+    #[arg(long, value_name = "NAME=DIR", help_heading = "Robot")]
+    pub package_path: Vec<String>,
+}
+
+/// The URDF's file rules from `--package-path` and `--allow-outside-files`.
+fn robot_files(package_paths: &[String], allow_outside_files: bool) -> anyhow::Result<asp_robot::RobotFiles> {
+    let package_paths = package_paths
+        .iter()
+        .map(|p| asp_robot::RobotFiles::parse_package_path(p).map_err(anyhow::Error::msg))
+        .collect::<anyhow::Result<_>>()?;
+    Ok(asp_robot::RobotFiles { package_paths, allow_outside_files })
 }
 
 fn point(flag: &str, s: &str) -> anyhow::Result<[f64; 3]> {
@@ -96,7 +114,13 @@ pub fn setup(args: &crate::flags::PlanArgs) -> anyhow::Result<Option<asp_robot::
         }
         return Ok(None);
     };
-    let robot = if name == "panda" { Robot::panda() } else { Robot::from_urdf_file(std::path::Path::new(name))? };
+    let files = robot_files(&a.package_path, args.load.allow_outside_files)?;
+    let robot = if name == "panda" {
+        Robot::panda()
+    } else {
+        Robot::from_urdf_file_checked(std::path::Path::new(name), &ChainSpec::default(), &files)?
+    };
+    robot.check_can_grasp()?;
     if a.replans == 0 {
         anyhow::bail!("--replans must be at least 1");
     }
@@ -119,7 +143,7 @@ pub fn run(args: &RobotArgs) -> anyhow::Result<ExitCode> {
 fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     let spec = ChainSpec { base_link: args.base_link.clone(), tip_link: args.tip_link.clone() };
     let robot = match &args.urdf {
-        Some(p) => Robot::from_urdf_file_with(p, &spec)?,
+        Some(p) => Robot::from_urdf_file_checked(p, &spec, &robot_files(&args.package_path, args.allow_outside_files)?)?,
         None => Robot::from_urdf_str(asp_robot::PANDA_URDF, std::path::Path::new("<builtin panda>"), &spec)?,
     };
     println!("robot {} from {}", robot.name, robot.source.display());
