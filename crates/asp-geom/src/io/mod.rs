@@ -131,6 +131,7 @@ fn finish(mut assembly: Assembly, options: &LoadOptions) -> Result<Assembly> {
     assembly.dedupe_names();
     assembly.set_fixed(&options.fixed)?;
     assembly.validate()?;
+    crate::validate::check_model(&assembly)?;
     Ok(assembly)
 }
 

@@ -644,7 +644,9 @@ f 3 4 8 7\nf 4 1 5 8\nf 5 6 7 8
 fn folders_of_obj_and_stl_files() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("b_tetra.STL"), ascii_stl(&TETRAHEDRON)).unwrap();
-    std::fs::write(dir.path().join("c_binary.stl"), binary_stl(&TETRAHEDRON)).unwrap();
+    // the same tetrahedron in binary, 2 units along x (the same mesh at the same place is a duplicate)
+    let shifted = TETRAHEDRON.map(|t| t.map(|[x, y, z]| [x + 2.0, y, z]));
+    std::fs::write(dir.path().join("c_binary.stl"), binary_stl(&shifted)).unwrap();
     std::fs::write(dir.path().join("a_cube.obj"), CUBE_OBJ).unwrap();
     std::fs::write(dir.path().join("notes.txt"), "ignored").unwrap();
     std::fs::write(dir.path().join("a_cube.mtl"), "ignored").unwrap();
@@ -662,7 +664,11 @@ fn folders_of_obj_and_stl_files() {
         assert_eq!(tetra.mesh.vertices.len(), 4, "STL corners are shared");
         assert!(tetra.mesh.topology().is_closed_manifold());
     }
-    assert_eq!(assembly.parts[1].mesh, assembly.parts[2].mesh, "ASCII and binary read alike");
+    let (ascii, binary) = (&assembly.parts[1].mesh, &assembly.parts[2].mesh);
+    assert_eq!(ascii.triangles, binary.triangles, "ASCII and binary read alike");
+    for (a, b) in ascii.vertices.iter().zip(&binary.vertices) {
+        assert_near(*b - Vec3::new(0.02, 0.0, 0.0), *a, 1e-7);
+    }
 
     let single = load(&dir.path().join("b_tetra.STL"), &LoadOptions::default()).unwrap();
     assert_eq!(names(&single), ["b_tetra"]);
@@ -875,8 +881,13 @@ fn sparse_accessors_substitute_values() {
                         "values": {"bufferView": sparse_values}});
     let over_data = f.accessor(json!({"bufferView": base, "componentType": 5126, "count": 3, "type": "VEC3",
                                       "min": [0, 0, 0], "max": [5, 6, 7], "sparse": sparse}));
+    // over zeros: two substitutions, so that the triangle has an area
+    let two_indices = f.view([1u8, 2, 0, 0].to_vec());
+    let two_values = f.view([1.0f32, 0.0, 0.0, 5.0, 6.0, 7.0].iter().flat_map(|c| c.to_le_bytes()).collect());
+    let two = json!({"count": 2, "indices": {"bufferView": two_indices, "componentType": 5121},
+                     "values": {"bufferView": two_values}});
     let over_zeros = f.accessor(json!({"componentType": 5126, "count": 3, "type": "VEC3",
-                                       "min": [0, 0, 0], "max": [5, 6, 7], "sparse": sparse}));
+                                       "min": [0, 0, 0], "max": [5, 6, 7], "sparse": two}));
     for (accessor, first) in [(over_data, TRIANGLE[0]), (over_zeros, [0.0; 3])] {
         let path = write_gltf(dir.path(), "sparse.gltf", &f, single_mesh(accessor, None));
         let part = &load(&path, &LoadOptions::default()).unwrap().parts[0];
