@@ -309,3 +309,54 @@ fn onnx_files_and_plan_json_of_other_kinds() {
         }
     }
 }
+
+/// The peak resident memory (bytes) of `asp ARGS` and its exit code, from `/usr/bin/time`
+/// (None where it is not installed).
+fn peak_memory(args: &[&str]) -> Option<(u64, Option<i32>)> {
+    let time = Path::new("/usr/bin/time");
+    if !time.exists() {
+        eprintln!("skipped: /usr/bin/time is not installed");
+        return None;
+    }
+    let o = Command::new(time).arg("-f").arg("peak_kb=%M").arg(env!("CARGO_BIN_EXE_asp")).args(args).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    let kb: u64 = err.lines().find_map(|l| l.strip_prefix("peak_kb=")).and_then(|v| v.trim().parse().ok()).expect("a peak");
+    // time's own exit code is the command's
+    Some((kb * 1024, o.status.code()))
+}
+
+#[test]
+fn peak_memory_on_hostile_files_stays_within_ten_times_their_size() {
+    const FIXED: u64 = 200 << 20;
+    let dir = tempfile::tempdir().unwrap();
+    // an instancing bomb: one mesh of 2,500 triangles placed by 10,000 nodes (25 M triangles)
+    let n = 2500;
+    let mut positions = Vec::new();
+    for i in 0..n {
+        let x = i as f32;
+        positions.extend([[x, 0.0, 0.0], [x + 1.0, 0.0, 0.0], [x, 1.0, 0.0]]);
+    }
+    let bin: Vec<u8> = positions.iter().flatten().flat_map(|c: &f32| c.to_le_bytes()).collect();
+    let nodes: Vec<serde_json::Value> = (0..10_000).map(|i| json!({"mesh": 0, "translation": [0, 0, i]})).collect();
+    let mut bomb = document(json!(nodes), json!({"byteLength": bin.len()}));
+    bomb["accessors"][0]["count"] = json!(3 * n);
+    bomb["accessors"][0]["max"] = json!([n, 1, 0]);
+    bomb["bufferViews"][0]["byteLength"] = json!(bin.len());
+    let bomb = write(dir.path(), "instances.glb", glb(bomb.to_string().as_bytes(), &bin));
+    // a position accessor of many zeros without a buffer view (sparse over nothing)
+    let mut zeros = document(json!([{"mesh": 0}]), json!({"byteLength": 36}));
+    zeros["accessors"][0] = json!({"componentType": 5126, "count": 1u64 << 30, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]});
+    let zeros = write(dir.path(), "zeros.glb", glb(zeros.to_string().as_bytes(), &triangle_bin(TRIANGLE)));
+    // a binary STL whose header announces 50 M triangles over a file of a few bytes
+    let mut stl = vec![0u8; 80];
+    stl.extend(50_000_000u32.to_le_bytes());
+    stl.extend([0u8; 100]);
+    let stl = write(dir.path(), "liar.stl", stl);
+    for file in [&bomb, &zeros, &stl] {
+        let size = std::fs::metadata(file).unwrap().len();
+        let out = dir.path().join("plan.json");
+        let Some((peak, code)) = peak_memory(&["plan", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet", "--timeout", "5"]) else { return };
+        assert_eq!(code, Some(2), "{} is refused", file.display());
+        assert!(peak <= 10 * size + FIXED, "{}: peak {} MB for a file of {} kB", file.display(), peak >> 20, size >> 10);
+    }
+}

@@ -48,6 +48,7 @@ fn read_gltf(path: &Path, bytes: &[u8], options: &LoadOptions, external: &Extern
     let up = options.up.or(settings.up).unwrap_or(Axis::Y);
     let mut builder = PartBuilder::new(&document, buffers, units.metres, options.limits);
     if let Some(scene) = &scene {
+        check_announced(&document, scene, &options.limits)?;
         builder.add_scene(scene)?;
     }
     Ok(Assembly { parts: builder.parts, units, up, source: path.to_path_buf(), warnings: builder.warnings })
@@ -443,6 +444,31 @@ impl<'a> PartBuilder<'a> {
         };
         Ok((vertices, triangulate(primitive.mode(), &indices)?))
     }
+}
+
+/// Checks the parts and triangles the scene announces (every mesh instance counted, from the
+/// accessors' counts) against the caps before any buffer data is read: an instancing bomb (a
+/// small mesh placed by thousands of nodes) is refused before it takes memory.
+fn check_announced(document: &Document, scene: &Scene, limits: &Limits) -> Res<()> {
+    let per_mesh: Vec<usize> = document
+        .meshes()
+        .map(|m| m.primitives().filter(|p| is_triangles(p.mode())).map(|p| announced_triangles(&p)).fold(0, usize::saturating_add))
+        .collect();
+    let mut seen = vec![false; document.nodes().len()];
+    let mut stack: Vec<Node> = scene.nodes().collect();
+    let (mut parts, mut triangles) = (0usize, 0usize);
+    while let Some(node) = stack.pop() {
+        if std::mem::replace(&mut seen[node.index()], true) {
+            continue; // a cycle or a second parent: reported while the scene is read
+        }
+        if let Some(mesh) = node.mesh() {
+            parts += 1;
+            triangles = triangles.saturating_add(per_mesh[mesh.index()]);
+        }
+        stack.extend(node.children());
+    }
+    limits.check_parts(parts)?;
+    limits.check_triangles(triangles)
 }
 
 /// The longest part name accepted (bytes): names are printed in tables, errors and pages.
