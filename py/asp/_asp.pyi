@@ -12,6 +12,9 @@ def load(
     unit: str | None = None,
     up: str | None = None,
     fixed: Sequence[str] = ...,
+    max_triangles: int | None = None,
+    max_parts: int | None = None,
+    allow_outside_files: bool | None = None,
 ) -> Assembly: ...
 def default_settings() -> dict[str, Any]: ...
 def order_names() -> list[str]: ...

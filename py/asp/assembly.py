@@ -40,6 +40,9 @@ def load(
     unit: str | None = None,
     up: str | None = None,
     fixed: Iterable[str] = (),
+    max_triangles: int | None = None,
+    max_parts: int | None = None,
+    allow_outside_files: bool | None = None,
 ) -> Assembly:
     """Loads a model: a ``.glb``/``.gltf`` file, or a folder of ``.obj``/``.stl`` files (one part
     per file).
@@ -50,12 +53,19 @@ def load(
         says, else +Y for glTF and +Z for OBJ/STL).
     :param fixed: names of base parts, on top of those the file marks as fixed. Without any, a
         ground plane under the lowest point is the base.
-    :raises LoadError: the file cannot be read or is not a model (the message names the file).
+    :param max_triangles: most triangles the model may have over all its parts (default 20 M);
+        checked against the file's own counts before its data is read.
+    :param max_parts: most parts the model may have (default 10,000).
+    :param allow_outside_files: let the model read files outside its folder (absolute paths,
+        ``..`` that climbs out, symlinks pointing out); refused by default (``docs/security.md``).
+    :raises LoadError: the file cannot be read, is not a model, is over a cap or names a file
+        outside its folder (the message names the file).
     :raises ConfigError: an unknown unit or axis, or a fixed part the model does not have.
     """
     if isinstance(fixed, str):
         fixed = [fixed]
-    native = _asp.load(os.fspath(path), unit=unit, up=up, fixed=list(fixed))
+    native = _asp.load(os.fspath(path), unit=unit, up=up, fixed=list(fixed), max_triangles=max_triangles,
+                       max_parts=max_parts, allow_outside_files=allow_outside_files)
     return Assembly(native)
 
 
@@ -156,6 +166,8 @@ class Assembly:
         drop_off: str | Sequence[float] | None = None,
         replans: int | None = None,
         grippers: int | None = None,
+        package_path: Sequence[str] | None = None,
+        allow_outside_files: bool | None = None,
     ) -> Plan:
         """Plans an assembly sequence: the pipeline of ``asp plan``, with the same settings under
         the flags' names (``--max-tests`` is ``max_tests``, ``--no-path-planner`` is
@@ -206,6 +218,9 @@ class Assembly:
             the floor in front of the model).
         :param drop_off: where removed parts are put down, ``(x, y, z)``.
         :param replans: path plans per grasp, the shortest kept (4).
+        :param package_path: where the robot URDF's ``package://NAME/`` meshes lie, ``NAME=DIR``
+            each.
+        :param allow_outside_files: let the robot's URDF name meshes outside its folder.
 
         The optimiser (with ``objective``):
 
@@ -358,8 +373,12 @@ def plan(
     unit: str | None = None,
     up: str | None = None,
     fixed: Iterable[str] = (),
+    max_triangles: int | None = None,
+    max_parts: int | None = None,
     **settings: Any,
 ) -> Plan:
     """Loads the model at ``path`` (:func:`load`) and plans it (:meth:`Assembly.plan`, whose
-    keywords ``settings`` are)."""
-    return load(path, unit=unit, up=up, fixed=fixed).plan(**settings)
+    keywords ``settings`` are; ``allow_outside_files`` counts for both)."""
+    outside = settings.get("allow_outside_files")
+    model = load(path, unit=unit, up=up, fixed=fixed, max_triangles=max_triangles, max_parts=max_parts, allow_outside_files=outside)
+    return model.plan(**settings)

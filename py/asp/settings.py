@@ -66,6 +66,8 @@ class PlanSettings(TypedDict, total=False):
     drop_off: str | tuple[float, float, float] | list[float]
     replans: int
     grippers: int
+    package_path: Sequence[str]
+    allow_outside_files: bool
 
 
 def given(settings: dict) -> dict:

@@ -143,11 +143,12 @@ pub struct RobotEntry {
 pub const ROBOTS: &[RobotEntry] =
     &[RobotEntry { name: "panda", help: "the shipped Franka-Panda-like arm", build: asp_robot::Robot::panda }];
 
-/// The robot `name` stands for: a catalogue robot, else a URDF file.
-pub fn robot(name: &str) -> Result<asp_robot::Robot> {
+/// The robot `name` stands for: a catalogue robot, else a URDF file whose meshes are found
+/// under `files`' rules.
+pub fn robot(name: &str, files: &asp_robot::RobotFiles) -> Result<asp_robot::Robot> {
     match ROBOTS.iter().find(|r| r.name == name) {
         Some(r) => Ok((r.build)()),
-        None => Ok(asp_robot::Robot::from_urdf_file(Path::new(name))?),
+        None => Ok(asp_robot::Robot::from_urdf_file_checked(Path::new(name), &asp_robot::ChainSpec::default(), files)?),
     }
 }
 
@@ -263,7 +264,8 @@ mod tests {
         assert_eq!((gnn.build)(None).unwrap().name(), "gnn");
         let e = ordering("sideways").unwrap_err().to_string();
         assert_eq!(e, "order: unknown order 'sideways' (use given, shuffled, random, bookkeeping, gnn)");
-        assert!(robot("panda").is_ok());
-        assert!(robot("/no/such/robot.urdf").unwrap_err().to_string().contains("/no/such/robot.urdf"));
+        let files = asp_robot::RobotFiles::default();
+        assert!(robot("panda", &files).is_ok());
+        assert!(robot("/no/such/robot.urdf", &files).unwrap_err().to_string().contains("/no/such/robot.urdf"));
     }
 }

@@ -56,6 +56,10 @@ pub struct PlanSettings {
     pub up: Option<Axis>,
     /// Names of base parts, on top of those the file marks as fixed.
     pub fixed: Vec<String>,
+    /// Whether the model may read files outside its folder (docs/security.md).
+    pub allow_outside_files: bool,
+    /// Caps on the model's size, checked before its data is read.
+    pub limits: asp_geom::io::Limits,
     /// Contact tolerance in model units (default 1e-4 × the model's diagonal).
     pub tolerance: Option<f64>,
     /// Contact distance for stability, model units (default 1e-3 × the diagonal).
@@ -107,6 +111,8 @@ impl Default for PlanSettings {
             unit: None,
             up: None,
             fixed: Vec::new(),
+            allow_outside_files: false,
+            limits: asp_geom::io::Limits::default(),
             tolerance: None,
             contact_distance: None,
             normals: WorldConfig::default().normal_clusters,
@@ -221,9 +227,16 @@ fn positive(name: &str, v: f64) -> Result<f64> {
     }
 }
 
-/// Loads the model at `path` with the settings' unit, up axis and fixed parts.
+/// Loads the model at `path` with the settings' unit, up axis, fixed parts, file rule
+/// ([`PlanSettings::allow_outside_files`]) and caps ([`PlanSettings::limits`]).
 pub fn load(path: &Path, settings: &PlanSettings) -> Result<Assembly> {
-    let options = LoadOptions { unit: settings.unit.clone(), up: settings.up, fixed: settings.fixed.clone() };
+    let options = LoadOptions {
+        unit: settings.unit.clone(),
+        up: settings.up,
+        fixed: settings.fixed.clone(),
+        allow_outside_files: settings.allow_outside_files,
+        limits: settings.limits,
+    };
     Ok(asp_geom::io::load(path, &options)?)
 }
 

@@ -117,6 +117,13 @@ pub struct PlanRequest {
     pub up: Option<String>,
     /// Base parts that stay in place, by name, on top of those the file marks as fixed.
     pub fixed: Vec<String>,
+    /// Most triangles a model may have over all its parts (default 20 M; docs/security.md).
+    pub max_triangles: Option<usize>,
+    /// Most parts a model may have (default 10,000).
+    pub max_parts: Option<usize>,
+    /// Let the model and the robot's URDF read files outside their folders: absolute paths, `..`
+    /// that climbs out, symlinks that point out (default: refused).
+    pub allow_outside_files: Option<bool>,
 
     // --- the removal test ---
     /// Contact tolerance: motions may push a part this deep into another (default 1e-4 × the
@@ -206,10 +213,12 @@ pub struct PlanRequest {
     pub replans: Option<usize>,
     /// Grippers in all: up to N-1 placed parts may be held (feasibility search).
     pub grippers: Option<usize>,
+    /// Where a URDF's `package://NAME/` meshes lie, `NAME=DIR` each.
+    pub package_path: Vec<String>,
 }
 
-/// The keys that belong to loading a model (`asp.load` in Python, not `Assembly.plan`).
-pub const LOAD_KEYS: [&str; 3] = ["unit", "up", "fixed"];
+/// The keys that belong to loading a model only (`asp.load` in Python, not `Assembly.plan`).
+pub const LOAD_KEYS: [&str; 5] = ["unit", "up", "fixed", "max_triangles", "max_parts"];
 
 impl PlanRequest {
     /// Every key of a request, in declaration order.
@@ -266,7 +275,7 @@ impl PlanRequest {
     pub fn to_json(&self) -> String {
         let mut value = serde_json::to_value(self).unwrap_or_default();
         if let serde_json::Value::Object(map) = &mut value {
-            map.retain(|k, v| !v.is_null() && !(k == "fixed" && v.as_array().is_some_and(Vec::is_empty)));
+            map.retain(|_, v| !v.is_null() && !v.as_array().is_some_and(Vec::is_empty));
         }
         value.to_string()
     }
@@ -283,13 +292,16 @@ impl PlanRequest {
             ($($field:ident),+) => {$(if self.$field.is_some() { keys.push(stringify!($field)); })+};
         }
         given!(
-            unit, up, tolerance, contact_distance, normals, sphere_directions, overlaps, stability, physics_threshold,
+            unit, up, max_triangles, max_parts, allow_outside_files, tolerance, contact_distance, normals, sphere_directions, overlaps, stability, physics_threshold,
             path_planner, subassemblies, grid, rrt_iterations, rrt_time, order, model, bookkeeping, seed, max_tests,
             timeout, objective, pareto, episodes, budget, threads, time_limit, exploration, polish, resolution, d_max,
             support, q, epsilon, q_use, robot, robot_base, drop_off, replans, grippers
         );
         if !self.fixed.is_empty() {
             keys.push("fixed");
+        }
+        if !self.package_path.is_empty() {
+            keys.push("package_path");
         }
         keys
     }
@@ -384,7 +396,7 @@ mod tests {
     #[test]
     fn keys_are_every_field_and_json_round_trips() {
         let keys = PlanRequest::keys();
-        assert_eq!(keys.len(), 40, "{keys:?}");
+        assert_eq!(keys.len(), 44, "{keys:?}");
         assert!(keys.iter().any(|k| k == "time_limit") && keys.iter().any(|k| k == "robot_base"));
         let r = PlanRequest {
             objective: Some(vec!["access".into()]),

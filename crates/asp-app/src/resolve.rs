@@ -84,7 +84,7 @@ fn check_applies(r: &PlanRequest) -> Result<()> {
     needs("physics_threshold", r.stability == Some(Stability::Physics), "`stability` physics")?;
     needs("epsilon", r.q.is_some(), "learned Q-functions (`q`)")?;
     needs("q_use", r.q.is_some(), "learned Q-functions (`q`)")?;
-    for key in ["robot_base", "drop_off", "replans"] {
+    for key in ["robot_base", "drop_off", "replans", "package_path"] {
         needs(key, r.robot.is_some(), "a robot (`robot`)")?;
     }
     Ok(())
@@ -154,6 +154,8 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         unit: r.unit.as_deref().map(unit).transpose()?,
         up: r.up.as_deref().map(axis).transpose()?,
         fixed: r.fixed.clone(),
+        allow_outside_files: r.allow_outside_files.unwrap_or(false),
+        limits: limits(r)?,
         tolerance: positive("tolerance", r.tolerance)?,
         contact_distance: positive("contact_distance", r.contact_distance)?,
         normals: r.normals.unwrap_or(d.normals),
@@ -180,10 +182,27 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
     })
 }
 
-/// The robot of the request, if any.
+/// The loaders' caps.
+fn limits(r: &PlanRequest) -> Result<asp_geom::io::Limits> {
+    let d = asp_geom::io::Limits::default();
+    Ok(asp_geom::io::Limits {
+        max_triangles: at_least_one("max_triangles", r.max_triangles)?.unwrap_or(d.max_triangles),
+        max_parts: at_least_one("max_parts", r.max_parts)?.unwrap_or(d.max_parts),
+    })
+}
+
+/// The robot of the request, if any: its URDF's meshes found under the rules of
+/// `package_path` and `allow_outside_files`, and refused when it has no gripper to take a part.
 fn robot(r: &PlanRequest) -> Result<Option<asp_robot::RobotSetup>> {
     let Some(name) = &r.robot else { return Ok(None) };
-    let robot = catalogue::robot(name).map_err(|e| AppError::setting("robot", e.to_string()))?;
+    let package_paths = r
+        .package_path
+        .iter()
+        .map(|p| asp_robot::RobotFiles::parse_package_path(p).map_err(|_| AppError::setting("package_path", format!("'{p}' is not NAME=DIR"))))
+        .collect::<Result<_>>()?;
+    let files = asp_robot::RobotFiles { package_paths, allow_outside_files: r.allow_outside_files.unwrap_or(false) };
+    let robot = catalogue::robot(name, &files).map_err(|e| AppError::setting("robot", e.to_string()))?;
+    robot.check_can_grasp().map_err(|e| AppError::setting("robot", e.to_string()))?;
     let replans = at_least_one("replans", r.replans)?.unwrap_or(asp_robot::RemovalConfig::default().replans);
     let to_vec = |p: [f64; 3]| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
     Ok(Some(asp_robot::RobotSetup {
@@ -255,25 +274,53 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
 /// `asp._asp.default_settings()` and the docs show these.
 pub fn defaults() -> serde_json::Map<String, Value> {
     let d = PlanSettings::default();
-    let values = json!({
-        "unit": null, "up": null, "fixed": [],
-        "tolerance": null, "contact_distance": null, "normals": d.normals, "sphere_directions": d.sphere_directions,
-        "overlaps": Overlaps::Strict.name(), "stability": Stability::Contact.name(),
-        "physics_threshold": default_physics_threshold(), "path_planner": d.path_planner,
-        "subassemblies": d.subassemblies, "grid": d.grid, "rrt_iterations": d.rrt_iterations, "rrt_time": d.rrt_time,
-        "order": catalogue::ORDERINGS[0].name, "model": null, "bookkeeping": false, "seed": 0,
-        "max_tests": null, "timeout": DEFAULT_TIMEOUT,
-        "objective": null, "pareto": false, "episodes": DEFAULT_EPISODES, "budget": DEFAULT_BUDGET,
-        "threads": null, "time_limit": null, "exploration": DEFAULT_EXPLORATION, "polish": DEFAULT_POLISH,
-        "resolution": asp_geom::distmap::DEFAULT_RESOLUTION, "d_max": null, "support": Support::Below.name(),
-        "q": null, "epsilon": DEFAULT_EPSILON, "q_use": QUse::Rollouts.name(),
-        "robot": null, "robot_base": null, "drop_off": null,
-        "replans": asp_robot::RemovalConfig::default().replans, "grippers": 1,
-    });
-    match values {
-        Value::Object(map) => map,
-        _ => serde_json::Map::new(),
-    }
+    let defaults: [(&str, Value); 44] = [
+        ("unit", Value::Null),
+        ("up", Value::Null),
+        ("fixed", json!([])),
+        ("max_triangles", json!(asp_geom::io::DEFAULT_MAX_TRIANGLES)),
+        ("max_parts", json!(asp_geom::io::DEFAULT_MAX_PARTS)),
+        ("allow_outside_files", json!(false)),
+        ("tolerance", Value::Null),
+        ("contact_distance", Value::Null),
+        ("normals", json!(d.normals)),
+        ("sphere_directions", json!(d.sphere_directions)),
+        ("overlaps", json!(Overlaps::Strict.name())),
+        ("stability", json!(Stability::Contact.name())),
+        ("physics_threshold", json!(default_physics_threshold())),
+        ("path_planner", json!(d.path_planner)),
+        ("subassemblies", json!(d.subassemblies)),
+        ("grid", json!(d.grid)),
+        ("rrt_iterations", json!(d.rrt_iterations)),
+        ("rrt_time", json!(d.rrt_time)),
+        ("order", json!(catalogue::ORDERINGS[0].name)),
+        ("model", Value::Null),
+        ("bookkeeping", json!(false)),
+        ("seed", json!(0)),
+        ("max_tests", Value::Null),
+        ("timeout", json!(DEFAULT_TIMEOUT)),
+        ("objective", Value::Null),
+        ("pareto", json!(false)),
+        ("episodes", json!(DEFAULT_EPISODES)),
+        ("budget", json!(DEFAULT_BUDGET)),
+        ("threads", Value::Null),
+        ("time_limit", Value::Null),
+        ("exploration", json!(DEFAULT_EXPLORATION)),
+        ("polish", json!(DEFAULT_POLISH)),
+        ("resolution", json!(asp_geom::distmap::DEFAULT_RESOLUTION)),
+        ("d_max", Value::Null),
+        ("support", json!(Support::Below.name())),
+        ("q", Value::Null),
+        ("epsilon", json!(DEFAULT_EPSILON)),
+        ("q_use", json!(QUse::Rollouts.name())),
+        ("robot", Value::Null),
+        ("robot_base", Value::Null),
+        ("drop_off", Value::Null),
+        ("replans", json!(asp_robot::RemovalConfig::default().replans)),
+        ("grippers", json!(1)),
+        ("package_path", json!([])),
+    ];
+    defaults.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
 }
 
 #[cfg(test)]

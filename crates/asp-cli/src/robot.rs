@@ -43,6 +43,21 @@ pub struct CheckArgs {
     /// Seed of the sampled configurations and of the IK restarts.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Where the URDF's `package://NAME/` meshes lie (repeatable).
+    #[arg(long, value_name = "NAME=DIR")]
+    pub package_path: Vec<String>,
+    /// Let the URDF name meshes outside its folder.
+    #[arg(long)]
+    pub allow_outside_files: bool,
+}
+
+/// The URDF's file rules from `--package-path` and `--allow-outside-files`.
+fn robot_files(package_paths: &[String], allow_outside_files: bool) -> anyhow::Result<asp_robot::RobotFiles> {
+    let package_paths = package_paths
+        .iter()
+        .map(|p| asp_robot::RobotFiles::parse_package_path(p).map_err(anyhow::Error::msg))
+        .collect::<anyhow::Result<_>>()?;
+    Ok(asp_robot::RobotFiles { package_paths, allow_outside_files })
 }
 
 /// Runs `asp robot`.
@@ -55,7 +70,7 @@ pub fn run(args: &RobotArgs) -> anyhow::Result<ExitCode> {
 fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     let spec = ChainSpec { base_link: args.base_link.clone(), tip_link: args.tip_link.clone() };
     let robot = match &args.urdf {
-        Some(p) => Robot::from_urdf_file_with(p, &spec)?,
+        Some(p) => Robot::from_urdf_file_checked(p, &spec, &robot_files(&args.package_path, args.allow_outside_files)?)?,
         None => Robot::from_urdf_str(asp_robot::PANDA_URDF, std::path::Path::new("<builtin panda>"), &spec)?,
     };
     println!("robot {} from {}", robot.name, robot.source.display());

@@ -21,6 +21,7 @@ pub mod physics;
 pub mod puzzles;
 pub mod rrt;
 pub mod sweep;
+pub mod validate;
 pub mod world;
 
 pub use assembly::{Assembly, Part, Units};

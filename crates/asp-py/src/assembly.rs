@@ -53,11 +53,30 @@ impl PyAssembly {
 
 /// Loads the model at `path` (a `.glb`/`.gltf` file or a folder of `.obj`/`.stl` files, one part
 /// each) with an optional unit (`m`, `mm`, ... or metres per unit), up axis (`z`, `-y`, ...) and
-/// base part names; errors are `asp.LoadError` (naming the file) or `asp.ConfigError`.
+/// base part names, under the caps and the file rule of `docs/security.md`; errors are
+/// `asp.LoadError` (naming the file) or `asp.ConfigError`.
 #[pyfunction]
-#[pyo3(signature = (path, unit=None, up=None, fixed=Vec::new()))]
-pub fn load(py: Python<'_>, path: PathBuf, unit: Option<&str>, up: Option<&str>, fixed: Vec<String>) -> PyResult<PyAssembly> {
-    let request = asp_app::PlanRequest { unit: unit.map(String::from), up: up.map(String::from), fixed, ..Default::default() };
+#[pyo3(signature = (path, unit=None, up=None, fixed=Vec::new(), max_triangles=None, max_parts=None, allow_outside_files=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn load(
+    py: Python<'_>,
+    path: PathBuf,
+    unit: Option<&str>,
+    up: Option<&str>,
+    fixed: Vec<String>,
+    max_triangles: Option<usize>,
+    max_parts: Option<usize>,
+    allow_outside_files: Option<bool>,
+) -> PyResult<PyAssembly> {
+    let request = asp_app::PlanRequest {
+        unit: unit.map(String::from),
+        up: up.map(String::from),
+        fixed,
+        max_triangles,
+        max_parts,
+        allow_outside_files,
+        ..Default::default()
+    };
     let settings = asp_app::resolve(&request).map_err(|e| Error::from(e).into_py(py))?;
     let assembly = py.detach(|| pipeline::load(&path, &settings)).map_err(|e| Error::from(e).into_py(py))?;
     Ok(PyAssembly { inner: Arc::new(assembly), graph: Mutex::new(None) })

@@ -34,6 +34,22 @@ pub enum RobotError {
         /// The missing link.
         link: String,
     },
+    /// A file the robot names (a mesh) is missing or lies outside the allowed folders.
+    #[error("{}: {message}", path.display())]
+    Reference {
+        /// The robot file.
+        path: PathBuf,
+        /// Which reference and why.
+        message: String,
+    },
+    /// The robot loads but cannot carry out any removal (no gripper).
+    #[error("{}: {message}", path.display())]
+    Unusable {
+        /// The robot file.
+        path: PathBuf,
+        /// What it lacks.
+        message: String,
+    },
     /// The links and joints do not form the serial chain asked for.
     #[error("{}: {message}", path.display())]
     Chain {

@@ -17,7 +17,7 @@ pub use ik::{IkConfig, IkOutcome, IkSolution};
 pub use removal::{PlanStats, RemovalConfig, RemovalPlanner, RobotCell, RobotFailure, RobotRemoval};
 pub use checker::{HoldingChecker, RobotChecker};
 pub use search::{CellSetup, RobotExtension, RobotSetup, ROBOT_PATH};
-pub use robot::{ChainSpec, Finger, Joint, JointKind, Link, Robot};
+pub use robot::{ChainSpec, Finger, Joint, JointKind, Link, Robot, RobotFiles};
 pub use shape::{LinkShape, ShapeKind};
 
 /// The URDF of the default robot (a Franka-Panda-like arm with a parallel gripper), embedded.

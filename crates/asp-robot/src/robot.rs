@@ -91,6 +91,59 @@ pub struct ChainSpec {
     pub tip_link: Option<String>,
 }
 
+/// Where the files a URDF names (its meshes) may lie: beside the URDF, in the folders of the
+/// ROS packages the user names (`package://NAME/...` → `DIR/...`), or anywhere when allowed.
+#[derive(Clone, Debug, Default)]
+pub struct RobotFiles {
+    /// `NAME=DIR` pairs resolving `package://NAME/` (`--package-path`).
+    pub package_paths: Vec<(String, PathBuf)>,
+    /// Accept absolute mesh paths and paths that leave their folder (`--allow-outside-files`).
+    pub allow_outside_files: bool,
+}
+
+impl RobotFiles {
+    /// Parses a `NAME=DIR` package path.
+    pub fn parse_package_path(text: &str) -> std::result::Result<(String, PathBuf), String> {
+        match text.split_once('=') {
+            Some((name, dir)) if !name.is_empty() && !dir.is_empty() => Ok((name.to_string(), PathBuf::from(dir))),
+            _ => Err(format!("--package-path '{text}' is not NAME=DIR")),
+        }
+    }
+}
+
+/// Checks every mesh a link names (collision and visual): resolved inside the URDF's folder or
+/// the named package's folder, and present.
+fn check_meshes(urdf: &urdf_rs::Robot, path: &Path, files: &RobotFiles) -> Result<()> {
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let err = |message: String| RobotError::Reference { path: path.to_path_buf(), message };
+    for link in &urdf.links {
+        let geometries = link.collision.iter().map(|c| &c.geometry).chain(link.visual.iter().map(|v| &v.geometry));
+        for geometry in geometries {
+            let urdf_rs::Geometry::Mesh { filename, .. } = geometry else { continue };
+            let what = format!("link '{}': mesh", link.name);
+            let (base, reference): (&Path, PathBuf) = if let Some(rest) = filename.strip_prefix("package://") {
+                let (package, inner) = rest.split_once('/').unwrap_or((rest, ""));
+                let Some((_, dir)) = files.package_paths.iter().find(|(name, _)| name == package) else {
+                    return Err(err(format!(
+                        "{what} '{filename}' is in package '{package}', which is not known (give --package-path {package}=DIR)"
+                    )));
+                };
+                (dir.as_path(), PathBuf::from(inner))
+            } else if let Some(rest) = filename.strip_prefix("file://") {
+                (folder, PathBuf::from(rest))
+            } else {
+                (folder, PathBuf::from(filename))
+            };
+            let resolved = asp_geom::io::resolve_inside(base, &reference, &[], files.allow_outside_files)
+                .map_err(|refused| err(refused.describe(&what, filename)))?;
+            if !resolved.is_file() {
+                return Err(err(format!("{what} '{filename}' is missing (looked for {})", resolved.display())));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// A serial-chain robot arm with a parallel gripper.
 #[derive(Clone, Debug)]
 pub struct Robot {
@@ -189,17 +242,32 @@ impl Robot {
         Robot::from_urdf_file_with(path, &ChainSpec::default())
     }
 
-    /// Loads a URDF file with the given chain ends.
+    /// Loads a URDF file with the given chain ends (meshes beside the file only).
     pub fn from_urdf_file_with(path: &Path, spec: &ChainSpec) -> Result<Robot> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| RobotError::Read { path: path.to_path_buf(), message: one_line(&e.to_string()) })?;
-        Robot::from_urdf_str(&text, path, spec)
+        Robot::from_urdf_file_checked(path, spec, &RobotFiles::default())
     }
 
-    /// Parses URDF text; `path` names it in error messages.
+    /// Loads a URDF file with the given chain ends, its meshes resolved by `files`.
+    pub fn from_urdf_file_checked(path: &Path, spec: &ChainSpec, files: &RobotFiles) -> Result<Robot> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| RobotError::Read { path: path.to_path_buf(), message: one_line(&e.to_string()) })?;
+        Robot::from_urdf_str_with(&text, path, spec, files)
+    }
+
+    /// Parses URDF text; `path` names it in error messages and locates its meshes.
     pub fn from_urdf_str(text: &str, path: &Path, spec: &ChainSpec) -> Result<Robot> {
+        Robot::from_urdf_str_with(text, path, spec, &RobotFiles::default())
+    }
+
+    /// [`Robot::from_urdf_str`] with the meshes resolved by `files`.
+    pub fn from_urdf_str_with(text: &str, path: &Path, spec: &ChainSpec, files: &RobotFiles) -> Result<Robot> {
         let p = || path.to_path_buf();
         let urdf = urdf_rs::read_from_string(text).map_err(|e| RobotError::parse(p(), e))?;
+        let max_links = asp_geom::io::DEFAULT_MAX_PARTS;
+        if urdf.links.len() > max_links || urdf.joints.len() > max_links {
+            return Err(RobotError::chain(p(), format!("more than {max_links} links or joints")));
+        }
+        check_meshes(&urdf, path, files)?;
         let link_index: HashMap<&str, usize> = urdf.links.iter().enumerate().map(|(i, l)| (l.name.as_str(), i)).collect();
         if link_index.len() != urdf.links.len() {
             return Err(RobotError::chain(p(), "two links share a name"));
@@ -308,6 +376,27 @@ impl Robot {
             }
         }
         Ok(Robot { name: urdf.name.clone(), source: path.to_path_buf(), links, joints, movable, fingers, base: Isometry3::identity(), notes })
+    }
+
+    /// Checks that the robot can carry a part out at all: it needs a parallel gripper (prismatic
+    /// finger joints after the last arm joint) that opens. Called before planning with it.
+    pub fn check_can_grasp(&self) -> Result<()> {
+        let tip = self.links.last().map_or("", |l| l.name.as_str());
+        if self.fingers.is_empty() {
+            return Err(RobotError::Unusable {
+                path: self.source.clone(),
+                message: format!(
+                    "no gripper below tool link '{tip}' (asp needs prismatic finger joints after the last arm joint to hold a part); add fingers or name another tool link"
+                ),
+            });
+        }
+        if self.max_opening() <= 0.0 {
+            return Err(RobotError::Unusable {
+                path: self.source.clone(),
+                message: format!("the gripper below tool link '{tip}' does not open (its finger joints have no travel)"),
+            });
+        }
+        Ok(())
     }
 
     /// The number of movable joints (degrees of freedom of the arm).

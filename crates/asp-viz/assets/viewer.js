@@ -92,7 +92,8 @@ const parts = data.parts.map((p, i) => {
   scene.add(mesh);
   const centre = new THREE.Vector3();
   geometry.boundingBox.getCenter(centre);
-  return { ...p, index: i, mesh, material, colour, centre };
+  // `swatch`: the file's sRGB bytes as CSS (`colour` is three's Color, which CSS cannot read)
+  return { ...p, index: i, mesh, material, colour, swatch: css(p.colour), centre };
 });
 const steps = data.steps.map((s) => {
   const moves = (s.moves || []).map((m) => ({ parts: m.parts, t: vec(m.translation) }));
@@ -262,7 +263,7 @@ if (baseParts.length) {
   base.appendChild(head);
   baseParts.forEach((p, i) => {
     const s = document.createElement('span');
-    s.innerHTML = `<span class="swatch" style="background:${css(p.colour)}"></span>`;
+    s.innerHTML = `<span class="swatch" style="background:${p.swatch}"></span>`;
     s.appendChild(document.createTextNode(p.name + (i + 1 < baseParts.length ? ', ' : '')));
     base.appendChild(s);
   });
@@ -272,7 +273,7 @@ if (baseParts.length) {
 const list = document.getElementById('asp-steps');
 const items = steps.map((s, k) => {
   const li = document.createElement('li');
-  li.innerHTML = `<span class="swatch" style="background:${css(parts[s.part].colour)}"></span>`;
+  li.innerHTML = `<span class="swatch" style="background:${parts[s.part].swatch}"></span>`;
   const how = (s.motion ? (s.motion.kind === 'path' ? ' (path)' : '') : '') +
     (s.group.length > 1 ? ` + ${s.group.length - 1} parts (subassembly)` : '');
   li.appendChild(document.createTextNode(s.name + how));

@@ -9,10 +9,25 @@ use asp_geom::{Assembly, Units};
 use asp_search::report::{MotionEntry, PlanReport};
 use std::path::{Path, PathBuf};
 
-/// Reads and parses a plan JSON (`docs/plan-format.md`).
+/// Reads and parses a plan JSON (`docs/plan-format.md`); a plan of another major format
+/// version is refused before its fields are read.
 pub fn read_plan(path: &Path) -> Result<PlanReport> {
     let text = std::fs::read_to_string(path).map_err(|e| VizError::io(path, e))?;
-    serde_json::from_str(&text).map_err(|e| VizError::input(path, format!("not a plan JSON: {e}")))
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| VizError::input(path, format!("not a plan JSON: {e}")))?;
+    let ours = asp_search::report::FORMAT_VERSION;
+    let major = |v: &str| v.split('.').next().map(str::to_string);
+    match value.get("format_version").and_then(|v| v.as_str()) {
+        Some(v) if major(v) == major(ours) => {}
+        Some(v) => {
+            return Err(VizError::input(
+                path,
+                format!("plan format version {v} is not one this asp reads ({ours}); plan the model again with this asp"),
+            ))
+        }
+        None => return Err(VizError::input(path, "not a plan JSON: it has no format_version")),
+    }
+    serde_json::from_value(value).map_err(|e| VizError::input(path, format!("not a plan JSON: {e}")))
 }
 
 /// Where the plan's model is: `model` when given, else the plan's `model` field as written
@@ -49,7 +64,7 @@ pub fn load_model(report: &PlanReport, plan_path: &Path, model: Option<&Path>) -
     let up = Axis::parse(&report.up)
         .ok_or_else(|| VizError::input(plan_path, format!("'{}' is not an up axis", report.up)))?;
     let fixed = report.parts.iter().filter(|p| p.fixed).map(|p| p.name.clone()).collect();
-    let assembly = load(&path, &LoadOptions { unit: Some(unit), up: Some(up), fixed })?;
+    let assembly = load(&path, &LoadOptions { unit: Some(unit), up: Some(up), fixed, ..LoadOptions::default() })?;
     check_parts(&assembly, report, &path)?;
     Ok(assembly)
 }

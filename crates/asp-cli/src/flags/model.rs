@@ -19,6 +19,16 @@ pub struct ModelArgs {
     /// is the base.
     #[arg(long, num_args = 1.., value_name = "NAME")]
     pub fixed: Vec<String>,
+    /// Let the model (and a URDF) read files outside its folder: absolute paths, `..` that
+    /// climbs out, symlinks that point out (docs/security.md).
+    #[arg(long)]
+    pub allow_outside_files: bool,
+    /// Most triangles a model may have over all its parts.
+    #[arg(long, value_name = "N")]
+    pub max_triangles: Option<usize>,
+    /// Most parts a model may have.
+    #[arg(long, value_name = "N")]
+    pub max_parts: Option<usize>,
     /// Contact tolerance in model units: motions may push a part this deep into another
     /// [default: 1e-4 × the model's diagonal].
     #[arg(long)]
@@ -67,9 +77,12 @@ pub struct ModelArgs {
 impl ModelArgs {
     /// The request keys these flags set.
     pub fn put(&self, map: &mut Map) {
-        put!(map, self, unit, up, tolerance, contact_distance, overlaps, normals, sphere_directions, stability, physics_threshold, rrt_iterations, rrt_time);
+        put!(map, self, unit, up, max_triangles, max_parts, tolerance, contact_distance, overlaps, normals, sphere_directions, stability, physics_threshold, rrt_iterations, rrt_time);
         if !self.fixed.is_empty() {
             map.insert("fixed".into(), self.fixed.clone().into());
+        }
+        if self.allow_outside_files {
+            map.insert("allow_outside_files".into(), true.into());
         }
         if self.ignore_overlapping {
             map.insert("overlaps".into(), "lenient".into());

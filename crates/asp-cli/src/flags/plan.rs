@@ -150,6 +150,9 @@ pub struct PlanRobotArgs {
     /// (feasibility search only; the plan's steps say which parts are held).
     #[arg(long, value_name = "N", help_heading = "Robot")]
     pub grippers: Option<usize>,
+    /// Where the URDF's `package://NAME/` meshes lie (repeatable).
+    #[arg(long, value_name = "NAME=DIR", help_heading = "Robot")]
+    pub package_path: Vec<String>,
 }
 
 impl PlanArgs {
@@ -179,5 +182,8 @@ impl PlanRobotArgs {
     /// The request keys these flags set.
     pub fn put(&self, map: &mut Map) {
         put!(map, self, robot, robot_base, drop_off, replans, grippers);
+        if !self.package_path.is_empty() {
+            map.insert("package_path".into(), self.package_path.clone().into());
+        }
     }
 }

@@ -138,6 +138,14 @@ fn the_viewer_plays_a_found_plan_in_a_headless_browser() {
     // the step list names every part with its number
     let items = browser.eval("document.querySelectorAll('#asp-steps li').length");
     assert_eq!(items.as_u64(), Some(total));
+    // ... each with its part's colour as swatch (it was rgb(undefined,...), blank)
+    let swatches = browser.eval("JSON.stringify([...document.querySelectorAll('#asp-steps .swatch')].map((s) => [s.style.background, getComputedStyle(s).backgroundColor]))");
+    let swatches: Vec<(String, String)> = serde_json::from_str(swatches.as_str().unwrap()).unwrap();
+    assert_eq!(swatches.len() as u64, total);
+    for (inline, computed) in &swatches {
+        assert!(inline.starts_with("rgb(") && !inline.contains("undefined"), "swatch style '{inline}'");
+        assert!(computed.starts_with("rgb(") && computed != "rgba(0, 0, 0, 0)", "swatch colour '{computed}'");
+    }
     browser.assert_no_errors();
 }
 

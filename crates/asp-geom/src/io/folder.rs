@@ -1,6 +1,6 @@
 //! Folders of OBJ / STL files (one file per part, in world coordinates) and single such files.
 
-use super::{io_error, lowercase_first, LoadOptions};
+use super::{io_error, lowercase_first, refs, Limits, LoadOptions};
 use crate::assembly::{Assembly, Part, Units};
 use crate::error::{GeomError, Result};
 use crate::math::{Axis, Vec3};
@@ -37,13 +37,20 @@ pub(crate) fn load_folder(dir: &Path, options: &LoadOptions) -> Result<Assembly>
     if files.is_empty() {
         return Err(GeomError::format(dir, "the folder has no .obj or .stl files"));
     }
+    options.limits.check_parts(files.len()).map_err(|reason| GeomError::format(dir, reason))?;
+    for file in &files {
+        let name = file.file_name().map(PathBuf::from).unwrap_or_default();
+        refs::resolve_inside(dir, &name, &[], options.allow_outside_files).map_err(|refused| {
+            GeomError::format(dir, refused.describe("file", &name.to_string_lossy()))
+        })?;
+    }
     assemble(dir, &files, options)
 }
 
 /// One `.obj` / `.stl` file, its bytes in memory, as a one-part assembly.
 pub(crate) fn single_file_from_bytes(file: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Assembly> {
     let units = options.unit.clone().unwrap_or_else(Units::metres);
-    let mut mesh = mesh_from_bytes(file, bytes)?;
+    let mut mesh = mesh_from_bytes(file, bytes, &options.limits)?;
     mesh.scale(units.metres as f32);
     Ok(Assembly {
         parts: vec![Part::new(part_name(file), mesh, false, serde_json::Value::Null)],
@@ -78,11 +85,13 @@ fn assemble(source: &Path, files: &[PathBuf], options: &LoadOptions) -> Result<A
     let parts = files
         .par_iter()
         .map(|file| {
-            let mut mesh = read_mesh(file)?;
+            let mut mesh = read_mesh(file, &options.limits)?;
             mesh.scale(scale);
             Ok(Part::new(part_name(file), mesh, false, serde_json::Value::Null))
         })
         .collect::<Result<Vec<Part>>>()?;
+    let triangles = parts.iter().map(|p| p.mesh.triangles.len()).sum();
+    options.limits.check_triangles(triangles).map_err(|reason| GeomError::format(source, reason))?;
     Ok(Assembly {
         parts,
         units,
@@ -93,22 +102,28 @@ fn assemble(source: &Path, files: &[PathBuf], options: &LoadOptions) -> Result<A
 }
 
 /// The mesh of one file, in the file's units.
-fn read_mesh(path: &Path) -> Result<Mesh> {
+fn read_mesh(path: &Path, limits: &Limits) -> Result<Mesh> {
     let bytes = std::fs::read(path).map_err(|source| io_error(path, source))?;
-    mesh_from_bytes(path, &bytes)
+    mesh_from_bytes(path, &bytes, limits)
 }
 
 /// The mesh of one file's bytes (`path` gives the format by its extension and names errors).
-fn mesh_from_bytes(path: &Path, bytes: &[u8]) -> Result<Mesh> {
-    match Format::of(path) {
-        Some(Format::Obj) => read_obj(path, bytes),
-        Some(Format::Stl) => read_stl(path, bytes),
-        None => Err(GeomError::format(path, "not an .obj or .stl file")),
-    }
+fn mesh_from_bytes(path: &Path, bytes: &[u8], limits: &Limits) -> Result<Mesh> {
+    let mesh = match Format::of(path) {
+        Some(Format::Obj) => read_obj(path, bytes)?,
+        Some(Format::Stl) => read_stl(path, bytes, limits)?,
+        None => return Err(GeomError::format(path, "not an .obj or .stl file")),
+    };
+    limits.check_triangles(mesh.triangles.len()).map_err(|reason| GeomError::format(path, reason))?;
+    Ok(mesh)
 }
 
 /// An STL file, ASCII or binary. Identical vertices are shared (STL stores none).
-fn read_stl(path: &Path, bytes: &[u8]) -> Result<Mesh> {
+fn read_stl(path: &Path, bytes: &[u8], limits: &Limits) -> Result<Mesh> {
+    if is_binary_stl(bytes) {
+        let announced = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
+        limits.check_triangles(announced).map_err(|reason| GeomError::format(path, format!("invalid stl file: {reason}")))?;
+    }
     let mut bytes = bytes.to_vec();
     if is_binary_stl(&bytes) {
         // Many CAD tools start binary headers with "solid", which stl_io takes for ASCII.

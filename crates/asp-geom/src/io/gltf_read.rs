@@ -5,7 +5,7 @@
 //! JSON; buffer data is read here with explicit bounds checks, because the crate's accessor
 //! iterators panic on some malformed files.
 
-use super::{lowercase_first, LoadOptions};
+use super::{lowercase_first, refs, Limits, LoadOptions, MAX_ZERO_FILLED};
 use crate::assembly::{Assembly, Part, Units};
 use crate::error::{GeomError, Result};
 use crate::math::{Axis, Pose, Vec3};
@@ -41,13 +41,14 @@ fn read_gltf(path: &Path, bytes: &[u8], options: &LoadOptions, external: &Extern
         (bytes, None)
     };
     let document = parse_document(json)?;
-    let buffers = load_buffers(&document, path, blob, external)?;
+    let buffers = load_buffers(&document, path, blob, options.allow_outside_files, external)?;
     let scene = document.default_scene().or_else(|| document.scenes().next());
     let settings = scene.as_ref().map(scene_settings).transpose()?.unwrap_or_default();
     let units = options.unit.clone().or(settings.unit).unwrap_or_else(Units::metres);
     let up = options.up.or(settings.up).unwrap_or(Axis::Y);
-    let mut builder = PartBuilder::new(&document, buffers, units.metres);
+    let mut builder = PartBuilder::new(&document, buffers, units.metres, options.limits);
     if let Some(scene) = &scene {
+        check_announced(&document, scene, &options.limits)?;
         builder.add_scene(scene)?;
     }
     Ok(Assembly { parts: builder.parts, units, up, source: path.to_path_buf(), warnings: builder.warnings })
@@ -143,12 +144,13 @@ fn load_buffers<'a>(
     document: &Document,
     path: &Path,
     blob: Option<&'a [u8]>,
+    allow_outside: bool,
     external: &External,
 ) -> Res<Vec<Cow<'a, [u8]>>> {
     document
         .buffers()
         .map(|buffer| {
-            let data = buffer_data(&buffer, path, blob, external)?;
+            let data = buffer_data(&buffer, path, blob, allow_outside, external)?;
             if data.len() < buffer.length() {
                 return Err(format!(
                     "truncated buffer {}: {} bytes, expected {}",
@@ -166,6 +168,7 @@ fn buffer_data<'a>(
     buffer: &gltf::Buffer,
     path: &Path,
     blob: Option<&'a [u8]>,
+    allow_outside: bool,
     external: &External,
 ) -> Res<Cow<'a, [u8]>> {
     let index = buffer.index();
@@ -179,8 +182,11 @@ fn buffer_data<'a>(
                 .map_err(|e| format!("buffer {index}: invalid data uri ({e})"))
         }
         gltf::buffer::Source::Uri(uri) => {
-            let file =
-                external_file(path, uri).ok_or_else(|| format!("buffer {index}: unsupported uri '{uri}'"))?;
+            let reference =
+                external_file(uri).ok_or_else(|| format!("buffer {index}: unsupported uri '{uri}'"))?;
+            let folder = path.parent().unwrap_or(Path::new(""));
+            let file = refs::resolve_inside(folder, &reference, &[], allow_outside)
+                .map_err(|refused| refused.describe(&format!("buffer {index} uri"), uri))?;
             external(&file).map(Cow::Owned).map_err(|e| match e.kind() {
                 std::io::ErrorKind::NotFound => {
                     format!("buffer file '{}' is missing", file.display())
@@ -195,8 +201,9 @@ fn buffer_data<'a>(
     }
 }
 
-/// Where a buffer URI points: relative to the glTF file, or a `file:` URI. None for other schemes.
-fn external_file(gltf_path: &Path, uri: &str) -> Option<PathBuf> {
+/// Where a buffer URI points, relative to the glTF file's folder (a `file:` URI gives an
+/// absolute path). None for other schemes.
+fn external_file(uri: &str) -> Option<PathBuf> {
     let decoded = percent_decode(uri)?;
     if let Some(rest) = decoded.strip_prefix("file://").or_else(|| decoded.strip_prefix("file:")) {
         return Some(PathBuf::from(rest));
@@ -204,7 +211,7 @@ fn external_file(gltf_path: &Path, uri: &str) -> Option<PathBuf> {
     if decoded.contains("://") {
         return None;
     }
-    Some(gltf_path.parent().unwrap_or(Path::new("")).join(decoded))
+    Some(PathBuf::from(decoded))
 }
 
 /// Decodes `%xx` escapes of a URI; None when the result is not UTF-8.
@@ -309,10 +316,13 @@ struct PartBuilder<'a> {
     node_count: usize,
     parts: Vec<Part>,
     warnings: Vec<String>,
+    limits: Limits,
+    /// Triangles of the parts so far (checked against `limits` before each mesh is baked).
+    triangles: usize,
 }
 
 impl<'a> PartBuilder<'a> {
-    fn new(document: &Document, buffers: Vec<Cow<'a, [u8]>>, scale: f64) -> Self {
+    fn new(document: &Document, buffers: Vec<Cow<'a, [u8]>>, scale: f64, limits: Limits) -> Self {
         PartBuilder {
             buffers,
             scale,
@@ -320,6 +330,8 @@ impl<'a> PartBuilder<'a> {
             node_count: document.nodes().len(),
             parts: Vec::new(),
             warnings: Vec::new(),
+            limits,
+            triangles: 0,
         }
     }
 
@@ -353,8 +365,18 @@ impl<'a> PartBuilder<'a> {
             .or(mesh.name())
             .map(str::to_string)
             .unwrap_or_else(|| format!("part_{}", self.parts.len()));
+        if name.len() > MAX_NAME_BYTES {
+            return Err(format!(
+                "node {}: its name has {} bytes (at most {MAX_NAME_BYTES}); shorten it",
+                node.index(),
+                name.len()
+            ));
+        }
         let label = format!("node '{name}'");
+        self.limits.check_parts(self.parts.len() + 1)?;
         let local = self.local_mesh(mesh)?;
+        self.triangles += local.triangles.len();
+        self.limits.check_triangles(self.triangles).map_err(|e| format!("{label}: {e}"))?;
         if local.triangles.is_empty() && !local.skipped.is_empty() {
             self.warnings.push(format!("{label}: its mesh has only point or line primitives; not a part"));
             return Ok(());
@@ -393,6 +415,10 @@ impl<'a> PartBuilder<'a> {
                 local.skipped.push(format!("{context} ({mode})"));
                 continue;
             }
+            let announced = announced_triangles(&primitive);
+            self.limits
+                .check_triangles(self.triangles + local.triangles.len() + announced)
+                .map_err(|reason| format!("{context}: {reason}"))?;
             let (vertices, triangles) =
                 self.read_primitive(&primitive).map_err(|reason| format!("{context}: {reason}"))?;
             // the running total is checked below, so the previous one fits in u32
@@ -420,12 +446,62 @@ impl<'a> PartBuilder<'a> {
     }
 }
 
+/// Checks the parts and triangles the scene announces (every mesh instance counted, from the
+/// accessors' counts) against the caps before any buffer data is read: an instancing bomb (a
+/// small mesh placed by thousands of nodes) is refused before it takes memory.
+fn check_announced(document: &Document, scene: &Scene, limits: &Limits) -> Res<()> {
+    let per_mesh: Vec<usize> = document
+        .meshes()
+        .map(|m| m.primitives().filter(|p| is_triangles(p.mode())).map(|p| announced_triangles(&p)).fold(0, usize::saturating_add))
+        .collect();
+    let mut seen = vec![false; document.nodes().len()];
+    let mut stack: Vec<Node> = scene.nodes().collect();
+    let (mut parts, mut triangles) = (0usize, 0usize);
+    while let Some(node) = stack.pop() {
+        if std::mem::replace(&mut seen[node.index()], true) {
+            continue; // a cycle or a second parent: reported while the scene is read
+        }
+        if let Some(mesh) = node.mesh() {
+            parts += 1;
+            triangles = triangles.saturating_add(per_mesh[mesh.index()]);
+        }
+        stack.extend(node.children());
+    }
+    limits.check_parts(parts)?;
+    limits.check_triangles(triangles)
+}
+
+/// The longest part name accepted (bytes): names are printed in tables, errors and pages.
+const MAX_NAME_BYTES: usize = 1024;
+
+/// The triangles a primitive's header counts announce (before any data is read).
+fn announced_triangles(primitive: &Primitive) -> usize {
+    let count = match primitive.indices() {
+        Some(indices) => indices.count(),
+        None => primitive.get(&Semantic::Positions).map_or(0, |p| p.count()),
+    };
+    match primitive.mode() {
+        Mode::Triangles => count / 3,
+        _ => count.saturating_sub(2),
+    }
+}
+
 fn is_triangles(mode: Mode) -> bool {
     matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan)
 }
 
 /// The node's local transform as a matrix (glTF: `matrix`, or translation × rotation × scale).
 fn local_matrix(node: &Node) -> Res<DMat4> {
+    let finite = match node.transform() {
+        Transform::Matrix { matrix } => matrix.iter().flatten().all(|v| v.is_finite()),
+        Transform::Decomposed { translation, rotation, scale } => {
+            translation.iter().chain(&rotation).chain(&scale).all(|v| v.is_finite())
+        }
+    };
+    if !finite {
+        let name = node.name().map(|n| format!(" ('{n}')")).unwrap_or_default();
+        return Err(format!("node {}{name}: its transform has NaN or infinite values", node.index()));
+    }
     match node.transform() {
         Transform::Matrix { matrix } => Ok(DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)))),
         Transform::Decomposed { translation, rotation, scale } => {
@@ -486,10 +562,6 @@ fn triangulate(mode: Mode, indices: &[u32]) -> Res<Vec<[u32; 3]>> {
 
 // ---------------------------------------------------------------------------------------------
 // Accessors
-
-/// Largest element count accepted for an accessor that has no buffer view (sparse over zeros):
-/// such counts are not backed by file bytes, so a corrupted count must not exhaust memory.
-const MAX_ZERO_FILLED: usize = 1 << 22;
 
 fn read_positions(accessor: &Accessor, buffers: &[Cow<[u8]>]) -> Res<Vec<DVec3>> {
     if accessor.dimensions() != Dimensions::Vec3 {

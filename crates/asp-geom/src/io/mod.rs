@@ -4,9 +4,11 @@ mod atomic;
 mod folder;
 mod glb_write;
 mod gltf_read;
+mod refs;
 
 pub use atomic::{write_atomic, write_atomic_with};
 pub use glb_write::write_glb;
+pub use refs::{canonical, resolve_inside, Refused, OUTSIDE_FLAG};
 
 use crate::assembly::{Assembly, Units};
 use crate::error::{GeomError, Result};
@@ -22,6 +24,56 @@ pub struct LoadOptions {
     pub up: Option<Axis>,
     /// Names of base parts, on top of those the file marks as fixed.
     pub fixed: Vec<String>,
+    /// Let the model read files outside its folder (absolute buffer paths, `..`, symlinks out).
+    /// Off by default: a model from someone else reads only what lies beside it.
+    pub allow_outside_files: bool,
+    /// Caps on what a file may make asp allocate.
+    pub limits: Limits,
+}
+
+/// The default cap on triangles over all parts ([`Limits::max_triangles`]).
+pub const DEFAULT_MAX_TRIANGLES: usize = 20_000_000;
+/// The default cap on parts ([`Limits::max_parts`]).
+pub const DEFAULT_MAX_PARTS: usize = 10_000;
+/// Largest element count accepted for a glTF accessor that has no buffer view (zeros with
+/// sparse substitutions): such counts are not backed by file bytes.
+pub const MAX_ZERO_FILLED: usize = 1 << 18;
+
+/// Caps on the size of a model, checked against the counts in its headers before memory is taken
+/// (`--max-triangles`, `--max-parts` raise them).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// Triangles over all parts (every instance counted).
+    pub max_triangles: usize,
+    /// Parts (mesh instances, files of a folder).
+    pub max_parts: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits { max_triangles: DEFAULT_MAX_TRIANGLES, max_parts: DEFAULT_MAX_PARTS }
+    }
+}
+
+impl Limits {
+    /// Checks `triangles` against the cap; the error names the flag that lifts it.
+    pub fn check_triangles(&self, triangles: usize) -> std::result::Result<(), String> {
+        if triangles > self.max_triangles {
+            return Err(format!(
+                "more than {} triangles (the model announces {triangles}; raise the cap with --max-triangles)",
+                self.max_triangles
+            ));
+        }
+        Ok(())
+    }
+
+    /// Checks `parts` against the cap; the error names the flag that lifts it.
+    pub fn check_parts(&self, parts: usize) -> std::result::Result<(), String> {
+        if parts > self.max_parts {
+            return Err(format!("more than {} parts (raise the cap with --max-parts)", self.max_parts));
+        }
+        Ok(())
+    }
 }
 
 /// Loads `path`: a `.glb`/`.gltf` file or a folder of `.obj`/`.stl` files (one part per file).
@@ -79,6 +131,7 @@ fn finish(mut assembly: Assembly, options: &LoadOptions) -> Result<Assembly> {
     assembly.dedupe_names();
     assembly.set_fixed(&options.fixed)?;
     assembly.validate()?;
+    crate::validate::check_model(&assembly)?;
     Ok(assembly)
 }
 

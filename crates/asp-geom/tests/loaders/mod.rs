@@ -296,7 +296,7 @@ fn nested_nodes_give_world_coordinates_in_metres() {
     check_nested_scene(&load(&glb_path, &LoadOptions::default()).unwrap());
 
     // options override the file: metres and +Y, and more fixed parts
-    let options = LoadOptions { unit: Some(Units::metres()), up: Some(Axis::Y), fixed: vec!["tri".into()] };
+    let options = LoadOptions { unit: Some(Units::metres()), up: Some(Axis::Y), fixed: vec!["tri".into()], ..LoadOptions::default() };
     let assembly = load(&path, &options).unwrap();
     assert_eq!(assembly.up, Axis::Y);
     assert_points(&vertices(&assembly.parts[0]), &[[10.0, 0.0, 5.0], [10.0, 2.0, 5.0], [8.0, 0.0, 5.0]], 1.0);
@@ -316,6 +316,71 @@ fn gltf_with_an_external_bin_file() {
     std::fs::remove_file(dir.path().join("my parts.bin")).unwrap();
     assert_message(&load_error(&path), "external.gltf", "buffer file");
     assert_message(&load_error(&path), "my parts.bin", "is missing");
+}
+
+#[test]
+fn buffers_outside_the_model_folder_are_refused_unless_allowed() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model");
+    std::fs::create_dir_all(dir.path().join("other")).unwrap();
+    std::fs::create_dir(&model).unwrap();
+    let (fixture, content) = nested_scene();
+    std::fs::write(dir.path().join("other/secret.bin"), &fixture.bin).unwrap();
+    let secret = dir.path().join("other/secret.bin");
+    let cases = [
+        ("up.gltf", "../other/secret.bin".to_string(), "points outside the model's folder"),
+        ("absolute.gltf", secret.display().to_string(), "is an absolute path"),
+        ("file_uri.gltf", format!("file://{}", secret.display()), "is an absolute path"),
+    ];
+    for (name, uri, cause) in cases {
+        let path = model.join(name);
+        std::fs::write(&path, fixture.document(content.clone(), json!({"uri": uri})).to_string()).unwrap();
+        let message = load_error(&path);
+        assert_message(&message, name, cause);
+        assert_message(&message, &uri, "--allow-outside-files");
+        let allowed = LoadOptions { allow_outside_files: true, ..LoadOptions::default() };
+        check_nested_scene(&load(&path, &allowed).unwrap());
+    }
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(&secret, model.join("link.bin")).unwrap();
+        let path = model.join("link.gltf");
+        std::fs::write(&path, fixture.document(content.clone(), json!({"uri": "link.bin"})).to_string()).unwrap();
+        assert_message(&load_error(&path), "link.gltf", "points outside the model's folder");
+        // a folder of parts whose file is a symlink out
+        let parts = dir.path().join("parts");
+        std::fs::create_dir(&parts).unwrap();
+        std::fs::write(dir.path().join("outside.stl"), ascii_stl(&[[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]])).unwrap();
+        std::os::unix::fs::symlink(dir.path().join("outside.stl"), parts.join("a.stl")).unwrap();
+        assert_message(&load_error(&parts), "a.stl", "points outside the model's folder");
+    }
+}
+
+#[test]
+fn counts_past_the_caps_are_refused_before_reading() {
+    use asp_geom::io::Limits;
+    let dir = tempfile::tempdir().unwrap();
+    let (fixture, content) = nested_scene();
+    let path = write_gltf(dir.path(), "nested.gltf", &fixture, content);
+    let small = |max_triangles, max_parts| LoadOptions { limits: Limits { max_triangles, max_parts }, ..LoadOptions::default() };
+    assert_message(&load(&path, &small(1, 100)).unwrap_err().to_string(), "nested.gltf", "--max-triangles");
+    assert_message(&load(&path, &small(100, 1)).unwrap_err().to_string(), "nested.gltf", "--max-parts");
+    check_nested_scene(&load(&path, &small(100, 100)).unwrap());
+    // a binary STL header announcing more triangles than the cap
+    let stl = dir.path().join("big.stl");
+    std::fs::write(&stl, binary_stl(&[[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]; 3])).unwrap();
+    assert_message(&load(&stl, &small(2, 100)).unwrap_err().to_string(), "big.stl", "--max-triangles");
+}
+
+#[test]
+fn non_finite_transforms_name_the_node() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut f = Fixture::default();
+    let positions = f.positions(&TRIANGLE);
+    let mut content = single_mesh(positions, None);
+    content["nodes"][0]["scale"] = json!([1.0, 1e39, 1.0]);
+    let path = write_gltf(dir.path(), "inf.gltf", &f, content);
+    assert_message(&load_error(&path), "inf.gltf", "node 0 ('the_part'): its transform has NaN or infinite values");
 }
 
 #[test]
@@ -579,7 +644,9 @@ f 3 4 8 7\nf 4 1 5 8\nf 5 6 7 8
 fn folders_of_obj_and_stl_files() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("b_tetra.STL"), ascii_stl(&TETRAHEDRON)).unwrap();
-    std::fs::write(dir.path().join("c_binary.stl"), binary_stl(&TETRAHEDRON)).unwrap();
+    // the same tetrahedron in binary, 2 units along x (the same mesh at the same place is a duplicate)
+    let shifted = TETRAHEDRON.map(|t| t.map(|[x, y, z]| [x + 2.0, y, z]));
+    std::fs::write(dir.path().join("c_binary.stl"), binary_stl(&shifted)).unwrap();
     std::fs::write(dir.path().join("a_cube.obj"), CUBE_OBJ).unwrap();
     std::fs::write(dir.path().join("notes.txt"), "ignored").unwrap();
     std::fs::write(dir.path().join("a_cube.mtl"), "ignored").unwrap();
@@ -597,7 +664,11 @@ fn folders_of_obj_and_stl_files() {
         assert_eq!(tetra.mesh.vertices.len(), 4, "STL corners are shared");
         assert!(tetra.mesh.topology().is_closed_manifold());
     }
-    assert_eq!(assembly.parts[1].mesh, assembly.parts[2].mesh, "ASCII and binary read alike");
+    let (ascii, binary) = (&assembly.parts[1].mesh, &assembly.parts[2].mesh);
+    assert_eq!(ascii.triangles, binary.triangles, "ASCII and binary read alike");
+    for (a, b) in ascii.vertices.iter().zip(&binary.vertices) {
+        assert_near(*b - Vec3::new(0.02, 0.0, 0.0), *a, 1e-7);
+    }
 
     let single = load(&dir.path().join("b_tetra.STL"), &LoadOptions::default()).unwrap();
     assert_eq!(names(&single), ["b_tetra"]);
@@ -810,8 +881,13 @@ fn sparse_accessors_substitute_values() {
                         "values": {"bufferView": sparse_values}});
     let over_data = f.accessor(json!({"bufferView": base, "componentType": 5126, "count": 3, "type": "VEC3",
                                       "min": [0, 0, 0], "max": [5, 6, 7], "sparse": sparse}));
+    // over zeros: two substitutions, so that the triangle has an area
+    let two_indices = f.view([1u8, 2, 0, 0].to_vec());
+    let two_values = f.view([1.0f32, 0.0, 0.0, 5.0, 6.0, 7.0].iter().flat_map(|c| c.to_le_bytes()).collect());
+    let two = json!({"count": 2, "indices": {"bufferView": two_indices, "componentType": 5121},
+                     "values": {"bufferView": two_values}});
     let over_zeros = f.accessor(json!({"componentType": 5126, "count": 3, "type": "VEC3",
-                                       "min": [0, 0, 0], "max": [5, 6, 7], "sparse": sparse}));
+                                       "min": [0, 0, 0], "max": [5, 6, 7], "sparse": two}));
     for (accessor, first) in [(over_data, TRIANGLE[0]), (over_zeros, [0.0; 3])] {
         let path = write_gltf(dir.path(), "sparse.gltf", &f, single_mesh(accessor, None));
         let part = &load(&path, &LoadOptions::default()).unwrap().parts[0];

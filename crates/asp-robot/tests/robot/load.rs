@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use asp_robot::{ChainSpec, JointKind, Robot, ShapeKind};
+use asp_robot::{ChainSpec, JointKind, Robot, RobotFiles, ShapeKind};
 
 fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> std::path::PathBuf {
     let p = dir.path().join(name);
@@ -79,6 +79,9 @@ fn a_small_arm_with_prismatic_and_mesh_geometry() {
           <joint name="j3" type="fixed"><origin xyz="0 0 0.05"/><parent link="l2"/><child link="tool0"/></joint>
         </robot>"#,
     );
+    // the mesh a link names must exist beside the file
+    one_line_naming(&Robot::from_urdf_file(&p).unwrap_err(), &p);
+    std::fs::write(dir.path().join("base.stl"), "solid x\nendsolid x\n").unwrap();
     let r = Robot::from_urdf_file(&p).unwrap();
     assert_eq!(r.dof(), 2);
     assert_eq!(r.links().last().unwrap().name, "tool0");
@@ -88,4 +91,80 @@ fn a_small_arm_with_prismatic_and_mesh_geometry() {
     // naming a tip that is not below the base is a one-line error
     let e = Robot::from_urdf_file_with(&p, &ChainSpec { base_link: Some("l2".into()), tip_link: Some("l1".into()) }).unwrap_err();
     one_line_naming(&e, &p);
+}
+
+/// A one-joint arm whose base link's collision mesh is `mesh`.
+fn arm_with_mesh(mesh: &str) -> String {
+    format!(
+        r#"<robot name="m">
+          <link name="base"><collision><geometry><mesh filename="{mesh}"/></geometry></collision></link>
+          <link name="tool0"/>
+          <joint name="j1" type="revolute"><parent link="base"/><child link="tool0"/><axis xyz="0 0 1"/>
+            <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+        </robot>"#
+    )
+}
+
+#[test]
+fn meshes_stay_inside_the_robot_folder_or_a_named_package() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = dir.path().join("robot");
+    let pkg = dir.path().join("pkg");
+    std::fs::create_dir_all(robot.join("meshes")).unwrap();
+    std::fs::create_dir_all(pkg.join("meshes")).unwrap();
+    std::fs::write(robot.join("meshes/base.stl"), "solid x\nendsolid x\n").unwrap();
+    std::fs::write(pkg.join("meshes/base.stl"), "solid x\nendsolid x\n").unwrap();
+    std::fs::write(dir.path().join("secret.stl"), "solid x\nendsolid x\n").unwrap();
+    let secret = dir.path().join("secret.stl").display().to_string();
+    let load = |name: &str, mesh: &str, files: &RobotFiles| {
+        let p = robot.join(name);
+        std::fs::write(&p, arm_with_mesh(mesh)).unwrap();
+        (Robot::from_urdf_file_checked(&p, &ChainSpec::default(), files), p)
+    };
+    let none = RobotFiles::default();
+    let with_pkg = RobotFiles { package_paths: vec![("pkg".into(), pkg.clone())], allow_outside_files: false };
+    for (name, mesh, files, cause) in [
+        ("abs.urdf", secret.as_str(), &none, "is an absolute path"),
+        ("up.urdf", "../secret.stl", &none, "points outside"),
+        ("pkg_up.urdf", "package://pkg/../secret.stl", &with_pkg, "points outside"),
+        ("unknown.urdf", "package://pkg/meshes/base.stl", &none, "--package-path pkg=DIR"),
+        ("missing.urdf", "meshes/gone.stl", &none, "is missing"),
+    ] {
+        let (result, p) = load(name, mesh, files);
+        let e = result.unwrap_err();
+        one_line_naming(&e, &p);
+        let s = e.to_string();
+        assert!(s.contains(cause) && s.contains(mesh) && s.contains("link 'base'"), "{s}");
+        if cause == "points outside" || cause == "is an absolute path" {
+            assert!(s.contains("--allow-outside-files"), "{s}");
+        }
+    }
+    assert!(load("ok.urdf", "meshes/base.stl", &none).0.is_ok());
+    assert!(load("pkg.urdf", "package://pkg/meshes/base.stl", &with_pkg).0.is_ok());
+    let allow = RobotFiles { allow_outside_files: true, ..RobotFiles::default() };
+    assert!(load("abs_allowed.urdf", &secret, &allow).0.is_ok());
+}
+
+#[test]
+fn robots_that_cannot_work_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    // no gripper: loads (asp robot check shows it) but cannot plan
+    let p = write(&dir, "nogripper.urdf", &arm_with_mesh("m.stl"));
+    std::fs::write(dir.path().join("m.stl"), "solid x\nendsolid x\n").unwrap();
+    let e = Robot::from_urdf_file(&p).unwrap().check_can_grasp().unwrap_err();
+    one_line_naming(&e, &p);
+    assert!(e.to_string().contains("no gripper below tool link 'tool0'"), "{e}");
+    Robot::panda().check_can_grasp().unwrap();
+    // inverted limits, a loop of links, a missing link
+    let inverted = arm_with_mesh("m.stl").replace(r#"lower="-1" upper="1""#, r#"lower="1" upper="-1""#);
+    let looped = r#"<robot name="l"><link name="a"/><link name="b"/>
+        <joint name="j1" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+        <joint name="j2" type="revolute"><parent link="b"/><child link="a"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+        </robot>"#;
+    for (name, text, cause) in [("inverted.urdf", inverted.as_str(), "need finite lower"), ("loop.urdf", looped, "root link")] {
+        let p = write(&dir, name, text);
+        let e = Robot::from_urdf_file(&p).unwrap_err();
+        one_line_naming(&e, &p);
+        assert!(e.to_string().contains(cause), "{e}");
+    }
 }

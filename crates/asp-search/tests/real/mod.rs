@@ -12,7 +12,7 @@ fn data(rel: &str) -> std::path::PathBuf {
 }
 
 fn world(rel: &str, unit: Option<&str>, overlaps: OverlapPolicy) -> asp_geom::Result<World> {
-    let options = LoadOptions { unit: unit.and_then(Units::parse), up: Some(Axis::Z), fixed: vec![] };
+    let options = LoadOptions { unit: unit.and_then(Units::parse), up: Some(Axis::Z), fixed: vec![], ..LoadOptions::default() };
     let assembly = load(&data(rel), &options)?;
     World::new(assembly, &WorldConfig { overlaps, ..WorldConfig::default() })
 }
@@ -133,7 +133,7 @@ fn pump_without_subassemblies_ends_in_no_plan_with_its_stuck_core_explained_and_
     assert_eq!(report.remaining, Some(state.iter().collect::<Vec<_>>()));
     // every other part comes off that core in a plan the independent sweep re-checks
     let core = left.iter().map(|n| format!("PumpAssembly - {n}")).collect();
-    let options = LoadOptions { unit: Units::parse("mm"), up: Some(Axis::Z), fixed: core };
+    let options = LoadOptions { unit: Units::parse("mm"), up: Some(Axis::Z), fixed: core, ..LoadOptions::default() };
     let rest = World::new(load(&data("pump"), &options).unwrap(), &WorldConfig::default()).unwrap();
     let (checker, outcome) = plan(rest, &Dfs::builder().bookkeeping(true).build());
     assert_eq!(outcome.status, Status::Found);
@@ -301,7 +301,7 @@ fn issue_9_pump_threaded_bolts_leave_by_screwing_and_every_step_rechecks() {
 
     // without the screw rule the bolts leave by straight lines (the M16 one only out of the
     // nut it overlaps... if at all): no screw motion anywhere
-    let options = LoadOptions { unit: Units::parse("mm"), up: Some(Axis::Z), fixed: vec![] };
+    let options = LoadOptions { unit: Units::parse("mm"), up: Some(Axis::Z), fixed: vec![], ..LoadOptions::default() };
     let plain = World::new(load(&data("pump-threaded"), &options).unwrap(), &WorldConfig { fasteners: false, ..WorldConfig::default() }).unwrap();
     let (_, outcome) = plan(plain, &Dfs::builder().build());
     eprintln!("pump-threaded without the screw rule: {:?}", outcome.status);
