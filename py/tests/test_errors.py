@@ -174,3 +174,43 @@ def test_export_error_is_an_asp_error_and_a_runtime_error():
     from asp.train import ExportError
 
     assert issubclass(ExportError, asp.AspError) and issubclass(ExportError, RuntimeError)
+
+
+def test_files_a_model_names_stay_inside_its_folder(tmp_path):
+    """Issue 25: a glTF whose buffer climbs out of its folder is refused by asp.load (and
+    asp.plan, and batches, which load through it) unless allowed, as on the command line."""
+    import json
+    import struct
+
+    (tmp_path / "other").mkdir()
+    (tmp_path / "model").mkdir()
+    (tmp_path / "other" / "secret.bin").write_bytes(struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0))
+    doc = {
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"name": "a", "mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "buffers": [{"uri": "../other/secret.bin", "byteLength": 36}],
+    }
+    model = tmp_path / "model" / "up.gltf"
+    model.write_text(json.dumps(doc))
+    for call in (lambda: asp.load(model), lambda: asp.plan(model)):
+        with pytest.raises(asp.LoadError, match="outside the model's folder") as e:
+            call()
+        assert str(model) in str(e.value)
+    # allowed, the reference is read: the one-triangle model is then refused for its geometry
+    with pytest.raises(asp.LoadError) as e:
+        asp.load(model, allow_outside_files=True)
+    assert "outside" not in str(e.value)
+    with pytest.raises(asp.LoadError, match="more than 0 parts|parts"):
+        asp.load(LACK_PATH(), max_parts=1)
+
+
+def LACK_PATH():  # noqa: N802
+    import os
+
+    from conftest import ROOT
+
+    return os.path.join(ROOT, LACK)
