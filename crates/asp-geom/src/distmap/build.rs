@@ -2,12 +2,14 @@
 //! the contact graph.
 
 use super::*;
+use super::maps::MapWorld;
 use crate::assembly::Assembly;
 use crate::boxes::{box_distance, first_overlap, fit_boxes, fit_voxels, single_box};
 use crate::error::{GeomError, Result};
 use crate::math::{Aabb, Vec3};
 use crate::partset::PartSet;
-use crate::world::{World, WorldConfig};
+use crate::world::World;
+use std::sync::Arc;
 use parry3d::shape::TriMesh;
 use rayon::prelude::*;
 
@@ -34,8 +36,39 @@ impl SweepFrame {
 }
 
 impl DistanceMaps {
-    /// Computes every map of `assembly` (rows in parallel with rayon).
+    /// Computes every map of `assembly` (rows in parallel with rayon). When a part is a mesh,
+    /// the maps build their own collision world (settings of [`MapConfig::world_config`]) and keep
+    /// it ([`DistanceMaps::world`]).
     pub fn build(assembly: &Assembly, config: &MapConfig) -> Result<DistanceMaps> {
+        Self::build_with(assembly, config, None)
+    }
+
+    /// [`DistanceMaps::build`] on the collision world of a run, so the maps, the depth-first
+    /// planner and the robot share one `World`: the maps of `world.assembly()`, equal to the maps
+    /// built alone. The world must have the maps' settings ([`MapConfig::world_config`]; its
+    /// candidate directions may differ, the maps do not read them), else an error names the
+    /// setting. The maps keep the world ([`DistanceMaps::world`]).
+    pub fn build_on(world: Arc<World>, config: &MapConfig) -> Result<DistanceMaps> {
+        let assembly = world.assembly();
+        let want = config.world_config(assembly);
+        let have = world.config();
+        let differs = [
+            ("tolerance", have.tolerance != want.tolerance),
+            ("contact distance", have.contact_distance != want.contact_distance),
+            ("overlap policy", have.overlaps != want.overlaps),
+            ("max overlap fraction", have.max_overlap_fraction != want.max_overlap_fraction),
+            ("exact boxes", have.exact_boxes != want.exact_boxes),
+            ("fasteners", have.fasteners != want.fasteners),
+        ];
+        if let Some((name, _)) = differs.iter().find(|(_, d)| *d) {
+            return Err(GeomError::config(format!(
+                "distance maps: the collision world's {name} differs from the maps' settings"
+            )));
+        }
+        Self::build_with(&world.assembly().clone(), config, Some(world))
+    }
+
+    fn build_with(assembly: &Assembly, config: &MapConfig, given: Option<Arc<World>>) -> Result<DistanceMaps> {
         let n = assembly.len();
         if n == 0 {
             return Err(GeomError::Assembly {
@@ -131,19 +164,15 @@ impl DistanceMaps {
         // pair needs shape casting or the contact graph needs mesh contacts.
         let need_mesh = shapes.iter().any(|s| matches!(s, Shape::Mesh));
         let contact_distance = config.contact_distance.unwrap_or(DEFAULT_RELATIVE_CONTACT * diag);
-        let world = if need_mesh {
-            let world_config = WorldConfig {
-                tolerance: Some(tolerance.max(f32::MIN_POSITIVE)),
-                contact_distance: Some(contact_distance.max(f32::MIN_POSITIVE)),
-                overlaps: config.overlaps,
-                ..WorldConfig::default()
-            };
-            let world = World::new(assembly.clone(), &world_config)?;
-            warnings.extend(world.warnings().iter().cloned());
-            Some(world)
-        } else {
-            None
+        // a given world is kept for the robot even when no pair reads it
+        let (world, kept) = match given {
+            _ if !need_mesh => (None, given),
+            Some(world) => (Some(world), None),
+            None => (Some(Arc::new(World::new(assembly.clone(), &config.world_config(assembly))?)), None),
         };
+        if let Some(world) = &world {
+            warnings.extend(world.warnings().iter().cloned());
+        }
 
         let dirs = hemisphere.directions().to_vec();
         let frame_dirs: Vec<Vec3> = dirs.iter().map(|d| *d / frame.cell).collect();
@@ -311,6 +340,7 @@ impl DistanceMaps {
             contacts: contacts.iter().map(Bits::from_set).collect(),
             bases: Bits::from_set(&bases),
             warnings,
+            world: MapWorld(world.or(kept)),
         };
         maps.index();
         Ok(maps)

@@ -1,7 +1,9 @@
 //! How distance maps are computed: limits, defaults, the gravity rule and [`MapConfig`].
 
 use crate::error::{GeomError, Result};
+use crate::assembly::Assembly;
 use crate::overlap::OverlapPolicy;
+use crate::world::WorldConfig;
 
 /// Largest supported map resolution `N_M` (`N_M² ≤ 256` directions fit a [`DirMask`]).
 pub const MAX_RESOLUTION: usize = 15;
@@ -54,6 +56,21 @@ impl Default for MapConfig {
 }
 
 impl MapConfig {
+    /// The settings of the collision world the maps of `assembly` build for their mesh parts
+    /// (tolerance and contact distance resolved to metres): give a world built with them to
+    /// [`crate::distmap::DistanceMaps::build_on`].
+    pub fn world_config(&self, assembly: &Assembly) -> WorldConfig {
+        let diag = assembly.diagonal();
+        let tolerance = self.tolerance.unwrap_or(DEFAULT_RELATIVE_TOLERANCE * diag);
+        let contact_distance = self.contact_distance.unwrap_or(DEFAULT_RELATIVE_CONTACT * diag);
+        WorldConfig {
+            tolerance: Some(tolerance.max(f32::MIN_POSITIVE)),
+            contact_distance: Some(contact_distance.max(f32::MIN_POSITIVE)),
+            overlaps: self.overlaps,
+            ..WorldConfig::default()
+        }
+    }
+
     /// A builder starting from the defaults.
     pub fn builder() -> MapConfigBuilder {
         MapConfigBuilder { config: MapConfig::default() }

@@ -5,6 +5,8 @@ use super::{Bits, DirMask, Hemisphere, Support};
 use crate::feasibility::{Motion, Stability};
 use crate::math::{Aabb, Vec3};
 use crate::partset::PartSet;
+use crate::world::World;
+use std::sync::Arc;
 
 /// How the maps of one part were computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -70,6 +72,18 @@ pub struct DistanceMaps {
     /// no part is fixed.
     pub(super) bases: Bits,
     pub(super) warnings: Vec<String>,
+    /// The collision world the maps were built on or built (when a part is a mesh).
+    pub(super) world: MapWorld,
+}
+
+/// The maps' collision world (`World` has no `Debug`: it prints whether there is one).
+#[derive(Clone)]
+pub(super) struct MapWorld(pub(super) Option<Arc<World>>);
+
+impl std::fmt::Debug for MapWorld {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(if self.0.is_some() { "Some(World)" } else { "None" })
+    }
 }
 
 impl DistanceMaps {
@@ -127,6 +141,13 @@ impl DistanceMaps {
     /// How the maps of part `i` were computed.
     pub fn geometry(&self, i: usize) -> PartGeometry {
         self.geometry[i]
+    }
+
+    /// The collision world the maps were built on ([`DistanceMaps::build_on`]) or built
+    /// themselves (a part is a mesh); `None` for maps of boxes and voxels built alone. The robot
+    /// reuses it instead of building a second one.
+    pub fn world(&self) -> Option<&Arc<World>> {
+        self.world.0.as_ref()
     }
 
     /// Problems met while building (voxels that do not match meshes, open meshes).
