@@ -719,11 +719,6 @@ impl World {
         })
     }
 
-    /// Whether part `p`'s blocking row is already computed.
-    pub fn row_cached(&self, p: usize) -> bool {
-        self.rows[p].get().is_some()
-    }
-
     /// How far `p` must travel along `dir` for its bounds to clear the bounds of the other
     /// present real parts, plus the contact distance. With no other part left, it clears its own
     /// starting bounds (so the last part is lifted by its size, not by nothing).
