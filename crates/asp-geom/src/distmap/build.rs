@@ -161,7 +161,7 @@ impl DistanceMaps {
             }
         }
         // The collision world (welded, oriented meshes; eroded copies; contacts), only when a
-        // pair needs shape casting or the contact graph needs mesh contacts.
+        // pair needs triangle sweeps or the contact graph needs mesh contacts.
         let need_mesh = shapes.iter().any(|s| matches!(s, Shape::Mesh));
         let contact_distance = config.contact_distance.unwrap_or(DEFAULT_RELATIVE_CONTACT * diag);
         // a given world is kept for the robot even when no pair reads it

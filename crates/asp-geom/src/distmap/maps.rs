@@ -15,7 +15,7 @@ pub enum PartGeometry {
     Voxels,
     /// Exact sweeps of the part's boxes (`extras.asp.boxes`, or its mesh is one axis-aligned box).
     Box,
-    /// Shape casting of the eroded mesh (both parts of a pair must be boxes for exact sweeps).
+    /// Exact triangle sweeps of the eroded mesh (both parts of a pair must be boxes for box sweeps).
     Mesh,
 }
 

@@ -75,7 +75,7 @@ fn stacked_boxes_from_meshes_and_boxes_agree() {
     )
     .unwrap();
     assert_eq!(boxes.geometry(0), PartGeometry::Box);
-    // Turn the top box into a general mesh (subdivided) to force shape casting.
+    // Turn the top box into a general mesh (subdivided) to force exact triangle sweeps.
     let extra = top.vertices.len() as u32;
     top.vertices.push(Vec3::new(0.5, 0.5, 2.0));
     let t = top.triangles.iter().position(|t| t.iter().all(|&v| top.vertices[v as usize].z == 2.0)).unwrap();
