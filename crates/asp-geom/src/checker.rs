@@ -54,12 +54,6 @@ impl Checker {
         &self.world
     }
 
-    /// The physics stability check, when the stability mode is [`StabilityMode::Physics`] (e.g. to
-    /// [`PhysicsStability::prepare`] its shapes up front).
-    pub fn physics(&self) -> Option<&PhysicsStability> {
-        self.physics.as_ref()
-    }
-
     /// Whether `state` stands with the `held` parts (present, not fixed) held in place by a
     /// gripper or a fixture: they count as fixed. Not counted as a removal test.
     pub fn stability_holding(&self, state: &PartSet, held: &PartSet) -> Stability {

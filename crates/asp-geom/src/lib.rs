@@ -8,6 +8,8 @@ pub mod erode;
 pub mod error;
 pub mod feasibility;
 pub mod fastener;
+// test fixtures and puzzle models, public for the other crates' tests and examples
+#[doc(hidden)]
 pub mod fixtures;
 pub mod graph;
 pub mod grid;
@@ -18,6 +20,7 @@ pub mod overlap;
 pub mod meta;
 pub mod partset;
 pub mod physics;
+#[doc(hidden)]
 pub mod puzzles;
 pub mod rrt;
 pub mod sweep;

@@ -26,7 +26,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Settings of the collision world. Lengths in metres; `None` means "relative to the model".
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct WorldConfig {
     /// Contact tolerance: a motion is blocked only when it pushes a part deeper than this into
     /// another. Default `1e-4 ×` the model's diagonal.
@@ -173,6 +173,8 @@ pub struct World {
     fixed: PartSet,
     rows: Vec<OnceLock<Vec<PartSet>>>,
     warnings: Vec<String>,
+    /// The settings it was built with, `tolerance` and `contact_distance` resolved to metres.
+    config: WorldConfig,
 }
 
 impl World {
@@ -241,6 +243,7 @@ impl World {
             fixed,
             rows,
             warnings,
+            config: WorldConfig { tolerance: Some(tolerance), contact_distance: Some(contact_distance), ..config.clone() },
         };
         world.measure_contacts(config.max_overlap_fraction, config.overlaps)?;
         if config.fasteners {
@@ -500,6 +503,11 @@ impl World {
         &self.notes
     }
 
+    /// The settings this world was built with (tolerance and contact distance in metres).
+    pub fn config(&self) -> &WorldConfig {
+        &self.config
+    }
+
     /// The overlap policy this world was built with.
     pub fn overlap_policy(&self) -> OverlapPolicy {
         self.policy
@@ -709,11 +717,6 @@ impl World {
             }
             row
         })
-    }
-
-    /// Whether part `p`'s blocking row is already computed.
-    pub fn row_cached(&self, p: usize) -> bool {
-        self.rows[p].get().is_some()
     }
 
     /// How far `p` must travel along `dir` for its bounds to clear the bounds of the other

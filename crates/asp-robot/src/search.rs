@@ -350,10 +350,14 @@ impl RobotExtension {
             contact_distance: Some(model.maps.contact_distance()),
             ..WorldConfig::default()
         };
-        let world = World::new(model.assembly.as_ref().clone(), &config).map_err(SearchError::from)?;
+        // the maps' world when it has the robot's settings (one World per run), else a new one
+        let world = match model.maps.world() {
+            Some(w) if *w.config() == config => w.clone(),
+            _ => Arc::new(World::new(model.assembly.as_ref().clone(), &config).map_err(SearchError::from)?),
+        };
         let cell = self.setup.cell(model.assembly);
         let m = Arc::new(RobotModel {
-            planner: RemovalPlanner::new(Arc::new(world), cell, self.setup.config.clone()),
+            planner: RemovalPlanner::new(world, cell, self.setup.config.clone()),
             replans: self.setup.config.replans,
             assembly: model.assembly.clone(),
             cache: Mutex::new(HashMap::new()),

@@ -246,3 +246,22 @@ fn lazy_robot_rollouts_repeat_themselves_with_fewer_robot_plans() {
     assert!(lazy.3 < eager.3, "robot path searches lazy {} vs eager {}", lazy.3, eager.3);
     assert!(lazy.1 < 0.0 && eager.1 < 0.0);
 }
+
+#[test]
+fn the_robot_reuses_the_maps_world() {
+    use asp_geom::distmap::{DistanceMaps, MapConfig};
+    use asp_search::mdp::ModelContext;
+    // a mesh model: the maps build a collision world with the robot's settings, the robot takes it
+    let assembly = Arc::new(asp_geom::fixtures::tube());
+    let maps = Arc::new(DistanceMaps::build(&assembly, &MapConfig::builder().resolution(5).build().unwrap()).unwrap());
+    let world = maps.world().expect("a mesh part: the maps built a world").clone();
+    let ext = RobotExtension::new(RobotSetup::panda());
+    let model = ext.model(&ModelContext { assembly: &assembly, maps: &maps, seed: 7 }).unwrap();
+    assert!(std::ptr::eq(model.planner().world(), &*world), "one World per run");
+    // boxes only: the maps keep no world, the robot builds its own
+    let boxes = Arc::new(stacks());
+    let maps = Arc::new(DistanceMaps::build(&boxes, &MapConfig::builder().resolution(5).build().unwrap()).unwrap());
+    assert!(maps.world().is_none());
+    let model = RobotExtension::new(RobotSetup::panda()).model(&ModelContext { assembly: &boxes, maps: &maps, seed: 7 }).unwrap();
+    assert_eq!(model.planner().world().num_parts(), boxes.len());
+}

@@ -1,7 +1,7 @@
 //! [`AssemblyGraph`]: the graph of the assembled model (thesis 3.4.1, eqs. 3.5-3.7) with its node
 //! and edge attributes (3.4.2, eqs. 3.11-3.12), computed once per model.
 
-use super::config::GraphConfig;
+use super::config::{GraphConfig, DIRECTION_BINS};
 use super::descriptor::descriptor_into;
 use super::sample::{sample_triangles, SurfaceSample};
 use crate::error::{GeomError, Result};
@@ -55,9 +55,6 @@ struct PairFeatures {
     /// The contact directions of `Q_i^j` and of `Q_j^i`.
     directions: [[f32; DIRECTION_BINS]; 2],
 }
-
-/// Floats of an edge's contact directions (`+u1, +u2, −u1, −u2, +up, −up`).
-pub const DIRECTION_BINS: usize = 6;
 
 impl AssemblyGraph {
     /// The graph of the assembled model of `world`: samples and descriptors per part (in

@@ -2,6 +2,9 @@
 
 use crate::error::{GeomError, Result};
 
+/// Floats of an edge's contact directions (`+u1, +u2, −u1, −u2, +up, −up`).
+pub const DIRECTION_BINS: usize = 6;
+
 /// The largest spherical-harmonic degree asp evaluates (the recurrences are tested to here).
 pub const MAX_DEGREE: usize = 20;
 /// The most radius shells a descriptor may have.
@@ -111,7 +114,7 @@ impl GraphConfig {
     /// Length of an edge's attributes: `2D + 8` (two descriptors, six contact directions,
     /// `above`, `normal_up`), `2D + 2` without contact directions.
     pub fn edge_dim(&self) -> usize {
-        let directions = if self.contact_directions { super::build::DIRECTION_BINS } else { 0 };
+        let directions = if self.contact_directions { DIRECTION_BINS } else { 0 };
         2 * self.descriptor_dim() + directions + 2
     }
 }

@@ -17,7 +17,8 @@ pub mod harmonics;
 pub mod sample;
 mod state;
 
-pub use build::{contact_directions, horizontal_frame, AssemblyGraph, DIRECTION_BINS};
+pub use build::{contact_directions, horizontal_frame, AssemblyGraph};
+pub use config::DIRECTION_BINS;
 pub use config::{GraphConfig, GraphConfigBuilder, MAX_DEGREE, MAX_POINTS_PER_PART, MAX_RADIUS_BINS};
 pub use descriptor::sh_descriptor;
 pub use sample::{sample_surface, SurfaceSample};

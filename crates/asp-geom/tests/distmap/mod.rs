@@ -419,3 +419,56 @@ fn maps_agree_with_the_collision_world_on_voxel_cubes() {
     eprintln!("world disagrees with the exact voxel reference on {world_disagrees} of {pairs} pairs");
     assert!(world_disagrees * 20 < pairs, "{world_disagrees} of {pairs}");
 }
+
+/// Every map, stability verdict and warning of `a` and `b`, bit for bit.
+fn assert_same_maps(a: &DistanceMaps, b: &DistanceMaps) {
+    let n = a.num_parts();
+    assert_eq!(n, b.num_parts());
+    for i in 0..=n {
+        for j in (0..=n).filter(|&j| j != i) {
+            let bits = |m: &DistanceMaps| m.map(i, j).iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(a), bits(b), "M({i}, {j})");
+        }
+    }
+    for p in 0..n {
+        let state = PartSet::full(n).without(p);
+        assert_eq!(a.stability(&state), b.stability(&state), "without {p}");
+        assert_eq!(a.clearance(p, &PartSet::full(n)), b.clearance(p, &PartSet::full(n)));
+    }
+    assert_eq!(a.warnings(), b.warnings());
+}
+
+#[test]
+fn maps_built_on_a_world_equal_the_maps_built_alone() {
+    use asp_geom::distmap::Support;
+    use asp_geom::World;
+    let mut mesh_models = 0;
+    for model in [fixtures::ring_on_locked_post(), fixtures::hooked_bracket(), fixtures::tube(), fixtures::dowel_in_two_boards()] {
+        for support in [Support::Below, Support::ContactGraph] {
+            let config = MapConfig::builder().resolution(5).support(support).build().unwrap();
+            let alone = DistanceMaps::build(&model, &config).unwrap();
+            let world = Arc::new(World::new(model.clone(), &config.world_config(&model)).unwrap());
+            let on = DistanceMaps::build_on(world.clone(), &config).unwrap();
+            assert_same_maps(&alone, &on);
+            // the given world is the one kept, for the robot
+            assert!(Arc::ptr_eq(on.world().unwrap(), &world), "{:?}", model.source);
+            // maps built alone keep the world they built, exactly when a part is a mesh
+            let meshes = (0..alone.num_parts()).any(|i| alone.geometry(i) == PartGeometry::Mesh);
+            assert_eq!(alone.world().is_some(), meshes, "{:?}", model.source);
+            mesh_models += usize::from(meshes);
+        }
+    }
+    assert!(mesh_models > 0, "no model read the world's meshes");
+}
+
+#[test]
+fn maps_refuse_a_world_with_other_settings() {
+    use asp_geom::World;
+    let model = fixtures::ring_on_locked_post();
+    let config = config(5);
+    let mut settings = config.world_config(&model);
+    settings.tolerance = settings.tolerance.map(|t| 2.0 * t);
+    let world = Arc::new(World::new(model, &settings).unwrap());
+    let err = DistanceMaps::build_on(world, &config).unwrap_err().to_string();
+    assert!(err.contains("tolerance"), "{err}");
+}

@@ -1,0 +1,370 @@
+//! Computing the maps: part shapes (voxels, boxes, meshes), the rows of sweeps in parallel, and
+//! the contact graph.
+
+use super::*;
+use super::maps::MapWorld;
+use crate::assembly::Assembly;
+use crate::boxes::{box_distance, first_overlap, fit_boxes, fit_voxels, single_box};
+use crate::error::{GeomError, Result};
+use crate::math::{Aabb, Vec3};
+use crate::partset::PartSet;
+use crate::world::World;
+use std::sync::Arc;
+use parry3d::shape::TriMesh;
+use rayon::prelude::*;
+
+/// One part's geometry prepared for sweeps: boxes in the sweep frame, or meshes.
+enum Shape {
+    Boxes { boxes: Vec<Aabb>, integer: bool },
+    Mesh,
+}
+
+/// A part's voxels with the origin and cell size fitted to its mesh.
+type VoxelFit = (Vec<[i32; 3]>, Vec3, Vec3);
+
+/// The frame box sweeps run in: world = origin + grid * cell.
+#[derive(Clone, Copy, Debug)]
+struct SweepFrame {
+    origin: Vec3,
+    cell: Vec3,
+}
+
+impl SweepFrame {
+    fn frame_box(&self, b: &Aabb) -> Aabb {
+        Aabb::new((b.mins - self.origin) / self.cell, (b.maxs - self.origin) / self.cell)
+    }
+}
+
+impl DistanceMaps {
+    /// Computes every map of `assembly` (rows in parallel with rayon). When a part is a mesh,
+    /// the maps build their own collision world (settings of [`MapConfig::world_config`]) and keep
+    /// it ([`DistanceMaps::world`]).
+    pub fn build(assembly: &Assembly, config: &MapConfig) -> Result<DistanceMaps> {
+        Self::build_with(assembly, config, None)
+    }
+
+    /// [`DistanceMaps::build`] on the collision world of a run, so the maps, the depth-first
+    /// planner and the robot share one `World`: the maps of `world.assembly()`, equal to the maps
+    /// built alone. The world must have the maps' settings ([`MapConfig::world_config`]; its
+    /// candidate directions may differ, the maps do not read them), else an error names the
+    /// setting. The maps keep the world ([`DistanceMaps::world`]).
+    pub fn build_on(world: Arc<World>, config: &MapConfig) -> Result<DistanceMaps> {
+        let assembly = world.assembly();
+        let want = config.world_config(assembly);
+        let have = world.config();
+        let differs = [
+            ("tolerance", have.tolerance != want.tolerance),
+            ("contact distance", have.contact_distance != want.contact_distance),
+            ("overlap policy", have.overlaps != want.overlaps),
+            ("max overlap fraction", have.max_overlap_fraction != want.max_overlap_fraction),
+            ("exact boxes", have.exact_boxes != want.exact_boxes),
+            ("fasteners", have.fasteners != want.fasteners),
+        ];
+        if let Some((name, _)) = differs.iter().find(|(_, d)| *d) {
+            return Err(GeomError::config(format!(
+                "distance maps: the collision world's {name} differs from the maps' settings"
+            )));
+        }
+        Self::build_with(&world.assembly().clone(), config, Some(world))
+    }
+
+    fn build_with(assembly: &Assembly, config: &MapConfig, given: Option<Arc<World>>) -> Result<DistanceMaps> {
+        let n = assembly.len();
+        if n == 0 {
+            return Err(GeomError::Assembly {
+                path: assembly.source.clone(),
+                reason: "the model has no parts".into(),
+            });
+        }
+        if n > MAX_PARTS {
+            return Err(GeomError::Assembly {
+                path: assembly.source.clone(),
+                reason: format!("distance maps support at most {MAX_PARTS} parts, the model has {n}"),
+            });
+        }
+        let hemisphere = Hemisphere::new(config.resolution, assembly.up)?;
+        let diag = assembly.diagonal();
+        let d_max = config.d_max.unwrap_or(diag).max(f32::MIN_POSITIVE);
+        let tolerance = config.tolerance.unwrap_or(DEFAULT_RELATIVE_TOLERANCE * diag);
+        let dcount = hemisphere.len();
+        let stride = dcount.div_ceil(8) * 8;
+        let mut warnings = Vec::new();
+        let aabbs: Vec<Aabb> = assembly
+            .parts
+            .iter()
+            .map(|p| p.mesh.aabb().unwrap_or(Aabb::new(Vec3::ZERO, Vec3::ZERO)))
+            .collect();
+
+        // Geometry: voxels, single boxes, or meshes.
+        let mut voxel_fits: Vec<Option<VoxelFit>> = Vec::with_capacity(n);
+        for p in &assembly.parts {
+            let fit = if config.use_voxels {
+                p.meta.cells.as_ref().and_then(|cells| match fit_voxels(cells, &p.mesh) {
+                    Some((o, c)) => Some((cells.clone(), o, c)),
+                    None => {
+                        warnings.push(format!(
+                            "part '{}': its voxels do not match its mesh; using the mesh",
+                            p.name
+                        ));
+                        None
+                    }
+                })
+            } else {
+                None
+            };
+            voxel_fits.push(fit);
+        }
+        // A shared grid when every voxel part agrees on origin and cell size.
+        let mut frame = SweepFrame { origin: Vec3::ZERO, cell: Vec3::ONE };
+        let mut shared_grid = false;
+        if let Some((_, o0, c0)) = voxel_fits.iter().flatten().next() {
+            let agree = voxel_fits.iter().flatten().all(|(_, o, c)| {
+                let eps = 1e-3 * c0.min_element();
+                (*c - *c0).abs().max_element() <= eps && {
+                    // origins may differ by whole cells
+                    let k = (*o - *o0) / *c0;
+                    (k - k.round()).abs().max_element() * c0.min_element() <= eps
+                }
+            });
+            if agree {
+                frame = SweepFrame { origin: *o0, cell: *c0 };
+                shared_grid = true;
+            }
+        }
+        let mut geometry = Vec::with_capacity(n);
+        let mut shapes = Vec::with_capacity(n);
+        for (i, p) in assembly.parts.iter().enumerate() {
+            if let Some((cells, o, c)) = &voxel_fits[i] {
+                let boxes = cells
+                    .iter()
+                    .map(|v| {
+                        let lo = Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32);
+                        if shared_grid {
+                            let shift = ((*o - frame.origin) / frame.cell).round();
+                            Aabb::new(lo + shift, lo + shift + Vec3::ONE)
+                        } else {
+                            Aabb::new(*o + lo * *c, *o + (lo + Vec3::ONE) * *c)
+                        }
+                    })
+                    .collect();
+                geometry.push(PartGeometry::Voxels);
+                shapes.push(Shape::Boxes { boxes, integer: shared_grid });
+            } else if let Some(boxes) = p.meta.boxes.as_ref().and_then(|b| fit_boxes(b, &p.mesh)) {
+                geometry.push(PartGeometry::Box);
+                shapes.push(Shape::Boxes { boxes: boxes.iter().map(|b| frame.frame_box(b)).collect(), integer: false });
+            } else if let Some(b) = single_box(&p.mesh) {
+                geometry.push(PartGeometry::Box);
+                shapes.push(Shape::Boxes { boxes: vec![frame.frame_box(&b)], integer: false });
+            } else {
+                geometry.push(PartGeometry::Mesh);
+                shapes.push(Shape::Mesh);
+            }
+        }
+        // The collision world (welded, oriented meshes; eroded copies; contacts), only when a
+        // pair needs triangle sweeps or the contact graph needs mesh contacts.
+        let need_mesh = shapes.iter().any(|s| matches!(s, Shape::Mesh));
+        let contact_distance = config.contact_distance.unwrap_or(DEFAULT_RELATIVE_CONTACT * diag);
+        // a given world is kept for the robot even when no pair reads it
+        let (world, kept) = match given {
+            _ if !need_mesh => (None, given),
+            Some(world) => (Some(world), None),
+            None => (Some(Arc::new(World::new(assembly.clone(), &config.world_config(assembly))?)), None),
+        };
+        if let Some(world) = &world {
+            warnings.extend(world.warnings().iter().cloned());
+        }
+
+        let dirs = hemisphere.directions().to_vec();
+        let frame_dirs: Vec<Vec3> = dirs.iter().map(|d| *d / frame.cell).collect();
+        let frame_tol = tolerance / frame.cell.min_element();
+        let upv = hemisphere.up();
+        let low: Vec<f32> = aabbs.iter().map(|b| lowest_along(b, upv)).collect();
+        let floor_level = low.iter().copied().fold(f32::INFINITY, f32::min);
+        let n1 = n + 1;
+
+        // Row i: M(p_i, p_j) for j in 0..=n (j = n is the floor).
+        let rows: Vec<(Vec<f32>, Vec<DirMask>)> = (0..n1)
+            .into_par_iter()
+            .map(|i| {
+                let mut vals = vec![0.0f32; n1 * stride];
+                let mut masks = vec![DirMask::EMPTY; n1];
+                for j in 0..n1 {
+                    if i == j {
+                        continue;
+                    }
+                    let row = &mut vals[j * stride..j * stride + dcount];
+                    if j == n {
+                        // Parts never move into the floor along the half sphere.
+                        row.fill(d_max);
+                        continue;
+                    }
+                    if i == n {
+                        // The floor rises along m until it touches p_j's lowest point.
+                        let gap = low[j] - floor_level;
+                        let gap = if gap <= tolerance { 0.0 } else { gap };
+                        for (d, m) in dirs.iter().enumerate() {
+                            let c = m.dot(upv);
+                            row[d] = if c > 1e-6 { (gap / c).min(d_max) } else { d_max };
+                        }
+                    } else {
+                        match (&shapes[i], &shapes[j]) {
+                            (
+                                Shape::Boxes { boxes: bi, integer: ii },
+                                Shape::Boxes { boxes: bj, integer: ij },
+                            ) => {
+                                let tol = if *ii && *ij { 0.0 } else { frame_tol };
+                                let ai = frame.frame_box(&aabbs[i]);
+                                let aj = frame.frame_box(&aabbs[j]);
+                                for (d, m) in frame_dirs.iter().enumerate() {
+                                    let mut best = d_max;
+                                    if first_overlap(&ai, *m, &aj, tol).is_some_and(|t| t < d_max) {
+                                        for a in bi {
+                                            for b in bj {
+                                                if let Some(t) = first_overlap(a, *m, b, tol) {
+                                                    best = best.min(t);
+                                                }
+                                            }
+                                        }
+                                    }
+                                    row[d] = best;
+                                }
+                            }
+                            _ => {
+                                let world = world.as_ref().expect("built when a part is a mesh");
+                                let (_, erosion) = world.pair_erosion(i, j);
+                                let (moving, fixed) = world.pair_shapes(i, j);
+                                let ignored = world.ignores(i, j);
+                                let strict = world.is_strict_pair(i, j);
+                                for (d, m) in dirs.iter().enumerate() {
+                                    let near = first_overlap(&aabbs[i], *m, &aabbs[j], 0.0).is_some_and(|t| t < d_max);
+                                    let mut v = if !ignored && near {
+                                        cast_distance(&moving, &fixed, *m, d_max, erosion)
+                                    } else {
+                                        d_max
+                                    };
+                                    if strict && near && v > 0.0 {
+                                        // an input overlap: no sample may enter new material
+                                        if let Some(t) = world.strict_entry(i, j, Vec3::ZERO, *m, v, false) {
+                                            v = v.min(if t <= erosion { 0.0 } else { t });
+                                        }
+                                    }
+                                    row[d] = v;
+                                }
+                            }
+                        }
+                    }
+                    let mut mask = DirMask::EMPTY;
+                    for (d, v) in row.iter().enumerate() {
+                        if *v < d_max {
+                            mask.insert(d);
+                        }
+                    }
+                    masks[j] = mask;
+                }
+                (vals, masks)
+            })
+            .collect();
+        let mut values = Vec::with_capacity(n1 * n1 * stride);
+        let mut blocked = Vec::with_capacity(n1 * n1);
+        for (v, m) in rows {
+            values.extend(v);
+            blocked.extend(m);
+        }
+        let fixed: Vec<bool> = assembly.parts.iter().map(|p| p.fixed).collect();
+        let floor_is_base = !fixed.iter().any(|&f| f);
+        let mut bases = PartSet::from_indices(n1, (0..n).filter(|&i| fixed[i]));
+        if floor_is_base {
+            bases.insert(n);
+        }
+        let contacts = if config.support == Support::ContactGraph {
+            let mut contacts = vec![PartSet::empty(n1); n1];
+            let mut touch = |i: usize, j: usize| {
+                contacts[i].insert(j);
+                contacts[j].insert(i);
+            };
+            if let Some(w) = &world {
+                // the world's contact graph (its ground, when present, is index n)
+                for i in 0..w.num_parts() + usize::from(w.ground().is_some()) {
+                    for j in w.contacts(i).iter().filter(|&j| j > i) {
+                        touch(i, j);
+                    }
+                }
+            } else {
+                for i in 0..n {
+                    for j in (i + 1)..n {
+                        if let (Shape::Boxes { boxes: bi, .. }, Shape::Boxes { boxes: bj, .. }) =
+                            (&shapes[i], &shapes[j])
+                        {
+                            let near = bi.iter().any(|a| {
+                                bj.iter().any(|b| box_distance(a, b, frame.cell) <= contact_distance)
+                            });
+                            if near {
+                                touch(i, j);
+                            }
+                        }
+                    }
+                    if floor_is_base && low[i] - floor_level <= contact_distance {
+                        touch(i, n);
+                    }
+                }
+            }
+            contacts
+        } else {
+            Vec::new()
+        };
+        let mut maps = DistanceMaps {
+            n,
+            hemisphere,
+            diagonal: diag,
+            contact_distance,
+            d_max,
+            tolerance,
+            stride,
+            values,
+            blocked,
+            fixed,
+            aabbs,
+            geometry,
+            blockers: Vec::new(),
+            blocker_set: Vec::new(),
+            init_row: Vec::new(),
+            words: n.div_ceil(64),
+            dominators: Vec::new(),
+            blocker_masks: Vec::new(),
+            along: Vec::new(),
+            blocks: Vec::new(),
+            supporters: Vec::new(),
+            dependents: Vec::new(),
+            on_floor: Vec::new(),
+            support: config.support,
+            contacts: contacts.iter().map(Bits::from_set).collect(),
+            bases: Bits::from_set(&bases),
+            warnings,
+            world: MapWorld(world.or(kept)),
+        };
+        maps.index();
+        Ok(maps)
+    }
+}
+
+/// The smallest `p · up` over the corners of box `b`.
+fn lowest_along(b: &Aabb, up: Vec3) -> f32 {
+    (0..3).map(|k| (b.mins[k] * up[k]).min(b.maxs[k] * up[k])).sum()
+}
+
+
+/// Distance the mesh `moving`, eroded by `erosion`, travels along `dir` before touching `fixed`
+/// (exact triangle sweeps, [`crate::sweep`]), less the erosion (contacts within it read 0), capped at `d_max`.
+fn cast_distance(moving: &TriMesh, fixed: &TriMesh, dir: Vec3, d_max: f32, erosion: f32) -> f32 {
+    match crate::sweep::sweep_distance(moving, dir, fixed, d_max) {
+        Some(hit) => {
+            let t = hit - erosion;
+            if t <= erosion {
+                0.0
+            } else {
+                t.min(d_max)
+            }
+        }
+        None => d_max,
+    }
+}

@@ -1,0 +1,147 @@
+use super::*;
+use super::maps::clear_distance;
+use crate::assembly::Assembly;
+use crate::feasibility::Stability;
+use crate::math::{Aabb, Axis, Vec3};
+use crate::partset::PartSet;
+use crate::assembly::Part;
+use crate::fixtures;
+use crate::mesh::Mesh;
+
+fn part(name: &str, mesh: Mesh) -> Part {
+    fixtures::part(name, mesh, false)
+}
+
+fn assembly(parts: Vec<Part>) -> Assembly {
+    fixtures::assemble("test", parts, Axis::Z)
+}
+
+#[test]
+fn hemisphere_has_the_axes_and_no_duplicates() {
+    let h = Hemisphere::new(5, Axis::Z).unwrap();
+    assert_eq!(h.len(), 25);
+    assert_eq!(h.directions()[h.up_index()], Vec3::Z);
+    for axis in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y] {
+        assert!(h.directions().iter().any(|d| (*d - axis).length() < 1e-6), "{axis:?}");
+    }
+    for (a, d) in h.directions().iter().enumerate() {
+        assert!((d.length() - 1.0).abs() < 1e-5 && d.z >= 0.0);
+        for e in &h.directions()[a + 1..] {
+            assert!((*d - *e).length() > 1e-3);
+        }
+    }
+    let hy = Hemisphere::new(3, Axis::Y).unwrap();
+    assert_eq!(hy.directions()[hy.up_index()], Vec3::Y);
+    assert!(hy.directions().iter().all(|d| d.y >= 0.0));
+    assert!(Hemisphere::new(4, Axis::Z).is_err());
+    assert!(MapConfig::builder().resolution(17).build().is_err());
+    assert!(MapConfig::builder().d_max(-1.0).build().is_err());
+}
+
+#[test]
+fn dirmask_operations() {
+    let all = DirMask::first(81);
+    assert_eq!(all.len(), 81);
+    assert!(all.contains(80) && !all.contains(81));
+    let mut m = DirMask::EMPTY;
+    m.insert(3);
+    m.insert(70);
+    assert_eq!(all.and(m).iter().collect::<Vec<_>>(), vec![3, 70]);
+    assert_eq!(all.and_not(m).len(), 79);
+    assert_eq!(DirMask::first(256).len(), 256);
+}
+
+#[test]
+fn clear_distance_of_boxes() {
+    // (box sweeps themselves are tested in `crate::boxes`)
+    let a = Aabb::new(Vec3::ZERO, Vec3::ONE);
+    let b = Aabb::new(Vec3::new(2.0, 0.0, 0.0), Vec3::new(3.0, 1.0, 1.0));
+    // already apart: nothing to travel
+    assert_eq!(clear_distance(&a, Vec3::X, &b), 0.0);
+    let rest = Aabb::new(Vec3::ZERO, Vec3::new(3.0, 1.0, 2.0));
+    assert_eq!(clear_distance(&a, Vec3::X, &rest), 3.0);
+    assert_eq!(clear_distance(&a, Vec3::Z, &rest), 2.0);
+}
+
+#[test]
+fn stacked_boxes_from_meshes_and_boxes_agree() {
+    // Two stacked boxes: the top one leaves upward and sideways, the bottom one only
+    // sideways (the top one blocks up).
+    let mut top = Mesh::cuboid(Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 1.0, 2.0));
+    let bottom = Mesh::cuboid(Vec3::ZERO, Vec3::ONE);
+    let boxes = DistanceMaps::build(
+        &assembly(vec![part("bottom", bottom.clone()), part("top", top.clone())]),
+        &MapConfig::builder().resolution(3).build().unwrap(),
+    )
+    .unwrap();
+    assert_eq!(boxes.geometry(0), PartGeometry::Box);
+    // Turn the top box into a general mesh (subdivided) to force exact triangle sweeps.
+    let extra = top.vertices.len() as u32;
+    top.vertices.push(Vec3::new(0.5, 0.5, 2.0));
+    let t = top.triangles.iter().position(|t| t.iter().all(|&v| top.vertices[v as usize].z == 2.0)).unwrap();
+    let [a, b, c] = top.triangles.remove(t);
+    top.triangles.extend([[a, b, extra], [b, c, extra], [c, a, extra]]);
+    assert!(top.topology().is_closed_manifold());
+    let meshes = DistanceMaps::build(
+        &assembly(vec![part("bottom", bottom), part("top", top)]),
+        &MapConfig::builder().resolution(3).build().unwrap(),
+    )
+    .unwrap();
+    assert_eq!(meshes.geometry(1), PartGeometry::Mesh);
+    let d_max = boxes.d_max();
+    assert!((d_max - 6f32.sqrt()).abs() < 1e-5);
+    let h = boxes.hemisphere();
+    let up = h.up_index();
+    for maps in [&boxes, &meshes] {
+        // bottom vs top: moving up hits immediately; horizontal is free
+        assert_eq!(maps.map(0, 1)[up], 0.0);
+        assert_eq!(maps.map(0, 1)[h.index(2, 2)], d_max); // +x
+        // top vs bottom: every half-sphere direction is free
+        assert!(maps.map(1, 0).iter().all(|&v| v == d_max));
+        // the floor supports the bottom, the bottom supports the top
+        assert!(maps.on_floor(0) && !maps.on_floor(1));
+        assert_eq!(maps.supporters(1), &[0]);
+        let full = PartSet::full(2);
+        assert!(maps.is_collision_free(1, &full));
+        // the bottom slides out sideways, but that drops the top
+        assert!(maps.is_collision_free(0, &full));
+        assert!(!maps.free_mask(0, &full).contains(up));
+        assert_eq!(maps.stability(&PartSet::from_indices(2, [1])), Stability::Unstable {
+            floating: PartSet::from_indices(2, [1])
+        });
+    }
+}
+
+#[test]
+fn map_state_tracks_removals() {
+    // A column of three boxes: only the top leaves, then the middle, then the bottom.
+    let parts = (0..3)
+        .map(|k| {
+            let z = k as f32;
+            part(&format!("b{k}"), Mesh::cuboid(Vec3::new(0.0, 0.0, z), Vec3::new(1.0, 1.0, z + 1.0)))
+        })
+        .collect();
+    let maps = DistanceMaps::build(&assembly(parts), &MapConfig::default()).unwrap();
+    let mut s = MapState::new(&maps);
+    let mut acts = Vec::new();
+    s.feasible_actions(&mut acts);
+    assert_eq!(acts, vec![2]);
+    let before: f32 = s.min_map(1).iter().sum();
+    s.remove(2);
+    let after: f32 = s.min_map(1).iter().sum();
+    assert!(after > before);
+    let direct = maps.min_map(1, &s.present());
+    assert_eq!(s.min_map(1), direct.as_slice());
+    s.feasible_actions(&mut acts);
+    assert_eq!(acts, vec![1]);
+    // the middle box is already outside the bottom one's box: no travel, straight up
+    let (d, t) = s.clearance(1).unwrap();
+    assert_eq!(d, maps.hemisphere().up_index());
+    assert_eq!(t, 0.0);
+    s.remove(1);
+    s.feasible_actions(&mut acts);
+    assert_eq!(acts, vec![0]);
+    s.remove(0);
+    assert!(s.is_complete());
+}
+
