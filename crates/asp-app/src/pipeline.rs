@@ -457,7 +457,14 @@ pub fn optimiser_problem(assembly: &Arc<Assembly>, settings: &PlanSettings, o: &
     }
     let config = config.build()?;
     let started = Instant::now();
-    let maps = Arc::new(DistanceMaps::build(&assembly, &config)?);
+    // one World per run: the maps of mesh models build it anyway and keep it; with extensions
+    // (a robot, which needs a world even on box and voxel models) it is built first and shared
+    let maps = if o.extensions.is_empty() {
+        Arc::new(DistanceMaps::build(assembly, &config)?)
+    } else {
+        let world = Arc::new(World::new(assembly.as_ref().clone(), &config.world_config(assembly))?);
+        Arc::new(DistanceMaps::build_on(world, &config)?)
+    };
     let map_seconds = started.elapsed().as_secs_f64();
     let model = ModelContext { assembly, maps: &maps, seed: settings.seed };
     let objectives = resolve_objectives(&o.objectives, &o.extensions, &model)?;
