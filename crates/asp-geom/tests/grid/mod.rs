@@ -277,6 +277,31 @@ fn issue_9_the_state_budget_ends_the_search() {
     assert!(s.complete() || s.plan.status == GridStatus::Budget);
 }
 
+/// Issue 28: with no fixed part, when the larger side of a separation keeps the reference, the
+/// new reference was stored as a position within the staying side but read as an index into the
+/// units: a panic (`Option::unwrap()` on `None`) or a wrong reference. The key burr with its
+/// pieces reordered (the largest piece not first) panicked on its third separation.
+#[test]
+fn issue_28_no_fixed_part_and_the_reference_not_first_does_not_panic() {
+    let pieces = pieces(&puzzles::burr_key());
+    let order = [2, 1, 0, 3, 4, 5];
+    let reordered: Vec<Vec<Cell>> = order.iter().map(|&i| pieces[i].clone()).collect();
+    let model = VoxelModel::from_cells(reordered.clone(), vec![false; 6]);
+    let s = solve(&model);
+    assert!(s.complete(), "{:?}", s.plan);
+    replay_solution(&model, &s);
+    // the same plan, part for part, as the original order's
+    let original = solve(&VoxelModel::from_cells(pieces, vec![false; 6]));
+    let mut taken: Vec<Vec<usize>> = s.plan.steps.iter().map(|st| st.parts.iter().map(|&p| order[p]).collect()).collect();
+    taken.iter_mut().for_each(|t| t.sort_unstable());
+    let expect: Vec<Vec<usize>> = original.plan.steps.iter().map(|st| st.parts.clone()).collect();
+    assert_eq!(taken, expect);
+    // through the assembly too, as `asp plan` sees it
+    let a = puzzles::voxel_puzzle("burr_key_reordered", &reordered);
+    let s = solve(&VoxelModel::of(&a).unwrap());
+    assert!(s.complete());
+}
+
 /// A tiny seeded generator (xorshift64*).
 struct Rng(u64);
 impl Rng {
