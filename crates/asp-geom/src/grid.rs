@@ -534,7 +534,9 @@ impl Solver<'_> {
                         dir = scale(dir, -1);
                         let stay_units: Vec<usize> = staying.iter().map(|&i| local.units[i]).collect();
                         let base = self.base(&stay_units);
-                        local.reference = staying.iter().position(|&i| local.units[i] == base).unwrap();
+                        // an index into `local.units` (as `bfs` and the next `Local` read it),
+                        // not a position within `staying` (issue 28: a panic, or a wrong reference)
+                        local.reference = staying.iter().copied().find(|&i| local.units[i] == base).unwrap();
                     }
                     let clearance = self.clearance(&local, &offsets, &leaving, &staying, dir);
                     let leave_units: Vec<usize> = leaving.iter().map(|&i| local.units[i]).collect();
