@@ -94,7 +94,7 @@ pub fn run(a: &MctsArgs) -> anyhow::Result<std::process::ExitCode> {
         crate::output::positive("d-max", d)?;
     }
     let objectives: Vec<&str> = a.objective.split(',').map(str::trim).filter(|n| !n.is_empty()).collect();
-    asp_search::objective::check_objective_names(&a.objective, &[]).context("--objective")?;
+    asp_search::extension::check_objective_names(&a.objective, &[]).context("--objective")?;
     let mut settings = Vec::new();
     for name in a.settings.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         settings.push(match name {

@@ -8,7 +8,7 @@ use crate::optimise::SupportArg;
 use asp_geom::distmap::Support;
 use asp_search::collect::{self, CollectSettings};
 use asp_search::collect_q::{self, TransitionSettings, TransitionsModel};
-use asp_search::objective::check_objective_names;
+use asp_search::extension::check_objective_names;
 use asp_search::pipeline::OptimiseSettings;
 use indicatif::{ProgressBar, ProgressStyle};
 use asp_search::{BuiltinOrder, OrderingSource};

@@ -3,7 +3,7 @@
 
 use anyhow::{bail, Context};
 use asp_geom::distmap::Support;
-use asp_search::objective::check_objective_names;
+use asp_search::extension::check_objective_names;
 use asp_search::MdpExtension;
 use std::sync::Arc;
 use asp_search::pipeline::OptimiseSettings;

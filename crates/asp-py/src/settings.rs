@@ -306,7 +306,7 @@ pub fn q_graph_settings(dict: &Bound<'_, PyDict>) -> Result<(PlanSettings, Optim
     }
     let mut optimise = optimise_settings(&k)?.ok_or_else(|| Error::config("objective: no objective given"))?;
     optimise.pareto = optimise.objectives.split(',').filter(|n| !n.trim().is_empty()).count() > 1;
-    asp_search::objective::check_objective_names(&optimise.objectives, &[]).map_err(Error::from)?;
+    asp_search::extension::check_objective_names(&optimise.objectives, &[]).map_err(Error::from)?;
     let plan = PlanSettings {
         tolerance: k.positive("tolerance")?,
         contact_distance: k.positive("contact_distance")?,

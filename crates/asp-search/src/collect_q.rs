@@ -13,7 +13,7 @@
 
 use crate::collect::{self, io_error, ModelItem};
 use crate::mdp::Mdp;
-use crate::objective::StepKind;
+use crate::step::StepKind;
 use crate::pipeline::{self, OptimiseSettings, PlanSettings};
 use crate::qgraph::{direction_history, QGraphConfig};
 use crate::search::{Transition, DEFAULT_RECORD_LIMIT};
@@ -179,7 +179,7 @@ fn checked(settings: &TransitionSettings) -> Result<()> {
     if settings.limit == 0 {
         return Err(SearchError::config("the transitions limit must be at least 1"));
     }
-    crate::objective::check_objective_names(&settings.optimise.objectives, &settings.optimise.extensions)
+    crate::extension::check_objective_names(&settings.optimise.objectives, &settings.optimise.extensions)
 }
 
 /// Collects the transitions of `models` into `out` (created; files of the format are

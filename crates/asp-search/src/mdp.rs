@@ -15,11 +15,13 @@
 //! [`crate::search::SearchStats::filtered`]).
 //!
 //! # Extensions
-//! An [`MdpExtension`] adds named objectives and filters to the planning pipeline for a model
-//! (how a crate above asp-search, such as the robot, plugs into `asp plan --objective`).
+//! An [`crate::extension::MdpExtension`] adds named objectives and filters to the planning
+//! pipeline for a model (how a crate above asp-search, such as the robot, plugs into
+//! `asp plan --objective`).
 
 use crate::error::{Result, SearchError};
-use crate::objective::{Objective, StepContext, StepKind};
+use crate::objective::Objective;
+use crate::step::{StepContext, StepKind};
 use asp_geom::distmap::{DistanceMaps, MapState};
 use asp_geom::{Assembly, Motion, PartSet};
 use std::fmt::Debug;
@@ -96,39 +98,11 @@ pub struct FilterCount {
     pub count: u64,
 }
 
-/// What an [`MdpExtension`] gets to prepare its objectives and filters for one model.
-#[derive(Clone, Copy, Debug)]
-pub struct ModelContext<'a> {
-    /// The assembly (metres, world frame).
-    pub assembly: &'a Arc<Assembly>,
-    /// Its distance maps.
-    pub maps: &'a Arc<DistanceMaps>,
-    /// The run's seed.
-    pub seed: u64,
-}
-
-/// Objectives and filters beyond the built-in ones, for the planning pipeline (e.g. a robot:
-/// the `robot-path` objective and the filter "the arm can grasp the part and carry it out").
-pub trait MdpExtension: Send + Sync + Debug {
-    /// The objective names it provides (for validation and messages).
-    fn objective_names(&self) -> Vec<String> {
-        Vec::new()
-    }
-
-    /// The objective called `name` on this model, or `None` when it does not provide it.
-    fn objective(&self, _name: &str, _model: &ModelContext<'_>) -> Result<Option<Arc<dyn Objective>>> {
-        Ok(None)
-    }
-
-    /// Filters every problem on this model gets, whatever its objectives.
-    fn filters(&self, _model: &ModelContext<'_>) -> Result<Vec<Arc<dyn ActionFilter>>> {
-        Ok(Vec::new())
-    }
-
-    /// What it adds to the plan of `sequence` (removal order) on this model, e.g. a robot's
-    /// grasps and paths per step; default `None`.
-    fn describe(&self, _model: &ModelContext<'_>, _sequence: &[usize]) -> Result<Option<crate::report::RobotReport>> {
-        Ok(None)
+impl<'s, 'm> StepContext<'s, 'm> {
+    /// The removal of present `part` from `state` in `problem` (the context takes the problem's
+    /// assembly and seed).
+    pub fn new(problem: &'s Mdp, state: &'s mut MapState<'m>, part: usize, kind: StepKind) -> Self {
+        StepContext::from_parts(problem.assembly(), problem.seed(), state, part, kind)
     }
 }
 

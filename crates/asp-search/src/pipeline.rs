@@ -6,16 +6,16 @@
 //! that name the setting, not a command-line flag. Every step is also public on its own, so a
 //! caller that plans many times on one model (data collection, benchmarks) builds the world once.
 
-use crate::mdp::{MdpExtension, ModelContext};
-use crate::objective::resolve_objectives;
+use crate::extension::{MdpExtension, ModelContext};
+use crate::extension::resolve_objectives;
 use crate::policy::Policy;
 use crate::ordering::{BuiltinOrder, OrderingSource};
 use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
 use crate::grid::GridRun;
 use asp_geom::grid::{GridConfig, VoxelModel};
 use crate::report::{GridEntry, OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
-use crate::search::{EpisodeHook, SearchOutcome, SearchStatus, StopToken, DEFAULT_BUDGET, DEFAULT_EPISODES};
-use crate::{Dfs, Mcts, Mdp, ParetoMcts, Planner, Result, SearchError};
+use crate::search::{EpisodeHook, SearchOutcome, SearchStatus, DEFAULT_BUDGET, DEFAULT_EPISODES};
+use crate::{Dfs, Mcts, Mdp, ParetoMcts, Planner, Result, SearchError, StopToken};
 use asp_geom::distmap::{DistanceMaps, MapConfig, Support};
 use asp_geom::io::LoadOptions;
 use asp_geom::math::Axis;
@@ -435,7 +435,7 @@ pub struct OptimiserProblem {
 /// (built-in or from the extensions), the extensions' filters, and `settings.seed` as the
 /// problem's seed. Several objectives need `o.pareto`.
 pub fn optimiser_problem(assembly: &Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<OptimiserProblem> {
-    crate::objective::check_objective_names(&o.objectives, &o.extensions)?;
+    crate::extension::check_objective_names(&o.objectives, &o.extensions)?;
     if o.objectives.split(',').filter(|s| !s.trim().is_empty()).count() > 1 && !o.pareto {
         return Err(SearchError::config(format!(
             "objectives {}: several objectives need a Pareto search (or give one objective)",

@@ -16,7 +16,7 @@
 
 use crate::error::{Result, SearchError};
 use crate::mdp::Mdp;
-use crate::objective::{StepContext, StepKind};
+use crate::step::{StepContext, StepKind};
 use asp_geom::distmap::{DistanceMaps, MapState};
 use asp_geom::PartSet;
 use rand::{RngExt, SeedableRng};

@@ -23,7 +23,7 @@
 
 use crate::hypervolume::ParetoFront;
 use crate::mdp::{FilterCounts, Mdp};
-use crate::objective::StepKind;
+use crate::step::StepKind;
 use asp_geom::distmap::MapState;
 
 /// The longest block of consecutive removals a move takes.

@@ -60,15 +60,15 @@
 use crate::error::{Result, SearchError};
 use crate::hypervolume::ParetoFront;
 use crate::mdp::{FilterCount, FilterCounts, Mdp, MAX_OBJECTIVES};
-use crate::objective::StepKind;
+use crate::step::StepKind;
 use crate::policy::{rng_for, Policy, PolicyContext, PolicyWorker, RandomPolicy, SearchRng};
 use crate::polish::{Ended, Polisher};
+use crate::problem::StopToken;
 use asp_geom::distmap::MapState;
 use asp_geom::{Motion, PartSet};
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::marker::PhantomData;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -106,30 +106,6 @@ pub struct SearchSettings {
     pub(crate) record_limit: usize,
     pub(crate) lazy_filters: bool,
     pub(crate) polish: f64,
-}
-
-/// Stops running searches from another thread (Ctrl-C from Python, a caller's deadline): each
-/// search thread finishes its current iteration and the search returns what it has found, as
-/// with a time limit ([`SearchStats::stopped`]). Clones share the token.
-#[derive(Clone, Debug, Default)]
-pub struct StopToken(Arc<AtomicBool>);
-
-impl StopToken {
-    /// A token that has not been stopped.
-    pub fn new() -> Self {
-        StopToken::default()
-    }
-
-    /// Asks every search holding the token to stop.
-    pub fn stop(&self) {
-        self.0.store(true, Ordering::Relaxed);
-    }
-
-    /// Whether [`StopToken::stop`] was called.
-    #[inline]
-    pub fn is_stopped(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
-    }
 }
 
 impl Default for SearchSettings {

@@ -209,7 +209,7 @@ fn stacks() -> Assembly {
 /// One search of `stacks()` with the robot filter asked lazily or for every candidate: its
 /// best sequence and value, the removals put to the filter, and the robot's path searches.
 fn robot_search(lazy: bool) -> (Vec<usize>, f64, u64, u64) {
-    use asp_search::mdp::{MdpExtension, ModelContext};
+    use asp_search::extension::{MdpExtension, ModelContext};
     use asp_search::pipeline::optimiser_problem;
     use asp_search::Mcts;
     let assembly = Arc::new(stacks());
