@@ -8,7 +8,7 @@ use asp_geom::distmap::Support;
 use asp_search::bench_mcts::{self, MctsRow, MctsSetting};
 use asp_search::collect;
 use asp_search::pipeline::OptimiseSettings;
-use asp_search::search::DEFAULT_BUDGET;
+use asp_search::mcts::DEFAULT_BUDGET;
 use clap::Args;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -49,7 +49,7 @@ pub struct MctsArgs {
     #[arg(long, default_value_t = std::f64::consts::FRAC_1_SQRT_2)]
     pub exploration: f64,
     /// The local search's share of each search's work (`asp plan --polish`; 0: off).
-    #[arg(long, value_name = "SHARE", default_value_t = asp_search::search::DEFAULT_POLISH)]
+    #[arg(long, value_name = "SHARE", default_value_t = asp_search::mcts::DEFAULT_POLISH)]
     pub polish: f64,
     /// Distance map resolution N_M.
     #[arg(long, default_value_t = asp_geom::distmap::DEFAULT_RESOLUTION)]

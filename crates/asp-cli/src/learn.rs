@@ -73,7 +73,7 @@ pub struct TransitionsArgs {
     #[arg(long, default_value_t = asp_search::collect_q::DEFAULT_EPISODES)]
     pub episodes: usize,
     /// Search budget: MCTS iterations per step of an episode (the thesis uses 5).
-    #[arg(long, default_value_t = asp_search::search::DEFAULT_BUDGET)]
+    #[arg(long, default_value_t = asp_search::mcts::DEFAULT_BUDGET)]
     pub budget: usize,
     /// Base seed (the search of model m uses a seed derived from it and m).
     #[arg(long, default_value_t = 0)]
@@ -88,7 +88,7 @@ pub struct TransitionsArgs {
     #[arg(long, value_enum, default_value_t = SupportArg::Below)]
     pub support: SupportArg,
     /// The most transitions recorded per model (its search goes on without recording beyond it).
-    #[arg(long, default_value_t = asp_search::search::DEFAULT_RECORD_LIMIT)]
+    #[arg(long, default_value_t = asp_search::mcts::DEFAULT_RECORD_LIMIT)]
     pub max_transitions: usize,
     /// Loading and testing.
     #[command(flatten)]

@@ -8,7 +8,7 @@ use asp_search::MdpExtension;
 use std::sync::Arc;
 use asp_search::pipeline::OptimiseSettings;
 use asp_search::report::{OptimisationEntry, ParetoEntry};
-use asp_search::search::{DEFAULT_BUDGET, DEFAULT_EPISODES};
+use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
@@ -55,7 +55,7 @@ pub struct OptimiseArgs {
     pub exploration: f64,
     /// Local search over the answer's sequences: block moves of 1-3 removals around every
     /// sequence the search finds, taking at most this share of the search's work (0: off).
-    #[arg(long, value_name = "SHARE", default_value_t = asp_search::search::DEFAULT_POLISH, help_heading = "Optimisation")]
+    #[arg(long, value_name = "SHARE", default_value_t = asp_search::mcts::DEFAULT_POLISH, help_heading = "Optimisation")]
     pub polish: f64,
     /// Distance map resolution N_M (odd, 3 to 15): N_M × N_M directions on the half sphere.
     #[arg(long, default_value_t = asp_geom::distmap::DEFAULT_RESOLUTION, help_heading = "Optimisation")]

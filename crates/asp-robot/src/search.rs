@@ -9,7 +9,7 @@
 //!   objective plans the shortest for the step taken. Expansion and replay plan `k` times
 //!   ([`RemovalConfig::replans`]) and keep the shortest; simulation plans once (5.4.2) and takes
 //!   the first path found, the one the filter found when it admitted the step (rollouts ask the
-//!   filter lazily, [`asp_search::search`]). Verdicts are remembered per state and part and
+//!   filter lazily, [`asp_search::mcts`]). Verdicts are remembered per state and part and
 //!   carry over between numbers of replans ([`RobotModel`]). The lift direction is the
 //!   distance maps' straight-line removal direction of the step.
 //!

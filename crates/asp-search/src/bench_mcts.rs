@@ -11,7 +11,7 @@
 use crate::bench::MeanStd;
 use crate::pipeline::{self, OptimiseSettings, PlanSettings};
 use crate::policy::{Policy, RandomPolicy};
-use crate::search::SearchOutcome;
+use crate::mcts::SearchOutcome;
 use crate::{Mcts, ParetoMcts, Result, SearchError};
 use serde::Serialize;
 use std::path::Path;

@@ -5,7 +5,7 @@
 //! For every model the distance maps, objectives and filters are built as the optimiser builds
 //! them ([`pipeline::optimiser_problem`]); one search per model (MCTS for one objective,
 //! Pareto-MCTS for several) runs `episodes` episodes on one thread with recording on
-//! ([`crate::search::SearchBuilder::record_transitions`]), its seed derived from the base seed
+//! ([`crate::mcts::SearchBuilder::record_transitions`]), its seed derived from the base seed
 //! and the model's position. Models go in parallel; the output depends only on the models, the
 //! settings and the seed. The index records, per model, the keyword arguments of `asp.load`
 //! and `Assembly.q_graphs` that rebuild the same maps, so the Python trainer computes each
@@ -16,7 +16,7 @@ use crate::mdp::Mdp;
 use crate::step::StepKind;
 use crate::pipeline::{self, OptimiseSettings, PlanSettings};
 use crate::qgraph::{direction_history, QGraphConfig};
-use crate::search::{Transition, DEFAULT_RECORD_LIMIT};
+use crate::mcts::{Transition, DEFAULT_RECORD_LIMIT};
 use crate::{Mcts, ParetoMcts, Result, SearchError};
 use asp_geom::distmap::Support;
 use rayon::prelude::*;

@@ -12,7 +12,7 @@
 //! An [`ActionFilter`] (a robot that must grasp a part and carry it out, or an objective with
 //! rules of its own) removes actions from a state's feasible set; every rejection is counted
 //! under the filter's reason ([`FilterCounts`], reported as
-//! [`crate::search::SearchStats::filtered`]).
+//! [`crate::mcts::SearchStats::filtered`]).
 //!
 //! # Extensions
 //! An [`crate::extension::MdpExtension`] adds named objectives and filters to the planning
@@ -51,7 +51,7 @@ pub enum Verdict {
 /// [`StepContext::seed`] for randomised checks). A sequence whose rollout steps were admitted as
 /// [`StepKind::Simulation`] is replayed as [`StepKind::Replay`] at the end of a search; a filter
 /// whose replay rejects what its simulation admitted loses that answer (counted in
-/// [`crate::search::SearchStats::replay_failures`]), so let replays try at least what
+/// [`crate::mcts::SearchStats::replay_failures`]), so let replays try at least what
 /// simulations try (e.g. the same seed first).
 pub trait ActionFilter: Send + Sync + Debug {
     /// A short name for the statistics (e.g. `robot`).

@@ -14,7 +14,7 @@ use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step
 use crate::grid::GridRun;
 use asp_geom::grid::{GridConfig, VoxelModel};
 use crate::report::{GridEntry, OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
-use crate::search::{EpisodeHook, SearchOutcome, SearchStatus, DEFAULT_BUDGET, DEFAULT_EPISODES};
+use crate::mcts::{EpisodeHook, SearchOutcome, SearchStatus, DEFAULT_BUDGET, DEFAULT_EPISODES};
 use crate::{Dfs, Mcts, Mdp, ParetoMcts, Planner, Result, SearchError, StopToken};
 use asp_geom::distmap::{DistanceMaps, MapConfig, Support};
 use asp_geom::io::LoadOptions;
@@ -171,7 +171,7 @@ pub struct OptimiseSettings {
     /// Exploration constant of UCT / MOUCB.
     pub exploration: f64,
     /// The share of the search's work its local search over the answer's sequences may take
-    /// ([`crate::search::SearchBuilder::polish`]; 0: none).
+    /// ([`crate::mcts::SearchBuilder::polish`]; 0: none).
     pub polish: f64,
     /// Distance map resolution N_M.
     pub resolution: usize,
@@ -197,7 +197,7 @@ impl Default for OptimiseSettings {
             threads: None,
             time_limit: None,
             exploration: std::f64::consts::FRAC_1_SQRT_2,
-            polish: crate::search::DEFAULT_POLISH,
+            polish: crate::mcts::DEFAULT_POLISH,
             resolution: asp_geom::distmap::DEFAULT_RESOLUTION,
             d_max: None,
             support: Support::Below,

@@ -19,7 +19,7 @@
 //! search finds replays.
 //!
 //! Its work is counted in map steps and filter checks and kept to a share of the search's own
-//! ([`crate::search::SearchBuilder::polish`]), so the search stays deterministic for a seed.
+//! ([`crate::mcts::SearchBuilder::polish`]), so the search stays deterministic for a seed.
 
 use crate::hypervolume::ParetoFront;
 use crate::mdp::{FilterCounts, Mdp};

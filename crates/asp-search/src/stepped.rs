@@ -29,7 +29,7 @@ use crate::error::{Result, SearchError};
 use crate::mdp::Mdp;
 use crate::pipeline::{self, OptimiseSettings, PlanResult, PlanSettings};
 use crate::policy::Policy;
-use crate::search::{EpisodeEnd, Next};
+use crate::mcts::{EpisodeEnd, Next};
 use crate::StopToken;
 use std::path::Path;
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
