@@ -86,7 +86,7 @@ pub fn bench_model(
     if checkpoints.iter().any(|t| !(t.is_finite() && *t > 0.0)) || checkpoints.windows(2).any(|w| w[0] >= w[1]) {
         return Err(AppError::config(format!("checkpoints must be positive and increasing, got {checkpoints:?}")));
     }
-    asp_search::objective::check_objective_names(&o.objectives, &o.extensions)?;
+    asp_search::extension::check_objective_names(&o.objectives, &o.extensions)?;
     let pareto = o.pareto || o.objectives.split(',').filter(|s| !s.trim().is_empty()).count() > 1;
     let assembly = Arc::new(pipeline::load(path, plan)?);
     let o = OptimiseSettings { pareto, ..o.clone() };

@@ -5,7 +5,7 @@
 //! For every model the distance maps, objectives and filters are built as the optimiser builds
 //! them ([`pipeline::optimiser_problem`]); one search per model (MCTS for one objective,
 //! Pareto-MCTS for several) runs `episodes` episodes on one thread with recording on
-//! ([`asp_search::search::SearchBuilder::record_transitions`]), its seed derived from the base seed
+//! ([`asp_search::mcts::SearchBuilder::record_transitions`]), its seed derived from the base seed
 //! and the model's position. Models go in parallel; the output depends only on the models, the
 //! settings and the seed. The index records, per model, the keyword arguments of `asp.load`
 //! and `Assembly.q_graphs` that rebuild the same maps, so the Python trainer computes each
@@ -16,7 +16,7 @@ use asp_search::Mdp;
 use asp_search::StepKind;
 use crate::pipeline::{self, OptimiseSettings, PlanSettings};
 use asp_search::qgraph::{direction_history, QGraphConfig};
-use asp_search::search::DEFAULT_RECORD_LIMIT;
+use asp_search::mcts::DEFAULT_RECORD_LIMIT;
 use asp_search::Transition;
 use asp_search::{Mcts, ParetoMcts};
 use crate::error::{AppError, Result};
@@ -181,7 +181,7 @@ fn checked(settings: &TransitionSettings) -> Result<()> {
     if settings.limit == 0 {
         return Err(AppError::config("the transitions limit must be at least 1"));
     }
-    Ok(asp_search::objective::check_objective_names(&settings.optimise.objectives, &settings.optimise.extensions)?)
+    Ok(asp_search::extension::check_objective_names(&settings.optimise.objectives, &settings.optimise.extensions)?)
 }
 
 /// Collects the transitions of `models` into `out` (created; files of the format are

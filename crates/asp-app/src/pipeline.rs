@@ -7,14 +7,14 @@
 //! caller that plans many times on one model (data collection, benchmarks) builds the world once.
 
 use asp_search::{CheckerExtension, MdpExtension, ModelContext};
-use asp_search::objective::resolve_objectives;
+use asp_search::extension::resolve_objectives;
 use crate::catalogue::PolicySource;
 use asp_search::{BuiltinOrder, OrderingSource};
 use asp_search::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
 use asp_search::grid::GridRun;
 use asp_geom::grid::{GridConfig, VoxelModel};
 use asp_search::report::{GridEntry, OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
-use asp_search::search::{DEFAULT_BUDGET, DEFAULT_EPISODES};
+use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES};
 use asp_search::{EpisodeHook, SearchOutcome, SearchStatus, StopToken};
 use asp_search::{Dfs, Mcts, Mdp, ParetoMcts, Planner};
 use crate::error::{AppError, Result};
@@ -165,7 +165,7 @@ pub struct OptimiseSettings {
     /// Exploration constant of UCT / MOUCB.
     pub exploration: f64,
     /// The share of the search's work its local search over the answer's sequences may take
-    /// ([`asp_search::search::SearchBuilder::polish`]; 0: none).
+    /// ([`asp_search::mcts::SearchBuilder::polish`]; 0: none).
     pub polish: f64,
     /// Distance map resolution N_M.
     pub resolution: usize,
@@ -191,7 +191,7 @@ impl Default for OptimiseSettings {
             threads: None,
             time_limit: None,
             exploration: std::f64::consts::FRAC_1_SQRT_2,
-            polish: asp_search::search::DEFAULT_POLISH,
+            polish: asp_search::mcts::DEFAULT_POLISH,
             resolution: asp_geom::distmap::DEFAULT_RESOLUTION,
             d_max: None,
             support: Support::Below,
@@ -436,7 +436,7 @@ pub struct OptimiserProblem {
 /// (built-in or from the extensions), the extensions' filters, and `settings.seed` as the
 /// problem's seed. Several objectives need `o.pareto`.
 pub fn optimiser_problem(assembly: &Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<OptimiserProblem> {
-    asp_search::objective::check_objective_names(&o.objectives, &o.extensions)?;
+    asp_search::extension::check_objective_names(&o.objectives, &o.extensions)?;
     if o.objectives.split(',').filter(|s| !s.trim().is_empty()).count() > 1 && !o.pareto {
         return Err(AppError::config(format!(
             "objectives {}: several objectives need a Pareto search (or give one objective)",

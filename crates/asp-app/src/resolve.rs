@@ -9,7 +9,7 @@ use crate::pipeline::{OptimiseSettings, PlanSettings, StabilitySetting, DEFAULT_
 use crate::request::{Overlaps, PlanRequest, QUse, Stability, Support};
 use asp_geom::math::{Axis, Vec3};
 use asp_geom::Units;
-use asp_search::search::{DEFAULT_BUDGET, DEFAULT_EPISODES, DEFAULT_EXPLORATION, DEFAULT_POLISH};
+use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES, DEFAULT_EXPLORATION, DEFAULT_POLISH};
 use asp_search::MdpExtension;
 use serde_json::{json, Value};
 use std::sync::Arc;
@@ -223,7 +223,7 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
     if names.iter().any(|n| n == asp_robot::ROBOT_PATH) && extensions.is_empty() {
         return Err(AppError::setting("objective", format!("{list}: robot-path needs a robot (`robot` panda or a URDF file)")));
     }
-    asp_search::objective::check_objective_names(&list, &extensions).map_err(|e| AppError::setting("objective", e.to_string()))?;
+    asp_search::extension::check_objective_names(&list, &extensions).map_err(|e| AppError::setting("objective", e.to_string()))?;
     let pareto = r.pareto.unwrap_or(false);
     if names.len() > 1 && !pareto {
         return Err(AppError::setting("objective", format!("{list}: several objectives need `pareto` (or give one objective)")));

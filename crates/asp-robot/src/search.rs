@@ -9,7 +9,7 @@
 //!   objective plans the shortest for the step taken. Expansion and replay plan `k` times
 //!   ([`RemovalConfig::replans`]) and keep the shortest; simulation plans once (5.4.2) and takes
 //!   the first path found, the one the filter found when it admitted the step (rollouts ask the
-//!   filter lazily, [`asp_search::search`]). Verdicts are remembered per state and part and
+//!   filter lazily, [`asp_search::mcts`]). Verdicts are remembered per state and part and
 //!   carry over between numbers of replans ([`RobotModel`]). The lift direction is the
 //!   distance maps' straight-line removal direction of the step.
 //!
@@ -21,8 +21,10 @@ use std::sync::{Arc, Mutex};
 use asp_geom::distmap::{DistanceMaps, MapState};
 use asp_geom::math::{Pose, Vec3};
 use asp_geom::{Assembly, Checker, FeasibilityChecker, Motion, PartSet, World, WorldConfig};
-use asp_search::mdp::{ActionFilter, MdpExtension, ModelContext, Verdict};
-use asp_search::objective::{Objective, StepContext, StepKind};
+use asp_search::extension::{MdpExtension, ModelContext};
+use asp_search::mdp::{ActionFilter, Verdict};
+use asp_search::objective::Objective;
+use asp_search::step::{StepContext, StepKind};
 use asp_search::CheckerExtension;
 use asp_search::report::{RobotEntry, RobotReport, RobotStepEntry};
 use asp_search::{Mdp, PathLength, PlanOutcome, SearchError};

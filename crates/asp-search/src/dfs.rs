@@ -12,8 +12,7 @@
 //! Subassemblies of the result are then planned on their own base, recursively.
 
 use crate::ordering::{state_seed, BuiltinOrder, OrderingFactory, PartOrdering, WithBookkeeping};
-use crate::problem::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StopReason, Stuck, StuckReason, Subassembly};
-use crate::Planner;
+use crate::problem::{Budget, PlanOutcome, Planner, Problem, Progress, Stats, Status, Step, StopReason, Stuck, StuckReason, Subassembly};
 use asp_geom::{MotionKind, Outcome, PartSet};
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;

@@ -14,7 +14,7 @@
 use crate::error::{Result, SearchError};
 use crate::hypervolume::ParetoFront;
 use crate::mdp::Mdp;
-use crate::objective::StepKind;
+use crate::step::StepKind;
 use asp_geom::distmap::MapState;
 use asp_geom::PartSet;
 use std::collections::HashMap;

@@ -12,14 +12,16 @@
 //! An [`ActionFilter`] (a robot that must grasp a part and carry it out, or an objective with
 //! rules of its own) removes actions from a state's feasible set; every rejection is counted
 //! under the filter's reason ([`FilterCounts`], reported as
-//! [`crate::search::SearchStats::filtered`]).
+//! [`crate::mcts::SearchStats::filtered`]).
 //!
 //! # Extensions
-//! An [`MdpExtension`] adds named objectives and filters to the planning pipeline for a model
-//! (how a crate above asp-search, such as the robot, plugs into `asp plan --objective`).
+//! An [`crate::extension::MdpExtension`] adds named objectives and filters to the planning
+//! pipeline for a model (how a crate above asp-search, such as the robot, plugs into
+//! `asp plan --objective`).
 
 use crate::error::{Result, SearchError};
-use crate::objective::{Objective, StepContext, StepKind};
+use crate::objective::Objective;
+use crate::step::{StepContext, StepKind};
 use asp_geom::distmap::{DistanceMaps, MapState};
 use asp_geom::{Assembly, Motion, PartSet};
 use std::fmt::Debug;
@@ -49,7 +51,7 @@ pub enum Verdict {
 /// [`StepContext::seed`] for randomised checks). A sequence whose rollout steps were admitted as
 /// [`StepKind::Simulation`] is replayed as [`StepKind::Replay`] at the end of a search; a filter
 /// whose replay rejects what its simulation admitted loses that answer (counted in
-/// [`crate::search::SearchStats::replay_failures`]), so let replays try at least what
+/// [`crate::mcts::SearchStats::replay_failures`]), so let replays try at least what
 /// simulations try (e.g. the same seed first).
 pub trait ActionFilter: Send + Sync + Debug {
     /// A short name for the statistics (e.g. `robot`).
@@ -96,39 +98,11 @@ pub struct FilterCount {
     pub count: u64,
 }
 
-/// What an [`MdpExtension`] gets to prepare its objectives and filters for one model.
-#[derive(Clone, Copy, Debug)]
-pub struct ModelContext<'a> {
-    /// The assembly (metres, world frame).
-    pub assembly: &'a Arc<Assembly>,
-    /// Its distance maps.
-    pub maps: &'a Arc<DistanceMaps>,
-    /// The run's seed.
-    pub seed: u64,
-}
-
-/// Objectives and filters beyond the built-in ones, for the planning pipeline (e.g. a robot:
-/// the `robot-path` objective and the filter "the arm can grasp the part and carry it out").
-pub trait MdpExtension: Send + Sync + Debug {
-    /// The objective names it provides (for validation and messages).
-    fn objective_names(&self) -> Vec<String> {
-        Vec::new()
-    }
-
-    /// The objective called `name` on this model, or `None` when it does not provide it.
-    fn objective(&self, _name: &str, _model: &ModelContext<'_>) -> Result<Option<Arc<dyn Objective>>> {
-        Ok(None)
-    }
-
-    /// Filters every problem on this model gets, whatever its objectives.
-    fn filters(&self, _model: &ModelContext<'_>) -> Result<Vec<Arc<dyn ActionFilter>>> {
-        Ok(Vec::new())
-    }
-
-    /// What it adds to the plan of `sequence` (removal order) on this model, e.g. a robot's
-    /// grasps and paths per step; default `None`.
-    fn describe(&self, _model: &ModelContext<'_>, _sequence: &[usize]) -> Result<Option<crate::report::RobotReport>> {
-        Ok(None)
+impl<'s, 'm> StepContext<'s, 'm> {
+    /// The removal of present `part` from `state` in `problem` (the context takes the problem's
+    /// assembly and seed).
+    pub fn new(problem: &'s Mdp, state: &'s mut MapState<'m>, part: usize, kind: StepKind) -> Self {
+        StepContext::from_parts(problem.assembly(), problem.seed(), state, part, kind)
     }
 }
 

@@ -27,135 +27,14 @@
 //! that depends only on the problem's seed, the state and the part.
 //!
 //! New objectives implement [`Objective`]; the built-in ones are named by [`objective_by_name`],
-//! others come from an [`crate::mdp::MdpExtension`].
+//! others come from an [`crate::extension::MdpExtension`].
 
 use crate::error::{Result, SearchError};
-use crate::mdp::{Mdp, MdpExtension, ModelContext};
-use asp_geom::distmap::{DirMask, DistanceMaps, MapState};
-use asp_geom::{Assembly, Motion, PartMeta, PartSet};
+use crate::step::StepContext;
+use asp_geom::distmap::{DirMask, DistanceMaps};
+use asp_geom::PartSet;
 use std::fmt::Debug;
 use std::sync::Arc;
-
-/// Which part of the search takes a removal step. Objectives and filters that plan (a robot
-/// arm) may spend more effort where the result is kept: the thesis plans a robot's path `k`
-/// times at expansion and once in simulation (5.4.2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum StepKind {
-    /// The removal becomes an edge of the search graph; its reward is kept there.
-    Expansion,
-    /// A rollout (simulation) step: the reward counts for one sampled sequence.
-    Simulation,
-    /// Replaying a finished sequence: an answer's values and motions, exact references, data
-    /// collection.
-    Replay,
-}
-
-/// What an objective (or a feasibility filter) sees of one removal: the part, the state it
-/// leaves (before the removal), the problem, and the step's kind.
-pub struct StepContext<'s, 'm> {
-    problem: &'s Mdp,
-    state: &'s mut MapState<'m>,
-    part: usize,
-    kind: StepKind,
-    clearance: Option<Option<(usize, f32)>>,
-}
-
-impl Debug for StepContext<'_, '_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("StepContext").field("part", &self.part).field("kind", &self.kind).finish_non_exhaustive()
-    }
-}
-
-impl<'s, 'm> StepContext<'s, 'm> {
-    /// The removal of present `part` from `state` in `problem`.
-    pub fn new(problem: &'s Mdp, state: &'s mut MapState<'m>, part: usize, kind: StepKind) -> Self {
-        StepContext { problem, state, part, kind, clearance: None }
-    }
-
-    /// The part being removed.
-    #[inline]
-    pub fn part(&self) -> usize {
-        self.part
-    }
-
-    /// Which part of the search takes the step.
-    #[inline]
-    pub fn kind(&self) -> StepKind {
-        self.kind
-    }
-
-    /// The state before the removal (mutable only so that minimum maps are computed lazily:
-    /// never remove parts from it).
-    #[inline]
-    pub fn state(&mut self) -> &mut MapState<'m> {
-        self.state
-    }
-
-    /// The parts present before the removal.
-    pub fn present(&self) -> PartSet {
-        self.state.present()
-    }
-
-    /// The distance maps.
-    #[inline]
-    pub fn maps(&self) -> &'m DistanceMaps {
-        self.state.maps()
-    }
-
-    /// The problem (objectives, filters, the assembly when the caller gave it).
-    #[inline]
-    pub fn problem(&self) -> &'s Mdp {
-        self.problem
-    }
-
-    /// The assembly the maps were built from, when the problem carries it
-    /// ([`Mdp::with_assembly`]; the planning pipeline always sets it). Metres, world frame.
-    pub fn assembly(&self) -> Option<&'s Assembly> {
-        self.problem.assembly()
-    }
-
-    /// What the file says about the moving part (grasps, kind, boxes), when the problem
-    /// carries the assembly.
-    pub fn meta(&self) -> Option<&'s PartMeta> {
-        self.assembly().map(|a| &a.parts[self.part].meta)
-    }
-
-    /// The straight-line removal on the maps: the free direction's index in
-    /// [`asp_geom::distmap::Hemisphere::directions`] along which the part's bounds clear the
-    /// remaining parts' bounds soonest, and that travel (metres); `None` when the part is
-    /// blocked. Computed once per step and shared by every objective.
-    pub fn clearance(&mut self) -> Option<(usize, f32)> {
-        if self.clearance.is_none() {
-            self.clearance = Some(self.state.clearance(self.part));
-        }
-        self.clearance.expect("just set")
-    }
-
-    /// [`StepContext::clearance`] as a motion (without the contact margin the plan adds).
-    pub fn motion(&mut self) -> Option<Motion> {
-        let maps = self.maps();
-        self.clearance().map(|(d, t)| Motion::Linear { direction: maps.hemisphere().directions()[d], distance: t })
-    }
-
-    /// A seed for randomised work (a planner's samples) that depends only on the problem's seed
-    /// ([`Mdp::with_seed`]), the present parts and the moving part: the same step gives the same
-    /// seed in every thread, episode and replay.
-    pub fn seed(&self) -> u64 {
-        let mut h = splitmix(self.problem.seed() ^ 0x6a09_e667_f3bc_c909);
-        for w in self.state.present().words() {
-            h = splitmix(h ^ w);
-        }
-        splitmix(h ^ self.part as u64)
-    }
-}
-
-/// SplitMix64's finaliser: a cheap, well-mixed hash of one word.
-fn splitmix(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
 
 /// One objective of the MDP: the reward of a removal, with the objective's own memory.
 pub trait Objective: Send + Sync + Debug {
@@ -350,45 +229,7 @@ pub fn parse_objectives(list: &str) -> Result<Vec<Arc<dyn Objective>>> {
     collect_objectives(list, |name| objective_by_name(name).map(Some), &[])
 }
 
-/// Checks a comma-separated list of objective names against the built-in ones and those the
-/// `extensions` provide (before a model is loaded: for early, clear errors).
-pub fn check_objective_names(list: &str, extensions: &[Arc<dyn MdpExtension>]) -> Result<()> {
-    let provided: Vec<String> = extensions.iter().flat_map(|e| e.objective_names()).collect();
-    let names = collect_names(list)?;
-    for name in &names {
-        if objective_by_name(name).is_err() && !provided.iter().any(|p| p == name.trim()) {
-            return Err(unknown(name, &provided));
-        }
-    }
-    Ok(())
-}
-
-/// The objectives of a comma-separated list on one model: the built-in ones by name, the
-/// others from the first extension that provides them.
-pub fn resolve_objectives(
-    list: &str,
-    extensions: &[Arc<dyn MdpExtension>],
-    model: &ModelContext<'_>,
-) -> Result<Vec<Arc<dyn Objective>>> {
-    let provided: Vec<String> = extensions.iter().flat_map(|e| e.objective_names()).collect();
-    collect_objectives(
-        list,
-        |name| {
-            if let Ok(o) = objective_by_name(name) {
-                return Ok(Some(o));
-            }
-            for e in extensions {
-                if let Some(o) = e.objective(name.trim(), model)? {
-                    return Ok(Some(o));
-                }
-            }
-            Ok(None)
-        },
-        &provided,
-    )
-}
-
-fn collect_names(list: &str) -> Result<Vec<&str>> {
+pub(crate) fn collect_names(list: &str) -> Result<Vec<&str>> {
     let names: Vec<&str> = list.split(',').filter(|s| !s.trim().is_empty()).collect();
     if names.is_empty() {
         return Err(SearchError::config("no objective given"));
@@ -396,13 +237,13 @@ fn collect_names(list: &str) -> Result<Vec<&str>> {
     Ok(names)
 }
 
-fn unknown(name: &str, provided: &[String]) -> SearchError {
+pub(crate) fn unknown(name: &str, provided: &[String]) -> SearchError {
     let mut known: Vec<String> = OBJECTIVE_NAMES.iter().map(|s| s.to_string()).collect();
     known.extend(provided.iter().cloned());
     SearchError::UnknownObjective { name: name.to_string(), known: known.join(", ") }
 }
 
-fn collect_objectives(
+pub(crate) fn collect_objectives(
     list: &str,
     mut by_name: impl FnMut(&str) -> Result<Option<Arc<dyn Objective>>>,
     provided: &[String],

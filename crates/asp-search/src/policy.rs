@@ -16,7 +16,7 @@
 
 use crate::error::{Result, SearchError};
 use crate::mdp::Mdp;
-use crate::objective::{StepContext, StepKind};
+use crate::step::{StepContext, StepKind};
 use asp_geom::distmap::{DistanceMaps, MapState};
 use asp_geom::PartSet;
 use rand::{RngExt, SeedableRng};
@@ -110,7 +110,7 @@ pub trait PolicyWorker {
 
     /// Priors (non-negative, e.g. a softmax of Q-values) of the feasible `actions` of a state
     /// the search adds to its graph, written to `out` (as long as `actions`). They order
-    /// expansions and, with [`crate::search::SearchBuilder::prior_weight`], add a PUCT bonus
+    /// expansions and, with [`crate::mcts::SearchBuilder::prior_weight`], add a PUCT bonus
     /// `w · P(a) · √N(s) / (1 + N(s, a))` to the tree policy.
     fn priors(&mut self, _ctx: &mut PolicyContext<'_, '_>, _actions: &[usize], out: &mut [f64]) -> Result<()> {
         out.fill(0.0);

@@ -19,11 +19,11 @@
 //! search finds replays.
 //!
 //! Its work is counted in map steps and filter checks and kept to a share of the search's own
-//! ([`crate::search::SearchBuilder::polish`]), so the search stays deterministic for a seed.
+//! ([`crate::mcts::SearchBuilder::polish`]), so the search stays deterministic for a seed.
 
 use crate::hypervolume::ParetoFront;
 use crate::mdp::{FilterCounts, Mdp};
-use crate::objective::StepKind;
+use crate::step::StepKind;
 use asp_geom::distmap::MapState;
 
 /// The longest block of consecutive removals a move takes.

@@ -1,7 +1,8 @@
 //! What every planner gets (a [`Problem`] and a [`Budget`]) and gives back (a [`PlanOutcome`]).
 
 use asp_geom::{CounterSnapshot, FeasibilityChecker, Motion, PartSet};
-use crate::search::StopToken;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// A planning problem: the feasibility checker of an assembly and the state to take apart.
@@ -28,6 +29,39 @@ impl<'a> Problem<'a> {
     /// Whether only fixed parts remain.
     pub fn is_goal(&self, state: &PartSet) -> bool {
         state.iter().all(|p| self.checker.is_fixed(p))
+    }
+}
+
+/// A planner: takes a problem apart within a budget. Every planner runs the same conformance
+/// tests (`tests/conformance`).
+pub trait Planner {
+    /// A short name for reports.
+    fn name(&self) -> &'static str;
+    /// Searches for a disassembly sequence.
+    fn solve(&self, problem: &Problem, budget: &Budget) -> PlanOutcome;
+}
+
+/// Stops running searches from another thread (Ctrl-C from Python, a caller's deadline): each
+/// search thread finishes its current iteration and the search returns what it has found, as
+/// with a time limit ([`crate::SearchStats::stopped`]). Clones share the token.
+#[derive(Clone, Debug, Default)]
+pub struct StopToken(Arc<AtomicBool>);
+
+impl StopToken {
+    /// A token that has not been stopped.
+    pub fn new() -> Self {
+        StopToken::default()
+    }
+
+    /// Asks every search holding the token to stop.
+    pub fn stop(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether [`StopToken::stop`] was called.
+    #[inline]
+    pub fn is_stopped(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
     }
 }
 
@@ -212,7 +246,7 @@ pub struct Stats {
     pub stopped_by: Option<StopReason>,
 }
 
-/// The result of [`crate::Planner::solve`].
+/// The result of [`Planner::solve`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlanOutcome {
     /// How the search ended.

@@ -211,7 +211,7 @@ fn stacks() -> Assembly {
 /// One search of `stacks()` with the robot filter asked lazily or for every candidate: its
 /// best sequence and value, the removals put to the filter, and the robot's path searches.
 fn robot_search(lazy: bool) -> (Vec<usize>, f64, u64, u64) {
-    use asp_search::mdp::{MdpExtension, ModelContext};
+    use asp_search::extension::{MdpExtension, ModelContext};
     use asp_app::pipeline::optimiser_problem;
     use asp_search::Mcts;
     let assembly = Arc::new(stacks());
@@ -250,7 +250,7 @@ fn lazy_robot_rollouts_repeat_themselves_with_fewer_robot_plans() {
 #[test]
 fn the_robot_reuses_the_maps_world() {
     use asp_geom::distmap::{DistanceMaps, MapConfig};
-    use asp_search::mdp::ModelContext;
+    use asp_search::extension::ModelContext;
     // a mesh model: the maps build a collision world with the robot's settings, the robot takes it
     let assembly = Arc::new(asp_geom::fixtures::tube());
     let maps = Arc::new(DistanceMaps::build(&assembly, &MapConfig::builder().resolution(5).build().unwrap()).unwrap());

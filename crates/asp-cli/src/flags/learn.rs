@@ -55,7 +55,7 @@ pub struct TransitionsArgs {
     #[arg(long, value_parser = super::choice::<Support>())]
     pub support: Option<Support>,
     /// The most transitions recorded per model (its search goes on without recording beyond it).
-    #[arg(long, default_value_t = asp_search::search::DEFAULT_RECORD_LIMIT)]
+    #[arg(long, default_value_t = asp_search::mcts::DEFAULT_RECORD_LIMIT)]
     pub max_transitions: usize,
     /// Loading and testing.
     #[command(flatten)]

@@ -3,7 +3,7 @@
 
 use crate::fixtures::{close, exact_instances, figure_6_2, maps, problem, soma};
 use asp_search::exact::exact_front;
-use asp_search::search::SearchStatus;
+use asp_search::SearchStatus;
 use asp_search::{Mcts, SearchError};
 
 #[test]

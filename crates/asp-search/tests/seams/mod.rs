@@ -7,7 +7,7 @@ use asp_geom::distmap::DistanceMaps;
 use asp_search::exact::exact_front;
 use asp_search::objective::parse_objectives;
 use asp_search::policy::{PolicyContext, PolicyWorker, SearchRng};
-use asp_search::search::StopToken;
+use asp_search::StopToken;
 use asp_search::{
     ActionFilter, Mcts, Mdp, Objective, ParetoMcts, Policy, SearchError, StepContext, StepKind, Verdict,
 };
@@ -424,8 +424,8 @@ fn a_stop_token_ends_a_search_early_with_its_answer_so_far() {
 
 #[test]
 fn objectives_from_an_extension_resolve_by_name() {
-    use asp_search::mdp::{MdpExtension, ModelContext};
-    use asp_search::objective::{check_objective_names, resolve_objectives};
+    use asp_search::extension::{MdpExtension, ModelContext};
+    use asp_search::extension::{check_objective_names, resolve_objectives};
     #[derive(Debug)]
     struct Parity;
     impl MdpExtension for Parity {

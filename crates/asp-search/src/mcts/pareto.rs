@@ -1,6 +1,6 @@
 //! Pareto-MCTS (thesis 6.4.2, after Perez et al.): every node keeps a local Pareto front of the
 //! return vectors of the complete sequences through it (suffixes from its state, see
-//! [`crate::search`]); selection uses MOUCB, `HV(P(n'))/N(n') + c·sqrt(2 ln N(n) / N(n'))`,
+//! [`crate::mcts`]); selection uses MOUCB, `HV(P(n'))/N(n') + c·sqrt(2 ln N(n) / N(n'))`,
 //! with the hypervolume of the child's front as whole returns, in objectives normalised to
 //! `[0, 1]` by the global bounds of all returns seen (reference −0.1 in every normalised
 //! objective, so the extreme points of a front count); backpropagation adds the vector to each
@@ -19,7 +19,10 @@
 use crate::error::Result;
 use crate::hypervolume::{hypervolume_2d_in_place, ParetoFront};
 use crate::mdp::{Mdp, MAX_OBJECTIVES};
-use crate::search::{exploration_term, run, search_type, EpisodeHook, SearchOutcome, SelectContext, Tree, Variant};
+use super::graph::{exploration_term, SelectContext, Tree, Variant};
+use super::outcome::{EpisodeHook, SearchOutcome};
+use super::run::run;
+use super::settings::search_type;
 
 /// Reference coordinate of the normalised hypervolume used by MOUCB.
 const NORMALISED_REFERENCE: f64 = -0.1;
@@ -118,7 +121,7 @@ fn normalised_hypervolume(front: Option<&ParetoFront<()>>, reward: &[f64], ctx: 
 mod tests {
     use super::*;
     use crate::hypervolume::hypervolume_2d;
-    use crate::search::Bounds;
+    use crate::mcts::graph::Bounds;
 
     #[test]
     fn moucb_hypervolume_counts_every_point_of_a_large_front() {

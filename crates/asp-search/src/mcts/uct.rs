@@ -3,7 +3,7 @@
 //! siblings' maxima as local bounds, or the global bounds of all returns seen while a node has
 //! fewer than two valued children (Vodopivec et al.). Expansion, random rollouts, a search
 //! budget per step, episodes and transpositions are shared with [`crate::ParetoMcts`] (see
-//! [`crate::search`]).
+//! [`crate::mcts`]).
 //!
 //! ```
 //! # use asp_search::Mcts;
@@ -14,7 +14,10 @@
 
 use crate::error::{Result, SearchError};
 use crate::mdp::Mdp;
-use crate::search::{exploration_term, run, search_type, EpisodeHook, SearchOutcome, SelectContext, Tree, Variant};
+use super::graph::{exploration_term, SelectContext, Tree, Variant};
+use super::outcome::{EpisodeHook, SearchOutcome};
+use super::run::run;
+use super::settings::search_type;
 
 search_type!(
     /// Single-objective Monte Carlo tree search with max-backup UCT.
