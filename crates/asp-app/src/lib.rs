@@ -30,7 +30,7 @@ pub struct Hooks<'a> {
     pub progress: Option<&'a (dyn Fn(&Progress) + Sync)>,
 }
 
-/// Plans the model at `path` as `request` asks: [`resolve`], then the pipeline.
+/// Plans the model at `path` as `request` asks: [`resolve()`], then the pipeline.
 pub fn plan_file(path: &Path, request: &PlanRequest, hooks: Hooks<'_>) -> Result<PlanResult> {
     let mut settings = resolve(request)?;
     settings.cancel = hooks.cancel;

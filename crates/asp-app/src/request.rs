@@ -2,7 +2,7 @@
 //!
 //! A request says what its user asked for and nothing more: every field is optional, and a
 //! field left out takes the default of the search it belongs to. The defaults live in one place,
-//! [`crate::resolve`] (reading the library constants), and [`PlanRequest::defaults`] lists them.
+//! [`crate::resolve()`] (reading the library constants), and [`crate::resolve::defaults`] lists them.
 //! The keys are the Python keywords of `asp.Assembly.plan` and, with `-` for `_`, the flags of
 //! `asp plan` (`max_tests` is `--max-tests`; the switches `path_planner`, `subassemblies` and
 //! `grid` are `--no-path-planner`, ...). A setting that does not apply to the chosen search (an

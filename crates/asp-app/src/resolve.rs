@@ -147,7 +147,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
     };
     let timeout = match r.timeout {
         None => Some(DEFAULT_TIMEOUT),
-        Some(t) if t == 0.0 => None,
+        Some(0.0) => None,
         t => positive("timeout", t)?,
     };
     Ok(PlanSettings {

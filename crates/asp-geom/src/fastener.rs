@@ -95,8 +95,8 @@ fn lands(x: Vec3, angle: f32, axis: &SymmetryAxis, mesh: &TriMesh, slack: f32) -
         })
 }
 
-/// The shares of `points` that land on `mesh`'s surface (see [`lands`]) turned by each of
-/// [`ANGLES_DEG`] about `axis`.
+/// The shares of `points` that land on `mesh`'s surface turned by each of the check angles
+/// (60°, 120° and 180°) about `axis`.
 pub fn agreement(points: &[Vec3], axis: &SymmetryAxis, mesh: &TriMesh, slack: f32) -> [f32; 3] {
     ANGLES_DEG.map(|deg| {
         let near = points.iter().filter(|&&x| lands(x, deg.to_radians(), axis, mesh, slack)).count();
@@ -447,7 +447,7 @@ fn turns(flanks: &[(f32, bool, f32)]) -> usize {
 
 /// Whether `p` (surface `pm`, symmetry axis `axis`) and `q` (surface `qm`) are in threaded
 /// contact: `p`'s side faces touch or cut `q` (within `contact`), where `p` engages `q` at least
-/// [`FLANK_SHARE`] of its side surface is thread flanks alternating [`MIN_TURNS`] times along the
+/// a fifth of its side surface is thread flanks alternating at least 6 times along the
 /// axis (a thread drawn into a plain hole at its major diameter, as CAD draws tapped holes,
 /// counts: the crests touch, the flanks lie below them), and `q`'s surface near the axis is invariant under the same
 /// rotations. `None` otherwise.

@@ -315,7 +315,7 @@ fn hexagon_ring(vertices: &mut Vec<Vec3>, centre: (f32, f32), r: f32, z: f32) ->
 
 /// Issue 9's bolt and nut, in metres: a fixed plate (33 × 33 × 4 mm, a square clearance hole of
 /// 11 mm around the Z axis), a hexagon-head bolt (major radius 5 mm, pitch 1.5 mm, a real helical
-/// V-thread of depth 0.8 mm meshed with [`THREAD_FACETS`] facets per turn and rows a facet's rise
+/// V-thread of depth 0.8 mm meshed with 12 facets per turn and rows a facet's rise
 /// apart) whose head bears on the plate's top and whose shank reaches 3 mm below the nut, and a
 /// hexagon nut (6 mm) under the plate with the matching internal thread, its bore drawn
 /// `interference` inside the bolt's thread (0: the thread surfaces coincide, as they touch in

@@ -179,6 +179,7 @@ pub fn first_entry(samples: &[Vec3], from: Vec3, dir: Vec3, t_max: f32, other: &
 /// displaced by `from`, travels along unit `dir` (up to `t_max`) before a sample of either part
 /// enters the other's material; `None` when no sample does. With `first_only` any entry ends
 /// the search (a yes/no answer).
+#[allow(clippy::too_many_arguments)] // the pair's two sides (samples and mesh each) and the motion
 pub fn strict_entry(
     moving: &[Vec3],
     moving_mesh: &TriMesh,

@@ -47,11 +47,8 @@ pub fn plan(py: Python<'_>, assembly: Assembly, settings: &PlanSettings) -> PyRe
             })
             .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("cannot start the planning thread: {e}")))?;
         let mut raised: Option<PyErr> = None;
-        loop {
-            match py.detach(|| finished.lock().unwrap_or_else(|e| e.into_inner()).recv_timeout(SIGNAL_INTERVAL)) {
-                Err(RecvTimeoutError::Timeout) => {}
-                Ok(()) | Err(RecvTimeoutError::Disconnected) => break,
-            }
+        let wait = || py.detach(|| finished.lock().unwrap_or_else(|e| e.into_inner()).recv_timeout(SIGNAL_INTERVAL));
+        while let Err(RecvTimeoutError::Timeout) = wait() {
             if raised.is_none() {
                 if let Err(e) = py.check_signals() {
                     token.stop();

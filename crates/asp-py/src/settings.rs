@@ -1,11 +1,11 @@
 //! Settings from Python: a dict of keyword arguments (as `asp.Assembly.plan` passes them) into
 //! an [`asp_app::PlanRequest`], whose keys they are. Everything about a setting — its type, its
 //! default, which search it applies to, the names it accepts — is the request's and the
-//! catalogue's ([`asp_app::resolve`]); this module only translates Python values into JSON.
+//! catalogue's ([`asp_app::resolve()`]); this module only translates Python values into JSON.
 //!
 //! A key left out or `None` takes the default of the search it belongs to. Unknown keys, values
-//! of the wrong type or out of range, and settings of the other search are [`Kind::Config`]
-//! errors naming the keyword.
+//! of the wrong type or out of range, and settings of the other search are
+//! [`Kind::Config`](crate::errors::Kind::Config) errors naming the keyword.
 
 use crate::errors::Error;
 #[cfg(test)]
@@ -119,7 +119,7 @@ impl GraphSettings {
 
 /// Splits `dict` into the request keys of `request_keys` and the rest (which must be in
 /// `own_keys`), as JSON.
-fn split(dict: &Bound<'_, PyDict>, request_keys: &[&str], own_keys: &[&str]) -> Result<(Map<String, Value>, Map<String, Value>), Error> {
+fn split(dict: &Bound<'_, PyDict>, request_keys: &[&str], own_keys: &[&str]) -> Result<[Map<String, Value>; 2], Error> {
     let (mut request, mut own) = (Map::new(), Map::new());
     for (key, value) in dict_json(dict)? {
         if request_keys.contains(&key.as_str()) {
@@ -130,7 +130,7 @@ fn split(dict: &Bound<'_, PyDict>, request_keys: &[&str], own_keys: &[&str]) -> 
             return Err(Error::config(format!("unknown setting '{key}'")));
         }
     }
-    Ok((request, own))
+    Ok([request, own])
 }
 
 /// A count of `own` (`None` when missing or null), or a config error naming it.
@@ -146,7 +146,7 @@ fn count(own: &Map<String, Value>, key: &str) -> Result<Option<usize>, Error> {
 
 /// The settings of `asp.Assembly.graph`'s keywords (missing keys take the defaults).
 pub fn graph_settings(dict: &Bound<'_, PyDict>) -> Result<GraphSettings, Error> {
-    let (request, own) = split(dict, &WORLD_KEYS, &GRAPH_KEYS)?;
+    let [request, own] = split(dict, &WORLD_KEYS, &GRAPH_KEYS)?;
     let d = GraphConfig::default();
     let config = GraphConfig::builder()
         .radius_bins(count(&own, "radius_bins")?.unwrap_or(d.radius_bins))
@@ -166,7 +166,7 @@ const Q_GRAPH_REQUEST_KEYS: [&str; 7] = ["objective", "resolution", "d_max", "su
 /// overlaps), the optimiser's that shape the maps and the MDP (objective, resolution, `d_max`,
 /// support), and the neighbours per part node (default 8).
 pub fn q_graph_settings(dict: &Bound<'_, PyDict>) -> Result<(PlanSettings, asp_app::OptimiseSettings, usize), Error> {
-    let (mut request, own) = split(dict, &Q_GRAPH_REQUEST_KEYS, &["neighbours"])?;
+    let [mut request, own] = split(dict, &Q_GRAPH_REQUEST_KEYS, &["neighbours"])?;
     let neighbours = count(&own, "neighbours")?.unwrap_or(asp_search::qgraph::DEFAULT_NEIGHBOURS);
     if neighbours == 0 {
         return Err(Error::config("neighbours must be at least 1"));

@@ -139,6 +139,9 @@ impl FeasibilityChecker for RobotChecker<'_> {
     }
 }
 
+/// A state and the parts removed from it, as bitset words (the held-parts cache key).
+type HeldKey = (Vec<u64>, Vec<u64>);
+
 /// Held parts (`--grippers N`): a removal whose remaining state would not stand is admitted
 /// when holding at most `N - 1` of the remaining, non-fixed parts in place (a second gripper or
 /// a fixture) makes it stand. Candidates to hold: the parts that would fall first, then the
@@ -151,7 +154,7 @@ pub struct HoldingChecker<'c> {
     inner: &'c Checker,
     grippers: usize,
     /// Held parts by (state, removed parts).
-    held: Mutex<HashMap<(Vec<u64>, Vec<u64>), PartSet>>,
+    held: Mutex<HashMap<HeldKey, PartSet>>,
 }
 
 impl std::fmt::Debug for HoldingChecker<'_> {

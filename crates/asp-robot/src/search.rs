@@ -151,6 +151,9 @@ impl CheckerExtension for CellSetup {
     }
 }
 
+/// A state (bitset words), a part, the replans and whether only the first path counts.
+type PlanKey = (Vec<u64>, usize, usize, bool);
+
 /// The robot on one model for the optimiser: its planner on a collision world of the model and
 /// what it has learnt so far, by state and part: the plans made (by number of replans) and the
 /// verdicts of first paths.
@@ -167,7 +170,7 @@ pub struct RobotModel {
     replans: usize,
     assembly: Arc<Assembly>,
     /// Plans by state, part, replans and whether it is the first path found (simulation).
-    cache: Mutex<HashMap<(Vec<u64>, usize, usize, bool), Result<RobotRemoval, RobotFailure>>>,
+    cache: Mutex<HashMap<PlanKey, Result<RobotRemoval, RobotFailure>>>,
     /// Per (state, part): what is known of its feasibility.
     verdicts: Mutex<HashMap<(Vec<u64>, usize), Known>>,
 }

@@ -3,7 +3,7 @@
 //! [`asp_geom::grid`] takes a voxel model apart by moves of parts and groups on its grid; here
 //! its answer becomes the steps every report and picture reads: each separation a removal
 //! (a single part, or a subassembly with its own plan on its base) carrying the moves made
-//! before it ([`Step::moves`]). The pipeline ([`crate::pipeline::plan_assembly`]) uses it for
+//! before it ([`Step::moves`]). The pipeline (`asp_app::pipeline::plan_assembly`) uses it for
 //! voxel models when several parts must move in turn before anything can leave (straight away:
 //! the depth-first search could only spend its budget on path planning there), and as the
 //! fallback when the depth-first search ends without a plan.
@@ -53,7 +53,7 @@ impl GridRun {
     /// group than the single part that then leaves.
     pub fn needs_moves(&self) -> bool {
         let Some(first) = self.solution.plan.steps.first() else { return false };
-        !first.moves.is_empty() && !(first.parts.len() == 1 && first.moves.iter().all(|m| m.parts == first.parts))
+        !(first.moves.is_empty() || first.parts.len() == 1 && first.moves.iter().all(|m| m.parts == first.parts))
     }
 
     /// The plan outcome: the separations as removals with their moves; with no fixed part the

@@ -21,7 +21,7 @@
 //! but do not tell states apart: a state reached again keeps the memory of the path that reached
 //! it first (a cache, or a continuous configuration that a quantised key word stands for).
 //!
-//! A reward may depend on the state, the part, the objective's memory and the [`StepKind`]
+//! A reward may depend on the state, the part, the objective's memory and the [`StepKind`](crate::StepKind)
 //! only — anything else it needs from the history belongs in its memory. [`StepContext`] hands it
 //! the state, the removal's straight-line motion, the assembly and its part metadata, and a seed
 //! that depends only on the problem's seed, the state and the part.

@@ -162,10 +162,10 @@ impl<'p> Polisher<'p> {
         let w = self.w;
         let problem = self.problem;
         self.base.reset(&asp_geom::PartSet::full(problem.maps().num_parts()));
-        for lo in 0..from.min(len - 1) {
+        for (lo, &part) in seq.iter().enumerate().take(from.min(len - 1)) {
             self.memory.clear();
             self.memory.extend_from_slice(&self.memories[lo * w..(lo + 1) * w]);
-            problem.step(&mut self.base, &mut self.memory, seq[lo] as usize, StepKind::Replay, &mut self.rewards);
+            problem.step(&mut self.base, &mut self.memory, part as usize, StepKind::Replay, &mut self.rewards);
             self.steps += 1;
         }
         for lo in from..len - 1 {

@@ -353,9 +353,9 @@ fn collection_errors_name_the_cause() {
         optimise: OptimiseSettings { objectives: objectives.into(), episodes, ..OptimiseSettings::default() },
         ..TransitionSettings::default()
     };
-    let err = collect_transitions(&[model.clone()], &out, &with("speed", 5), &|_| {}).unwrap_err();
+    let err = collect_transitions(std::slice::from_ref(&model), &out, &with("speed", 5), &|_| {}).unwrap_err();
     assert!(err.to_string().contains("speed"), "{err}");
-    let err = collect_transitions(&[model.clone()], &out, &with("access", 0), &|_| {}).unwrap_err();
+    let err = collect_transitions(std::slice::from_ref(&model), &out, &with("access", 0), &|_| {}).unwrap_err();
     assert!(err.to_string().contains("episodes"), "{err}");
     let missing = dir.path().join("missing.glb");
     let err = collect_transitions(&[model, missing], &out, &with("access", 5), &|_| {}).unwrap_err();

@@ -42,7 +42,7 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Plan a feasible assembly sequence by taking the model apart (Assembly-by-Disassembly).
-    Plan(PlanArgs),
+    Plan(Box<PlanArgs>),
     /// Generate training assemblies (Soma cubes, aluminium profile assemblies).
     Gen(crate::gen::GenArgs),
     /// Collect training data from planning runs (`removability`: labelled states; `transitions`:

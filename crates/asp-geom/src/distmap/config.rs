@@ -5,7 +5,7 @@ use crate::assembly::Assembly;
 use crate::overlap::OverlapPolicy;
 use crate::world::WorldConfig;
 
-/// Largest supported map resolution `N_M` (`N_M² ≤ 256` directions fit a [`DirMask`]).
+/// Largest supported map resolution `N_M` (`N_M² ≤ 256` directions fit a [`DirMask`](super::DirMask)).
 pub const MAX_RESOLUTION: usize = 15;
 /// Default map resolution `N_M` (the thesis does not state its value): 9 × 9 = 81 directions.
 pub const DEFAULT_RESOLUTION: usize = 9;

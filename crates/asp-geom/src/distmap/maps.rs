@@ -19,7 +19,7 @@ pub enum PartGeometry {
     Mesh,
 }
 
-/// The distance maps of an assembly, with the indexes the incremental [`MapState`] needs.
+/// The distance maps of an assembly, with the indexes the incremental [`MapState`](super::MapState) needs.
 #[derive(Clone, Debug)]
 pub struct DistanceMaps {
     pub(super) n: usize,

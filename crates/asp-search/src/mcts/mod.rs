@@ -49,7 +49,7 @@
 //! episodes: it gets each episode's [`EpisodeEnd`] (its recorded transitions, the front so far)
 //! and may go on, swap the policy ([`Next::Policy`]: the tree stays, the thread's
 //! [`crate::PolicyWorker`] is rebuilt) or stop. A hook that always goes on changes nothing: the answer
-//! is `solve`'s. [`crate::stepped::SteppedSearch`] drives it from another thread (Python's
+//! is `solve`'s. `asp_app::stepped::SteppedSearch` drives it from another thread (Python's
 //! `Assembly.search`, the online Q-learning of thesis 6.5).
 //!
 //! # Plug-ins

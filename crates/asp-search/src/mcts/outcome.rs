@@ -81,11 +81,11 @@ pub struct SearchStats {
     /// Whether a time limit or a stop token ended the search early.
     #[serde(default)]
     pub stopped: bool,
-    /// Complete sequences the search found that did not replay ([`Mdp::evaluate`]: a filter
+    /// Complete sequences the search found that did not replay ([`Mdp::evaluate`](crate::Mdp::evaluate): a filter
     /// that rejects on replay what a rollout admitted); they are left out of the answer.
     #[serde(default)]
     pub replay_failures: u64,
-    /// Removals put to the problem's feasibility filters (all threads; [`FilterCounts::checks`]),
+    /// Removals put to the problem's feasibility filters (all threads; [`FilterCounts::checks`](crate::mdp::FilterCounts::checks)),
     /// recording and the local search included.
     #[serde(default)]
     pub filter_checks: u64,
@@ -116,10 +116,10 @@ pub struct SearchOutcome {
     pub stats: SearchStats,
     /// Quality over episodes and seconds (a row whenever it changed, and a last row).
     pub trace: Vec<TracePoint>,
-    /// The recorded transitions ([`SearchBuilder::record_transitions`]; empty without it): each
+    /// The recorded transitions ([`SearchBuilder::record_transitions`](crate::mcts::SearchBuilder::record_transitions); empty without it): each
     /// thread's in the order it took them, threads in order.
     pub transitions: Vec<Transition>,
-    /// Whether a thread reached its share of [`SearchBuilder::record_transitions_limit`] and
+    /// Whether a thread reached its share of [`SearchBuilder::record_transitions_limit`](crate::mcts::SearchBuilder::record_transitions_limit) and
     /// stopped recording (the search went on).
     pub transitions_capped: bool,
 }
@@ -137,7 +137,7 @@ pub struct Transition {
     pub kind: StepKind,
     /// The parts of `s`.
     pub present: PartSet,
-    /// The memory words of `s` ([`Mdp::memory_range`] per objective).
+    /// The memory words of `s` ([`Mdp::memory_range`](crate::Mdp::memory_range) per objective).
     pub memory: Vec<u64>,
     /// The feasible removals of `s` that the step chose from (increasing part order), computed
     /// with the step's kind — except for a rollout's first step from a node just added, which
@@ -170,7 +170,7 @@ pub struct EpisodeEnd {
     pub value: f64,
     /// Points on the front so far.
     pub front_size: usize,
-    /// The transitions the episode recorded ([`SearchBuilder::record_transitions`]; the limit
+    /// The transitions the episode recorded ([`SearchBuilder::record_transitions`](crate::mcts::SearchBuilder::record_transitions); the limit
     /// holds per episode), in the order it took them.
     pub transitions: Vec<Transition>,
     /// Whether the episode reached the recording limit.

@@ -17,9 +17,9 @@ pub const DEFAULT_EPISODES: usize = 1000;
 pub const DEFAULT_EXPLORATION: f64 = std::f64::consts::FRAC_1_SQRT_2;
 /// Default cap on tree nodes per thread; beyond it iterations roll out without expanding.
 pub const DEFAULT_MAX_NODES: usize = 1_000_000;
-/// Default share of a search's work its local search may take ([`SearchBuilder::polish`]).
+/// Default share of a search's work its local search may take ([`SearchBuilder::polish`](crate::mcts::SearchBuilder::polish)).
 pub const DEFAULT_POLISH: f64 = 0.25;
-/// Default cap on recorded transitions ([`SearchBuilder::record_transitions_limit`]).
+/// Default cap on recorded transitions ([`SearchBuilder::record_transitions_limit`](crate::mcts::SearchBuilder::record_transitions_limit)).
 pub const DEFAULT_RECORD_LIMIT: usize = 1_000_000;
 
 /// Settings of a tree search. Build with [`crate::Mcts::builder`] or
@@ -116,7 +116,7 @@ impl SearchSettings {
     pub fn record_transitions_limit(&self) -> usize {
         self.record_limit
     }
-    /// Whether rollouts ask the problem's filters lazily ([`SearchBuilder::lazy_filters`]).
+    /// Whether rollouts ask the problem's filters lazily ([`SearchBuilder::lazy_filters`](crate::mcts::SearchBuilder::lazy_filters)).
     pub fn lazy_filters(&self) -> bool {
         self.lazy_filters
     }
@@ -195,7 +195,7 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
     }
 
     /// The weight `w` of the PUCT bonus `w · P(a) · √N(s) / (1 + N(s, a))` that the policy's
-    /// priors ([`PolicyWorker::priors`]) add to the tree policy's score (default 0: priors only
+    /// priors ([`PolicyWorker::priors`](crate::PolicyWorker::priors)) add to the tree policy's score (default 0: priors only
     /// order expansions; finite and ≥ 0).
     pub fn prior_weight(mut self, weight: f64) -> Self {
         self.settings.prior_weight = weight;
@@ -218,7 +218,7 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
     }
 
     /// Records every removal step the search simulates (expansions and rollout steps) as a
-    /// [`Transition`] in [`SearchOutcome::transitions`] (default false). The search's answers
+    /// [`Transition`](crate::Transition) in [`SearchOutcome::transitions`](crate::SearchOutcome::transitions) (default false). The search's answers
     /// are the same either way; recording costs the feasible actions of each step's states and
     /// memory.
     pub fn record_transitions(mut self, yes: bool) -> Self {
@@ -256,7 +256,7 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
 
     /// The most transitions recorded (default 1,000,000, ≥ 1), split among the threads like the
     /// episodes; a thread that reaches its share stops recording and the outcome says so
-    /// ([`SearchOutcome::transitions_capped`]).
+    /// ([`SearchOutcome::transitions_capped`](crate::SearchOutcome::transitions_capped)).
     pub fn record_transitions_limit(mut self, limit: usize) -> Self {
         self.settings.record_limit = limit;
         self
@@ -307,7 +307,7 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
     }
 }
 
-/// Declares a search type that a [`SearchBuilder`] builds: the struct holding its
+/// Declares a search type that a [`SearchBuilder`](crate::mcts::SearchBuilder) builds: the struct holding its
 /// [`SearchSettings`], the builder's alias, `builder()` and `settings()`. Each variant adds its
 /// own `solve`.
 macro_rules! search_type {

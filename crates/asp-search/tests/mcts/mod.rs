@@ -234,7 +234,7 @@ fn q_guided_expansions_follow_the_priors_and_leave_rollouts_random() {
         .transitions
         .iter()
         .filter(|t| t.actions.len() > 1)
-        .all(|t| greedy(t)));
+        .all(greedy));
     assert!(
         "expansions".parse::<QUse>().unwrap() == QUse::Expansions
             && "sideways".parse::<QUse>().is_err()
