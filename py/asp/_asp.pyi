@@ -2,7 +2,31 @@
 
 from collections.abc import Sequence
 from os import PathLike
-from typing import Any
+from typing import Any, final
+
+__all__ = [
+    "__version__",
+    "PLAN_FORMAT_VERSION",
+    "load",
+    "default_settings",
+    "order_names",
+    "choices",
+    "Assembly",
+    "QGraphs",
+    "Search",
+    "EpisodeReport",
+    "GraphArrays",
+    "profile_preset",
+    "generator_canonical",
+    "gen_item",
+    "gen_manifest",
+    "model_items",
+    "collect_item",
+    "collect_index",
+    "bench_item",
+    "bench_table",
+    "mcts_table",
+]
 
 __version__: str
 PLAN_FORMAT_VERSION: str
@@ -20,6 +44,7 @@ def default_settings() -> dict[str, Any]: ...
 def order_names() -> list[str]: ...
 def choices() -> dict[str, list[str]]: ...
 
+@final
 class Assembly:
     @property
     def source(self) -> str: ...
@@ -35,39 +60,87 @@ class Assembly:
     def __len__(self) -> int: ...
     def plan(self, settings: dict[str, Any]) -> tuple[str, bool, str | None]:
         """``(plan_json, found, trace_csv)``."""
-    def graph(
-        self, present: Sequence[int], settings: dict[str, Any]
-    ) -> tuple[bytearray, bytearray, bytearray, bytearray, int, int, str]:
-        """``(nodes int64, x float32, edge_index int64, edge_attr float32, node_dim, edge_dim, features)``,
-        the arrays as little-endian bytes."""
+    def graph(self, present: Sequence[int], settings: dict[str, Any]) -> GraphArrays: ...
     def q_graphs(self, settings: dict[str, Any]) -> QGraphs: ...
     def search(self, settings: dict[str, Any], record: bool) -> Search:
         """A stepped optimiser run with ``Assembly.plan``'s keywords (an objective needed)."""
 
+@final
+class GraphArrays:
+    """A state graph's arrays as little-endian bytes (int64 ``nodes`` and ``edge_index``, float32
+    ``x`` and ``edge_attr``)."""
+    @property
+    def nodes(self) -> bytearray: ...
+    @property
+    def x(self) -> bytearray: ...
+    @property
+    def edge_index(self) -> bytearray: ...
+    @property
+    def edge_attr(self) -> bytearray: ...
+    @property
+    def node_dim(self) -> int: ...
+    @property
+    def edge_dim(self) -> int: ...
+    @property
+    def features(self) -> str: ...
+
+@final
+class EpisodeReport:
+    """What one episode of a ``Search`` did."""
+    @property
+    def transitions_jsonl(self) -> str: ...
+    @property
+    def episodes(self) -> int: ...
+    @property
+    def iterations(self) -> int: ...
+    @property
+    def seconds(self) -> float: ...
+    @property
+    def value(self) -> float: ...
+    @property
+    def front_size(self) -> int: ...
+    @property
+    def finished(self) -> bool: ...
+    @property
+    def exhausted(self) -> bool: ...
+    @property
+    def stopped(self) -> bool: ...
+    @property
+    def capped(self) -> bool: ...
+
+@final
 class Search:
-    index_json: str
-    swaps: int
-    ended: bool
-    def episode(self) -> tuple[str, int, int, float, float, int, bool, bool, bool, bool]:
-        """``(transitions_jsonl, episodes, iterations, seconds, value, front_size, finished,
-        exhausted, stopped, capped)``."""
+    @property
+    def index_json(self) -> str: ...
+    @property
+    def swaps(self) -> int: ...
+    @property
+    def ended(self) -> bool: ...
+    def episode(self) -> EpisodeReport: ...
     def set_q(self, paths: Sequence[str | PathLike[str]], epsilon: float | None = None, q_use: str | None = None) -> None: ...
     def result(self) -> tuple[str, bool, str]:
         """``(plan_json, found, trace_csv)``."""
 
+@final
 class QGraphs:
-    features: str
-    node_dim: int
-    edge_dim: int
-    directions: int
-    num_parts: int
-    removable: int
-    objectives: list[str]
-    reward_ranges: list[tuple[float, float] | None]
+    @property
+    def features(self) -> str: ...
+    @property
+    def node_dim(self) -> int: ...
+    @property
+    def edge_dim(self) -> int: ...
+    @property
+    def directions(self) -> int: ...
+    @property
+    def num_parts(self) -> int: ...
+    @property
+    def removable(self) -> int: ...
+    @property
+    def objectives(self) -> list[str]: ...
+    @property
+    def reward_ranges(self) -> list[tuple[float, float] | None]: ...
     def feasible_actions(self, present: Sequence[int]) -> list[int]: ...
-    def graph(
-        self, present: Sequence[int], actions: Sequence[int] = ..., history: Sequence[int] = ...
-    ) -> tuple[bytearray, bytearray, bytearray, bytearray, int, int, str]:
+    def graph(self, present: Sequence[int], actions: Sequence[int] = ..., history: Sequence[int] = ...) -> GraphArrays:
         """Like ``Assembly.graph``; the context node's part index is -1."""
 
 # the items of asp.batch (crates/asp-py/src/batch.rs): JSON strings in and out

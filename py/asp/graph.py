@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from asp import _asp
+
 __all__ = ["Graph"]
 
 
@@ -49,15 +51,14 @@ class Graph:
         return int(self.edge_attr.shape[1])
 
     @classmethod
-    def _from_native(cls, raw: tuple[bytearray, bytearray, bytearray, bytearray, int, int, str]) -> Graph:
-        """From ``asp._asp.Assembly.graph``'s little-endian buffers (writable arrays, no copy)."""
-        nodes, x, edge_index, edge_attr, node_dim, edge_dim, features = raw
-        n = len(nodes) // 8
-        e = len(edge_index) // 16
+    def _from_native(cls, raw: _asp.GraphArrays) -> Graph:
+        """From ``asp._asp.GraphArrays``' little-endian buffers (writable arrays, no copy)."""
+        n = len(raw.nodes) // 8
+        e = len(raw.edge_index) // 16
         return cls(
-            nodes=np.frombuffer(nodes, dtype="<i8").astype(np.int64, copy=False),
-            x=np.frombuffer(x, dtype="<f4").astype(np.float32, copy=False).reshape(n, node_dim),
-            edge_index=np.frombuffer(edge_index, dtype="<i8").astype(np.int64, copy=False).reshape(2, e),
-            edge_attr=np.frombuffer(edge_attr, dtype="<f4").astype(np.float32, copy=False).reshape(e, edge_dim),
-            features=features,
+            nodes=np.frombuffer(raw.nodes, dtype="<i8").astype(np.int64, copy=False),
+            x=np.frombuffer(raw.x, dtype="<f4").astype(np.float32, copy=False).reshape(n, raw.node_dim),
+            edge_index=np.frombuffer(raw.edge_index, dtype="<i8").astype(np.int64, copy=False).reshape(2, e),
+            edge_attr=np.frombuffer(raw.edge_attr, dtype="<f4").astype(np.float32, copy=False).reshape(e, raw.edge_dim),
+            features=raw.features,
         )

@@ -90,7 +90,12 @@ class Search:
         :raises ConfigError: the search has ended.
         :raises KeyboardInterrupt: Ctrl-C (the search ends).
         """
-        return Episode(*self._native.episode())
+        r = self._native.episode()
+        return Episode(
+            transitions_jsonl=r.transitions_jsonl, episodes=r.episodes, iterations=r.iterations, seconds=r.seconds,
+            value=r.value, front_size=r.front_size, finished=r.finished, exhausted=r.exhausted, stopped=r.stopped,
+            capped=r.capped,
+        )
 
     def set_q(self, models: str | Sequence[str | os.PathLike[str]], epsilon: float | None = None, q_use: str | None = None) -> None:
         """Guides the episodes from the next one on by the ε-greedy policy over these Q models (ONNX

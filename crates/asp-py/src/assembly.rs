@@ -4,20 +4,15 @@
 use crate::errors::Error;
 use crate::qgraphs::PyQGraphs;
 use crate::search::PySearch;
+use crate::arrays::GraphArrays;
 use crate::settings::GraphSettings;
 use crate::{run, settings};
 use asp_geom::{AssemblyGraph, PartSet, World};
 use asp_app::pipeline;
 use pyo3::prelude::*;
-use pyo3::types::{PyByteArray, PyDict};
+use pyo3::types::PyDict;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
-
-/// What `Assembly.graph` returns: the part indices (int64), `x` (float32), `edge_index` (int64)
-/// and `edge_attr` (float32) as little-endian bytes, `node_dim`, `edge_dim` and the features
-/// string; `asp.Graph` views the bytes as numpy arrays.
-pub type GraphBuffers<'py> =
-    (Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, usize, usize, String);
 
 /// A loaded model: its parts in file order, units, up axis and the load's warnings. Immutable;
 /// every plan starts from it afresh.
@@ -145,9 +140,9 @@ impl PyAssembly {
     }
 
     /// The graph of the state `present` (part indices) with the keyword settings of
-    /// `asp.Assembly.graph` (a dict), as little-endian buffers (see `GraphBuffers`). The model's
+    /// `asp.Assembly.graph` (a dict), as little-endian buffers ([`GraphArrays`]). The model's
     /// graph is built once per settings (without the GIL) and cached.
-    fn graph<'py>(&self, py: Python<'py>, present: Vec<i64>, settings: &Bound<'py, PyDict>) -> PyResult<GraphBuffers<'py>> {
+    fn graph<'py>(&self, py: Python<'py>, present: Vec<i64>, settings: &Bound<'py, PyDict>) -> PyResult<GraphArrays> {
         let settings = settings::graph_settings(settings).map_err(|e| e.into_py(py))?;
         let n = self.inner.len();
         let mut state = PartSet::empty(n);
@@ -168,13 +163,12 @@ impl PyAssembly {
                 })
             })
             .map_err(|e| e.into_py(py))?;
-        let bytes_i64 = |v: &mut dyn Iterator<Item = i64>| v.flat_map(i64::to_le_bytes).collect::<Vec<u8>>();
-        let bytes_f32 = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-        Ok((
-            PyByteArray::new(py, &bytes_i64(&mut graph.nodes.iter().map(|&i| i as i64))),
-            PyByteArray::new(py, &bytes_f32(&graph.x)),
-            PyByteArray::new(py, &bytes_i64(&mut graph.edge_index.iter().copied())),
-            PyByteArray::new(py, &bytes_f32(&graph.edge_attr)),
+        Ok(GraphArrays::new(
+            py,
+            graph.nodes.iter().map(|&i| i as i64),
+            &graph.x,
+            graph.edge_index.iter().copied(),
+            &graph.edge_attr,
             graph.node_dim,
             graph.edge_dim,
             features,

@@ -4,6 +4,7 @@
 //! arrays. This is the only crate of the workspace that depends on pyo3.
 //!
 //! - [`assembly`]: `load` and the `Assembly` handle (owns its data);
+//! - [`arrays`]: a state graph's arrays (`GraphArrays`);
 //! - [`settings`]: Python keywords into the plan request ([`asp_app::PlanRequest`]);
 //! - [`qgraphs`]: the `asp-q/1` graphs of optimiser states (`Assembly.q_graphs`);
 //! - [`run`]: the pipeline with the GIL released, interruptible by Ctrl-C;
@@ -11,6 +12,7 @@
 //! - [`batch`]: the items of `asp.batch` (generation, collection, benchmarks), JSON in and out;
 //! - [`errors`]: asp's errors as `asp.errors` exceptions.
 
+pub mod arrays;
 pub mod assembly;
 pub mod batch;
 pub mod errors;
@@ -66,6 +68,8 @@ fn asp_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<assembly::PyAssembly>()?;
     m.add_class::<qgraphs::PyQGraphs>()?;
     m.add_class::<search::PySearch>()?;
+    m.add_class::<search::EpisodeReport>()?;
+    m.add_class::<arrays::GraphArrays>()?;
     m.add_function(wrap_pyfunction!(batch::profile_preset, m)?)?;
     m.add_function(wrap_pyfunction!(batch::generator_canonical, m)?)?;
     m.add_function(wrap_pyfunction!(batch::gen_item, m)?)?;

@@ -4,14 +4,14 @@
 //! search's Q-function sees.
 
 use crate::errors::Error;
-use crate::assembly::GraphBuffers;
+use crate::arrays::GraphArrays;
 use crate::settings;
 use asp_geom::distmap::{DirMask, MapState};
 use asp_geom::PartSet;
 use asp_app::pipeline::{self, OptimiserProblem};
 use asp_search::qgraph::{QGraph, QGraphBuilder};
 use pyo3::prelude::*;
-use pyo3::types::{PyByteArray, PyDict};
+use pyo3::types::PyDict;
 use std::sync::{Arc, Mutex};
 
 /// The maps and MDP of one model with the graph builder of its states.
@@ -119,7 +119,7 @@ impl PyQGraphs {
     /// as little-endian buffers (the layout of `Assembly.graph`; the context node's part index
     /// is -1).
     #[pyo3(signature = (present, actions=Vec::new(), history=Vec::new()))]
-    fn graph<'py>(&self, py: Python<'py>, present: Vec<i64>, actions: Vec<i64>, history: Vec<i64>) -> PyResult<GraphBuffers<'py>> {
+    fn graph<'py>(&self, py: Python<'py>, present: Vec<i64>, actions: Vec<i64>, history: Vec<i64>) -> PyResult<GraphArrays> {
         let maps = self.problem.mdp.maps();
         let n = maps.num_parts();
         let set = part_set("present", &present, n).map_err(|e| e.into_py(py))?;
@@ -147,13 +147,12 @@ impl PyQGraphs {
         state.reset(&set);
         builder.build(&mut state, history, &actions, graph);
         let config = builder.config();
-        let bytes_i64 = |v: &[i64]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-        let bytes_f32 = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-        Ok((
-            PyByteArray::new(py, &bytes_i64(&graph.nodes)),
-            PyByteArray::new(py, &bytes_f32(&graph.x)),
-            PyByteArray::new(py, &bytes_i64(&graph.edge_index)),
-            PyByteArray::new(py, &bytes_f32(&graph.edge_attr)),
+        Ok(GraphArrays::new(
+            py,
+            graph.nodes.iter().copied(),
+            &graph.x,
+            graph.edge_index.iter().copied(),
+            &graph.edge_attr,
             config.node_dim(),
             config.edge_dim(),
             config.features(),

@@ -17,9 +17,30 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
-/// One episode's report: `(transitions_jsonl, episodes, iterations, seconds, value, front_size,
-/// finished, exhausted, stopped, capped)`.
-pub type EpisodeTuple = (String, u64, u64, f64, f64, usize, bool, bool, bool, bool);
+/// What one episode did (`asp.Episode` is built from it).
+#[pyclass(frozen, get_all, module = "asp._asp", name = "EpisodeReport")]
+pub struct EpisodeReport {
+    /// Its transitions as lines of `transitions.jsonl` (empty without recording).
+    pub transitions_jsonl: String,
+    /// Episodes finished so far.
+    pub episodes: u64,
+    /// Its iterations.
+    pub iterations: u64,
+    /// Seconds since the previous episode ended.
+    pub seconds: f64,
+    /// The front's hypervolume (several objectives) or the best total so far.
+    pub value: f64,
+    /// Points on the front so far.
+    pub front_size: usize,
+    /// The search has ended after it.
+    pub finished: bool,
+    /// Every sequence has been explored.
+    pub exhausted: bool,
+    /// The time limit stopped it.
+    pub stopped: bool,
+    /// It reached the recording limit.
+    pub capped: bool,
+}
 
 /// A stepped search (see the module documentation).
 #[pyclass(frozen, module = "asp._asp", name = "Search")]
@@ -102,8 +123,8 @@ impl PySearch {
         self.lock().as_ref().is_none_or(SteppedSearch::ended)
     }
 
-    /// Runs the next episode; returns its report (see [`EpisodeTuple`]).
-    fn episode(&self, py: Python<'_>) -> PyResult<EpisodeTuple> {
+    /// Runs the next episode; returns its report.
+    fn episode(&self, py: Python<'_>) -> PyResult<EpisodeReport> {
         let mut guard = self.lock();
         let Some(search) = guard.as_mut() else {
             return Err(Error::config("the search has ended and its result was taken").into_py(py));
@@ -114,18 +135,18 @@ impl PySearch {
                 let mut lines = Vec::new();
                 collect_q::write_transition_lines(&mut lines, search.problem(), &end.transitions)
                     .map_err(|e| Error::config(format!("cannot write the transitions: {e}")).into_py(py))?;
-                Ok((
-                    String::from_utf8(lines).expect("JSON is UTF-8"),
-                    end.episodes,
-                    end.iterations,
-                    end.seconds,
-                    end.value,
-                    end.front_size,
-                    end.finished,
-                    end.exhausted,
-                    end.stopped,
-                    end.transitions_capped,
-                ))
+                Ok(EpisodeReport {
+                    transitions_jsonl: String::from_utf8(lines).expect("JSON is UTF-8"),
+                    episodes: end.episodes,
+                    iterations: end.iterations,
+                    seconds: end.seconds,
+                    value: end.value,
+                    front_size: end.front_size,
+                    finished: end.finished,
+                    exhausted: end.exhausted,
+                    stopped: end.stopped,
+                    capped: end.transitions_capped,
+                })
             }
             Poll::Done | Poll::Pending => Err(Error::config("the search has ended: no more episodes").into_py(py)),
         }
