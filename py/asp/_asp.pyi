@@ -168,9 +168,7 @@ def collect_item(
     max_tests: int | None,
     timeout: float | None,
     settings: dict[str, Any],
-    unit: str | None = None,
-    up: str | None = None,
-    fixed: Sequence[str] = ...,
+    load: dict[str, Any] | None = None,
 ) -> str: ...
 def collect_index(out: str | PathLike[str], runs: int, seed: int, entries: Sequence[str]) -> str: ...
 def bench_item(
@@ -180,9 +178,7 @@ def bench_item(
     settings: dict[str, Any],
     methods: str | None = None,
     model: str | None = None,
-    unit: str | None = None,
-    up: str | None = None,
-    fixed: Sequence[str] = ...,
+    load: dict[str, Any] | None = None,
 ) -> str: ...
 def bench_table(rows: Sequence[str]) -> str: ...
 def mcts_table(rows: Sequence[str]) -> tuple[str, str]:

@@ -101,14 +101,20 @@ pub fn model_items(py: Python<'_>, paths: Vec<PathBuf>) -> PyResult<Vec<(String,
         .collect())
 }
 
-/// Plan settings from `asp.Assembly.plan`'s keywords and `asp.load`'s.
-fn model_settings(dict: &Bound<'_, PyDict>, unit: Option<&str>, up: Option<&str>, fixed: Vec<String>) -> Result<PlanSettings, Error> {
-    let request = asp_app::PlanRequest {
-        unit: unit.map(String::from),
-        up: up.map(String::from),
-        fixed,
-        ..settings::request(dict, false)?
-    };
+/// Plan settings from `asp.Assembly.plan`'s keywords and `asp.load`'s (`load`: `unit`, `up`,
+/// `fixed`, `max_triangles`, `max_parts`).
+fn model_settings(dict: &Bound<'_, PyDict>, load: Option<&Bound<'_, PyDict>>) -> Result<PlanSettings, Error> {
+    let mut request = settings::request(dict, false)?;
+    if let Some(load) = load {
+        for key in load.keys() {
+            let key = key.to_string();
+            if !asp_app::request::LOAD_KEYS.contains(&key.as_str()) {
+                return Err(Error::config(format!("load: '{key}' is not a setting of asp.load")));
+            }
+        }
+        let l = settings::request(load, true)?;
+        (request.unit, request.up, request.fixed, request.max_triangles, request.max_parts) = (l.unit, l.up, l.fixed, l.max_triangles, l.max_parts);
+    }
     Ok(asp_app::resolve(&request)?)
 }
 
@@ -119,7 +125,7 @@ fn collect_settings(runs: usize, seed: u64, max_tests: Option<u64>, timeout: Opt
 /// Collects the labelled states of one model (`asp collect removability`'s work for one model)
 /// into `out/<dir>/` and returns its index entry as JSON.
 #[pyfunction]
-#[pyo3(signature = (path, index, name, dir, out, runs, seed, max_tests, timeout, settings, unit=None, up=None, fixed=Vec::new()))]
+#[pyo3(signature = (path, index, name, dir, out, runs, seed, max_tests, timeout, settings, load=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn collect_item(
     py: Python<'_>,
@@ -133,11 +139,9 @@ pub fn collect_item(
     max_tests: Option<u64>,
     timeout: Option<f64>,
     settings: &Bound<'_, PyDict>,
-    unit: Option<&str>,
-    up: Option<&str>,
-    fixed: Vec<String>,
+    load: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let plan = model_settings(settings, unit, up, fixed).map_err(|e| e.into_py(py))?;
+    let plan = model_settings(settings, load).map_err(|e| e.into_py(py))?;
     let settings = collect_settings(runs, seed, max_tests, timeout, plan);
     let item = ModelItem { path, index, name, dir };
     let entry = py.detach(|| collect::collect_model(&item, &out, &settings)).map_err(|e| Error::from(e).into_py(py))?;
@@ -164,7 +168,7 @@ pub fn collect_index(py: Python<'_>, out: PathBuf, runs: usize, seed: u64, entri
 /// `methods` is the comma-separated list (default: the cheap orderings, and the learned ones
 /// when `model` is given); `model` is the ONNX file of the `gnn` methods (default: shipped).
 #[pyfunction]
-#[pyo3(signature = (path, name, orderings, settings, methods=None, model=None, unit=None, up=None, fixed=Vec::new()))]
+#[pyo3(signature = (path, name, orderings, settings, methods=None, model=None, load=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn bench_item(
     py: Python<'_>,
@@ -174,11 +178,9 @@ pub fn bench_item(
     settings: &Bound<'_, PyDict>,
     methods: Option<String>,
     model: Option<String>,
-    unit: Option<&str>,
-    up: Option<&str>,
-    fixed: Vec<String>,
+    load: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let settings = model_settings(settings, unit, up, fixed).map_err(|e| e.into_py(py))?;
+    let settings = model_settings(settings, load).map_err(|e| e.into_py(py))?;
     let list = methods.unwrap_or_else(|| bench::default_methods(model.is_some()).to_string());
     let methods = bench::parse_methods(&list, model.as_deref().map(Path::new)).map_err(|e| Error::from(e).into_py(py))?;
     let rows = py

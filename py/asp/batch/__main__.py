@@ -58,6 +58,8 @@ def _models(p: argparse.ArgumentParser) -> None:
     p.add_argument("--unit", help="model unit (m, mm, ... or metres per unit; default from the file)")
     p.add_argument("--up", help="up axis (z, -y, ...; default from the file)")
     p.add_argument("--fixed", nargs="+", default=[], metavar="PART", help="base part names")
+    p.add_argument("--max-triangles", type=int, metavar="N", help="most triangles a model may have (default 20 M; docs/security.md)")
+    p.add_argument("--max-parts", type=int, metavar="N", help="most parts a model may have (default 10,000)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="any keyword of asp.Assembly.plan (repeatable), e.g. --set normals=20 --set stability=physics")
 
@@ -121,7 +123,7 @@ def job_of(args: argparse.Namespace) -> Job:
         if args.generator == "soma":
             return GenJob.soma(size=args.size, cell=args.cell, count=args.count, seed=args.seed)
         return GenJob.profiles(args.preset, _pairs(args.param, "param"), count=args.count, seed=args.seed)
-    load = LoadSettings(unit=args.unit, up=args.up, fixed=list(args.fixed))
+    load = LoadSettings(unit=args.unit, up=args.up, fixed=list(args.fixed), max_triangles=args.max_triangles, max_parts=args.max_parts)
     settings = _pairs(args.set, "set")
     if args.command == "plan":
         for key in ("order", "model", "seed", "max_tests", "timeout"):

@@ -149,9 +149,17 @@ class LoadSettings:
     unit: str | None = None
     up: str | None = None
     fixed: list[str] = field(default_factory=list)
+    max_triangles: int | None = None
+    """The cap on a model's triangles (``None``: asp's, docs/security.md)."""
+    max_parts: int | None = None
+    """The cap on a model's parts (``None``: asp's)."""
 
     def as_dict(self) -> dict[str, Any]:
-        return {"unit": self.unit, "up": self.up, "fixed": list(self.fixed)}
+        d: dict[str, Any] = {"unit": self.unit, "up": self.up, "fixed": list(self.fixed)}
+        for key in ("max_triangles", "max_parts"):
+            if getattr(self, key) is not None:
+                d[key] = getattr(self, key)
+        return d
 
 
 class PlanJob(Job):
@@ -198,7 +206,8 @@ def _plan(spec: dict[str, Any], payload: dict[str, Any], out: str) -> dict[str, 
 
     load = spec["load"]
     started = time.perf_counter()
-    assembly = asp.load(payload["path"], unit=load["unit"], up=load["up"], fixed=load["fixed"])
+    assembly = asp.load(payload["path"], unit=load["unit"], up=load["up"], fixed=load["fixed"],
+                        max_triangles=load.get("max_triangles"), max_parts=load.get("max_parts"))
     plan = assembly.plan(**spec["settings"])
     seconds = time.perf_counter() - started
     file = f"{payload['dir']}.json"
@@ -266,7 +275,7 @@ def _collect(spec: dict[str, Any], payload: dict[str, Any], out: str) -> dict[st
     load = spec["load"]
     entry = _asp.collect_item(
         payload["path"], payload["index"], payload["name"], payload["dir"], out, spec["runs"], spec["seed"],
-        spec["max_tests"], spec["timeout"], spec["settings"], unit=load["unit"], up=load["up"], fixed=load["fixed"],
+        spec["max_tests"], spec["timeout"], spec["settings"], load=load,
     )
     return {"entry": json.loads(entry)}
 
@@ -323,7 +332,7 @@ def _bench(spec: dict[str, Any], payload: dict[str, Any], out: str) -> dict[str,
         model = str(Path(spec["models_dir"]) / f"{payload['name']}.onnx")
     rows = _asp.bench_item(
         payload["path"], payload["name"], spec["orderings"], spec["settings"], methods=spec["methods"],
-        model=model, unit=load["unit"], up=load["up"], fixed=load["fixed"],
+        model=model, load=load,
     )
     file = f"{payload['dir']}.json"
     _write_atomic(Path(out) / file, rows + "\n")
