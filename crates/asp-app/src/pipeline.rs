@@ -344,27 +344,42 @@ pub fn plan_assembly(
         }
         grid = Some(run);
     }
-    let dfs = planner(settings, checker.world())?;
-    let mut search = |c: &dyn asp_geom::FeasibilityChecker| {
-        let mut problem = Problem::full(c);
-        problem.progress = progress;
-        dfs.solve(&problem, &budget)
+    // on a voxel model the grid's moves are the exact answer to what the path planner samples
+    // for: the depth-first search tries straight lines (and groups) first, then the grid, and
+    // only then the path planner (a piece that must turn to come out)
+    let grid_first = voxels.is_some() && settings.path_planner;
+    let run_dfs = |path_planner: bool| -> Result<(PlanOutcome, Option<asp_search::report::RobotReport>)> {
+        let dfs = planner(&PlanSettings { path_planner, ..settings.clone() }, checker.world())?;
+        let mut search = |c: &dyn asp_geom::FeasibilityChecker| {
+            let mut problem = Problem::full(c);
+            problem.progress = progress;
+            dfs.solve(&problem, &budget)
+        };
+        Ok(match &settings.checker_extension {
+            Some(e) => e.solve(&checker, settings.seed, &mut search)?,
+            None => (search(&checker as &dyn asp_geom::FeasibilityChecker), None),
+        })
     };
-    let (outcome, robot) = match &settings.checker_extension {
-        Some(e) => e.solve(&checker, settings.seed, &mut search)?,
-        None => (search(&checker as &dyn asp_geom::FeasibilityChecker), None),
-    };
+    let (mut outcome, mut robot) = run_dfs(settings.path_planner && !grid_first)?;
     // the grid plan when the depth-first search found no plan, or one with a subassembly it
     // could not take apart (a voxel puzzle lifted off the ground in one piece); not when only
     // gravity stopped it (the grid plan does not test gravity)
-    let found = outcome.status == Status::Found;
-    let gravity_only = matches!(&outcome.status, Status::NoPlan { stuck, .. }
-        if !stuck.is_empty() && stuck.iter().all(|s| matches!(s.reason, StuckReason::WouldLeaveUnsupported(_))));
-    if (!found && !gravity_only) || (found && !taken_apart(&outcome)) {
+    let wants_grid = |outcome: &PlanOutcome| {
+        let found = outcome.status == Status::Found;
+        let gravity_only = matches!(&outcome.status, Status::NoPlan { stuck, .. }
+            if !stuck.is_empty() && stuck.iter().all(|s| matches!(s.reason, StuckReason::WouldLeaveUnsupported(_))));
+        (!found && !gravity_only) || (found && !taken_apart(outcome))
+    };
+    if wants_grid(&outcome) {
         if let Some(model) = voxels {
+            let found = outcome.status == Status::Found;
             let run = grid.unwrap_or_else(|| GridRun::new(model, &GridConfig::default(), &budget, Instant::now()));
             if (!found && run.found()) || run.solution.complete() {
                 return Ok(grid_result(&checker, &run, "fallback", Some(&outcome), world_seconds));
+            }
+            if grid_first && !budget_spent(&outcome) {
+                // neither straight lines nor grid moves: the path planner's turn
+                (outcome, robot) = run_dfs(true)?;
             }
         }
     }
@@ -387,6 +402,12 @@ fn finish_report(report: &mut PlanReport, world: &asp_geom::World, outcome: &Pla
         search: outcome.stats.seconds,
         path_planner: outcome.stats.path_planner_seconds,
     });
+}
+
+/// Whether a search ended on its budget (tests, time or a cancel), so that another search
+/// would only spend more of it.
+fn budget_spent(outcome: &PlanOutcome) -> bool {
+    outcome.stats.stopped_by.is_some()
 }
 
 /// Whether every subassembly of a found plan was taken apart by its own plan.

@@ -317,7 +317,8 @@ fn type_message(serde: &str) -> String {
     }
     if let Some(rest) = text.strip_prefix("unknown variant ") {
         if let Some((got, want)) = rest.split_once(", expected ") {
-            let names: Vec<&str> = want.trim_start_matches("one of ").split(", ").map(|n| n.trim_matches('`')).collect();
+            let want = want.trim_start_matches("one of ").replace(" or ", ", ");
+            let names: Vec<&str> = want.split(", ").map(|n| n.trim_matches('`')).collect();
             return format!("unknown value '{}' (use {})", got.trim_matches('`'), names.join(", "));
         }
     }
@@ -418,6 +419,7 @@ mod tests {
         assert_eq!(e(r#"{"bookkeeping": "yes"}"#), "bookkeeping: must be true or false, got 'yes'");
         assert_eq!(e(r#"{"tolerance": "small"}"#), "tolerance: must be a number, got 'small'");
         assert_eq!(e(r#"{"overlaps": "loose"}"#), "overlaps: unknown value 'loose' (use strict, lenient, error)");
+        assert_eq!(e(r#"{"stability": "glue"}"#), "stability: unknown value 'glue' (use contact, physics)");
         assert_eq!(e(r#"{"robot_base": "1,2"}"#), "robot_base: must be three finite numbers x,y,z");
         assert_eq!(e(r#"{"colour": 1}"#), "colour: unknown setting");
         assert_eq!(e(r#"{"timeouts": 1}"#), "timeouts: unknown setting (did you mean `timeout`?)");

@@ -39,3 +39,26 @@ fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
     let first = r.report.assembly_sequence.first().and_then(|s| s.subassembly.as_ref());
     assert!(!r.found() || first.is_some_and(|g| g.status == "no_plan" && g.parts.len() == 6), "{}", r.report.to_json());
 }
+
+/// Issue 28 item 4: on a voxel puzzle the grid planner answers before the path planner, with or
+/// without a fixed piece (with one fixed, the path planner used to run for half a minute first).
+#[test]
+fn issue_28_voxel_puzzles_with_a_fixed_piece_get_the_grid_before_the_path_planner() {
+    let settings = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
+    use asp_geom::puzzles::{burr_level, small_puzzle, two_small_puzzles};
+    for (fixed, puzzle) in [(false, burr_level()), (true, burr_level()), (true, small_puzzle()), (false, two_small_puzzles()), (true, two_small_puzzles())] {
+        let mut a = puzzle;
+        if fixed {
+            // the largest piece (by volume) is the base
+            let largest = (0..a.parts.len()).max_by(|&i, &j| a.parts[i].mesh.signed_volume().total_cmp(&a.parts[j].mesh.signed_volume())).unwrap();
+            a.parts[largest].fixed = true;
+        }
+        let name = format!("{} (a fixed piece: {fixed})", a.source.display());
+        let started = std::time::Instant::now();
+        let r = plan_assembly(a, &settings, None).unwrap();
+        assert!(r.found(), "{name}: {}", r.report.to_json());
+        assert!(r.report.grid.is_some(), "{name}: a grid plan");
+        assert_eq!(r.report.stats.path_planner_calls, 0, "{name}: the path planner ran before the grid");
+        assert!(started.elapsed().as_secs_f64() < 10.0, "{name}: {:?}", started.elapsed());
+    }
+}

@@ -77,19 +77,25 @@ fn no_plan_exits_1_and_explains() {
     assert_eq!(plan["status"], "no_plan");
     assert_eq!(plan["explanation"][0]["name"], "block");
     assert_eq!(plan["explanation"][0]["parts"][0]["name"], "housing");
-    // with the path planner it is found, along a path
-    let o = asp(&["plan", model.to_str().unwrap(), "--json"]);
+    // with the path planner (and no grid) it is found, along a path
+    let o = asp(&["plan", model.to_str().unwrap(), "--no-grid", "--json"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(plan["assembly_sequence"][0]["motion"]["kind"], "path");
     assert_eq!(plan["stats"]["path_planner_calls"], 1);
-    // without the path planner the housing and block are a voxel model: the grid search finds
-    // the L (a move along +x, then out along +z) after the depth-first search gives up
-    let o = asp(&["plan", model.to_str().unwrap(), "--no-path-planner", "--json"]);
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    assert_eq!(plan["grid"]["reason"], "fallback");
-    assert_eq!(plan["assembly_sequence"][0]["moves"].as_array().unwrap().len(), 1);
+    // the housing and block are a voxel model: the grid search finds the L (a move along +x,
+    // then out along +z) once straight lines give up, before the path planner (issue 28 item 4),
+    // and without it the same
+    for flags in [&[][..], &["--no-path-planner"][..]] {
+        let mut args = vec!["plan", model.to_str().unwrap(), "--json"];
+        args.extend_from_slice(flags);
+        let o = asp(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(plan["grid"]["reason"], "fallback", "{flags:?}");
+        assert_eq!(plan["stats"]["path_planner_calls"], 0, "{flags:?}");
+        assert_eq!(plan["assembly_sequence"][0]["moves"].as_array().unwrap().len(), 1, "{flags:?}");
+    }
 }
 
 /// Asserts a one-line error naming `needle`, exit code 2, no panic.
