@@ -32,7 +32,7 @@ pub fn run(a: &MctsArgs) -> anyhow::Result<std::process::ExitCode> {
         extra.insert("pareto".into(), true.into());
     }
     crate::flags::put!(extra, a, budget, exploration, polish, resolution, d_max, support);
-    let mut plan = crate::learn::model_settings(&a.load, extra)?;
+    let mut plan = crate::request::model_settings(&a.load, extra)?;
     let optimise = plan.optimise.take().context("--objective")?;
     let mut settings = Vec::new();
     for name in a.settings.split(',').map(str::trim).filter(|s| !s.is_empty()) {

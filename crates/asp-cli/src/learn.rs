@@ -1,22 +1,14 @@
 //! `asp collect removability`, `asp collect transitions` and `asp bench feasible`: learned
 //! guidance's data and benchmarks (thesis chapters 3, 5 and 6). Flags in `flags::learn`.
 
-use crate::flags::{BenchArgs, BenchKind, CollectArgs, CollectKind, FeasibleArgs, ModelArgs, TransitionsArgs};
+use crate::flags::{BenchArgs, BenchKind, CollectArgs, CollectKind, FeasibleArgs, TransitionsArgs};
+use crate::request::model_settings;
 use anyhow::{bail, Context};
 use asp_app::bench::{self, BenchRow, Method};
 use asp_app::collect::{self, CollectSettings};
 use asp_app::collect_q::{self, TransitionSettings, TransitionsModel};
-use asp_app::PlanSettings;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::{IsTerminal, Write};
-
-/// The pipeline's settings of the model flags (and `extra` request keys).
-pub(crate) fn model_settings(args: &ModelArgs, extra: crate::flags::Map) -> anyhow::Result<PlanSettings> {
-    let mut map = crate::flags::Map::new();
-    args.put(&mut map);
-    map.extend(extra);
-    crate::request::resolve(&crate::request::request(map, None)?)
-}
 
 /// Runs `asp collect`.
 pub fn collect(args: &CollectArgs) -> anyhow::Result<std::process::ExitCode> {

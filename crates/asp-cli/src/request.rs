@@ -42,3 +42,11 @@ pub fn request(map: Map, settings: Option<&Path>) -> anyhow::Result<PlanRequest>
 pub fn resolve(request: &PlanRequest) -> anyhow::Result<PlanSettings> {
     asp_app::resolve(request).map_err(cli_error)
 }
+
+/// The pipeline's settings of the model flags (and `extra` request keys).
+pub(crate) fn model_settings(args: &crate::flags::ModelArgs, extra: Map) -> anyhow::Result<PlanSettings> {
+    let mut map = Map::new();
+    args.put(&mut map);
+    map.extend(extra);
+    resolve(&request(map, None)?)
+}
