@@ -4,7 +4,6 @@ mod distmap;
 mod fastener;
 mod fuzz;
 mod graph;
-mod grid;
 mod loaders;
 mod overlap;
 mod physics;

@@ -4,6 +4,7 @@ mod conformance;
 mod exact;
 mod fasteners;
 mod fixtures;
+mod grid;
 mod groups;
 mod hypervolume;
 mod mcts;

@@ -2,7 +2,8 @@
 //! here on plain cell sets (independently of the solver's pair tables), and the first
 //! separation's move count is checked against a brute-force BFS over every subset of pieces.
 
-use asp_geom::grid::{self, Cell, GridConfig, GridPlan, GridSolution, GridStatus, VoxelModel, DIRECTIONS};
+use asp_geom::grid::{Cell, VoxelModel};
+use asp_search::grid::{self, GridConfig, GridPlan, GridSolution, GridStatus, DIRECTIONS};
 use asp_geom::mesh::Mesh;
 use asp_geom::{fixtures, puzzles, Assembly, Part};
 use std::collections::{HashMap, HashSet, VecDeque};

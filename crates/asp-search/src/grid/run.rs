@@ -1,6 +1,6 @@
 //! Grid plans of interlocking voxel puzzles (issue 9 item 6) as plan outcomes.
 //!
-//! [`asp_geom::grid`] takes a voxel model apart by moves of parts and groups on its grid; here
+//! [`super::solver`] takes a voxel model apart by moves of parts and groups on its grid; here
 //! its answer becomes the steps every report and picture reads: each separation a removal
 //! (a single part, or a subassembly with its own plan on its base) carrying the moves made
 //! before it ([`Step::moves`]). The pipeline (`asp_app::pipeline::plan_assembly`) uses it for
@@ -9,7 +9,8 @@
 //! fallback when the depth-first search ends without a plan.
 
 use crate::problem::{Budget, GroupMove, PlanOutcome, Stats, Status, Step, Stuck, StuckReason, Subassembly};
-use asp_geom::grid::{self, GridConfig, GridPlan, GridSolution, GridStatus, VoxelModel};
+use super::solver::{self as grid, GridConfig, GridPlan, GridSolution, GridStatus};
+use asp_geom::grid::VoxelModel;
 use asp_geom::{Assembly, Motion, PartSet};
 use std::time::Instant;
 
