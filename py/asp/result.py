@@ -46,6 +46,11 @@ class Plan:
         """``"found"``, ``"no_plan"`` or ``"budget_exhausted"``."""
         return self._dict["status"]
 
+    def table(self) -> str:
+        """The plan as text, exactly as ``asp plan`` prints it for the same run: the table and,
+        for optimising runs, the optimiser's summary."""
+        return _asp.plan_text(self._json)
+
     def to_dict(self) -> dict[str, Any]:
         """The plan JSON as a fresh dict (changing it does not change the plan)."""
         return _json.loads(self._json)

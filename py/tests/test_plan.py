@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 
@@ -147,3 +148,30 @@ def test_defaults_are_the_librarys():
                           ("support", settings.Support), ("q_use", settings.QUse)]:
         assert list(typing.get_args(literal)) == choices[name], name
     assert asp.ORDERS == tuple(choices["order"])
+
+
+@pytest.mark.parametrize(
+    "flags",
+    [
+        [],
+        ["--objective", "access", "--episodes", "40", "--threads", "1", "--seed", "2"],
+    ],
+)
+def test_plan_table_is_the_clis_stdout(root, asp_cli, tmp_path, flags):
+    out_json = tmp_path / "plan.json"
+    code, out, err = asp_cli("plan", LACK, "--up", "z", "--out", str(out_json), *flags)
+    assert code == 0, err
+    # the CLI's own plan, as text from Python: its stdout byte for byte
+    cli_plan = asp.Plan(out_json.read_text(), True)
+    assert cli_plan.table() == out
+    assert out.startswith(f"{LACK}: found in ")
+    # and the same run from Python: the same text but for the wall times
+    kwargs = {} if not flags else {"objective": "access", "episodes": 40, "threads": 1, "seed": 2}
+    plan = asp.load(LACK, up="z").plan(**kwargs)
+    times = re.compile(r"\d+\.\d+ s\b")
+    assert times.sub("T s", plan.table()) == times.sub("T s", out)
+
+
+def test_plan_table_of_a_bad_json_is_an_asp_error():
+    with pytest.raises(asp.AspError, match="plan JSON: not a plan"):
+        asp.Plan('{"status": "found"}', True).table()

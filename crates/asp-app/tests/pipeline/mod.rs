@@ -16,7 +16,7 @@ fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
         let r = plan_assembly(a, &settings, None).unwrap();
         assert!(r.found(), "{name}: {}", r.report.to_json());
         let grid = r.report.grid.as_ref().expect("a grid plan");
-        assert_eq!(grid.reason, "needs_moves", "{name}");
+        assert_eq!(grid.reason, asp_search::report::GridReason::NeedsMoves, "{name}");
         assert_eq!(grid.first_separation_moves, Some(moves), "{name}");
         // every part is taken out once; the last step in disassembly order carries the moves
         let mut order = r.report.disassembly_sequence.clone();
@@ -24,7 +24,7 @@ fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
         assert_eq!(order, (0..r.report.parts.len()).collect::<Vec<_>>(), "{name}");
         let last = r.report.assembly_sequence.last().unwrap();
         assert_eq!(last.moves.len(), moves, "{name}: the first separation's moves, in assembly order");
-        assert_eq!(r.report.format_version, "1.7");
+        assert_eq!(r.report.format_version, "1.8");
     }
     // a voxel model the straight-line search answers keeps its plan (no grid entry)
     let r = plan_assembly(asp_geom::puzzles::burr_key(), &settings, None).unwrap();
@@ -37,5 +37,5 @@ fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
     let off = PlanSettings { grid: false, path_planner: false, ..settings.clone() };
     let r = plan_assembly(asp_geom::puzzles::burr_level(), &off, None).unwrap();
     let first = r.report.assembly_sequence.first().and_then(|s| s.subassembly.as_ref());
-    assert!(!r.found() || first.is_some_and(|g| g.status == "no_plan" && g.parts.len() == 6), "{}", r.report.to_json());
+    assert!(!r.found() || first.is_some_and(|g| g.status == asp_search::report::SubassemblyStatus::NoPlan && g.parts.len() == 6), "{}", r.report.to_json());
 }
