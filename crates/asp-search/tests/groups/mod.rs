@@ -57,8 +57,13 @@ fn issue_9_with_subassemblies_the_locked_core_leaves_as_one_group_that_cannot_be
     let Status::NoPlan { state, .. } = &inner.status else { panic!("{:?}", inner.status) };
     assert_eq!(state.iter().collect::<Vec<_>>(), [0, 1, 2], "nothing comes off the base");
     // in the plan JSON: one step with its parts, status no_plan and the explanation
+    // (issue 28: base, post and ring never get motions of their own, so the plan is partial,
+    // with that group as its one locked core)
     let report = PlanReport::new(w.assembly(), &outcome, w.tolerance(), &[]);
-    assert_eq!(report.status, asp_search::report::PlanStatus::Found);
+    assert_eq!(report.status, asp_search::report::PlanStatus::Partial);
+    assert_eq!(report.locked_cores.len(), 1);
+    assert_eq!(report.locked_cores[0].parts, [0, 1, 2]);
+    assert_eq!(report.locked_cores[0].base, step.part);
     let entry = report.assembly_sequence[0].subassembly.as_ref().expect("the group goes in first");
     assert_eq!(entry.parts, [0, 1, 2]);
     assert_eq!(entry.status, asp_search::report::SubassemblyStatus::NoPlan);
