@@ -38,3 +38,14 @@ pub fn stuck_tube() -> Scene {
     }, Explanation { part: cap, name: "cap".into(), reason: asp_search::report::ExplanationReason::DeadEnd, parts: vec![] }];
     Scene::new(scene.assembly.clone(), report, Path::new("fixture")).unwrap()
 }
+
+/// The burr without the grid planner: one step lifts all six pieces, a subassembly that
+/// cannot be taken apart, so the plan is `partial` with one locked core.
+pub fn locked_burr() -> Scene {
+    let checker = Checker::new(World::new(asp_geom::puzzles::burr_level(), &WorldConfig::default()).unwrap(), CheckerConfig::default());
+    let outcome = Dfs::builder().path_planner(false).build().solve(&Problem::full(&checker), &Budget::default());
+    let world = checker.world();
+    let report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
+    assert_eq!(report.status, asp_search::report::PlanStatus::Partial);
+    Scene::new(world.assembly().clone(), report, Path::new("fixture")).unwrap()
+}
