@@ -20,7 +20,9 @@ class Plan:
     prints it; every other attribute is read from it.
 
     A search that finds nothing is a result too: :attr:`status` is ``"no_plan"`` (with an
-    :attr:`explanation` of what holds which part) or ``"budget_exhausted"``.
+    :attr:`explanation` of what holds which part) or ``"budget_exhausted"``. A complete sequence
+    in which some parts go in as one unit because asp could not take them apart is
+    ``"partial"``, with its :attr:`locked_cores`; :attr:`found` is then False.
     """
 
     __slots__ = ("_json", "_found", "_trace", "_dict")
@@ -38,13 +40,27 @@ class Plan:
 
     @property
     def found(self) -> bool:
-        """Whether a complete sequence was found."""
+        """Whether a plan was found that gives every part its own motion (:attr:`status` is
+        ``"found"``; False for ``"partial"`` plans)."""
         return self._found
 
     @property
     def status(self) -> str:
-        """``"found"``, ``"no_plan"`` or ``"budget_exhausted"``."""
+        """``"found"``, ``"partial"`` (complete, with :attr:`locked_cores`), ``"no_plan"`` or
+        ``"budget_exhausted"`` (``docs/plan-format.md``, Statuses)."""
         return self._dict["status"]
+
+    @property
+    def locked_cores(self) -> list[dict[str, Any]]:
+        """For ``"partial"`` plans, the parts asp could not take apart, one dict per core:
+        ``base``, ``parts``, ``names``, ``status`` (why: ``"no_plan"``, ``"budget_exhausted"``
+        or ``"unplanned"``) and ``explanation`` (what holds each part); empty otherwise."""
+        return self.to_dict().get("locked_cores", [])
+
+    def table(self) -> str:
+        """The plan as text, exactly as ``asp plan`` prints it for the same run: the table and,
+        for optimising runs, the optimiser's summary."""
+        return _asp.plan_text(self._json)
 
     def to_dict(self) -> dict[str, Any]:
         """The plan JSON as a fresh dict (changing it does not change the plan)."""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 
@@ -64,8 +65,8 @@ def test_no_plan_pump_explains_what_holds_what(root, asp_cli):
     # single parts only: body, back lid, the two large screws through both, and the shaft and
     # ring pressed into the body (which, under the strict overlap rule, may leave only along
     # their axis) hold each other (with subassemblies, the default, they leave the ground as one
-    # subassembly and the pump plans; the Rust tests assert the same core)
-    assert a.plan().found
+    # subassembly that cannot be taken apart: a partial plan, test_a_plan_with_a_locked_core_is_partial)
+    assert a.plan().status == "partial"
     plan = a.plan(subassemblies=False)
     assert plan.status == "no_plan" and not plan.found
     assert plan.assembly_sequence == []
@@ -147,3 +148,57 @@ def test_defaults_are_the_librarys():
                           ("support", settings.Support), ("q_use", settings.QUse)]:
         assert list(typing.get_args(literal)) == choices[name], name
     assert asp.ORDERS == tuple(choices["order"])
+
+
+@pytest.mark.parametrize(
+    "flags",
+    [
+        [],
+        ["--objective", "access", "--episodes", "40", "--threads", "1", "--seed", "2"],
+    ],
+)
+def test_plan_table_is_the_clis_stdout(root, asp_cli, tmp_path, flags):
+    out_json = tmp_path / "plan.json"
+    code, out, err = asp_cli("plan", LACK, "--up", "z", "--out", str(out_json), *flags)
+    assert code == 0, err
+    # the CLI's own plan, as text from Python: its stdout byte for byte
+    cli_plan = asp.Plan(out_json.read_text(), True)
+    assert cli_plan.table() == out
+    assert out.startswith(f"{LACK}: found in ")
+    # and the same run from Python: the same text but for the wall times
+    kwargs = {} if not flags else {"objective": "access", "episodes": 40, "threads": 1, "seed": 2}
+    plan = asp.load(LACK, up="z").plan(**kwargs)
+    times = re.compile(r"\d+\.\d+ s\b")
+    assert times.sub("T s", plan.table()) == times.sub("T s", out)
+
+
+def test_plan_table_of_a_bad_json_is_an_asp_error():
+    with pytest.raises(asp.AspError, match="plan JSON: not a plan"):
+        asp.Plan('{"status": "found"}', True).table()
+
+
+def test_a_plan_with_a_locked_core_is_partial(root, asp_cli):
+    # issue 28: with subassemblies (the default) the pump's sequence is complete, but body, back
+    # lid, the two large screws, shaft and ring go in as one unit its own plan cannot open: the
+    # plan is partial, not found, with that core listed, as the CLI says it (exit code 1)
+    plan = asp.load(PUMP, unit="mm", up="z").plan()
+    assert plan.status == "partial" and not plan.found
+    assert plan.assembly_sequence and plan.remaining is None
+    cores = plan.locked_cores
+    assert len(cores) == 1
+    core = cores[0]
+    names = sorted(n.removeprefix("PumpAssembly - ") for n in core["names"])
+    assert names == ["BackLid2-1", "LargeScrew1-1", "LargeScrew2-1", "Pump-1", "Ring-1", "Shaft-1"]
+    assert core["status"] == "no_plan" and core["explanation"]
+    assert core["base"] in core["parts"]
+    cores[0]["names"] = []
+    assert plan.locked_cores[0]["names"], "locked_cores returns a copy"
+    code, out, err = asp_cli("plan", PUMP, "--unit", "mm", "--up", "z", "--json")
+    assert code == 1, err
+    assert without_seconds(plan.json) == without_seconds(out)
+    table = plan.table()
+    assert ": partial in " in table.splitlines()[0]
+    assert table.splitlines()[1].startswith(f"planned {len(plan.parts) - 6} of {len(plan.parts)} parts; 6 stay in 1 locked core: ")
+    # a plan that takes every part apart has none
+    lack = asp.plan(LACK, up="z")
+    assert lack.status == "found" and lack.found and lack.locked_cores == []

@@ -14,7 +14,7 @@ use asp_search::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, St
 use asp_search::grid::GridRun;
 use asp_geom::grid::VoxelModel;
 use asp_search::grid::GridConfig;
-use asp_search::report::{GridEntry, OptimisationEntry, ParetoEntry, PlanReport, Timings, CHECKER_DISTANCE_MAPS};
+use asp_search::report::{Checker as CheckerName, GridEntry, GridReason, OptimisationEntry, OptimisationMethod, ParetoEntry, PlanReport, Timings};
 use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES};
 use asp_search::{EpisodeHook, SearchOutcome, SearchStatus, StopToken};
 use asp_search::{Dfs, Mcts, Mdp, ParetoMcts, Planner};
@@ -214,9 +214,10 @@ pub struct PlanResult {
 }
 
 impl PlanResult {
-    /// Whether a complete sequence was found.
+    /// Whether a plan was found that gives every part its own motion (the report's status is
+    /// `found`; a `partial` plan, with locked cores, is not).
     pub fn found(&self) -> bool {
-        self.status == Status::Found
+        self.report.status == asp_search::report::PlanStatus::Found
     }
 }
 
@@ -341,7 +342,7 @@ pub fn plan_assembly(
     if let (Some(model), true) = (&voxels, probe.as_ref().is_some_and(GridRun::needs_moves)) {
         let run = GridRun::new(model.clone(), &GridConfig::default(), &budget, grid_started);
         if run.found() {
-            return Ok(grid_result(&checker, &run, "needs_moves", None, world_seconds));
+            return Ok(grid_result(&checker, &run, GridReason::NeedsMoves, None, world_seconds));
         }
         grid = Some(run);
     }
@@ -376,7 +377,7 @@ pub fn plan_assembly(
             let found = outcome.status == Status::Found;
             let run = grid.unwrap_or_else(|| GridRun::new(model, &GridConfig::default(), &budget, Instant::now()));
             if (!found && run.found()) || run.solution.complete() {
-                return Ok(grid_result(&checker, &run, "fallback", Some(&outcome), world_seconds));
+                return Ok(grid_result(&checker, &run, GridReason::Fallback, Some(&outcome), world_seconds));
             }
             if grid_first && !budget_spent(&outcome) {
                 // neither straight lines nor grid moves: the path planner's turn
@@ -420,7 +421,7 @@ fn taken_apart(outcome: &PlanOutcome) -> bool {
 
 /// The plan of a grid search (after the depth-first search's `before`, whose counters and time
 /// it keeps).
-fn grid_result(checker: &Checker, run: &GridRun, reason: &str, before: Option<&PlanOutcome>, world_seconds: f64) -> PlanResult {
+fn grid_result(checker: &Checker, run: &GridRun, reason: GridReason, before: Option<&PlanOutcome>, world_seconds: f64) -> PlanResult {
     let world = checker.world();
     let assembly = world.assembly();
     let mut outcome = run.outcome(assembly);
@@ -434,7 +435,7 @@ fn grid_result(checker: &Checker, run: &GridRun, reason: &str, before: Option<&P
     let cell = run.model.cell;
     report.grid = Some(GridEntry {
         cell: [u(cell.x), u(cell.y), u(cell.z)],
-        reason: reason.into(),
+        reason,
         states: run.solution.states,
         first_separation_moves: run.solution.first_separation_moves,
         seconds: run.solution.seconds,
@@ -564,7 +565,7 @@ pub fn optimise_problem(
         }
     }
     let mut report = PlanReport::new(&assembly, &plan, maps.tolerance(), &warnings);
-    report.stats.checker = CHECKER_DISTANCE_MAPS.into();
+    report.stats.checker = CheckerName::DistanceMaps;
     if let Some(best) = outcome.best() {
         for e in &o.extensions {
             if let Some(r) = e.describe(&model, &best.sequence)? {
@@ -582,7 +583,7 @@ pub fn optimise_problem(
     });
     let s = &outcome.stats;
     report.optimisation = Some(OptimisationEntry {
-        method: if o.pareto { "pareto_mcts" } else { "mcts" }.into(),
+        method: if o.pareto { OptimisationMethod::ParetoMcts } else { OptimisationMethod::Mcts },
         objectives: outcome.objectives.clone(),
         values: outcome.best().map(|b| b.values.clone()).unwrap_or_default(),
         hypervolume: o.pareto.then_some(outcome.value),

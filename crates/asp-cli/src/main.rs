@@ -10,7 +10,6 @@ mod output;
 mod plot;
 mod request;
 mod robot;
-mod text;
 mod view;
 
 use flags::{Cli, Command};

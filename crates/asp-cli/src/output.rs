@@ -24,6 +24,7 @@ pub(crate) fn settings(args: &PlanArgs) -> anyhow::Result<PlanSettings> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 enum Verdict {
     Found,
+    Partial,
     NotFound,
     Error,
     Interrupted,
@@ -33,7 +34,7 @@ impl Verdict {
     fn code(self) -> ExitCode {
         match self {
             Verdict::Found => ExitCode::SUCCESS,
-            Verdict::NotFound => ExitCode::from(1),
+            Verdict::Partial | Verdict::NotFound => ExitCode::from(1),
             Verdict::Error => ExitCode::from(2),
             Verdict::Interrupted => ExitCode::from(130),
         }
@@ -116,7 +117,7 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
     let mut names = BTreeSet::new();
     let mut printed = 0;
     let mut worst = Verdict::Found;
-    let mut counts = [0usize; 4];
+    let mut counts = [0usize; 5];
     let mut stdout = std::io::stdout().lock();
     if args.json && many {
         writeln!(stdout, "[")?;
@@ -150,10 +151,11 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
     }
     if many && !args.quiet {
         eprintln!(
-            "{} models in {:.2} s: {} found, {} not found, {} errors{}",
+            "{} models in {:.2} s: {} found, {} partial, {} not found, {} errors{}",
             models.len(),
             started.elapsed().as_secs_f64(),
             counts[Verdict::Found as usize],
+            counts[Verdict::Partial as usize],
             counts[Verdict::NotFound as usize],
             counts[Verdict::Error as usize],
             if worst == Verdict::Interrupted { ", interrupted" } else { "" }
@@ -229,19 +231,18 @@ fn plan_one(
         if separate {
             writeln!(stdout)?;
         }
-        crate::text::write_table(stdout, report)?;
-        if let Some(summary) = &report.optimisation {
-            crate::text::write_summary(stdout, summary, report.pareto_front.as_deref())?;
-        }
+        report.write_text(stdout)?;
     }
     stdout.flush()?;
     // Ctrl-C during any search (the optimiser's too) ends with 130 after its result is written
-    let interrupted = report.stats.stopped_by.as_deref() == Some(StopReason::Interrupted.as_str())
+    let interrupted = report.stats.stopped_by == Some(StopReason::Interrupted)
         || settings.cancel.as_ref().is_some_and(StopToken::is_stopped);
     Ok(if interrupted {
         Verdict::Interrupted
     } else if result.found() {
         Verdict::Found
+    } else if report.status == asp_search::report::PlanStatus::Partial {
+        Verdict::Partial
     } else {
         Verdict::NotFound
     })

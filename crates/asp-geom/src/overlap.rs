@@ -24,8 +24,10 @@ use crate::math::{Aabb, Vec3};
 use parry3d::query::{Ray, RayCullingMode};
 use parry3d::shape::TriMesh;
 
-/// What asp does with parts that overlap in the input beyond the tolerance.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// What asp does with parts that overlap in the input beyond the tolerance (in the plan JSON
+/// by its name: `strict`, `lenient`, `error`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum OverlapPolicy {
     /// The default: an overlapping pair may separate only along motions that enter no new
     /// material of the other part (the strict test above, on top of the shrunk sweep); pairs
@@ -102,9 +104,31 @@ pub struct OverlapNote {
     pub depth: f32,
     /// No shrinking up to the limit separates them.
     pub gross: bool,
-    /// How their mutual tests treat them: `strict`, `shrunk` (lenient or error policy, small
-    /// overlap) or `ignored` (lenient policy, gross overlap).
-    pub handling: &'static str,
+    /// How their mutual tests treat them.
+    pub handling: OverlapHandling,
+}
+
+/// How the mutual tests of an overlapping pair treat it (in the plan JSON by its name).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OverlapHandling {
+    /// They separate only along motions that enter no new material (the strict policy).
+    Strict,
+    /// One part is shrunk in their tests (lenient or error policy, small overlap).
+    Shrunk,
+    /// Their collisions with each other are ignored (lenient policy, gross overlap).
+    Ignored,
+}
+
+impl OverlapHandling {
+    /// `strict`, `shrunk` or `ignored`.
+    pub fn name(self) -> &'static str {
+        match self {
+            OverlapHandling::Strict => "strict",
+            OverlapHandling::Shrunk => "shrunk",
+            OverlapHandling::Ignored => "ignored",
+        }
+    }
 }
 
 /// A part's surface samples moved inward by `depth` along their outward normals: the

@@ -17,7 +17,7 @@ use crate::feasibility::{Motion, Stability};
 use crate::math::{aabb_of, sweep_overlap, Aabb, Pose, Vec3};
 use crate::mesh::{Mesh, Topology};
 use crate::fastener::{self, SymmetryAxis, Thread};
-use crate::overlap::{self, OverlapKind, OverlapNote, OverlapPolicy};
+use crate::overlap::{self, OverlapHandling, OverlapKind, OverlapNote, OverlapPolicy};
 use crate::partset::PartSet;
 use parry3d::query::{self, ClosestPoints, NonlinearRigidMotion, PointQuery};
 use parry3d::shape::{TriMesh, TriMeshFlags};
@@ -350,19 +350,19 @@ impl World {
                         self.ignored.insert((i, j));
                         self.ignored.insert((j, i));
                     }
-                    "strict"
+                    OverlapHandling::Strict
                 }
-                (_, false) => "shrunk",
+                (_, false) => OverlapHandling::Shrunk,
                 (OverlapPolicy::Lenient, true) => {
                     self.ignored.insert((i, j));
                     self.ignored.insert((j, i));
-                    "ignored"
+                    OverlapHandling::Ignored
                 }
             };
             let consequence = match handling {
-                "strict" => "they may separate only along motions that enter no new material of each other".to_string(),
-                "ignored" => "their collisions with each other are ignored".to_string(),
-                _ => format!("their mutual tests shrink '{}' by that much", self.name(self.pair_erosion(i, j).0)),
+                OverlapHandling::Strict => "they may separate only along motions that enter no new material of each other".to_string(),
+                OverlapHandling::Ignored => "their collisions with each other are ignored".to_string(),
+                OverlapHandling::Shrunk => format!("their mutual tests shrink '{}' by that much", self.name(self.pair_erosion(i, j).0)),
             };
             self.warnings.push(format!(
                 "parts '{a}' and '{b}' {what} in the input {measured} (tolerance {}); {consequence}",

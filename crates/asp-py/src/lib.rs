@@ -55,6 +55,16 @@ fn choices() -> std::collections::BTreeMap<&'static str, Vec<&'static str>> {
     .collect()
 }
 
+/// The plan JSON `json` as `asp plan` prints it (`Plan.table()`): the table and, for optimising
+/// runs, the optimiser's summary; an `asp.AspError` when `json` is not a plan.
+#[pyfunction]
+fn plan_text(py: Python<'_>, json: &str) -> PyResult<String> {
+    match serde_json::from_str::<asp_search::report::PlanReport>(json) {
+        Ok(report) => Ok(report.to_text()),
+        Err(e) => Err(errors::Error { kind: errors::Kind::Other, message: format!("plan JSON: not a plan ({e})"), path: None }.into_py(py)),
+    }
+}
+
 /// asp's native module (private: use the `asp` package).
 #[pymodule]
 #[pyo3(name = "_asp")]
@@ -65,6 +75,7 @@ fn asp_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(order_names, m)?)?;
     m.add_function(wrap_pyfunction!(choices, m)?)?;
+    m.add_function(wrap_pyfunction!(plan_text, m)?)?;
     m.add_class::<assembly::PyAssembly>()?;
     m.add_class::<qgraphs::PyQGraphs>()?;
     m.add_class::<search::PySearch>()?;

@@ -78,8 +78,9 @@ pub struct Budget {
     pub cancel: Option<StopToken>,
 }
 
-/// Why a search stopped before it could finish.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Why a search stopped before it could finish (in the plan JSON by [`StopReason::as_str`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum StopReason {
     /// The wall-time budget ran out.
     Timeout,

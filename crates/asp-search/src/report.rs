@@ -5,14 +5,17 @@
 //! reversed into an insertion).
 
 pub use crate::annotation::{RobotEntry, RobotReport, RobotStepEntry};
-use crate::problem::{PlanOutcome, Status, Step, StuckReason};
+use crate::problem::{PlanOutcome, Status, Step, StopReason, StuckReason};
 use asp_geom::math::Pose;
+use asp_geom::overlap::{OverlapHandling, OverlapPolicy};
 use asp_geom::{Assembly, Motion, PartSet};
 use serde::{Deserialize, Serialize};
 
+pub mod text;
+
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.7";
+pub const FORMAT_VERSION: &str = "1.8";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -27,8 +30,8 @@ pub struct PlanReport {
     pub up: String,
     /// The contact tolerance used, in model units.
     pub tolerance: f64,
-    /// `found`, `no_plan` or `budget_exhausted`.
-    pub status: String,
+    /// How the search ended.
+    pub status: PlanStatus,
     /// Every part of the model.
     pub parts: Vec<PartEntry>,
     /// One entry per non-fixed part, in assembly order (empty unless `found`).
@@ -49,6 +52,10 @@ pub struct PlanReport {
     /// For `no_plan`: the parts of the deepest dead-end state and what holds each.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub explanation: Vec<Explanation>,
+    /// For `partial`: the parts that go in together because no plan took them apart, one
+    /// entry per core (cores inside subassemblies included). Since format 1.8.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub locked_cores: Vec<LockedCore>,
     /// Pairs of parts that overlap in the input beyond the tolerance, and how their tests
     /// treated them (feasibility planning; absent when no pair overlaps). Since format 1.5.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -72,6 +79,25 @@ pub struct PlanReport {
     pub grid: Option<GridEntry>,
 }
 
+/// Parts that go in together as one unit because asp could not take them apart (format 1.8):
+/// what stays of a subassembly whose own plan is not `found`.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct LockedCore {
+    /// The subassembly's base (its step's part).
+    pub base: usize,
+    /// The parts of the core, by index (the base among them): the subassembly's parts its own
+    /// plan does not take off.
+    pub parts: Vec<usize>,
+    /// Their names.
+    pub names: Vec<String>,
+    /// Why: the subassembly's own status (`no_plan`: nothing comes off, `explanation` says what
+    /// holds what; `budget_exhausted`; `unplanned`: not tried).
+    pub status: SubassemblyStatus,
+    /// The subassembly's own explanation: the parts of its dead end and what holds each.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub explanation: Vec<Explanation>,
+}
+
 /// The grid search behind a plan (format 1.6).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct GridEntry {
@@ -80,7 +106,7 @@ pub struct GridEntry {
     /// Why the grid search made the plan: `needs_moves` (parts must move in turn before
     /// anything can leave, so it ran first) or `fallback` (the depth-first search found no
     /// plan).
-    pub reason: String,
+    pub reason: GridReason,
     /// States the breadth-first searches visited (every subassembly's included).
     pub states: u64,
     /// Moves before the model's first separation (the fewest possible).
@@ -123,7 +149,7 @@ impl PlanReport {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct OverlapsEntry {
     /// The overlap policy: `strict`, `lenient` or `error`.
-    pub policy: String,
+    pub policy: OverlapPolicy,
     /// One entry per overlapping pair.
     pub pairs: Vec<OverlapPair>,
 }
@@ -136,7 +162,7 @@ pub struct OverlapPair {
     /// Their names.
     pub names: [String; 2],
     /// `crossing`, `nested` or `coincident`.
-    pub kind: String,
+    pub kind: OverlapKindName,
     /// For `nested`: the part that lies inside the other.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inner: Option<usize>,
@@ -146,7 +172,7 @@ pub struct OverlapPair {
     pub gross: bool,
     /// `strict` (they separate only along motions that enter no new material), `shrunk` or
     /// `ignored`.
-    pub handling: String,
+    pub handling: OverlapHandling,
 }
 
 impl OverlapsEntry {
@@ -162,17 +188,21 @@ impl OverlapsEntry {
             .map(|n| OverlapPair {
                 parts: [n.parts.0, n.parts.1],
                 names: [world.name(n.parts.0).to_string(), world.name(n.parts.1).to_string()],
-                kind: n.kind.name().into(),
+                kind: match n.kind {
+                    asp_geom::overlap::OverlapKind::Crossing => OverlapKindName::Crossing,
+                    asp_geom::overlap::OverlapKind::Nested { .. } => OverlapKindName::Nested,
+                    asp_geom::overlap::OverlapKind::Coincident => OverlapKindName::Coincident,
+                },
                 inner: match n.kind {
                     asp_geom::overlap::OverlapKind::Nested { inner } => Some(inner),
                     _ => None,
                 },
                 depth: units.from_metres(n.depth as f64),
                 gross: n.gross,
-                handling: n.handling.into(),
+                handling: n.handling,
             })
             .collect();
-        Some(OverlapsEntry { policy: world.overlap_policy().name().into(), pairs })
+        Some(OverlapsEntry { policy: world.overlap_policy(), pairs })
     }
 }
 
@@ -220,9 +250,10 @@ pub struct SubassemblyEntry {
     /// Every part of it, by index (the step's part, its base, among them).
     pub parts: Vec<usize>,
     /// How it is built on its base: `found` (its `assembly_sequence` builds it part by part),
+    /// `partial` (its sequence is complete but holds a subassembly not taken apart; format 1.8),
     /// `no_plan` (it cannot be taken apart: a locked core, `explanation` says what holds
     /// what), `budget_exhausted`, or `unplanned` (not tried).
-    pub status: String,
+    pub status: SubassemblyStatus,
     /// Its own steps onto the base, in assembly order (for `no_plan` and `budget_exhausted`
     /// the parts that do come off, onto the parts that stay); steps may be subassemblies again.
     pub assembly_sequence: Vec<AssemblyStep>,
@@ -268,8 +299,8 @@ pub enum MotionEntry {
 pub struct StatsEntry {
     /// What the removal tests ran on: [`CHECKER_COLLISION_WORLD`] (shape casts on the meshes,
     /// the feasibility planner) or [`CHECKER_DISTANCE_MAPS`] (the optimiser; format 1.2).
-    #[serde(default = "collision_world")]
-    pub checker: String,
+    #[serde(default)]
+    pub checker: Checker,
     /// Removal tests run.
     pub removal_tests: u64,
     /// Tests failed by collision.
@@ -286,7 +317,7 @@ pub struct StatsEntry {
     pub timings: Option<Timings>,
     /// For `budget_exhausted`: `timeout`, `max_tests` or `interrupted` (Ctrl-C). Since 1.4.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stopped_by: Option<String>,
+    pub stopped_by: Option<StopReason>,
 }
 
 /// Where a run's wall time went, in seconds.
@@ -303,13 +334,9 @@ pub struct Timings {
 }
 
 /// `stats.checker` of plans tested on the collision world.
-pub const CHECKER_COLLISION_WORLD: &str = "collision_world";
+pub const CHECKER_COLLISION_WORLD: Checker = Checker::CollisionWorld;
 /// `stats.checker` of optimised plans, tested on distance maps.
-pub const CHECKER_DISTANCE_MAPS: &str = "distance_maps";
-
-fn collision_world() -> String {
-    CHECKER_COLLISION_WORLD.into()
-}
+pub const CHECKER_DISTANCE_MAPS: Checker = Checker::DistanceMaps;
 
 /// Why one part could not leave the deepest dead-end state.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -320,7 +347,7 @@ pub struct Explanation {
     pub name: String,
     /// `blocked` (every motion collides), `unsupported` (its removal leaves parts without
     /// support) or `dead_end` (it can leave, but nothing after that works).
-    pub reason: String,
+    pub reason: ExplanationReason,
     /// The parts involved: blockers, or parts left unsupported.
     pub parts: Vec<NamedPart>,
 }
@@ -347,7 +374,7 @@ pub struct ParetoEntry {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct OptimisationEntry {
     /// `mcts` (one objective) or `pareto_mcts`.
-    pub method: String,
+    pub method: OptimisationMethod,
     /// The objectives' names, in the order of every objective vector.
     pub objectives: Vec<String>,
     /// The objective vector of `assembly_sequence` (the best sequence, or the front's first).
@@ -402,8 +429,9 @@ impl PlanReport {
         let u = |m: f32| assembly.units.from_metres(m as f64);
         let name = |i: usize| assembly.parts.get(i).map(|p| p.name.clone()).unwrap_or_else(|| "ground".into());
         let named = |s: &PartSet| s.iter().map(|part| NamedPart { part, name: name(part) }).collect();
-        let status = status_name(&outcome.status);
         let steps = assembly_steps(&outcome.removals, &name, &u);
+        let status = complete(status_name(&outcome.status), &steps);
+        let locked_cores = if status == PlanStatus::Partial { locked_cores(&steps, &name) } else { Vec::new() };
         let found = outcome.status == Status::Found;
         let removed = removal_order(&outcome.removals);
         let remaining = (!found).then(|| (0..assembly.parts.len()).filter(|i| !removed.contains(i)).collect());
@@ -416,7 +444,7 @@ impl PlanReport {
             units: assembly.units.name.clone(),
             up: assembly.up.to_string(),
             tolerance: u(tolerance),
-            status: status.into(),
+            status,
             parts: assembly
                 .parts
                 .iter()
@@ -428,16 +456,17 @@ impl PlanReport {
             partial_assembly_sequence,
             remaining,
             stats: StatsEntry {
-                checker: CHECKER_COLLISION_WORLD.into(),
+                checker: Checker::CollisionWorld,
                 removal_tests: c.removal_tests,
                 failed_collision: c.failed_collision,
                 failed_gravity: c.failed_gravity,
                 path_planner_calls: c.path_planner_calls,
                 seconds: outcome.stats.seconds,
                 timings: None,
-                stopped_by: outcome.stats.stopped_by.map(|r| r.as_str().to_string()),
+                stopped_by: outcome.stats.stopped_by,
             },
             explanation,
+            locked_cores,
             overlaps: None,
             warnings: warnings.to_vec(),
             pareto_front: None,
@@ -461,10 +490,13 @@ fn assembly_steps(removals: &[Step], name: &dyn Fn(usize) -> String, u: &dyn Fn(
             subassembly: s.group.as_ref().map(|g| {
                 let named = |set: &PartSet| set.iter().map(|part| NamedPart { part, name: name(part) }).collect();
                 let (status, assembly_sequence, explanation) = match &g.plan {
-                    None => ("unplanned", Vec::new(), Vec::new()),
-                    Some(plan) => (status_name(&plan.status), assembly_steps(&plan.removals, name, u), explain(&plan.status, name, &named)),
+                    None => (SubassemblyStatus::Unplanned, Vec::new(), Vec::new()),
+                    Some(plan) => {
+                        let steps = assembly_steps(&plan.removals, name, u);
+                        (SubassemblyStatus::from(complete(status_name(&plan.status), &steps)), steps, explain(&plan.status, name, &named))
+                    }
                 };
-                Box::new(SubassemblyEntry { parts: g.parts.iter().collect(), status: status.into(), assembly_sequence, explanation })
+                Box::new(SubassemblyEntry { parts: g.parts.iter().collect(), status, assembly_sequence, explanation })
             }),
             robot: None,
             held: Vec::new(),
@@ -479,6 +511,43 @@ fn assembly_steps(removals: &[Step], name: &dyn Fn(usize) -> String, u: &dyn Fn(
                 .collect(),
         })
         .collect()
+}
+
+/// `found` only when every part gets its own motion: a found sequence holding a subassembly
+/// whose own plan is not `found` (recursively) is `partial`.
+fn complete(status: PlanStatus, steps: &[AssemblyStep]) -> PlanStatus {
+    let locked = steps.iter().any(|s| s.subassembly.as_ref().is_some_and(|g| g.status != SubassemblyStatus::Found));
+    if status == PlanStatus::Found && locked {
+        PlanStatus::Partial
+    } else {
+        status
+    }
+}
+
+/// The locked cores of `steps`: of each subassembly not `found`, the parts its own steps do not
+/// place; inside subassemblies too.
+fn locked_cores(steps: &[AssemblyStep], name: &dyn Fn(usize) -> String) -> Vec<LockedCore> {
+    let mut cores = Vec::new();
+    for step in steps {
+        let Some(g) = &step.subassembly else { continue };
+        if !matches!(g.status, SubassemblyStatus::Found | SubassemblyStatus::Partial) {
+            let placed: Vec<usize> = g
+                .assembly_sequence
+                .iter()
+                .flat_map(|s| s.subassembly.as_ref().map_or_else(|| vec![s.part], |inner| inner.parts.clone()))
+                .collect();
+            let parts: Vec<usize> = g.parts.iter().copied().filter(|p| !placed.contains(p)).collect();
+            cores.push(LockedCore {
+                base: step.part,
+                names: parts.iter().map(|&p| name(p)).collect(),
+                parts,
+                status: g.status,
+                explanation: g.explanation.clone(),
+            });
+        }
+        cores.extend(locked_cores(&g.assembly_sequence, name));
+    }
+    cores
 }
 
 /// The parts in removal order, a subassembly's parts at its step: those its own plan removes
@@ -500,11 +569,11 @@ pub fn removal_order(removals: &[Step]) -> Vec<usize> {
     order
 }
 
-fn status_name(status: &Status) -> &'static str {
+fn status_name(status: &Status) -> PlanStatus {
     match status {
-        Status::Found => "found",
-        Status::NoPlan { .. } => "no_plan",
-        Status::BudgetExhausted => "budget_exhausted",
+        Status::Found => PlanStatus::Found,
+        Status::NoPlan { .. } => PlanStatus::NoPlan,
+        Status::BudgetExhausted => PlanStatus::BudgetExhausted,
     }
 }
 
@@ -515,11 +584,11 @@ fn explain(status: &Status, name: &dyn Fn(usize) -> String, named: &dyn Fn(&Part
             .iter()
             .map(|s| {
                 let (reason, parts) = match &s.reason {
-                    StuckReason::Blocked(b) => ("blocked", named(b)),
-                    StuckReason::WouldLeaveUnsupported(f) => ("unsupported", named(f)),
-                    StuckReason::DeadEnd => ("dead_end", Vec::new()),
+                    StuckReason::Blocked(b) => (ExplanationReason::Blocked, named(b)),
+                    StuckReason::WouldLeaveUnsupported(f) => (ExplanationReason::Unsupported, named(f)),
+                    StuckReason::DeadEnd => (ExplanationReason::DeadEnd, Vec::new()),
                 };
-                Explanation { part: s.part, name: name(s.part), reason: reason.into(), parts }
+                Explanation { part: s.part, name: name(s.part), reason, parts }
             })
             .collect(),
         _ => Vec::new(),
@@ -551,5 +620,138 @@ fn insertion(motion: &Motion, u: &dyn Fn(f32) -> f64) -> MotionEntry {
                 .collect(),
             pivot: v3(*pivot, u),
         },
+    }
+}
+
+/// Declares a closed set of names in the plan JSON: a serde enum written by its snake-case name,
+/// with `as_str` giving that name.
+macro_rules! vocabulary {
+    ($(#[$meta:meta])* $name:ident { $($(#[$vmeta:meta])* $variant:ident => $text:literal,)+ }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+        #[serde(rename_all = "snake_case")]
+        pub enum $name {
+            $($(#[$vmeta])* $variant,)+
+        }
+
+        impl $name {
+            /// The name in the plan JSON.
+            pub fn as_str(self) -> &'static str {
+                match self {
+                    $($name::$variant => $text,)+
+                }
+            }
+        }
+
+        impl std::fmt::Display for $name {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(self.as_str())
+            }
+        }
+    };
+}
+
+vocabulary! {
+    /// How a plan's search ended (`status`).
+    PlanStatus {
+        /// Every part gets its own motion: `assembly_sequence` builds the product part by part.
+        Found => "found",
+        /// `assembly_sequence` is complete, but some of its subassemblies could not be taken
+        /// apart: their parts go in as one unit (`locked_cores`; format 1.8).
+        Partial => "partial",
+        /// No sequence exists under the model's tests: `explanation` says what holds what.
+        NoPlan => "no_plan",
+        /// The budget ran out first (`stats.stopped_by` says which).
+        BudgetExhausted => "budget_exhausted",
+    }
+}
+
+vocabulary! {
+    /// How a subassembly is built on its base (`subassembly.status`).
+    SubassemblyStatus {
+        /// Its `assembly_sequence` builds it part by part.
+        Found => "found",
+        /// Its `assembly_sequence` is complete but holds a subassembly not taken apart.
+        Partial => "partial",
+        /// It cannot be taken apart (a locked core); `explanation` says what holds what.
+        NoPlan => "no_plan",
+        /// Its own search ran out of budget.
+        BudgetExhausted => "budget_exhausted",
+        /// Its own plan was not tried.
+        Unplanned => "unplanned",
+    }
+}
+
+impl PlanStatus {
+    /// Whether `assembly_sequence` holds a complete sequence (`found` or `partial`).
+    pub fn has_sequence(self) -> bool {
+        matches!(self, PlanStatus::Found | PlanStatus::Partial)
+    }
+}
+
+impl From<PlanStatus> for SubassemblyStatus {
+    fn from(s: PlanStatus) -> Self {
+        match s {
+            PlanStatus::Found => SubassemblyStatus::Found,
+            PlanStatus::Partial => SubassemblyStatus::Partial,
+            PlanStatus::NoPlan => SubassemblyStatus::NoPlan,
+            PlanStatus::BudgetExhausted => SubassemblyStatus::BudgetExhausted,
+        }
+    }
+}
+
+vocabulary! {
+    /// Why the grid search made a plan (`grid.reason`).
+    GridReason {
+        /// Parts must move in turn before anything can leave, so it ran first.
+        NeedsMoves => "needs_moves",
+        /// The depth-first search found no plan.
+        Fallback => "fallback",
+    }
+}
+
+vocabulary! {
+    /// How two overlapping parts lie in each other (`overlaps.pairs[].kind`).
+    OverlapKindName {
+        /// Their surfaces cross.
+        Crossing => "crossing",
+        /// One lies wholly inside the other (`inner`).
+        Nested => "nested",
+        /// They occupy the same space.
+        Coincident => "coincident",
+    }
+}
+
+vocabulary! {
+    /// What the removal tests ran on (`stats.checker`).
+    #[derive(Default)]
+    Checker {
+        /// Shape casts on the meshes (the feasibility planner).
+        #[default]
+        CollisionWorld => "collision_world",
+        /// Distance maps (the optimiser; format 1.2).
+        DistanceMaps => "distance_maps",
+    }
+}
+
+vocabulary! {
+    /// Why a part cannot leave the deepest dead end (`explanation[].reason`).
+    ExplanationReason {
+        /// Every motion collides (`parts` are the blockers).
+        Blocked => "blocked",
+        /// Its removal leaves `parts` without support.
+        Unsupported => "unsupported",
+        /// It can leave, but nothing after that works.
+        DeadEnd => "dead_end",
+    }
+}
+
+vocabulary! {
+    /// The optimiser that made a plan (`optimisation.method`).
+    OptimisationMethod {
+        /// One objective.
+        Mcts => "mcts",
+        /// Several objectives: a Pareto front.
+        ParetoMcts => "pareto_mcts",
     }
 }

@@ -259,7 +259,7 @@ const baseParts = parts.filter((p) => initial.has(p.index));
 if (baseParts.length) {
   base.innerHTML = '';
   const head = document.createElement('b');
-  head.textContent = data.status === 'found' ? 'Base: ' : 'Dead end (the start): ';
+  head.textContent = (data.status === 'found' || data.status === 'partial') ? 'Base: ' : 'Dead end (the start): ';
   base.appendChild(head);
   baseParts.forEach((p, i) => {
     const s = document.createElement('span');
@@ -370,8 +370,8 @@ const api = {
   }),
 };
 window.aspViewer = api;
-// a found plan opens assembled; an unfinished one on its dead end, the stuck parts in red
-if (data.status === 'found') state.shown = steps.length;
+// a found or partial plan opens assembled (a partial one's locked cores in red); an unfinished one on its dead end, the stuck parts in red
+if (data.status === 'found' || data.status === 'partial') state.shown = steps.length;
 apply_state();
 renderer.render(scene, camera);
 api.ready = true;

@@ -171,13 +171,13 @@ fn panel_specs(scene: &Scene) -> Vec<PanelSpec> {
         }
     };
     let mut specs = Vec::new();
-    let found = scene.report.status == "found";
+    let found = scene.report.status.has_sequence();
     if !found {
         specs.push(PanelSpec {
             parts: scene.initial.iter().map(|&i| (i, colour_of_placed(i), Pose::from_translation(scene.offset(i, 0, 0)))).collect(),
             part: None,
             colour: STUCK,
-            title: format!("{}: {} parts left", scene.report.status.replace('_', " "), scene.initial.len()),
+            title: format!("{}: {} parts left", scene.report.status.as_str().replace('_', " "), scene.initial.len()),
             arrow: Vec::new(),
         });
     }

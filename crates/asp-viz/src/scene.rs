@@ -6,7 +6,7 @@ use crate::error::{Result, VizError};
 use asp_geom::io::{load, LoadOptions};
 use asp_geom::math::{aabb_of, Axis, Pose, Rot, Vec3};
 use asp_geom::{Assembly, Units};
-use asp_search::report::{MotionEntry, PlanReport};
+use asp_search::report::{MotionEntry, PlanReport, SubassemblyStatus};
 use std::path::{Path, PathBuf};
 
 /// Reads and parses a plan JSON (`docs/plan-format.md`); a plan of another major format
@@ -234,7 +234,7 @@ pub struct Scene {
     /// not found the deepest dead end (the explanation's parts; without an explanation the
     /// parts the last branch did not remove).
     pub initial: Vec<usize>,
-    /// The parts the plan's `explanation` names as stuck (empty unless `no_plan`).
+    /// The parts the plan's `explanation` names as stuck (`no_plan`), or its locked cores (`partial`).
     pub stuck: Vec<usize>,
     /// Metres per model unit (the plan's `units`).
     pub metres_per_unit: f64,
@@ -263,8 +263,8 @@ impl Scene {
             .metres;
         let mut order_recorded = true;
         // plans since format 1.3 carry the partial disassembly of a failed search with its motions
-        let sequence = if report.status == "found" { &report.assembly_sequence } else { &report.partial_assembly_sequence };
-        let steps: Vec<Step> = if report.status == "found" || !sequence.is_empty() {
+        let sequence = if report.status.has_sequence() { &report.assembly_sequence } else { &report.partial_assembly_sequence };
+        let steps: Vec<Step> = if report.status.has_sequence() || !sequence.is_empty() {
             sequence
                 .iter()
                 .map(|s| {
@@ -278,7 +278,10 @@ impl Scene {
                     }
                     let name = match &s.subassembly {
                         None => part.name.clone(),
-                        Some(g) => format!("{} + {} parts (subassembly)", part.name, g.parts.len() - 1),
+                        Some(g) if matches!(g.status, SubassemblyStatus::Found | SubassemblyStatus::Partial) => {
+                            format!("{} + {} parts (subassembly)", part.name, g.parts.len() - 1)
+                        }
+                        Some(g) => format!("{} + {} parts (subassembly, locked core: goes in as one unit)", part.name, g.parts.len() - 1),
                     };
                     let mut moves = Vec::with_capacity(s.moves.len());
                     for m in &s.moves {
@@ -331,7 +334,9 @@ impl Scene {
             }
         }
         let initial = (0..n).filter(|&i| !placed[i]).collect();
+        // the parts a plan could not take apart: a dead end's, or a partial plan's locked cores
         let mut stuck: Vec<usize> = report.explanation.iter().map(|e| e.part).filter(|&p| p < n).collect();
+        stuck.extend(report.locked_cores.iter().flat_map(|c| c.parts.iter().copied()).filter(|&p| p < n));
         stuck.sort_unstable();
         stuck.dedup();
         Ok(Scene { assembly, report, steps, initial, stuck, metres_per_unit: metres, order_recorded })

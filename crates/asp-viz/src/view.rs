@@ -3,6 +3,7 @@
 
 use crate::error::{Result, VizError};
 use crate::scene::{part_colour, Insertion, Scene, BASE, STUCK};
+use asp_search::report::{ExplanationReason, PlanStatus};
 use base64::Engine;
 use serde_json::{json, Value};
 use std::path::Path;
@@ -125,11 +126,10 @@ fn page_data(scene: &Scene) -> Value {
         .iter()
         .map(|e| {
             let names: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
-            let text = match e.reason.as_str() {
-                "blocked" => format!("{}: blocked by {}", e.name, names.join(", ")),
-                "unsupported" => format!("{}: removing it leaves {} unsupported", e.name, names.join(", ")),
-                "dead_end" => format!("{}: can leave, but every state after that is stuck", e.name),
-                other => format!("{}: {other} {}", e.name, names.join(", ")),
+            let text = match e.reason {
+                ExplanationReason::Blocked => format!("{}: blocked by {}", e.name, names.join(", ")),
+                ExplanationReason::Unsupported => format!("{}: removing it leaves {} unsupported", e.name, names.join(", ")),
+                ExplanationReason::DeadEnd => format!("{}: can leave, but every state after that is stuck", e.name),
             };
             json!({ "part": e.part, "name": e.name, "reason": e.reason, "text": text })
         })
@@ -153,21 +153,28 @@ fn page_data(scene: &Scene) -> Value {
 fn status_text(scene: &Scene) -> String {
     let n = scene.steps.len();
     let moving = n > 0 && scene.steps.iter().all(|s| s.motion.is_some());
-    match scene.report.status.as_str() {
-        "found" => format!("Plan found: {n} steps ({} parts, units {}).", scene.assembly.parts.len(), scene.report.units),
-        "no_plan" if moving => format!(
+    match scene.report.status {
+        PlanStatus::Found => format!("Plan found: {n} steps ({} parts, units {}).", scene.assembly.parts.len(), scene.report.units),
+        PlanStatus::Partial => format!(
+            "Partial plan: {n} steps ({} parts, units {}); {} parts go in as locked cores that asp could not take apart \
+             (in red).",
+            scene.assembly.parts.len(),
+            scene.report.units,
+            scene.report.locked_cores.iter().map(|c| c.parts.len()).sum::<usize>()
+        ),
+        PlanStatus::NoPlan if moving => format!(
             "No plan: the search got stuck with {} parts left (stuck parts in red). Steps: the partial plan, \
              the other {n} parts in assembly order onto them.",
             scene.initial.len()
         ),
-        "no_plan" => format!(
+        PlanStatus::NoPlan => format!(
             "No plan: the search got stuck with {} parts left (stuck parts in red). Steps: the other {n} parts, {}, \
              appearing in place (no motions are recorded for them).",
             scene.initial.len(),
             if scene.order_recorded { "in the order of the branch reached" } else { "order not recorded" }
         ),
-        other if moving => format!("{}: the partial plan reached ({n} parts).", other.replace('_', " ")),
-        other => format!("{}: the partial sequence reached ({n} parts; motions not recorded).", other.replace('_', " ")),
+        other if moving => format!("{}: the partial plan reached ({n} parts).", other.as_str().replace('_', " ")),
+        other => format!("{}: the partial sequence reached ({n} parts; motions not recorded).", other.as_str().replace('_', " ")),
     }
 }
 

@@ -196,9 +196,11 @@ class PlanJob(Job):
                    "load": self.spec["load"], "plans": rows}
         _write_atomic(out / "summary.json", json.dumps(summary, indent=2) + "\n")
         found = sum(1 for r in rows if r.get("found"))
+        partial = sum(1 for r in rows if r.get("status") == "partial")
         failed = sum(1 for r in rows if "error" in r)
+        locked = f", {partial} partial (locked cores)" if partial else ""
         errors = f", {failed} could not be planned (errors in summary.json)" if failed else ""
-        return f"{found} of {len(rows)} models planned{errors}; plans and summary.json in {out}"
+        return f"{found} of {len(rows)} models planned{locked}{errors}; plans and summary.json in {out}"
 
 
 def _plan(spec: dict[str, Any], payload: dict[str, Any], out: str) -> dict[str, Any]:

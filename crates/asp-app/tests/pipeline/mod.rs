@@ -16,7 +16,7 @@ fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
         let r = plan_assembly(a, &settings, None).unwrap();
         assert!(r.found(), "{name}: {}", r.report.to_json());
         let grid = r.report.grid.as_ref().expect("a grid plan");
-        assert_eq!(grid.reason, "needs_moves", "{name}");
+        assert_eq!(grid.reason, asp_search::report::GridReason::NeedsMoves, "{name}");
         assert_eq!(grid.first_separation_moves, Some(moves), "{name}");
         // every part is taken out once; the last step in disassembly order carries the moves
         let mut order = r.report.disassembly_sequence.clone();
@@ -24,7 +24,7 @@ fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
         assert_eq!(order, (0..r.report.parts.len()).collect::<Vec<_>>(), "{name}");
         let last = r.report.assembly_sequence.last().unwrap();
         assert_eq!(last.moves.len(), moves, "{name}: the first separation's moves, in assembly order");
-        assert_eq!(r.report.format_version, "1.7");
+        assert_eq!(r.report.format_version, "1.8");
     }
     // a voxel model the straight-line search answers keeps its plan (no grid entry)
     let r = plan_assembly(asp_geom::puzzles::burr_key(), &settings, None).unwrap();
@@ -32,12 +32,45 @@ fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
     assert!(r.report.grid.is_none(), "{}", r.report.to_json());
     let r = plan_assembly(asp_geom::fixtures::figure_6_2(0.01), &settings, None).unwrap();
     assert!(r.found() && r.report.grid.is_none());
-    // without the grid the burr only lifts off the ground in one piece, a subassembly that
-    // cannot be taken apart (straight lines and groups only)
-    let off = PlanSettings { grid: false, path_planner: false, ..settings.clone() };
+}
+
+/// Issue 28 item 1: a plan whose only sequence lifts an interlocked group in one piece is not
+/// `found`: without the grid the burr only lifts off the ground as one subassembly that cannot
+/// be taken apart (straight lines and groups only), so the plan is `partial` and names the core.
+#[test]
+fn issue_28_a_plan_that_lifts_a_locked_core_in_one_piece_is_partial() {
+    use asp_search::report::{PlanStatus, SubassemblyStatus};
+    let off = PlanSettings { grid: false, path_planner: false, timeout: Some(30.0), ..PlanSettings::default() };
     let r = plan_assembly(asp_geom::puzzles::burr_level(), &off, None).unwrap();
-    let first = r.report.assembly_sequence.first().and_then(|s| s.subassembly.as_ref());
-    assert!(!r.found() || first.is_some_and(|g| g.status == "no_plan" && g.parts.len() == 6), "{}", r.report.to_json());
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Partial, "{json}");
+    assert!(!r.found(), "a partial plan is not found");
+    // the sequence is complete: one step, the whole burr as a subassembly its own plan cannot open
+    assert_eq!(r.report.assembly_sequence.len(), 1, "{json}");
+    let g = r.report.assembly_sequence[0].subassembly.as_ref().expect("a subassembly step");
+    assert_eq!(g.status, SubassemblyStatus::NoPlan);
+    assert_eq!(g.parts.len(), 6);
+    assert!(r.report.remaining.is_none() && r.report.partial_assembly_sequence.is_empty());
+    // the locked core: every piece, with the group's own explanation as the reason
+    assert_eq!(r.report.locked_cores.len(), 1, "{json}");
+    let core = &r.report.locked_cores[0];
+    assert_eq!(core.parts, (0..6).collect::<Vec<_>>());
+    assert_eq!(core.base, r.report.assembly_sequence[0].part);
+    assert_eq!(core.names, r.report.parts.iter().map(|p| p.name.clone()).collect::<Vec<_>>());
+    assert_eq!(core.status, SubassemblyStatus::NoPlan);
+    assert!(!core.explanation.is_empty() && core.explanation == g.explanation, "{json}");
+    assert!(json.contains("\"status\": \"partial\"") && json.contains("\"locked_cores\""));
+    // the table says so, as loudly as it says found
+    let text = r.report.to_text();
+    let header = text.lines().next().unwrap();
+    assert!(header.contains(": partial in "), "{text}");
+    let names = core.names.join(", ");
+    assert_eq!(text.lines().nth(1), Some(format!("planned 0 of 6 parts; 6 stay in 1 locked core: {names}").as_str()), "{text}");
+    // with the grid the same burr is taken apart piece by piece: found
+    let on = PlanSettings { timeout: Some(30.0), ..PlanSettings::default() };
+    let r = plan_assembly(asp_geom::puzzles::burr_level(), &on, None).unwrap();
+    assert_eq!(r.report.status, PlanStatus::Found);
+    assert!(r.found() && r.report.locked_cores.is_empty());
 }
 
 /// Issue 28 item 4: on a voxel puzzle the grid planner answers before the path planner, with or

@@ -38,7 +38,7 @@ fn plans_a_fixture_prints_a_table_and_writes_the_json() {
     assert!(table.contains("found"), "{table}");
     assert!(table.contains("stick") && table.contains("handle") && table.contains("cap"), "{table}");
     let plan = json(&out);
-    assert_eq!(plan["format_version"], "1.7");
+    assert_eq!(plan["format_version"], "1.8");
     assert_eq!(plan["stats"]["checker"], "collision_world");
     assert_eq!(plan["status"], "found");
     assert_eq!(plan["up"], "+z");
@@ -335,7 +335,7 @@ fn issue_9_plans_an_interlocking_burr_by_grid_moves() {
     let table = String::from_utf8(o.stdout).unwrap();
     assert!(table.contains("grid plan") && table.contains("move piece"), "{table}");
     let plan = json(&out);
-    assert_eq!(plan["format_version"], "1.7");
+    assert_eq!(plan["format_version"], "1.8");
     assert_eq!(plan["status"], "found");
     assert_eq!(plan["grid"]["reason"], "needs_moves");
     assert_eq!(plan["grid"]["first_separation_moves"], asp_geom::puzzles::BURR_LEVEL_MOVES);
@@ -347,12 +347,46 @@ fn issue_9_plans_an_interlocking_burr_by_grid_moves() {
     assert!(present.is_empty(), "parts never taken out: {present:?}");
     // without the grid search (the planner before issue 9 item 6) the burr only lifts off the
     // ground in one piece: a subassembly of all six pieces that cannot be taken apart
+    // (issue 28: so the plan is partial, exit code 1)
     let o = asp(&["plan", model.to_str().unwrap(), "--no-grid", "--no-path-planner", "--json"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let g = &plan["assembly_sequence"][0]["subassembly"];
     assert_eq!(g["status"], "no_plan", "{plan}");
     assert_eq!(g["parts"].as_array().unwrap().len(), 6);
     assert!(plan["grid"].is_null());
+}
+
+/// Issue 28 item 1: a plan that lifts a locked core in one piece is `partial`, exit code 1, in
+/// the JSON (with the core and why), the table and `--each`'s summary.
+#[test]
+fn issue_28_a_plan_with_a_locked_core_is_partial_with_exit_code_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let models = dir.path().join("models");
+    std::fs::create_dir(&models).unwrap();
+    let burr = fixture_file(&models, &asp_geom::puzzles::burr_level(), "burr.glb");
+    fixture_file(&models, &fixtures::tube(), "tube.glb");
+    let out = dir.path().join("plan.json");
+    let off = ["--no-grid", "--no-path-planner"];
+    let o = asp(&["plan", burr.to_str().unwrap(), off[0], off[1], "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let table = String::from_utf8(o.stdout).unwrap();
+    let mut lines = table.lines();
+    assert!(lines.next().unwrap().contains(": partial in "), "{table}");
+    let plan = json(&out);
+    assert_eq!(plan["status"], "partial");
+    let cores = plan["locked_cores"].as_array().expect("locked cores");
+    assert_eq!(cores.len(), 1, "{plan}");
+    let names: Vec<&str> = cores[0]["names"].as_array().unwrap().iter().map(|n| n.as_str().unwrap()).collect();
+    assert_eq!(names.len(), 6);
+    assert_eq!(cores[0]["status"], "no_plan");
+    assert!(!cores[0]["explanation"].as_array().unwrap().is_empty(), "{plan}");
+    let line = format!("planned 0 of 6 parts; 6 stay in 1 locked core: {}", names.join(", "));
+    assert_eq!(lines.next(), Some(line.as_str()), "{table}");
+    // --each counts partial plans apart; the exit code is the worst (1)
+    let o = asp(&["plan", "--each", models.to_str().unwrap(), off[0], off[1]]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("2 models in") && stderr(&o).contains(": 1 found, 1 partial, 0 not found, 0 errors"), "{}", stderr(&o));
 }
 
 #[test]

@@ -32,7 +32,7 @@ fn a_pressed_peg_leaves_along_its_axis_only() {
     // the pair is reported: gross (no shrinking separates them), handled strictly, warned once
     let notes = w.overlap_notes();
     assert_eq!(notes.len(), 1, "{notes:?}");
-    assert_eq!((notes[0].parts, notes[0].gross, notes[0].handling), ((0, 1), true, "strict"));
+    assert_eq!((notes[0].parts, notes[0].gross, notes[0].handling), ((0, 1), true, asp_geom::overlap::OverlapHandling::Strict));
     assert_eq!(notes[0].kind, OverlapKind::Crossing);
     let warned: Vec<&String> = w.warnings().iter().filter(|s| s.contains("'plate' and 'peg'")).collect();
     assert_eq!(warned.len(), 1, "{:?}", w.warnings());
@@ -46,7 +46,7 @@ fn the_lenient_policy_lets_the_peg_slide_sideways_and_error_stops() {
     let w = world(fixtures::pressed_peg(), OverlapPolicy::Lenient).unwrap();
     let free = free_axes(&w, 1, &PartSet::full(2));
     assert!(free.contains(&"+x") && free.contains(&"+z"), "{free:?}");
-    assert_eq!(w.overlap_notes()[0].handling, "ignored");
+    assert_eq!(w.overlap_notes()[0].handling, asp_geom::overlap::OverlapHandling::Ignored);
     let err = world(fixtures::pressed_peg(), OverlapPolicy::Error).err().expect("error policy").to_string();
     assert!(err.contains("'plate' and 'peg'") && err.contains("overlaps policy"), "{err}");
 }

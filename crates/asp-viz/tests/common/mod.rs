@@ -12,7 +12,7 @@ pub fn planned(assembly: Assembly) -> Scene {
     let outcome = Dfs::builder().build().solve(&Problem::full(&checker), &Budget::default());
     let world = checker.world();
     let report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
-    assert_eq!(report.status, "found");
+    assert_eq!(report.status, asp_search::report::PlanStatus::Found);
     Scene::new(world.assembly().clone(), report, Path::new("fixture")).unwrap()
 }
 
@@ -24,7 +24,7 @@ pub fn stuck_tube() -> Scene {
     let mut report = scene.report.clone();
     let index = |name: &str| report.parts.iter().position(|p| p.name == name).unwrap();
     let (handle, stick, receptacle, cap) = (index("handle"), index("stick"), index("receptacle"), index("cap"));
-    report.status = "no_plan".into();
+    report.status = asp_search::report::PlanStatus::NoPlan;
     // format 1.3: the partial plan is the handle's step (its motion as in the found plan)
     report.partial_assembly_sequence = report.assembly_sequence.iter().filter(|s| s.part == handle).cloned().collect();
     report.remaining = Some(vec![stick, receptacle, cap]);
@@ -33,8 +33,19 @@ pub fn stuck_tube() -> Scene {
     report.explanation = vec![Explanation {
         part: stick,
         name: "stick".into(),
-        reason: "blocked".into(),
+        reason: asp_search::report::ExplanationReason::Blocked,
         parts: vec![NamedPart { part: receptacle, name: "receptacle".into() }, NamedPart { part: cap, name: "cap".into() }],
-    }, Explanation { part: cap, name: "cap".into(), reason: "dead_end".into(), parts: vec![] }];
+    }, Explanation { part: cap, name: "cap".into(), reason: asp_search::report::ExplanationReason::DeadEnd, parts: vec![] }];
     Scene::new(scene.assembly.clone(), report, Path::new("fixture")).unwrap()
+}
+
+/// The burr without the grid planner: one step lifts all six pieces, a subassembly that
+/// cannot be taken apart, so the plan is `partial` with one locked core.
+pub fn locked_burr() -> Scene {
+    let checker = Checker::new(World::new(asp_geom::puzzles::burr_level(), &WorldConfig::default()).unwrap(), CheckerConfig::default());
+    let outcome = Dfs::builder().path_planner(false).build().solve(&Problem::full(&checker), &Budget::default());
+    let world = checker.world();
+    let report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
+    assert_eq!(report.status, asp_search::report::PlanStatus::Partial);
+    Scene::new(world.assembly().clone(), report, Path::new("fixture")).unwrap()
 }

@@ -1,6 +1,6 @@
 //! The viewer page's content without a browser (the browser tests are in asp-cli's tests).
 
-use crate::common::{planned, stuck_tube};
+use crate::common::{locked_burr, planned, stuck_tube};
 use asp_geom::fixtures;
 use asp_viz::view::html;
 use base64::Engine;
@@ -59,6 +59,25 @@ fn an_unfinished_plan_shows_its_partial_sequence_and_stuck_parts() {
     assert_eq!(d["parts"][stick]["stuck"], true);
     assert_eq!(d["parts"][stick]["colour"], serde_json::json!(asp_viz::scene::STUCK));
     assert!(d["explanation"][0]["text"].as_str().unwrap().contains("blocked by receptacle, cap"));
+}
+
+/// Issue 28: a partial plan opens as a complete sequence, its locked core's parts in red and
+/// its step labelled as a locked core.
+#[test]
+fn a_partial_plan_highlights_its_locked_core() {
+    let scene = locked_burr();
+    let d = data(&html(&scene));
+    assert_eq!(d["status"], "partial");
+    assert!(d["status_text"].as_str().unwrap().starts_with("Partial plan: 1 steps"), "{}", d["status_text"]);
+    assert!(d["status_text"].as_str().unwrap().contains("6 parts go in as locked cores"), "{}", d["status_text"]);
+    assert_eq!(d["steps"].as_array().unwrap().len(), 1);
+    assert!(d["steps"][0]["name"].as_str().unwrap().contains("locked core"), "{}", d["steps"][0]["name"]);
+    let stuck: Vec<u64> = d["stuck"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+    assert_eq!(stuck, (0..6).collect::<Vec<u64>>());
+    for p in d["parts"].as_array().unwrap() {
+        assert_eq!(p["stuck"], true);
+        assert_eq!(p["colour"], serde_json::json!(asp_viz::scene::STUCK));
+    }
 }
 
 #[test]

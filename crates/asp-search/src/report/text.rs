@@ -1,22 +1,56 @@
-//! The plan as text: the table of `asp plan` and the optimiser's summary under it.
+//! The plan as text: the table `asp plan` prints and the optimiser's summary under it
+//! ([`PlanReport::write_text`]; Python's `Plan.table()`).
 
-use asp_search::report::{AssemblyStep, MotionEntry, OptimisationEntry, ParetoEntry, PlanReport};
+use super::{AssemblyStep, ExplanationReason, MotionEntry, OptimisationEntry, ParetoEntry, PlanReport, PlanStatus, SubassemblyStatus};
+use crate::problem::StopReason;
 use std::io::Write;
 
+impl PlanReport {
+    /// Writes the plan as `asp plan` prints it: the table, then (optimising runs) the
+    /// optimiser's summary.
+    pub fn write_text(&self, out: &mut impl Write) -> std::io::Result<()> {
+        write_table(out, self)?;
+        if let Some(summary) = &self.optimisation {
+            write_summary(out, summary, self.pareto_front.as_deref())?;
+        }
+        Ok(())
+    }
+
+    /// [`PlanReport::write_text`] into a string.
+    pub fn to_text(&self) -> String {
+        let mut out = Vec::new();
+        self.write_text(&mut out).expect("writing to memory does not fail");
+        String::from_utf8(out).expect("the plan text is UTF-8")
+    }
+}
+
 /// The human-readable plan: a header, the assembly sequence, and the explanation when stuck.
-pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
+fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
     let s = &r.stats;
     writeln!(
         out,
         "{}: {} in {:.3} s — {} removal tests ({} failed by collision, {} by gravity), {} path planner calls",
         r.model,
-        r.status.replace('_', " "),
+        r.status.as_str().replace('_', " "),
         s.seconds,
         s.removal_tests,
         s.failed_collision,
         s.failed_gravity,
         s.path_planner_calls
     )?;
+    if !r.locked_cores.is_empty() {
+        let locked: usize = r.locked_cores.iter().map(|c| c.parts.len()).sum();
+        let n = r.locked_cores.len();
+        let names: Vec<String> = r.locked_cores.iter().map(|c| c.names.join(", ")).collect();
+        writeln!(
+            out,
+            "planned {} of {} parts; {locked} stay in {n} locked core{}: {}",
+            r.parts.len().saturating_sub(locked),
+            r.parts.len(),
+            if n == 1 { "" } else { "s" },
+            names.join("; ")
+        )?;
+    }
     let width = r.parts.iter().map(|p| p.name.len()).max().unwrap_or(4).max(4);
     let fixed: Vec<&str> = r.parts.iter().filter(|p| p.fixed).map(|p| p.name.as_str()).collect();
     if !fixed.is_empty() {
@@ -31,7 +65,7 @@ pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Resu
         writeln!(
             out,
             "grid plan ({}): cells of {:.4} x {:.4} x {:.4} {}, {} states in {:.3} s, {first} moves before the first separation",
-            g.reason.replace('_', " "),
+            g.reason.as_str().replace('_', " "),
             g.cell[0],
             g.cell[1],
             g.cell[2],
@@ -41,10 +75,10 @@ pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Resu
         )?;
     }
     if let Some(o) = &r.overlaps {
-        writeln!(out, "overlapping in the input ({} pairs, policy {}):", o.pairs.len(), o.policy)?;
+        writeln!(out, "overlapping in the input ({} pairs, policy {}):", o.pairs.len(), o.policy.name())?;
         for p in &o.pairs {
             let bound = if p.gross { "more than " } else { "" };
-            writeln!(out, "  {} / {}: {}, {bound}{:.4} deep, {}", p.names[0], p.names[1], p.kind, p.depth, p.handling)?;
+            writeln!(out, "  {} / {}: {}, {bound}{:.4} deep, {}", p.names[0], p.names[1], p.kind, p.depth, p.handling.name())?;
         }
     }
     if !r.assembly_sequence.is_empty() {
@@ -66,17 +100,17 @@ pub(crate) fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Resu
         writeln!(out, "stuck with {} parts left; none can leave:", r.explanation.len())?;
         for e in &r.explanation {
             let others: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
-            let why = match e.reason.as_str() {
-                "blocked" => format!("blocked by {}", others.join(", ")),
-                "unsupported" => format!("would leave {} unsupported", others.join(", ")),
-                _ => "can leave, but every state after that is a dead end".into(),
+            let why = match e.reason {
+                ExplanationReason::Blocked => format!("blocked by {}", others.join(", ")),
+                ExplanationReason::Unsupported => format!("would leave {} unsupported", others.join(", ")),
+                ExplanationReason::DeadEnd => "can leave, but every state after that is a dead end".into(),
             };
             writeln!(out, "  {:<width$}  {why}", e.name)?;
         }
     }
-    if r.status == "budget_exhausted" {
-        match r.stats.stopped_by.as_deref() {
-            Some("interrupted") => writeln!(out, "interrupted (Ctrl-C) before a plan was found; the best partial plan so far is above")?,
+    if r.status == PlanStatus::BudgetExhausted {
+        match r.stats.stopped_by {
+            Some(StopReason::Interrupted) => writeln!(out, "interrupted (Ctrl-C) before a plan was found; the best partial plan so far is above")?,
             _ => writeln!(out, "the budget ran out (--max-tests / --timeout) before a plan was found")?,
         }
     }
@@ -116,17 +150,18 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
         if let Some(g) = &step.subassembly {
             let inner = format!("{indent}      ");
             let members: Vec<&str> = g.parts.iter().map(|&p| name(p)).collect();
-            let how = match g.status.as_str() {
-                "found" => "built on its base in this order:".to_string(),
-                "no_plan" => "cannot be taken apart (it goes in as one unit):".to_string(),
-                "unplanned" => "not planned".to_string(),
-                other => format!("{} before its own plan was found; the parts that come off:", other.replace('_', " ")),
+            let how = match g.status {
+                SubassemblyStatus::Found => "built on its base in this order:".to_string(),
+                SubassemblyStatus::Partial => "built on its base in this order, but not all of it part by part:".to_string(),
+                SubassemblyStatus::NoPlan => "cannot be taken apart (it goes in as one unit):".to_string(),
+                SubassemblyStatus::Unplanned => "not planned".to_string(),
+                other => format!("{} before its own plan was found; the parts that come off:", other.as_str().replace('_', " ")),
             };
             writeln!(out, "{inner}subassembly {} on base {}: {how}", members.join(", "), step.name)?;
             write_steps(out, r, &g.assembly_sequence, width.saturating_sub(6), &inner)?;
             for e in &g.explanation {
                 let others: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
-                writeln!(out, "{inner}  {} {} {}", e.name, e.reason.replace('_', " "), others.join(", "))?;
+                writeln!(out, "{inner}  {} {} {}", e.name, e.reason.as_str().replace('_', " "), others.join(", "))?;
             }
         }
         if !step.moves.is_empty() {
@@ -142,7 +177,7 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
 }
 
 /// Prints the Pareto front (or the best value) under the plan table.
-pub fn write_summary(
+fn write_summary(
     out: &mut impl std::io::Write,
     summary: &OptimisationEntry,
     front: Option<&[ParetoEntry]>,
@@ -151,7 +186,7 @@ pub fn write_summary(
     writeln!(
         out,
         "{}: {} episodes, {} iterations in {:.3} s ({} threads){}",
-        summary.method.replace('_', "-"),
+        summary.method.as_str().replace('_', "-"),
         summary.episodes,
         summary.iterations,
         summary.search_seconds,
