@@ -191,7 +191,7 @@ impl Default for OptimiseSettings {
             budget: DEFAULT_BUDGET,
             threads: None,
             time_limit: None,
-            exploration: std::f64::consts::FRAC_1_SQRT_2,
+            exploration: asp_search::mcts::DEFAULT_EXPLORATION,
             polish: asp_search::mcts::DEFAULT_POLISH,
             resolution: asp_geom::distmap::DEFAULT_RESOLUTION,
             d_max: None,
