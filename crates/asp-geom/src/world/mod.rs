@@ -118,8 +118,8 @@ impl World {
     pub fn new(assembly: Assembly, config: &WorldConfig) -> Result<World> {
         assembly.validate()?;
         let diag = assembly.diagonal().max(f32::MIN_POSITIVE);
-        let tolerance = config.tolerance.unwrap_or(1e-4 * diag);
-        let contact_distance = config.contact_distance.unwrap_or(1e-3 * diag);
+        let tolerance = config.tolerance.unwrap_or(DEFAULT_RELATIVE_TOLERANCE * diag);
+        let contact_distance = config.contact_distance.unwrap_or(DEFAULT_RELATIVE_CONTACT * diag);
         let positive = |v: f32| v.is_finite() && v > 0.0;
         if !positive(tolerance) || !positive(contact_distance) {
             return Err(GeomError::config("tolerance and contact distance must be positive"));
@@ -687,6 +687,13 @@ impl World {
         t + self.contact_distance
     }
 }
+
+/// Default contact tolerance ([`WorldConfig::tolerance`], [`crate::distmap::MapConfig`]),
+/// relative to the assembly's diagonal.
+pub const DEFAULT_RELATIVE_TOLERANCE: f32 = 1e-4;
+/// Default contact distance of the contact graph ([`WorldConfig::contact_distance`], the maps'),
+/// relative to the diagonal.
+pub const DEFAULT_RELATIVE_CONTACT: f32 = 1e-3;
 
 /// About how many surface samples per part the strict overlap rule uses (plus every vertex).
 const STRICT_SAMPLES: usize = 4000;

@@ -177,16 +177,7 @@ impl World {
     /// Contact-graph stability of the `present` parts on the `base` parts among them: every
     /// present part is linked through contacts to a present base part.
     pub fn contact_stability_among(&self, present: &PartSet, base: &PartSet) -> Stability {
-        let mut reached = present.intersection(base);
-        let mut frontier: Vec<usize> = reached.iter().collect();
-        while let Some(i) = frontier.pop() {
-            for j in self.contacts[i].intersection(present).iter() {
-                if !reached.contains(j) {
-                    reached.insert(j);
-                    frontier.push(j);
-                }
-            }
-        }
+        let reached = present.intersection(base).reached_within(present, |i| self.contacts[i].iter());
         let floating = PartSet::from_indices(
             self.geoms.len(),
             present.iter().filter(|&i| !reached.contains(i)),
