@@ -1,6 +1,7 @@
 //! `asp._asp.Assembly`: a loaded model, owned by the handle (no borrow of anything else), and
 //! `asp._asp.load`.
 
+use crate::buffers::GraphBuffers;
 use crate::errors::Error;
 use crate::qgraphs::PyQGraphs;
 use crate::search::PySearch;
@@ -12,12 +13,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
-
-/// What `Assembly.graph` returns: the part indices (int64), `x` (float32), `edge_index` (int64)
-/// and `edge_attr` (float32) as little-endian bytes, `node_dim`, `edge_dim` and the features
-/// string; `asp.Graph` views the bytes as numpy arrays.
-pub type GraphBuffers<'py> =
-    (Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, Bound<'py, PyByteArray>, usize, usize, String);
 
 /// A loaded model: its parts in file order, units, up axis and the load's warnings. Immutable;
 /// every plan starts from it afresh.

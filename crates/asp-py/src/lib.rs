@@ -13,6 +13,7 @@
 
 pub mod assembly;
 pub mod batch;
+pub mod buffers;
 pub mod errors;
 pub mod qgraphs;
 pub mod run;

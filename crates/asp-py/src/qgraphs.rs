@@ -4,7 +4,7 @@
 //! search's Q-function sees.
 
 use crate::errors::Error;
-use crate::assembly::GraphBuffers;
+use crate::buffers::GraphBuffers;
 use crate::settings;
 use asp_geom::distmap::{DirMask, MapState};
 use asp_geom::PartSet;
