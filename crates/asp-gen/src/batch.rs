@@ -1,109 +1,11 @@
 //! Batches: which generator, the seed of each assembly, generating in parallel and writing one
 //! GLB per assembly plus `manifest.json`.
 
-use crate::check::DisassemblyCheck;
 use crate::error::{GenError, Result};
-use crate::manifest::{Checks, Manifest, ManifestEntry, PartCounts, FORMAT_VERSION};
-use crate::profiles::{ConnectorShape, ProfileAssembly, ProfileParams};
-use crate::soma::{validate_cell, SomaCube, SomaParams};
-use asp_geom::Assembly;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
+pub use crate::generator::{Generated, Generator};
+use crate::manifest::{Manifest, ManifestEntry, FORMAT_VERSION};
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 use std::path::Path;
-
-/// What to generate, with all parameters.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", tag = "kind")]
-pub enum Generator {
-    /// Random Soma cubes (Algorithm 1).
-    Soma(SomaParams),
-    /// The classic 7-piece 3×3×3 Soma cube (the same cube for every seed).
-    ClassicSoma {
-        /// Edge length of one cell in metres.
-        cell: f64,
-    },
-    /// Aluminium profile assemblies.
-    Profiles(ProfileParams),
-}
-
-/// One generated assembly with what its checks found.
-#[derive(Clone, Debug)]
-pub struct Generated {
-    /// The assembly, ready to write.
-    pub assembly: Assembly,
-    /// Part counts by kind.
-    pub counts: PartCounts,
-    /// The generator's own checks.
-    pub checks: Checks,
-}
-
-impl Generator {
-    /// Checks the parameters.
-    pub fn validate(&self) -> Result<()> {
-        match self {
-            Generator::Soma(p) => p.validate(),
-            Generator::ClassicSoma { cell } => validate_cell(*cell),
-            Generator::Profiles(p) => p.validate(),
-        }
-    }
-
-    /// The start of every file name: `soma5`, `soma_classic`, `profiles`.
-    pub fn file_stem(&self) -> String {
-        match self {
-            Generator::Soma(p) => format!("soma{}", p.size),
-            Generator::ClassicSoma { .. } => "soma_classic".into(),
-            Generator::Profiles(_) => "profiles".into(),
-        }
-    }
-
-    /// Generates the assembly of `seed`; `source` names it (e.g. its file name).
-    pub fn generate(&self, seed: u64, source: &str) -> Result<Generated> {
-        match self {
-            Generator::Soma(p) => {
-                p.validate()?;
-                let cube = SomaCube::random(p.size, &mut ChaCha8Rng::seed_from_u64(seed))?;
-                Ok(soma_generated(&cube, p.cell, source))
-            }
-            Generator::ClassicSoma { cell } => {
-                validate_cell(*cell)?;
-                Ok(soma_generated(&SomaCube::classic(), *cell, source))
-            }
-            Generator::Profiles(p) => {
-                let profiles = ProfileAssembly::generate(p, seed)?;
-                let assembly = profiles.to_assembly(source);
-                let shapes = |s| profiles.connectors.iter().filter(|c| c.shape == s).count();
-                let counts = PartCounts::Profiles {
-                    profiles: profiles.profiles.len(),
-                    removable_profiles: profiles.profiles.iter().filter(|p| !p.fixed).count(),
-                    u_connectors: shapes(ConnectorShape::U),
-                    o_connectors: shapes(ConnectorShape::O),
-                    grasp_points: (0..profiles.profiles.len()).map(|i| profiles.grasp_points(i).len()).sum(),
-                };
-                let checks = checks(&assembly, &profiles.check_disassembly(), profiles.max_penetration().max(0.0));
-                Ok(Generated { assembly, counts, checks })
-            }
-        }
-    }
-}
-
-fn soma_generated(cube: &SomaCube, cell: f64, source: &str) -> Generated {
-    let assembly = cube.to_assembly(cell, source);
-    let counts = PartCounts::Soma { pieces: cube.pieces().len(), piece_sizes: cube.piece_sizes() };
-    let checks = checks(&assembly, &cube.check_disassembly(), 0.0);
-    Generated { assembly, counts, checks }
-}
-
-fn checks(assembly: &Assembly, check: &DisassemblyCheck, max_penetration: f64) -> Checks {
-    Checks {
-        contact_linked: check.linked,
-        straight_line_disassemblable: check.straight_line,
-        stuck_parts: check.stuck.iter().map(|&i| assembly.parts[i].name.clone()).collect(),
-        stable_order_found: check.stable_order,
-        max_penetration,
-    }
-}
 
 /// The seed of assembly `index` of a batch: SplitMix64 of the pair, so neighbouring batch
 /// seeds and indices give unrelated streams and any assembly can be made on its own.

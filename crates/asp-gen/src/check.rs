@@ -61,20 +61,8 @@ pub trait RemovalModel {
 
 /// Whether every part of `state` is linked to a present fixed part through contacts.
 pub fn is_contact_linked(model: &impl RemovalModel, state: &PartSet) -> bool {
-    let mut reached = PartSet::empty(model.num_parts());
-    let mut stack: Vec<usize> = state.iter().filter(|&i| model.is_fixed(i)).collect();
-    for &i in &stack {
-        reached.insert(i);
-    }
-    while let Some(i) = stack.pop() {
-        for &j in model.contacts(i) {
-            if state.contains(j) && !reached.contains(j) {
-                reached.insert(j);
-                stack.push(j);
-            }
-        }
-    }
-    reached.len() == state.len()
+    let fixed = PartSet::from_indices(model.num_parts(), state.iter().filter(|&i| model.is_fixed(i)));
+    fixed.reached_within(state, |i| model.contacts(i).iter().copied()).len() == state.len()
 }
 
 /// Runs the check: exact straight-line disassemblability, then a search for a stable order.

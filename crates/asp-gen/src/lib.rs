@@ -4,6 +4,7 @@ pub mod batch;
 pub mod check;
 pub mod cuboid;
 pub mod error;
+pub mod generator;
 pub mod manifest;
 pub mod profiles;
 pub mod soma;

@@ -1,7 +1,8 @@
 //! The `manifest.json` written beside every batch: what was generated, from which seeds, with
 //! which parameters, how many parts of each kind, and what the generator's own checks found.
 
-use crate::batch::Generator;
+pub use crate::generator::{Checks, PartCounts};
+use crate::generator::Generator;
 use serde::{Deserialize, Serialize};
 
 /// Version of the manifest layout; bumped on incompatible changes.
@@ -43,53 +44,4 @@ pub struct ManifestEntry {
     pub counts: PartCounts,
     /// The generator's own checks.
     pub checks: Checks,
-}
-
-/// Part counts by kind.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", tag = "kind")]
-pub enum PartCounts {
-    /// A Soma cube.
-    Soma {
-        /// Pieces (parts other than the floor).
-        pieces: usize,
-        /// How many pieces have 1, 2, 3 and 4 cells.
-        piece_sizes: [usize; 4],
-    },
-    /// An aluminium profile assembly.
-    Profiles {
-        /// All profiles.
-        profiles: usize,
-        /// Profiles that are not fixed.
-        removable_profiles: usize,
-        /// U-shaped connectors (under horizontal profiles).
-        u_connectors: usize,
-        /// O-shaped connectors (around vertical profiles).
-        o_connectors: usize,
-        /// Grasp points over all profiles.
-        grasp_points: usize,
-    },
-}
-
-/// What the generator verified on its own geometry (voxels or boxes), before any planner.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Checks {
-    /// The assembled state is contact-linked to the fixed parts.
-    pub contact_linked: bool,
-    /// Every non-fixed part comes out along a ±axis straight line, one after the other (exact).
-    pub straight_line_disassemblable: bool,
-    /// Parts that no ±axis motion frees once everything else that can leave has left.
-    pub stuck_parts: Vec<String>,
-    /// A top-down removal order was found in which every state stays contact-linked.
-    pub stable_order_found: bool,
-    /// Deepest interpenetration of two parts in metres (boxes of profile assemblies; 0 for
-    /// Soma cubes, whose cells cannot overlap).
-    pub max_penetration: f64,
-}
-
-impl Checks {
-    /// Whether every check passed.
-    pub fn passed(&self) -> bool {
-        self.contact_linked && self.straight_line_disassemblable && self.stable_order_found
-    }
 }

@@ -30,7 +30,7 @@
 //! through the plate it bears on, but its thread turns out of the nut.
 
 use crate::erode::symmetric_eigen;
-use crate::graph::sample::sample_triangles;
+use crate::sample::sample_triangles;
 use crate::math::Vec3;
 use parry3d::math::Mat3;
 use parry3d::query::PointQuery;

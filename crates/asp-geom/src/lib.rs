@@ -23,6 +23,7 @@ pub mod physics;
 #[doc(hidden)]
 pub mod puzzles;
 pub mod rrt;
+pub mod sample;
 pub mod sweep;
 pub mod validate;
 pub mod world;

@@ -5,7 +5,7 @@
 //! pair may separate only along motions that cut into no material it did not already overlap: a
 //! dowel leaves along its axis, never sideways.
 //!
-//! The strict test samples both surfaces ([`crate::graph::sample`]: sub-triangle centroids plus
+//! The strict test samples both surfaces ([`crate::sample`]: sub-triangle centroids plus
 //! the vertices), moves every sample inward by the tolerance (so touching and sliding never
 //! count, as in the shrink-then-sweep test), and follows each sample along the relative motion
 //! as a ray: the moving part's samples along `d` against the other's mesh, the other's samples
@@ -19,7 +19,7 @@
 //! The test is a sampling of the surfaces, so it is used *together with* the exact (shrunk)
 //! sweep of the pair, never instead of it: a strict pair is blocked when either blocks.
 
-use crate::graph::sample::sample_triangles;
+use crate::sample::sample_triangles;
 use crate::math::{Aabb, Vec3};
 use parry3d::query::{Ray, RayCullingMode};
 use parry3d::shape::TriMesh;

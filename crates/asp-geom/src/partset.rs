@@ -121,6 +121,24 @@ impl PartSet {
     pub fn iter(&self) -> impl Iterator<Item = usize> + '_ {
         set_bits(self.words.iter().copied())
     }
+
+    /// The contact-graph search shared by the world's stability and the generators' check:
+    /// the parts of `within` reached from this set (the seeds, kept whether or not in
+    /// `within`) through `neighbours`. The result is the set of reachable parts, so it does not
+    /// depend on the order of the search.
+    pub fn reached_within<I: IntoIterator<Item = usize>>(&self, within: &PartSet, neighbours: impl Fn(usize) -> I) -> PartSet {
+        let mut reached = self.clone();
+        let mut frontier: Vec<usize> = reached.iter().collect();
+        while let Some(i) = frontier.pop() {
+            for j in neighbours(i) {
+                if within.contains(j) && !reached.contains(j) {
+                    reached.insert(j);
+                    frontier.push(j);
+                }
+            }
+        }
+        reached
+    }
 }
 
 /// The indices of the set bits of a bitset given as 64-bit words (word `k` holds bits
@@ -165,5 +183,18 @@ mod tests {
         u.union_with(&t);
         assert_eq!(u, t);
         assert_eq!(s.iter().count(), 68);
+    }
+
+    #[test]
+    fn reached_within_follows_neighbours_inside_the_set_only() {
+        // a chain 0-1-2-3 and 4 alone; 2 is not in `within`, so 3 is cut off from the seed 0
+        let edges = [vec![1], vec![0, 2], vec![1, 3], vec![2], vec![]];
+        let all = PartSet::full(5);
+        let seeds = PartSet::from_indices(5, [0]);
+        assert_eq!(seeds.reached_within(&all, |i| edges[i].clone()), PartSet::from_indices(5, [0, 1, 2, 3]));
+        let without_2 = PartSet::from_indices(5, [0, 1, 3, 4]);
+        assert_eq!(seeds.reached_within(&without_2, |i| edges[i].clone()), PartSet::from_indices(5, [0, 1]));
+        // seeds outside `within` are kept
+        assert_eq!(PartSet::from_indices(5, [4]).reached_within(&PartSet::empty(5), |i| edges[i].clone()), PartSet::from_indices(5, [4]));
     }
 }

@@ -11,10 +11,8 @@ pub const MAX_RESOLUTION: usize = 15;
 pub const DEFAULT_RESOLUTION: usize = 9;
 /// Largest number of parts distance maps are built for.
 pub const MAX_PARTS: usize = 255;
-/// Default contact tolerance, relative to the assembly's diagonal (as the collision world).
-pub const DEFAULT_RELATIVE_TOLERANCE: f32 = 1e-4;
-/// Default contact distance of the contact graph, relative to the diagonal (as the world).
-pub const DEFAULT_RELATIVE_CONTACT: f32 = 1e-3;
+/// The default tolerance and contact distance are the collision world's: one constant each.
+pub use crate::world::{DEFAULT_RELATIVE_CONTACT, DEFAULT_RELATIVE_TOLERANCE};
 
 /// Which states stand (the gravity check).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -3,7 +3,7 @@
 
 use super::config::{GraphConfig, DIRECTION_BINS};
 use super::descriptor::descriptor_into;
-use super::sample::{sample_triangles, SurfaceSample};
+use crate::sample::{sample_triangles, SurfaceSample};
 use crate::error::{GeomError, Result};
 use crate::math::{Aabb, Vec3};
 use crate::world::World;

@@ -1,0 +1,92 @@
+//! One part's collision geometry: its parry mesh, bounds, cached eroded copies, exact boxes,
+//! strict-overlap samples and symmetry axis.
+
+use super::*;
+use crate::erode::eroded_mesh;
+
+/// One part's collision geometry.
+pub(super) struct Geom {
+    pub(super) mesh: Arc<TriMesh>,
+    pub(super) aabb: Aabb,
+    /// Eroded copies keyed by the erosion amount's bits.
+    pub(super) eroded: Mutex<BTreeMap<u32, Arc<TriMesh>>>,
+    pub(super) closed: bool,
+    /// The part's exact boxes when it is a known union of boxes ([`crate::boxes`]): pairs of
+    /// such parts are tested exactly on them instead of on the meshes.
+    pub(super) boxes: Option<Vec<Aabb>>,
+    /// Surface samples moved inward by the tolerance, for the strict overlap test (made the
+    /// first time a strict pair needs them).
+    pub(super) samples: OnceLock<Vec<Vec3>>,
+    /// The axis of near rotational symmetry (fasteners), made when first needed.
+    pub(super) axis: OnceLock<Option<SymmetryAxis>>,
+}
+
+impl Geom {
+    /// The collision geometry of `mesh`, and the topology of its welded surface.
+    pub(super) fn new(mesh: &Mesh) -> Result<(Geom, Topology)> {
+        let mut m = mesh.clone();
+        m.weld();
+        m.orient_outward();
+        let topology = m.topology();
+        let closed = topology.is_closed_manifold();
+        let aabb = m.aabb().ok_or_else(|| GeomError::config("empty mesh"))?;
+        let mesh = TriMesh::with_flags(m.vertices, m.triangles, TriMeshFlags::ORIENTED)
+            .map_err(|e| GeomError::config(format!("cannot build a collision mesh: {e}")))?;
+        let geom = Geom { mesh: Arc::new(mesh), aabb, eroded: Mutex::new(BTreeMap::new()), closed, boxes: None, samples: OnceLock::new(), axis: OnceLock::new() };
+        Ok((geom, topology))
+    }
+
+    pub(super) fn eroded_cached(&self, amount: f32) -> bool {
+        self.eroded.lock().unwrap_or_else(|e| e.into_inner()).contains_key(&amount.to_bits())
+    }
+
+    pub(super) fn eroded(&self, amount: f32) -> Arc<TriMesh> {
+        let mut cache = self.eroded.lock().unwrap_or_else(|e| e.into_inner());
+        cache.entry(amount.to_bits()).or_insert_with(|| Arc::new(self.erode(amount))).clone()
+    }
+
+    pub(super) fn erode(&self, amount: f32) -> TriMesh {
+        let (v, t) = eroded_mesh(self.mesh.vertices(), self.mesh.indices(), amount);
+        if v.len() == self.mesh.vertices().len() && t == self.mesh.indices() {
+            // the same triangles with moved vertices (no saddle vertex was split): refit a copy
+            // of the part's BVH and keep its topology instead of building both again
+            let mut shrunk = (*self.mesh).clone();
+            shrunk.set_vertices(&v);
+            return shrunk;
+        }
+        TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED)
+            .unwrap_or_else(|_| (*self.mesh).clone())
+    }
+
+    /// Whether this part shrunk by `amount` still overlaps `other`: surfaces crossing, or one
+    /// wholly inside the other.
+    pub(super) fn eroded_hits(&self, amount: f32, other: &Geom) -> bool {
+        // the tolerance's erosion is cached (every later test of the part uses it); the deeper
+        // trial erosions of overlapping pairs are tested as triangle soups (no BVH to build)
+        let shrunk = self.eroded_cached(amount).then(|| self.eroded(amount));
+        let soup;
+        let (vertices, triangles): (&[Vec3], &[[u32; 3]]) = match &shrunk {
+            Some(m) => (m.vertices(), m.indices()),
+            None => {
+                soup = eroded_mesh(self.mesh.vertices(), self.mesh.indices(), amount);
+                (&soup.0, &soup.1)
+            }
+        };
+        sweep::soup_crosses(vertices, triangles, &other.mesh)
+            || (other.closed && nests(&self.aabb, &other.aabb) && contains_point(&other.mesh, vertices[0]))
+            || (self.closed && nests(&other.aabb, &self.aabb) && {
+                let shrunk = shrunk.unwrap_or_else(|| Arc::new(self.erode(amount)));
+                contains_point(&shrunk, other.mesh.vertices()[0])
+            })
+    }
+}
+
+/// Whether box `a` lies within box `b`.
+pub(super) fn nests(a: &Aabb, b: &Aabb) -> bool {
+    (0..3).all(|i| a.mins[i] >= b.mins[i] && a.maxs[i] <= b.maxs[i])
+}
+
+/// Whether `point` is inside the closed mesh.
+pub(super) fn contains_point(mesh: &TriMesh, point: Vec3) -> bool {
+    mesh.local_aabb().contains_local_point(point) && mesh.project_local_point(point, false).is_inside
+}
