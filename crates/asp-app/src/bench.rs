@@ -6,12 +6,12 @@
 //! Each run gets a fresh collision world (built outside the timer), so every method pays for its
 //! own first tests of each part: cached blocking rows would otherwise favour later runs.
 
-use asp_search::OrderingSource;
+use crate::error::{AppError, Result};
 use crate::pipeline::{self, PlanSettings};
+use asp_geom::Checker;
+use asp_search::OrderingSource;
 use asp_search::Problem;
 use asp_search::{Planner, Status};
-use crate::error::{AppError, Result};
-use asp_geom::Checker;
 use serde::Serialize;
 use std::path::Path;
 use std::sync::Arc;

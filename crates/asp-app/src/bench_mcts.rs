@@ -9,12 +9,12 @@
 //! last value at or before it (`NaN` before the first complete sequence).
 
 use crate::bench::MeanStd;
-use crate::pipeline::{self, OptimiseSettings, PlanSettings};
 use crate::catalogue::{FixedPolicy, PolicySource};
+use crate::error::{AppError, Result};
+use crate::pipeline::{self, OptimiseSettings, PlanSettings};
 use asp_search::RandomPolicy;
 use asp_search::SearchOutcome;
 use asp_search::{Mcts, ParetoMcts};
-use crate::error::{AppError, Result};
 use serde::Serialize;
 use std::path::Path;
 use std::sync::Arc;
@@ -59,10 +59,7 @@ pub struct MctsRow {
 
 /// The measure of `outcome`'s trace at each checkpoint.
 pub fn values_at(outcome: &SearchOutcome, checkpoints: &[f64]) -> Vec<f64> {
-    checkpoints
-        .iter()
-        .map(|&t| outcome.trace.iter().take_while(|p| p.seconds <= t).last().map_or(f64::NAN, |p| p.value))
-        .collect()
+    checkpoints.iter().map(|&t| outcome.trace.iter().take_while(|p| p.seconds <= t).last().map_or(f64::NAN, |p| p.value)).collect()
 }
 
 /// Runs every setting `runs` times (seeds `0..runs`) on the model at `path` (reported as

@@ -80,7 +80,10 @@ pub const ORDERINGS: &[OrderingEntry] = &[
 /// The ordering called `name`, or an error listing the names.
 pub fn ordering(name: &str) -> Result<&'static OrderingEntry> {
     ORDERINGS.iter().find(|o| o.name == name).ok_or_else(|| {
-        AppError::setting("order", format!("unknown order '{name}' (use {})", ORDERINGS.iter().map(|o| o.name).collect::<Vec<_>>().join(", ")))
+        AppError::setting(
+            "order",
+            format!("unknown order '{name}' (use {})", ORDERINGS.iter().map(|o| o.name).collect::<Vec<_>>().join(", ")),
+        )
     })
 }
 
@@ -116,11 +119,7 @@ pub const OBJECTIVES: &[ObjectiveEntry] = &[
         help: "shared removal directions: fewer direction changes (thesis 6.16)",
         source: ObjectiveSource::BuiltIn,
     },
-    ObjectiveEntry {
-        name: "pathlen",
-        help: "straight-line removal path length, minimised",
-        source: ObjectiveSource::BuiltIn,
-    },
+    ObjectiveEntry { name: "pathlen", help: "straight-line removal path length, minimised", source: ObjectiveSource::BuiltIn },
     ObjectiveEntry {
         name: asp_robot::ROBOT_PATH,
         help: "the robot arm's total joint-space path (thesis 5.3), minimised; needs `robot`",

@@ -8,13 +8,13 @@
 //! straight candidate direction and the rest stays stable) or not. Runs go in parallel; the
 //! output depends only on the models, the settings and the seed.
 
-use asp_search::BuiltinOrder;
-use crate::pipeline::{self, PlanSettings};
-use asp_search::{Budget, Problem};
-use asp_search::{Dfs};
 use crate::error::{AppError, Result};
+use crate::pipeline::{self, PlanSettings};
 use asp_geom::graph::{AssemblyGraph, GraphConfig};
 use asp_geom::{FeasibilityChecker, MotionKind, Outcome, PartSet};
+use asp_search::BuiltinOrder;
+use asp_search::Dfs;
+use asp_search::{Budget, Problem};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::io::Write;
@@ -182,7 +182,12 @@ pub(crate) fn seed_of(base: u64, model: usize, run: usize) -> u64 {
 
 /// Collects the data set of `models` into `out` (created; existing files of the format are
 /// overwritten). `progress` is called after each model with its name and entry.
-pub fn collect(models: &[PathBuf], out: &Path, settings: &CollectSettings, progress: &(dyn Fn(&CollectedModel) + Sync)) -> Result<Collected> {
+pub fn collect(
+    models: &[PathBuf],
+    out: &Path,
+    settings: &CollectSettings,
+    progress: &(dyn Fn(&CollectedModel) + Sync),
+) -> Result<Collected> {
     if settings.runs == 0 {
         return Err(AppError::config("the number of runs must be at least 1"));
     }
@@ -219,8 +224,7 @@ pub fn model_items(models: &[PathBuf]) -> Vec<ModelItem> {
         .zip(unique_names(models))
         .enumerate()
         .map(|(index, (path, name))| {
-            let mut dir: String =
-                name.chars().map(|c| if c.is_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+            let mut dir: String = name.chars().map(|c| if c.is_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
             while !used.insert(dir.clone()) {
                 dir.push('_');
             }

@@ -12,15 +12,15 @@
 //! transition's state graphs with the search's own Rust code.
 
 use crate::collect::{self, io_error, ModelItem};
+use crate::error::{AppError, Result};
+use crate::pipeline::{self, OptimiseSettings, PlanSettings};
+use asp_geom::distmap::Support;
+use asp_search::mcts::DEFAULT_RECORD_LIMIT;
+use asp_search::qgraph::{direction_history, QGraphConfig};
 use asp_search::Mdp;
 use asp_search::StepKind;
-use crate::pipeline::{self, OptimiseSettings, PlanSettings};
-use asp_search::qgraph::{direction_history, QGraphConfig};
-use asp_search::mcts::DEFAULT_RECORD_LIMIT;
 use asp_search::Transition;
 use asp_search::{Mcts, ParetoMcts};
-use crate::error::{AppError, Result};
-use asp_geom::distmap::Support;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -288,18 +288,20 @@ fn problem_entry(problem: &Mdp) -> Result<(Vec<[f64; 2]>, QGraphConfig, Vec<Stri
 
 /// The index entry of `item` searched on `problem` (built with `plan` and `o`), without its
 /// transitions (`transitions`, `capped` and `episodes_run` are 0 and false).
-fn model_entry(item: &ModelItem, plan: &PlanSettings, o: &OptimiseSettings, problem: &Mdp, reward_ranges: Vec<[f64; 2]>) -> Result<TransitionsModel> {
+fn model_entry(
+    item: &ModelItem,
+    plan: &PlanSettings,
+    o: &OptimiseSettings,
+    problem: &Mdp,
+    reward_ranges: Vec<[f64; 2]>,
+) -> Result<TransitionsModel> {
     let maps = problem.maps();
     let model = std::fs::canonicalize(&item.path).map_err(|e| io_error(&item.path, e))?;
     Ok(TransitionsModel {
         name: item.name.clone(),
         dir: item.dir.clone(),
         model: model.display().to_string(),
-        load: LoadArgs {
-            unit: plan.unit.as_ref().map(|u| u.name.clone()),
-            up: plan.up.map(|a| a.to_string()),
-            fixed: plan.fixed.clone(),
-        },
+        load: LoadArgs { unit: plan.unit.as_ref().map(|u| u.name.clone()), up: plan.up.map(|a| a.to_string()), fixed: plan.fixed.clone() },
         maps: MapsArgs {
             objective: problem.objective_names().join(","),
             resolution: maps.hemisphere().resolution(),
@@ -326,14 +328,26 @@ fn model_entry(item: &ModelItem, plan: &PlanSettings, o: &OptimiseSettings, prob
 /// (as `asp collect transitions` would write it, with no transitions yet): what a stepped
 /// search (`asp.Assembly.search`) tells the online learner, which writes its episodes' lines
 /// under `<item.dir>/transitions.jsonl` and keeps the counts up to date.
-pub fn stepped_index(item: &ModelItem, plan: &PlanSettings, o: &OptimiseSettings, problem: &Mdp, episodes: usize) -> Result<TransitionsIndex> {
+pub fn stepped_index(
+    item: &ModelItem,
+    plan: &PlanSettings,
+    o: &OptimiseSettings,
+    problem: &Mdp,
+    episodes: usize,
+) -> Result<TransitionsIndex> {
     let (ranges, graph, objectives) = problem_entry(problem)?;
     let entry = model_entry(item, plan, o, problem, ranges)?;
     Ok(index_of(&graph, objectives, plan.seed, episodes, vec![entry]))
 }
 
 /// The `index.json` of a data set of `assemblies` whose state graphs are `graph`'s.
-fn index_of(graph: &QGraphConfig, objectives: Vec<String>, seed: u64, episodes: usize, assemblies: Vec<TransitionsModel>) -> TransitionsIndex {
+fn index_of(
+    graph: &QGraphConfig,
+    objectives: Vec<String>,
+    seed: u64,
+    episodes: usize,
+    assemblies: Vec<TransitionsModel>,
+) -> TransitionsIndex {
     TransitionsIndex {
         format: FORMAT.into(),
         version: VERSION,

@@ -6,25 +6,27 @@
 //! that name the setting, not a command-line flag. Every step is also public on its own, so a
 //! caller that plans many times on one model (data collection, benchmarks) builds the world once.
 
-use asp_search::{CheckerExtension, MdpExtension, ModelContext};
-use asp_search::extension::resolve_objectives;
 use crate::catalogue::PolicySource;
-use asp_search::{BuiltinOrder, OrderingSource};
-use asp_search::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
-use asp_search::grid::GridRun;
-use asp_geom::grid::VoxelModel;
-use asp_search::grid::GridConfig;
-use asp_search::report::{Checker as CheckerName, GridEntry, GridReason, OptimisationEntry, OptimisationMethod, ParetoEntry, PlanReport, Timings};
-use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES};
-use asp_search::{EpisodeHook, SearchOutcome, SearchStatus, StopToken};
-use asp_search::{Dfs, Mcts, Mdp, ParetoMcts, Planner};
 use crate::error::{AppError, Result};
 use asp_geom::distmap::{DistanceMaps, MapConfig, Support};
+use asp_geom::grid::VoxelModel;
 use asp_geom::io::LoadOptions;
 use asp_geom::math::Axis;
 use asp_geom::physics::PhysicsConfig;
 use asp_geom::rrt::RrtConfig;
-use asp_geom::{Assembly, Checker, OverlapPolicy, CheckerConfig, CounterSnapshot, Motion, StabilityMode, Units, World, WorldConfig};
+use asp_geom::{Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, OverlapPolicy, StabilityMode, Units, World, WorldConfig};
+use asp_search::extension::resolve_objectives;
+use asp_search::grid::GridConfig;
+use asp_search::grid::GridRun;
+use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES};
+use asp_search::report::{
+    Checker as CheckerName, GridEntry, GridReason, OptimisationEntry, OptimisationMethod, ParetoEntry, PlanReport, Timings,
+};
+use asp_search::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
+use asp_search::{BuiltinOrder, OrderingSource};
+use asp_search::{CheckerExtension, MdpExtension, ModelContext};
+use asp_search::{Dfs, Mcts, Mdp, ParetoMcts, Planner};
+use asp_search::{EpisodeHook, SearchOutcome, SearchStatus, StopToken};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -245,9 +247,8 @@ pub fn load(path: &Path, settings: &PlanSettings) -> Result<Assembly> {
 /// The collision world's settings, converted to metres.
 pub fn world_config(assembly: &Assembly, settings: &PlanSettings) -> Result<WorldConfig> {
     let metres = assembly.units.metres;
-    let to_m = |name: &str, v: Option<f64>| -> Result<Option<f32>> {
-        v.map(|v| positive(name, v).map(|v| (v * metres) as f32)).transpose()
-    };
+    let to_m =
+        |name: &str, v: Option<f64>| -> Result<Option<f32>> { v.map(|v| positive(name, v).map(|v| (v * metres) as f32)).transpose() };
     Ok(WorldConfig {
         tolerance: to_m("the tolerance", settings.tolerance)?,
         contact_distance: to_m("the contact distance", settings.contact_distance)?,
@@ -263,10 +264,8 @@ pub fn checker_config(settings: &PlanSettings) -> Result<CheckerConfig> {
     let stability = match settings.stability {
         StabilitySetting::Contact => StabilityMode::ContactGraph,
         StabilitySetting::Physics { threshold } => {
-            let physics = PhysicsConfig {
-                displacement_fraction: positive("the physics threshold", threshold)? as f32,
-                ..PhysicsConfig::default()
-            };
+            let physics =
+                PhysicsConfig { displacement_fraction: positive("the physics threshold", threshold)? as f32, ..PhysicsConfig::default() };
             physics.validate()?;
             StabilityMode::Physics(physics)
         }
@@ -323,11 +322,7 @@ pub fn plan_file(path: &Path, settings: &PlanSettings, progress: Option<&(dyn Fn
 
 /// Plans `assembly`: a feasible sequence by depth-first AbD, or, with
 /// [`PlanSettings::optimise`], an optimised one.
-pub fn plan_assembly(
-    assembly: Assembly,
-    settings: &PlanSettings,
-    progress: Option<&(dyn Fn(&Progress) + Sync)>,
-) -> Result<PlanResult> {
+pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Option<&(dyn Fn(&Progress) + Sync)>) -> Result<PlanResult> {
     if let Some(optimise) = &settings.optimise {
         return self::optimise(Arc::new(assembly), settings, optimise);
     }
@@ -398,12 +393,8 @@ pub fn plan_assembly(
 /// where the time went (loading is timed by the caller).
 fn finish_report(report: &mut PlanReport, world: &asp_geom::World, outcome: &PlanOutcome, world_seconds: f64) {
     report.overlaps = asp_search::report::OverlapsEntry::of(world);
-    report.stats.timings = Some(Timings {
-        load: 0.0,
-        world: world_seconds,
-        search: outcome.stats.seconds,
-        path_planner: outcome.stats.path_planner_seconds,
-    });
+    report.stats.timings =
+        Some(Timings { load: 0.0, world: world_seconds, search: outcome.stats.seconds, path_planner: outcome.stats.path_planner_seconds });
 }
 
 /// Whether a search ended on its budget (tests, time or a cancel), so that another search
@@ -414,9 +405,10 @@ fn budget_spent(outcome: &PlanOutcome) -> bool {
 
 /// Whether every subassembly of a found plan was taken apart by its own plan.
 fn taken_apart(outcome: &PlanOutcome) -> bool {
-    outcome.removals.iter().all(|s| {
-        s.group.as_ref().is_none_or(|g| g.plan.as_ref().is_some_and(|p| p.status == Status::Found && taken_apart(p)))
-    })
+    outcome
+        .removals
+        .iter()
+        .all(|s| s.group.as_ref().is_none_or(|g| g.plan.as_ref().is_some_and(|p| p.status == Status::Found && taken_apart(p))))
 }
 
 /// The plan of a grid search (after the depth-first search's `before`, whose counters and time
@@ -575,11 +567,7 @@ pub fn optimise_problem(
         }
     }
     report.pareto_front = o.pareto.then(|| {
-        outcome
-            .solutions
-            .iter()
-            .map(|s| ParetoEntry { objectives: s.values.clone(), disassembly_sequence: s.sequence.clone() })
-            .collect()
+        outcome.solutions.iter().map(|s| ParetoEntry { objectives: s.values.clone(), disassembly_sequence: s.sequence.clone() }).collect()
     });
     let s = &outcome.stats;
     report.optimisation = Some(OptimisationEntry {
@@ -619,9 +607,7 @@ fn adapt(maps: &DistanceMaps, outcome: &SearchOutcome) -> PlanOutcome {
                     Step::single(
                         part,
                         match m {
-                            Motion::Linear { direction, distance } => {
-                                Motion::Linear { direction: *direction, distance: distance + margin }
-                            }
+                            Motion::Linear { direction, distance } => Motion::Linear { direction: *direction, distance: distance + margin },
                             other => other.clone(),
                         },
                     )

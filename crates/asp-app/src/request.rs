@@ -232,8 +232,7 @@ impl PlanRequest {
     /// A request from a JSON object. An unknown key, or a value of the wrong type, is an
     /// [`AppError::Setting`] naming the key.
     pub fn from_json(text: &str) -> Result<PlanRequest> {
-        let value: serde_json::Value =
-            serde_json::from_str(text).map_err(|e| AppError::setting("request", format!("not JSON: {e}")))?;
+        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| AppError::setting("request", format!("not JSON: {e}")))?;
         PlanRequest::from_value(value)
     }
 
@@ -292,10 +291,48 @@ impl PlanRequest {
             ($($field:ident),+) => {$(if self.$field.is_some() { keys.push(stringify!($field)); })+};
         }
         given!(
-            unit, up, max_triangles, max_parts, allow_outside_files, tolerance, contact_distance, normals, sphere_directions, overlaps, stability, physics_threshold,
-            path_planner, subassemblies, grid, rrt_iterations, rrt_time, order, model, bookkeeping, seed, max_tests,
-            timeout, objective, pareto, episodes, budget, threads, time_limit, exploration, polish, resolution, d_max,
-            support, q, epsilon, q_use, robot, robot_base, drop_off, replans, grippers
+            unit,
+            up,
+            max_triangles,
+            max_parts,
+            allow_outside_files,
+            tolerance,
+            contact_distance,
+            normals,
+            sphere_directions,
+            overlaps,
+            stability,
+            physics_threshold,
+            path_planner,
+            subassemblies,
+            grid,
+            rrt_iterations,
+            rrt_time,
+            order,
+            model,
+            bookkeeping,
+            seed,
+            max_tests,
+            timeout,
+            objective,
+            pareto,
+            episodes,
+            budget,
+            threads,
+            time_limit,
+            exploration,
+            polish,
+            resolution,
+            d_max,
+            support,
+            q,
+            epsilon,
+            q_use,
+            robot,
+            robot_base,
+            drop_off,
+            replans,
+            grippers
         );
         if !self.fixed.is_empty() {
             keys.push("fixed");
@@ -356,13 +393,15 @@ fn names<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<Stri
         Many(Vec<String>),
     }
     let split = |s: &str| s.split(',').map(str::trim).filter(|n| !n.is_empty()).map(String::from).collect::<Vec<_>>();
-    Ok(match Option::<OneOrMany>::deserialize(d)
-        .map_err(|_| serde::de::Error::custom("must be a comma-separated string or a list of strings"))?
-    {
-        None => None,
-        Some(OneOrMany::One(s)) => Some(split(&s)),
-        Some(OneOrMany::Many(v)) => Some(v.iter().flat_map(|s| split(s)).collect()),
-    })
+    Ok(
+        match Option::<OneOrMany>::deserialize(d)
+            .map_err(|_| serde::de::Error::custom("must be a comma-separated string or a list of strings"))?
+        {
+            None => None,
+            Some(OneOrMany::One(s)) => Some(split(&s)),
+            Some(OneOrMany::Many(v)) => Some(v.iter().flat_map(|s| split(s)).collect()),
+        },
+    )
 }
 
 /// [`names`] as paths.
@@ -428,7 +467,10 @@ mod tests {
 
     #[test]
     fn lists_come_as_strings_or_lists_and_nulls_are_left_out() {
-        let r = PlanRequest::from_json(r#"{"objective": ["access", "dirchange"], "q": "a.onnx, b.onnx", "robot_base": "1, 2, 3", "timeout": null}"#).unwrap();
+        let r = PlanRequest::from_json(
+            r#"{"objective": ["access", "dirchange"], "q": "a.onnx, b.onnx", "robot_base": "1, 2, 3", "timeout": null}"#,
+        )
+        .unwrap();
         assert_eq!(r.objective, Some(vec!["access".to_string(), "dirchange".to_string()]));
         assert_eq!(r.q, Some(vec![PathBuf::from("a.onnx"), PathBuf::from("b.onnx")]));
         assert_eq!(r.robot_base, Some([1.0, 2.0, 3.0]));

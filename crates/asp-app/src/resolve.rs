@@ -106,7 +106,8 @@ fn at_least_one(key: &str, v: Option<usize>) -> Result<Option<usize>> {
 
 /// The unit of `unit` (`m`, `mm`, ... or metres per unit).
 pub fn unit(name: &str) -> Result<Units> {
-    Units::parse(name).ok_or_else(|| AppError::setting("unit", format!("unknown unit '{name}' (use m, cm, mm, in, ft or a number of metres)")))
+    Units::parse(name)
+        .ok_or_else(|| AppError::setting("unit", format!("unknown unit '{name}' (use m, cm, mm, in, ft or a number of metres)")))
 }
 
 /// The axis of `up` (`x`, `-z`, ...).
@@ -126,14 +127,15 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         None => Vec::new(),
     };
     let optimise = optimise(r, extensions)?;
-    let checker_extension: Option<Arc<dyn asp_search::CheckerExtension>> =
-        (optimise.is_none() && (robot.is_some() || grippers > 1)).then(|| {
-            Arc::new(asp_robot::CellSetup { robot: robot.clone(), grippers }) as Arc<dyn asp_search::CheckerExtension>
-        });
+    let checker_extension: Option<Arc<dyn asp_search::CheckerExtension>> = (optimise.is_none() && (robot.is_some() || grippers > 1))
+        .then(|| Arc::new(asp_robot::CellSetup { robot: robot.clone(), grippers }) as Arc<dyn asp_search::CheckerExtension>);
     let order_name = r.order.as_deref().unwrap_or(catalogue::ORDERINGS[0].name);
     let entry = catalogue::ordering(order_name)?;
     if r.model.is_some() && !entry.takes_model {
-        return Err(AppError::setting("model", format!("the removability model of `order` gnn; it has no effect with `order` {order_name}")));
+        return Err(AppError::setting(
+            "model",
+            format!("the removability model of `order` gnn; it has no effect with `order` {order_name}"),
+        ));
     }
     let order = (entry.build)(r.model.as_deref()).map_err(|e| match (&r.model, e) {
         (Some(_), e) => AppError::setting("model", e.to_string()),
@@ -198,7 +200,9 @@ fn robot(r: &PlanRequest) -> Result<Option<asp_robot::RobotSetup>> {
     let package_paths = r
         .package_path
         .iter()
-        .map(|p| asp_robot::RobotFiles::parse_package_path(p).map_err(|_| AppError::setting("package_path", format!("'{p}' is not NAME=DIR"))))
+        .map(|p| {
+            asp_robot::RobotFiles::parse_package_path(p).map_err(|_| AppError::setting("package_path", format!("'{p}' is not NAME=DIR")))
+        })
         .collect::<Result<_>>()?;
     let files = asp_robot::RobotFiles { package_paths, allow_outside_files: r.allow_outside_files.unwrap_or(false) };
     let robot = catalogue::robot(name, &files).map_err(|e| AppError::setting("robot", e.to_string()))?;
@@ -347,7 +351,10 @@ mod tests {
         assert!(s.optimise.is_none() && s.checker_extension.is_none());
         let o = resolve(&PlanRequest::from_json(r#"{"objective": "access"}"#).unwrap()).unwrap().optimise.unwrap();
         let od = OptimiseSettings::default();
-        assert_eq!((o.episodes, o.budget, o.polish, o.resolution, o.exploration), (od.episodes, od.budget, od.polish, od.resolution, od.exploration));
+        assert_eq!(
+            (o.episodes, o.budget, o.polish, o.resolution, o.exploration),
+            (od.episodes, od.budget, od.polish, od.resolution, od.exploration)
+        );
     }
 
     #[test]
@@ -363,7 +370,10 @@ mod tests {
         assert_eq!(err(r#"{"physics_threshold": 0.1}"#), "physics_threshold: needs `stability` physics");
         assert_eq!(err(r#"{"objective": "access", "epsilon": 0.1}"#), "epsilon: needs learned Q-functions (`q`)");
         assert_eq!(err(r#"{"drop_off": [0, 0, 1]}"#), "drop_off: needs a robot (`robot`)");
-        assert_eq!(err(r#"{"objective": "access", "grippers": 2}"#), "grippers: applies to the feasibility search only (without `objective`)");
+        assert_eq!(
+            err(r#"{"objective": "access", "grippers": 2}"#),
+            "grippers: applies to the feasibility search only (without `objective`)"
+        );
     }
 
     #[test]
@@ -372,8 +382,11 @@ mod tests {
         assert!(resolve(&PlanRequest::from_json(r#"{"timeout": 0}"#).unwrap()).unwrap().timeout.is_none());
         assert_eq!(err(r#"{"order": "sideways"}"#), "order: unknown order 'sideways' (use given, shuffled, random, bookkeeping, gnn)");
         assert_eq!(err(r#"{"model": "m.onnx"}"#), "model: the removability model of `order` gnn; it has no effect with `order` given");
-        assert!(err(r#"{"order": "gnn", "model": "/no/such.onnx"}"#).starts_with("model: ") );
-        assert_eq!(err(r#"{"objective": "access,dirchange"}"#), "objective: access,dirchange: several objectives need `pareto` (or give one objective)");
+        assert!(err(r#"{"order": "gnn", "model": "/no/such.onnx"}"#).starts_with("model: "));
+        assert_eq!(
+            err(r#"{"objective": "access,dirchange"}"#),
+            "objective: access,dirchange: several objectives need `pareto` (or give one objective)"
+        );
         assert!(err(r#"{"objective": "speed"}"#).starts_with("objective: unknown objective 'speed'"));
         assert!(err(r#"{"objective": "robot-path"}"#).contains("robot-path needs a robot"));
         assert_eq!(err(r#"{"objective": "access", "q": "a.onnx", "epsilon": 1.5}"#), "epsilon: must be in [0, 1], got 1.5");

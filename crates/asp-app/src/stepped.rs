@@ -26,8 +26,8 @@
 use crate::collect::ModelItem;
 use crate::collect_q::{self, TransitionsIndex};
 use crate::error::{AppError, Result};
-use asp_search::Mdp;
 use crate::pipeline::{self, OptimiseSettings, PlanResult, PlanSettings};
+use asp_search::Mdp;
 use asp_search::Policy;
 use asp_search::{EpisodeEnd, Next, StopToken};
 use std::path::Path;
@@ -111,7 +111,8 @@ impl SteppedSearch {
                     Ok(Next::Continue) => o,
                     Ok(Next::Policy(p)) => OptimiseSettings { policy: Some(Arc::new(crate::catalogue::FixedPolicy(p))), ..o },
                     Ok(Next::Stop) | Err(_) => {
-                        let _ = outbox.send(Message::Done(Box::new(Err(AppError::config("the stepped search ended before its first episode")))));
+                        let _ = outbox
+                            .send(Message::Done(Box::new(Err(AppError::config("the stepped search ended before its first episode")))));
                         return;
                     }
                 };

@@ -77,7 +77,9 @@ pub fn run(a: &MctsArgs) -> anyhow::Result<std::process::ExitCode> {
         if tty {
             eprintln!("[{}/{}] {}", k + 1, models.len(), path.display());
         }
-        rows.extend(bench_mcts::bench_model(path, &name, &plan, &optimise, &settings, &checkpoints, a.runs).map_err(crate::request::cli_error)?);
+        rows.extend(
+            bench_mcts::bench_model(path, &name, &plan, &optimise, &settings, &checkpoints, a.runs).map_err(crate::request::cli_error)?,
+        );
     }
     let mut stdout = std::io::stdout().lock();
     bench_mcts::write_table(&mut stdout, &rows)?;

@@ -163,23 +163,18 @@ pub fn run(args: &GenArgs) -> anyhow::Result<ExitCode> {
     let bar = if batch_args.quiet || !std::io::stderr().is_terminal() {
         ProgressBar::hidden()
     } else {
-        let style = ProgressStyle::with_template("{bar:30} {pos}/{len} assemblies {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar());
+        let style =
+            ProgressStyle::with_template("{bar:30} {pos}/{len} assemblies {elapsed}").unwrap_or_else(|_| ProgressStyle::default_bar());
         ProgressBar::new(batch.count as u64).with_style(style)
     };
     let manifest = write_batch(&batch, &batch_args.out, &|| bar.inc(1))?;
     bar.finish_and_clear();
-    let failed: Vec<&str> =
-        manifest.assemblies.iter().filter(|e| !e.checks.passed()).map(|e| e.file.as_str()).collect();
+    let failed: Vec<&str> = manifest.assemblies.iter().filter(|e| !e.checks.passed()).map(|e| e.file.as_str()).collect();
     if !batch_args.quiet {
         let noun = if manifest.count == 1 { "assembly" } else { "assemblies" };
         eprintln!("wrote {} {noun} and manifest.json to {}", manifest.count, batch_args.out.display());
         if !failed.is_empty() {
-            eprintln!(
-                "warning: {} failed the generator's checks (see manifest.json): {}",
-                failed.len(),
-                failed.join(", ")
-            );
+            eprintln!("warning: {} failed the generator's checks (see manifest.json): {}", failed.len(), failed.join(", "));
         }
     }
     Ok(if failed.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
@@ -241,8 +236,7 @@ mod tests {
         let read = |f: &str| std::fs::read(out.join(f)).unwrap();
         let first: Vec<Vec<u8>> = ["soma3_000.glb", "soma3_001.glb", "soma3_002.glb", "manifest.json"].map(read).into();
         assert_eq!(run(&args).unwrap(), ExitCode::SUCCESS);
-        let second: Vec<Vec<u8>> =
-            ["soma3_000.glb", "soma3_001.glb", "soma3_002.glb", "manifest.json"].map(read).into();
+        let second: Vec<Vec<u8>> = ["soma3_000.glb", "soma3_001.glb", "soma3_002.glb", "manifest.json"].map(read).into();
         assert!(first == second, "same seed, same bytes");
         assert_ne!(first[0], first[1]);
     }

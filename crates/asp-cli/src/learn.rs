@@ -34,10 +34,7 @@ pub fn collect(args: &CollectArgs) -> anyhow::Result<std::process::ExitCode> {
     let progress = |m: &collect::CollectedModel| {
         let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         if tty {
-            eprintln!(
-                "[{k}/{total}] {}: {} parts, {} states ({} of {} runs complete)",
-                m.name, m.parts, m.states, m.runs_found, a.runs
-            );
+            eprintln!("[{k}/{total}] {}: {} parts, {} states ({} of {} runs complete)", m.name, m.parts, m.states, m.runs_found, a.runs);
         }
     };
     let index = collect::collect(&models, &a.out, &settings, &progress)?;
@@ -71,8 +68,8 @@ fn transitions(a: &TransitionsArgs) -> anyhow::Result<std::process::ExitCode> {
     let settings = TransitionSettings { seed: a.seed, plan, optimise, limit: a.max_transitions };
     let models = collect::model_paths(&a.models)?;
     let bar = if std::io::stderr().is_terminal() {
-        let style = ProgressStyle::with_template("{bar:30} {pos}/{len} models {elapsed} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar());
+        let style =
+            ProgressStyle::with_template("{bar:30} {pos}/{len} models {elapsed} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar());
         ProgressBar::new(models.len() as u64).with_style(style)
     } else {
         ProgressBar::hidden()
@@ -86,10 +83,7 @@ fn transitions(a: &TransitionsArgs) -> anyhow::Result<std::process::ExitCode> {
     let index = index?;
     let transitions: usize = index.assemblies.iter().map(|m| m.transitions).sum();
     for m in index.assemblies.iter().filter(|m| m.capped) {
-        eprintln!(
-            "warning: {}: recording stopped at --max-transitions {} before the search ended",
-            m.model, a.max_transitions
-        );
+        eprintln!("warning: {}: recording stopped at --max-transitions {} before the search ended", m.model, a.max_transitions);
     }
     println!(
         "{}: {} models, {} transitions ({}), features {} ({} node, {} edge attributes)",

@@ -78,8 +78,8 @@ fn models(args: &PlanArgs) -> anyhow::Result<Vec<PathBuf>> {
         let before = models.len();
         for p in &paths {
             let is_model_file = p.is_file() && matches!(ext(p).as_deref(), Some("glb" | "gltf"));
-            let is_parts_folder = p.is_dir()
-                && std::fs::read_dir(p).map(|d| d.filter_map(|e| e.ok()).any(|e| is_part(&e.path()))).unwrap_or(false);
+            let is_parts_folder =
+                p.is_dir() && std::fs::read_dir(p).map(|d| d.filter_map(|e| e.ok()).any(|e| is_part(&e.path()))).unwrap_or(false);
             if is_model_file || is_parts_folder {
                 models.push(p.clone());
             }
@@ -235,8 +235,8 @@ fn plan_one(
     }
     stdout.flush()?;
     // Ctrl-C during any search (the optimiser's too) ends with 130 after its result is written
-    let interrupted = report.stats.stopped_by == Some(StopReason::Interrupted)
-        || settings.cancel.as_ref().is_some_and(StopToken::is_stopped);
+    let interrupted =
+        report.stats.stopped_by == Some(StopReason::Interrupted) || settings.cancel.as_ref().is_some_and(StopToken::is_stopped);
     Ok(if interrupted {
         Verdict::Interrupted
     } else if result.found() {
@@ -260,4 +260,3 @@ fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
     bar.enable_steady_tick(Duration::from_millis(120));
     Some(bar)
 }
-

@@ -119,8 +119,7 @@ pub fn write_manifest(batch: &Batch, mut assemblies: Vec<ManifestEntry>, out: &P
         assemblies,
     };
     let path = out.join("manifest.json");
-    let json =
-        serde_json::to_string_pretty(&manifest).map_err(|e| GenError::Io { path: path.clone(), source: e.into() })?;
+    let json = serde_json::to_string_pretty(&manifest).map_err(|e| GenError::Io { path: path.clone(), source: e.into() })?;
     let tmp = out.join(".manifest.json.tmp");
     std::fs::write(&tmp, format!("{json}\n"))
         .and_then(|()| std::fs::rename(&tmp, &path))

@@ -83,15 +83,11 @@ pub fn check_disassembly(model: &impl RemovalModel) -> DisassemblyCheck {
     let rankings = [top_down(true), movable.iter().rev().copied().collect(), top_down(false)];
     let blockers: Vec<Vec<PartSet>> =
         (0..n).map(|i| DIRECTIONS.iter().map(|&a| PartSet::from_indices(n, model.blockers(i, a))).collect()).collect();
-    let free_axis = |i: usize, state: &PartSet| {
-        DIRECTIONS.iter().zip(&blockers[i]).find(|(_, b)| !b.intersects(state)).map(|(&a, _)| a)
-    };
+    let free_axis = |i: usize, state: &PartSet| DIRECTIONS.iter().zip(&blockers[i]).find(|(_, b)| !b.intersects(state)).map(|(&a, _)| a);
     // straight lines only: take out whatever can leave, until nothing can
     let mut state = PartSet::full(n);
     let mut order = Vec::new();
-    while let Some((i, axis)) =
-        rankings[0].iter().filter(|&&i| state.contains(i)).find_map(|&i| Some((i, free_axis(i, &state)?)))
-    {
+    while let Some((i, axis)) = rankings[0].iter().filter(|&&i| state.contains(i)).find_map(|&i| Some((i, free_axis(i, &state)?))) {
         state.remove(i);
         order.push((i, axis));
     }
@@ -99,8 +95,7 @@ pub fn check_disassembly(model: &impl RemovalModel) -> DisassemblyCheck {
     let stable = stuck.is_empty().then(|| {
         rankings.iter().find_map(|ranked| {
             let dead = HashSet::new();
-            let mut search =
-                StableSearch { model, ranked, free_axis: &free_axis, dead, budget: SEARCH_BUDGET, order: Vec::new() };
+            let mut search = StableSearch { model, ranked, free_axis: &free_axis, dead, budget: SEARCH_BUDGET, order: Vec::new() };
             (search.run(&PartSet::full(n)) == Some(true)).then_some(search.order)
         })
     });
@@ -108,13 +103,7 @@ pub fn check_disassembly(model: &impl RemovalModel) -> DisassemblyCheck {
     if let Some(Some(stable)) = stable {
         order = stable;
     }
-    DisassemblyCheck {
-        linked: is_contact_linked(model, &PartSet::full(n)),
-        straight_line: stuck.is_empty(),
-        stuck,
-        stable_order,
-        order,
-    }
+    DisassemblyCheck { linked: is_contact_linked(model, &PartSet::full(n)), straight_line: stuck.is_empty(), stuck, stable_order, order }
 }
 
 /// Depth-first search for a removal order whose states all stay contact-linked.
@@ -194,9 +183,7 @@ impl RemovalModel for BoxModel {
         let (a, negative) = (axis.index as usize, axis.negative);
         (0..self.parts.len())
             .filter(|&j| j != i)
-            .filter(|&j| {
-                self.parts[i].iter().any(|x| self.parts[j].iter().any(|y| x.sweep_hits(y, a, negative, self.tol)))
-            })
+            .filter(|&j| self.parts[i].iter().any(|x| self.parts[j].iter().any(|y| x.sweep_hits(y, a, negative, self.tol))))
             .collect()
     }
 
@@ -220,11 +207,7 @@ mod tests {
     #[test]
     fn a_stack_comes_apart_top_down() {
         // floor (fixed), a block on it, a block on that
-        let parts = vec![
-            vec![Cuboid::new([-1.0, -1.0, -1.0], [2.0, 2.0, 0.0])],
-            vec![unit(0.0, 0.0, 0.0)],
-            vec![unit(0.0, 0.0, 1.0)],
-        ];
+        let parts = vec![vec![Cuboid::new([-1.0, -1.0, -1.0], [2.0, 2.0, 0.0])], vec![unit(0.0, 0.0, 0.0)], vec![unit(0.0, 0.0, 1.0)]];
         let check = check_disassembly(&BoxModel::new(parts, vec![true, false, false], 1e-9));
         assert!(check.linked && check.straight_line && check.stable_order);
         assert_eq!(check.order, vec![(2, Axis::Z), (1, Axis::Z)]);

@@ -51,8 +51,7 @@ impl Cuboid {
     /// Whether moving this box along `axis` (towards `negative` or positive infinity) would
     /// push it into `other` deeper than `tol`.
     pub fn sweep_hits(&self, other: &Cuboid, axis: usize, negative: bool, tol: f64) -> bool {
-        let ahead =
-            if negative { other.mins[axis] < self.maxs[axis] - tol } else { other.maxs[axis] > self.mins[axis] + tol };
+        let ahead = if negative { other.mins[axis] < self.maxs[axis] - tol } else { other.maxs[axis] > self.mins[axis] + tol };
         ahead && (0..3).filter(|&b| b != axis).all(|b| self.overlap_along(other, b) > tol)
     }
 
@@ -101,9 +100,7 @@ pub fn box_union(boxes: &[Cuboid]) -> Mesh {
             for k in 0..lines[2].len().saturating_sub(1) {
                 let idx = [i, j, k];
                 let centre = [0, 1, 2].map(|a| 0.5 * (lines[a][idx[a]] + lines[a][idx[a] + 1]));
-                let inside = boxes
-                    .iter()
-                    .any(|b| (0..3).all(|a| round(b.mins[a]) < centre[a] && centre[a] < round(b.maxs[a])));
+                let inside = boxes.iter().any(|b| (0..3).all(|a| round(b.mins[a]) < centre[a] && centre[a] < round(b.maxs[a])));
                 if inside {
                     cells.push([i as i32, j as i32, k as i32]);
                 }

@@ -1,8 +1,8 @@
 //! The `manifest.json` written beside every batch: what was generated, from which seeds, with
 //! which parameters, how many parts of each kind, and what the generator's own checks found.
 
-pub use crate::generator::{Checks, PartCounts};
 use crate::generator::Generator;
+pub use crate::generator::{Checks, PartCounts};
 use serde::{Deserialize, Serialize};
 
 /// Version of the manifest layout; bumped on incompatible changes.

@@ -319,21 +319,13 @@ impl ProfileAssembly {
         for _ in 0..RESTARTS {
             let mut b = Builder { p: params, profiles: Vec::new(), connectors: Vec::new(), end_slabs: Vec::new() };
             match b.build(&mut rng) {
-                Ok(()) => {
-                    return Ok(ProfileAssembly {
-                        params: params.clone(),
-                        profiles: b.profiles,
-                        connectors: b.connectors,
-                    })
-                }
+                Ok(()) => return Ok(ProfileAssembly { params: params.clone(), profiles: b.profiles, connectors: b.connectors }),
                 Err(why) => last = why,
             }
         }
         Err(GenError::Construction {
             seed,
-            reason: format!(
-                "{last} after {RESTARTS} fresh starts; ask for fewer profiles, fewer supports or a larger assembly"
-            ),
+            reason: format!("{last} after {RESTARTS} fresh starts; ask for fewer profiles, fewer supports or a larger assembly"),
         })
     }
 
@@ -403,11 +395,7 @@ impl ProfileAssembly {
                     let mut close = [0.0; 3];
                     close[closing] = 1.0;
                     let orientation = quaternion(cross(close, approach), close, approach).map(|q| tidy(q, 1e12));
-                    out.push(GraspPoint {
-                        position: position.map(|x| tidy(x, 1e9)),
-                        orientation,
-                        width: p.profile_size,
-                    });
+                    out.push(GraspPoint { position: position.map(|x| tidy(x, 1e9)), orientation, width: p.profile_size });
                 }
             }
         }
@@ -607,8 +595,7 @@ impl Builder<'_> {
     /// Four profiles along the outline at height `z`, between the corner posts.
     fn frame(&mut self, z: f64, role: Role, layer: Option<usize>, fixed: bool) -> std::result::Result<(), String> {
         let (d, l, w) = (self.p.profile_size, self.p.length, self.p.width);
-        let lines =
-            [(0, [0.0, d / 2.0, z]), (0, [0.0, w - d / 2.0, z]), (1, [d / 2.0, 0.0, z]), (1, [l - d / 2.0, 0.0, z])];
+        let lines = [(0, [0.0, d / 2.0, z]), (0, [0.0, w - d / 2.0, z]), (1, [d / 2.0, 0.0, z]), (1, [l - d / 2.0, 0.0, z])];
         for (axis, at) in lines {
             let seg = self.segments(axis, at).into_iter().find(|s| s.lo_end.is_some() && s.hi_end.is_some());
             let seg = seg.ok_or("the outline is blocked")?;
@@ -671,8 +658,8 @@ impl Builder<'_> {
         let mut connected = vec![false; supports.len()];
         let sides = std::iter::repeat_n(Side::Back, self.p.back).chain(std::iter::repeat_n(Side::Front, self.p.front));
         for (n, side) in sides.enumerate() {
-            let placed = (0..TRIES_PER_PROFILE)
-                .find_map(|_| self.try_layer_profile(side, z, layer, (x_front, x_back), supports, &connected, rng));
+            let placed =
+                (0..TRIES_PER_PROFILE).find_map(|_| self.try_layer_profile(side, z, layer, (x_front, x_back), supports, &connected, rng));
             let index = placed.ok_or_else(|| format!("no room for layer profile {} of layer {}", n + 1, layer + 1))?;
             let p = &self.profiles[index];
             for (k, &s) in supports.iter().enumerate() {
@@ -799,11 +786,7 @@ impl Builder<'_> {
                 let mut slab = profile.cuboid;
                 let t = self.p.connector_thickness;
                 (slab.mins[axis], slab.maxs[axis]) = if end == seg.lo { (end, end + t) } else { (end - t, end) };
-                let touches_another = self
-                    .profiles
-                    .iter()
-                    .enumerate()
-                    .any(|(j, q)| j != attached_to && q.cuboid.touches(&slab, TOLERANCE));
+                let touches_another = self.profiles.iter().enumerate().any(|(j, q)| j != attached_to && q.cuboid.touches(&slab, TOLERANCE));
                 if touches_another {
                     return Err(format!("a {role:?} profile ends against two profiles"));
                 }
@@ -814,8 +797,7 @@ impl Builder<'_> {
             }
         }
         let new_boxes = std::iter::once(&profile.cuboid).chain(connectors.iter().flat_map(|c| &c.cells));
-        let existing: Vec<&Cuboid> =
-            self.profiles.iter().map(|p| &p.cuboid).chain(self.connectors.iter().flat_map(|c| &c.cells)).collect();
+        let existing: Vec<&Cuboid> = self.profiles.iter().map(|p| &p.cuboid).chain(self.connectors.iter().flat_map(|c| &c.cells)).collect();
         for b in new_boxes {
             if existing.iter().any(|e| e.overlaps(b, TOLERANCE)) {
                 return Err(format!("a {role:?} profile overlaps an existing part"));
@@ -853,11 +835,7 @@ impl Builder<'_> {
             }
         } else {
             let b = 1 - a;
-            lines[a] = if at_lo {
-                vec![end, end + t, end + 2.0 * t, end + c]
-            } else {
-                vec![end - c, end - 2.0 * t, end - t, end]
-            };
+            lines[a] = if at_lo { vec![end, end + t, end + 2.0 * t, end + c] } else { vec![end - c, end - 2.0 * t, end - t, end] };
             lines[b] = around(centre[b]);
             lines[2] = vec![centre[2] - d / 2.0 - t, centre[2] - d / 2.0, centre[2] + d / 2.0];
             let (near, far) = if at_lo { (0, 2) } else { (2, 0) };

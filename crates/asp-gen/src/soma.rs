@@ -208,18 +208,20 @@ impl SomaCube {
             .pieces
             .iter()
             .zip(&self.names)
-            .map(|(cells, name)| Part::new(
-                name.clone(),
-                Mesh::from_voxels(cells, Vec3::splat(c), Vec3::ZERO),
-                false,
-                json!({
-                    "kind": "soma_piece",
-                    "cube_size": self.size,
-                    "cell_size": cell,
-                    "origin": [0.0, 0.0, 0.0],
-                    "cells": cells,
-                }),
-            ))
+            .map(|(cells, name)| {
+                Part::new(
+                    name.clone(),
+                    Mesh::from_voxels(cells, Vec3::splat(c), Vec3::ZERO),
+                    false,
+                    json!({
+                        "kind": "soma_piece",
+                        "cube_size": self.size,
+                        "cell_size": cell,
+                        "origin": [0.0, 0.0, 0.0],
+                        "cells": cells,
+                    }),
+                )
+            })
             .collect();
         let edge = self.size as f32 * c;
         parts.push(Part::new(
@@ -381,8 +383,7 @@ mod tests {
     fn an_enclosed_piece_is_reported_stuck() {
         // piece 1 hooks under and around piece 0: neither can leave first along any axis
         let layers = [["000", "011", "000"], ["110", "010", "000"], ["000", "000", "000"]];
-        let labels: Vec<usize> =
-            layers.iter().flat_map(|l| l.iter().flat_map(|r| r.bytes().map(|b| (b - b'0') as usize))).collect();
+        let labels: Vec<usize> = layers.iter().flat_map(|l| l.iter().flat_map(|r| r.bytes().map(|b| (b - b'0') as usize))).collect();
         let cube = SomaCube::from_labels(3, labels).unwrap();
         let check = cube.check_disassembly();
         assert!(!check.straight_line);

@@ -200,8 +200,7 @@ fn profiles(params: &ProfileParams, seed: u64) -> ProfileAssembly {
 
 #[test]
 fn profile_presets_have_the_thesis_counts() {
-    for (params, removable, total) in [(ProfileParams::single_layer(), 21, 29), (ProfileParams::double_layer(), 30, 38)]
-    {
+    for (params, removable, total) in [(ProfileParams::single_layer(), 21, 29), (ProfileParams::double_layer(), 30, 38)] {
         for seed in 0..5 {
             let a = profiles(&params, seed);
             let free = a.profiles.iter().filter(|p| !p.fixed).count();
@@ -234,9 +233,7 @@ fn profile_parts_do_not_overlap_beyond_the_tolerance() {
             let boxes: Vec<_> = asm.parts[..a.profiles.len()].iter().map(|p| p.mesh.aabb().unwrap()).collect();
             for (i, x) in boxes.iter().enumerate() {
                 for y in &boxes[i + 1..] {
-                    let depth = (0..3)
-                        .map(|k| x.maxs[k].min(y.maxs[k]) - x.mins[k].max(y.mins[k]))
-                        .fold(f32::INFINITY, f32::min);
+                    let depth = (0..3).map(|k| x.maxs[k].min(y.maxs[k]) - x.mins[k].max(y.mins[k])).fold(f32::INFINITY, f32::min);
                     assert!(depth <= 1e-5, "profiles overlap by {depth}");
                 }
             }
@@ -385,8 +382,7 @@ fn supports_and_layer_profiles_follow_the_front_back_rules() {
     let params = ProfileParams::double_layer();
     for seed in 0..8 {
         let a = profiles(&params, seed);
-        let supports: Vec<[f64; 3]> =
-            a.profiles.iter().filter(|p| p.role == Role::Support).map(|p| p.centre()).collect();
+        let supports: Vec<[f64; 3]> = a.profiles.iter().filter(|p| p.role == Role::Support).map(|p| p.centre()).collect();
         assert_eq!(supports.len(), 2);
         for (k, s) in supports.iter().enumerate() {
             assert!(s[0] >= params.min_length && s[0] <= params.length - params.min_length);
@@ -401,16 +397,8 @@ fn supports_and_layer_profiles_follow_the_front_back_rules() {
         let x_back = supports.iter().map(|s| s[0]).fold(f64::NEG_INFINITY, f64::max);
         for p in &a.profiles {
             match p.role {
-                Role::Back => assert!(if p.axis == 1 {
-                    p.centre()[0] >= x_front - 1e-9
-                } else {
-                    p.cuboid.mins[0] >= x_front - 1e-9
-                }),
-                Role::Front => assert!(if p.axis == 1 {
-                    p.centre()[0] <= x_back + 1e-9
-                } else {
-                    p.cuboid.maxs[0] <= x_back + 1e-9
-                }),
+                Role::Back => assert!(if p.axis == 1 { p.centre()[0] >= x_front - 1e-9 } else { p.cuboid.mins[0] >= x_front - 1e-9 }),
+                Role::Front => assert!(if p.axis == 1 { p.centre()[0] <= x_back + 1e-9 } else { p.cuboid.maxs[0] <= x_back + 1e-9 }),
                 _ => {}
             }
             if let Some(l) = p.layer {
@@ -474,8 +462,7 @@ fn written_files_load_with_no_options_and_keep_their_metadata() {
     let dir = tempfile::tempdir().unwrap();
     let generator = Generator::Profiles(ProfileParams::single_layer());
     let manifest = write(generator.clone(), 2, 3, dir.path());
-    let from_disk: Manifest =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("manifest.json")).unwrap()).unwrap();
+    let from_disk: Manifest = serde_json::from_str(&std::fs::read_to_string(dir.path().join("manifest.json")).unwrap()).unwrap();
     assert_eq!(from_disk, manifest);
     assert_eq!(manifest.generator, generator);
     for entry in &manifest.assemblies {
@@ -512,9 +499,7 @@ fn written_files_load_with_no_options_and_keep_their_metadata() {
 #[test]
 fn the_same_seed_writes_the_same_bytes() {
     let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
-    for generator in
-        [Generator::Soma(SomaParams { size: 4, cell: 0.05 }), Generator::Profiles(ProfileParams::double_layer())]
-    {
+    for generator in [Generator::Soma(SomaParams { size: 4, cell: 0.05 }), Generator::Profiles(ProfileParams::double_layer())] {
         let manifest = write(generator.clone(), 3, 9, a.path());
         write(generator.clone(), 3, 9, b.path());
         for name in manifest.assemblies.iter().map(|e| e.file.as_str()).chain(["manifest.json"]) {
@@ -543,11 +528,9 @@ fn plans_to_completion_with(path: &std::path::Path, config: &WorldConfig) -> std
     let outcome = Dfs::builder().build().solve(&Problem::full(&checker), &budget);
     match outcome.status {
         Status::Found => recheck_on_boxes(path, checker.world(), &outcome.removals),
-        Status::NoPlan { stuck, .. } => Err(format!(
-            "{}: no plan, stuck: {:?}",
-            path.display(),
-            stuck.iter().map(|s| checker.world().name(s.part)).collect::<Vec<_>>()
-        )),
+        Status::NoPlan { stuck, .. } => {
+            Err(format!("{}: no plan, stuck: {:?}", path.display(), stuck.iter().map(|s| checker.world().name(s.part)).collect::<Vec<_>>()))
+        }
         Status::BudgetExhausted => Err(format!("{}: budget exhausted", path.display())),
     }
 }
@@ -569,8 +552,7 @@ fn a_batch_of_fifty_5x5x5_cubes_plans_to_completion() {
     // eroded pieces); the planner now tests voxel pieces exactly on their cells
     let dir = tempfile::tempdir().unwrap();
     let manifest = write(Generator::Soma(SomaParams { size: 5, cell: 0.05 }), 50, 0, dir.path());
-    let failures: Vec<String> =
-        manifest.assemblies.iter().filter_map(|e| plans_to_completion(&dir.path().join(&e.file)).err()).collect();
+    let failures: Vec<String> = manifest.assemblies.iter().filter_map(|e| plans_to_completion(&dir.path().join(&e.file)).err()).collect();
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
@@ -657,7 +639,9 @@ fn recheck_on_boxes(path: &std::path::Path, world: &World, removals: &[asp_searc
             let shift = direction * (distance * i as f32 / 200.0);
             for q in (0..parts.len()).filter(|&q| present[q]) {
                 let hit = boxes[p].iter().any(|a| {
-                    boxes[q].iter().any(|b| (0..3).all(|c| a.mins[c] + shift[c] + tol < b.maxs[c] && b.mins[c] < a.maxs[c] + shift[c] - tol))
+                    boxes[q]
+                        .iter()
+                        .any(|b| (0..3).all(|c| a.mins[c] + shift[c] + tol < b.maxs[c] && b.mins[c] < a.maxs[c] + shift[c] - tol))
                 });
                 if hit {
                     return Err(format!("{}: step {k}: '{}' hits '{}'", path.display(), parts[p].name, parts[q].name));

@@ -93,9 +93,7 @@ fn bench(c: &mut Criterion) {
             // the physics check of the state with part 1 removed (rapier, 1 s simulated)
             let physics = PhysicsStability::new(&world, &PhysicsConfig::default());
             let state = full.without(1);
-            c.bench_function(&format!("stability_physics/{name}"), |b| {
-                b.iter(|| black_box(physics.stability(&world, &state)))
-            });
+            c.bench_function(&format!("stability_physics/{name}"), |b| b.iter(|| black_box(physics.stability(&world, &state))));
         }
     }
 }

@@ -56,11 +56,5 @@ fn tile(copies: &[Assembly]) -> Option<Assembly> {
             parts.push(Part::new(format!("copy{k}/{}", part.name), mesh, part.fixed, part.extras.clone()));
         }
     }
-    Some(Assembly {
-        parts,
-        units: Units::metres(),
-        up: Axis::Z,
-        source: PathBuf::from("tiled"),
-        warnings: Vec::new(),
-    })
+    Some(Assembly { parts, units: Units::metres(), up: Axis::Z, source: PathBuf::from("tiled"), warnings: Vec::new() })
 }

@@ -144,10 +144,7 @@ impl Assembly {
         }
         for p in &self.parts {
             if p.mesh.triangles.is_empty() {
-                return Err(err(format!(
-                    "part '{}' has no triangles; remove it from the file or export its surface as triangles",
-                    p.name
-                )));
+                return Err(err(format!("part '{}' has no triangles; remove it from the file or export its surface as triangles", p.name)));
             }
             if !p.mesh.is_finite() {
                 return Err(err(format!("part '{}' has NaN or infinite vertex coordinates", p.name)));

@@ -24,9 +24,7 @@ pub fn part_boxes(part: &Part) -> Result<Option<Vec<Aabb>>, String> {
             .ok_or_else(|| "its voxels (extras.asp.cells) do not match its mesh".to_string());
     }
     if let Some(boxes) = &part.meta.boxes {
-        return fit_boxes(boxes, &part.mesh)
-            .map(Some)
-            .ok_or_else(|| "its boxes (extras.asp.boxes) do not match its mesh".to_string());
+        return fit_boxes(boxes, &part.mesh).map(Some).ok_or_else(|| "its boxes (extras.asp.boxes) do not match its mesh".to_string());
     }
     Ok(single_box(&part.mesh).map(|b| vec![b]))
 }
@@ -61,9 +59,7 @@ fn unit_boxes(cells: &[[i32; 3]]) -> Vec<Aabb> {
 /// bounds, with that scale and offset, when the mapped boxes describe the mesh.
 fn fit(boxes: &[Aabb], mesh: &Mesh) -> Option<(Vec<Aabb>, Vec3, Vec3)> {
     let target = mesh.aabb()?;
-    let (lo, hi) = boxes
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), b| (lo.min(b.mins), hi.max(b.maxs)));
+    let (lo, hi) = boxes.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), b| (lo.min(b.mins), hi.max(b.maxs)));
     let scale = (target.maxs - target.mins) / (hi - lo);
     if !(scale.is_finite() && scale.min_element() > 0.0) {
         return None;
@@ -90,10 +86,7 @@ pub fn single_box(mesh: &Mesh) -> Option<Aabb> {
     let ext = b.maxs - b.mins;
     let eps = 1e-5 * ext.max_element().max(f32::MIN_POSITIVE);
     let on = |a: f32, lo: f32, hi: f32| (a - lo).abs() <= eps || (a - hi).abs() <= eps;
-    let corners = mesh
-        .vertices
-        .iter()
-        .all(|v| on(v.x, b.mins.x, b.maxs.x) && on(v.y, b.mins.y, b.maxs.y) && on(v.z, b.mins.z, b.maxs.z));
+    let corners = mesh.vertices.iter().all(|v| on(v.x, b.mins.x, b.maxs.x) && on(v.y, b.mins.y, b.maxs.y) && on(v.z, b.mins.z, b.maxs.z));
     let vol = ext.x as f64 * ext.y as f64 * ext.z as f64;
     (corners && vol > 0.0 && (mesh.signed_volume().abs() - vol).abs() <= 1e-4 * vol).then_some(b)
 }
@@ -131,9 +124,7 @@ pub fn first_overlap(moving: &Aabb, dir: Vec3, fixed: &Aabb, tol: f32) -> Option
 /// How deep two boxes overlap: the least shrinking of either that separates them (the smallest,
 /// over the axes, of the shorter push out to either side); `<= 0` when they do not overlap.
 pub fn overlap_depth(a: &Aabb, b: &Aabb) -> f32 {
-    (0..3)
-        .map(|k| (a.maxs[k] - b.mins[k]).min(b.maxs[k] - a.mins[k]))
-        .fold(f32::INFINITY, f32::min)
+    (0..3).map(|k| (a.maxs[k] - b.mins[k]).min(b.maxs[k] - a.mins[k])).fold(f32::INFINITY, f32::min)
 }
 
 /// The distance between two boxes given in a frame whose unit along axis `k` is `cell[k]`

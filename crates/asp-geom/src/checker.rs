@@ -1,9 +1,7 @@
 //! The default [`FeasibilityChecker`]: straight-line removal tests on the collision world,
 //! RRT-Connect paths as the slow test, and a stability check of what remains.
 
-use crate::feasibility::{
-    CounterSnapshot, Counters, FeasibilityChecker, MotionKind, Outcome, Stability,
-};
+use crate::feasibility::{CounterSnapshot, Counters, FeasibilityChecker, MotionKind, Outcome, Stability};
 use crate::partset::PartSet;
 use crate::physics::{PhysicsConfig, PhysicsStability};
 use crate::rrt::{plan_removal_path, RrtConfig};

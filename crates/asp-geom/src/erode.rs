@@ -76,11 +76,7 @@ pub fn eroded_mesh(vertices: &[Vec3], triangles: &[[u32; 3]], amount: f32) -> (V
             let mut order: Vec<(f32, Vec3)> = normals[v as usize]
                 .iter()
                 .map(|&n| {
-                    let near = list
-                        .iter()
-                        .filter(|c| c.2.dot(n) > SAME_PLANE)
-                        .map(|c| c.1.dot(bisector))
-                        .fold(f32::NEG_INFINITY, f32::max);
+                    let near = list.iter().filter(|c| c.2.dot(n) > SAME_PLANE).map(|c| c.1.dot(bisector)).fold(f32::NEG_INFINITY, f32::max);
                     (if n.dot(own) > SAME_PLANE { f32::INFINITY } else { near }, n)
                 })
                 .collect();

@@ -30,8 +30,8 @@
 //! through the plate it bears on, but its thread turns out of the nut.
 
 use crate::erode::symmetric_eigen;
-use crate::sample::sample_triangles;
 use crate::math::Vec3;
+use crate::sample::sample_triangles;
 use parry3d::math::Mat3;
 use parry3d::query::PointQuery;
 use parry3d::shape::TriMesh;
@@ -223,11 +223,7 @@ pub fn kinematic_axis(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Option<(Symm
     let abar = mul(&ainv, bd).map(|v| -v);
     let foot = cross(d, abar);
     let pitch = (d[0] * abar[0] + d[1] * abar[1] + d[2] * abar[2]) * scale;
-    let point = Vec3::new(
-        (centre[0] + foot[0] * scale) as f32,
-        (centre[1] + foot[1] * scale) as f32,
-        (centre[2] + foot[2] * scale) as f32,
-    );
+    let point = Vec3::new((centre[0] + foot[0] * scale) as f32, (centre[1] + foot[1] * scale) as f32, (centre[2] + foot[2] * scale) as f32);
     point.is_finite().then_some((SymmetryAxis { point, direction: dir, radius: 0.0 }, pitch as f32))
 }
 
@@ -411,8 +407,7 @@ fn contact_zone(axis: &SymmetryAxis, pm: &TriMesh, qm: &TriMesh, contact: f32, m
     // sampled densely where it matters: q's triangles with a corner in the zone (a tapped hole
     // is a small part of a pump body's surface)
     let in_zone = |x: Vec3| axis.radial(x) <= radius && (lo..=hi).contains(&along(x));
-    let near: Vec<[u32; 3]> =
-        qm.indices().iter().filter(|t| t.iter().any(|&i| in_zone(qm.vertices()[i as usize]))).copied().collect();
+    let near: Vec<[u32; 3]> = qm.indices().iter().filter(|t| t.iter().any(|&i| in_zone(qm.vertices()[i as usize]))).copied().collect();
     let qs = sample_triangles(qm.vertices(), &near, 4 * SAMPLES);
     // a bore: q's faces around p's side (not a plane p is pushed into, which is symmetric too)
     let local: Vec<Vec3> = qs

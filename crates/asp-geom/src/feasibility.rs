@@ -54,10 +54,9 @@ impl Motion {
     pub fn length(&self) -> f32 {
         match self {
             Motion::Linear { distance, .. } | Motion::Screw { distance, .. } => *distance,
-            Motion::Path { poses, pivot } => poses
-                .windows(2)
-                .map(|w| (w[1].transform_point(*pivot) - w[0].transform_point(*pivot)).length())
-                .sum(),
+            Motion::Path { poses, pivot } => {
+                poses.windows(2).map(|w| (w[1].transform_point(*pivot) - w[0].transform_point(*pivot)).length()).sum()
+            }
         }
     }
 }

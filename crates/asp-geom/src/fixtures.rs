@@ -18,12 +18,7 @@ pub fn box_part(name: &str, mins: [f32; 3], maxs: [f32; 3]) -> Part {
 /// A movable part made of the unit voxels `cells` scaled by `cell` (metres), carrying them in
 /// its metadata (`extras.asp.voxels`) so distance maps sweep them exactly.
 pub fn voxel_part(name: &str, cells: &[[i32; 3]], cell: f32) -> Part {
-    Part::new(
-        name,
-        Mesh::from_voxels(cells, Vec3::splat(cell), Vec3::ZERO),
-        false,
-        serde_json::json!({ "asp": { "voxels": cells } }),
-    )
+    Part::new(name, Mesh::from_voxels(cells, Vec3::splat(cell), Vec3::ZERO), false, serde_json::json!({ "asp": { "voxels": cells } }))
 }
 
 /// An assembly in metres with `up` as the up axis; its source reads `fixture:{name}`.
@@ -57,11 +52,7 @@ pub fn figure_6_2(cell: f32) -> Assembly {
     base.extend([[2, 0, 2], [2, 1, 2], [2, 2, 2]]);
     assembly(
         "figure_6_2",
-        vec![
-            voxel_part("base", &base, cell),
-            voxel_part("top", &[[1, 1, 1]], cell),
-            voxel_part("ball", &[[2, 1, 1]], cell),
-        ],
+        vec![voxel_part("base", &base, cell), voxel_part("top", &[[1, 1, 1]], cell), voxel_part("ball", &[[2, 1, 1]], cell)],
     )
 }
 
@@ -82,14 +73,9 @@ pub fn stacked_boxes() -> Assembly {
 /// A fixed plate (3 × 3 × 2) with a 1 × 1 blind hole of depth 1 and a peg of 1 × 1 × 2 in it
 /// with zero clearance: the peg leaves only along +Z, the hole's axis.
 pub fn peg_in_hole() -> Assembly {
-    let plate: Vec<[i32; 3]> = (0..3)
-        .flat_map(|x| (0..3).flat_map(move |y| (0..2).map(move |z| [x, y, z])))
-        .filter(|c| *c != [1, 1, 1])
-        .collect();
-    assembly(
-        "peg_in_hole",
-        vec![part("plate", voxels(&plate), true), part("peg", voxels(&[[1, 1, 1], [1, 1, 2]]), false)],
-    )
+    let plate: Vec<[i32; 3]> =
+        (0..3).flat_map(|x| (0..3).flat_map(move |y| (0..2).map(move |z| [x, y, z]))).filter(|c| *c != [1, 1, 1]).collect();
+    assembly("peg_in_hole", vec![part("plate", voxels(&plate), true), part("peg", voxels(&[[1, 1, 1], [1, 1, 2]]), false)])
 }
 
 /// The four-part tube of the seed's figure 2.1, from boxes: a fixed receptacle (a square tube
@@ -98,10 +84,8 @@ pub fn peg_in_hole() -> Assembly {
 /// handle is gone, or down after the cap is gone (along ±Z only); handle and cap also slide off
 /// sideways.
 pub fn tube() -> Assembly {
-    let ring: Vec<[i32; 3]> = (0..3)
-        .flat_map(|x| (0..3).flat_map(move |y| (0..4).map(move |z| [x, y, z])))
-        .filter(|c| !(c[0] == 1 && c[1] == 1))
-        .collect();
+    let ring: Vec<[i32; 3]> =
+        (0..3).flat_map(|x| (0..3).flat_map(move |y| (0..4).map(move |z| [x, y, z]))).filter(|c| !(c[0] == 1 && c[1] == 1)).collect();
     assembly(
         "tube",
         vec![
@@ -118,17 +102,9 @@ pub fn tube() -> Assembly {
 /// path planner must find the L.
 pub fn l_path() -> Assembly {
     let channel = [[1, 1, 1], [2, 1, 1], [3, 1, 1], [3, 1, 2], [3, 1, 3], [3, 1, 4]];
-    let housing: Vec<[i32; 3]> = (0..5)
-        .flat_map(|x| (0..3).flat_map(move |y| (0..5).map(move |z| [x, y, z])))
-        .filter(|c| !channel.contains(c))
-        .collect();
-    assembly(
-        "l_path",
-        vec![
-            part("housing", voxels(&housing), true),
-            part("block", cuboid([1.2, 1.2, 1.2], [1.8, 1.8, 1.8]), false),
-        ],
-    )
+    let housing: Vec<[i32; 3]> =
+        (0..5).flat_map(|x| (0..3).flat_map(move |y| (0..5).map(move |z| [x, y, z]))).filter(|c| !channel.contains(c)).collect();
+    assembly("l_path", vec![part("housing", voxels(&housing), true), part("block", cuboid([1.2, 1.2, 1.2], [1.8, 1.8, 1.8]), false)])
 }
 
 /// A fixed base, two pillars and a keystone lying across both. Either pillar may slide out
@@ -155,10 +131,7 @@ pub fn arch() -> Assembly {
 pub fn ring_on_locked_post() -> Assembly {
     let layer = |lo: i32, hi: i32, z: i32| (lo..hi).flat_map(move |x| (lo..hi).map(move |y| [x, y, z]));
     let foot: Vec<[i32; 3]> = layer(1, 4, 1).collect();
-    let base: Vec<[i32; 3]> = (0..3)
-        .flat_map(|z| layer(0, 5, z))
-        .filter(|c| !foot.contains(c) && *c != [2, 2, 2])
-        .collect();
+    let base: Vec<[i32; 3]> = (0..3).flat_map(|z| layer(0, 5, z)).filter(|c| !foot.contains(c) && *c != [2, 2, 2]).collect();
     let post: Vec<[i32; 3]> = foot.iter().copied().chain((2..6).map(|z| [2, 2, z])).chain(layer(1, 4, 6)).collect();
     let ring: Vec<[i32; 3]> = layer(1, 4, 3).filter(|c| *c != [2, 2, 3]).collect();
     let cap: Vec<[i32; 3]> = layer(1, 4, 7).collect();
@@ -245,11 +218,7 @@ pub fn dowel_in_two_boards() -> Assembly {
     lower.fixed = true;
     assembly(
         "dowel_in_two_boards",
-        vec![
-            lower,
-            box_part("upper", [0.0, 0.0, 1.0], [3.0, 3.0, 2.0]),
-            part("dowel", prism(1.5, 1.5, 0.3, 0.5, 1.5, 16), false),
-        ],
+        vec![lower, box_part("upper", [0.0, 0.0, 1.0], [3.0, 3.0, 2.0]), part("dowel", prism(1.5, 1.5, 0.3, 0.5, 1.5, 16), false)],
     )
 }
 
@@ -357,9 +326,8 @@ pub fn bolt_and_nut(interference: f32) -> Assembly {
     let mut v = Vec::new();
     let mut t = Vec::new();
     let first = rows(below);
-    let bore = helical_rows(&mut v, centre, z0, dz, first..=first + rows(nut_h), |i, z| {
-        thread_radius(major, depth, pitch, i, z) - interference
-    });
+    let bore =
+        helical_rows(&mut v, centre, z0, dz, first..=first + rows(nut_h), |i, z| thread_radius(major, depth, pitch, i, z) - interference);
     for w in bore.windows(2) {
         ring_strip(&w[1], &w[0], &mut t); // facing the axis
     }

@@ -169,11 +169,8 @@ fn voxelise(mesh: &Mesh, cell: Vec3, origin: Vec3, max_cells: usize) -> Option<V
     if count == 0 || count > 8 * max_cells || count.saturating_mul(mesh.triangles.len()) > MAX_VOXELISE_WORK {
         return None;
     }
-    let tris: Vec<[[f64; 3]; 3]> = mesh
-        .triangles
-        .iter()
-        .map(|t| t.map(|i| mesh.vertices[i as usize].to_array().map(|x| x as f64)))
-        .collect();
+    let tris: Vec<[[f64; 3]; 3]> =
+        mesh.triangles.iter().map(|t| t.map(|i| mesh.vertices[i as usize].to_array().map(|x| x as f64))).collect();
     // a ray direction off every lattice plane and diagonal
     let dir = [0.8113_f64, 0.4521, 0.3702];
     let mut cells = Vec::new();

@@ -6,8 +6,8 @@ pub mod checker;
 pub mod distmap;
 pub mod erode;
 pub mod error;
-pub mod feasibility;
 pub mod fastener;
+pub mod feasibility;
 // test fixtures and puzzle models, public for the other crates' tests and examples
 #[doc(hidden)]
 pub mod fixtures;
@@ -16,8 +16,8 @@ pub mod grid;
 pub mod io;
 pub mod math;
 pub mod mesh;
-pub mod overlap;
 pub mod meta;
+pub mod overlap;
 pub mod partset;
 pub mod physics;
 #[doc(hidden)]
@@ -35,7 +35,7 @@ pub use feasibility::{CounterSnapshot, FeasibilityChecker, Motion, MotionKind, O
 pub use graph::{AssemblyGraph, GraphConfig, StateGraph};
 pub use mesh::Mesh;
 pub use meta::{Grasp, PartMeta};
+pub use overlap::OverlapPolicy;
 pub use partset::PartSet;
 pub use physics::{PhysicsConfig, PhysicsStability};
-pub use overlap::OverlapPolicy;
 pub use world::{World, WorldConfig};

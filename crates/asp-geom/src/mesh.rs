@@ -51,8 +51,7 @@ impl Mesh {
             self.vertices.push(Vec3::new(pick(1, a.x, b.x), pick(2, a.y, b.y), pick(4, a.z, b.z)));
         }
         // faces as (v0,v1,v2,v3) counter-clockwise from outside
-        const FACES: [[u32; 4]; 6] =
-            [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        const FACES: [[u32; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
         for f in FACES {
             self.triangles.push([base + f[0], base + f[1], base + f[2]]);
             self.triangles.push([base + f[0], base + f[2], base + f[3]]);
@@ -114,10 +113,7 @@ impl Mesh {
 
     /// This mesh moved by `pose`.
     pub fn transformed(&self, pose: &Pose) -> Mesh {
-        Mesh {
-            vertices: self.vertices.iter().map(|v| pose.transform_point(*v)).collect(),
-            triangles: self.triangles.clone(),
-        }
+        Mesh { vertices: self.vertices.iter().map(|v| pose.transform_point(*v)).collect(), triangles: self.triangles.clone() }
     }
 
     /// Multiplies every coordinate by `factor` (unit conversion).
@@ -190,11 +186,8 @@ impl Mesh {
         }
         self.vertices = vertices;
         let tris = std::mem::take(&mut self.triangles);
-        let mut tris: Vec<[u32; 3]> = tris
-            .into_iter()
-            .map(|t| t.map(|i| remap[i as usize]))
-            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
-            .collect();
+        let mut tris: Vec<[u32; 3]> =
+            tris.into_iter().map(|t| t.map(|i| remap[i as usize])).filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]).collect();
         tris.retain(|t| self.triangle_normal(t).length_squared() > 0.0);
         self.triangles = tris;
     }

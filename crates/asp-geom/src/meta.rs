@@ -52,17 +52,15 @@ impl PartMeta {
         if let Some(v) = lookup(extras, "boxes") {
             match parse_boxes(v) {
                 Some(b) => meta.boxes = Some(b),
-                None => problems.push(
-                    "extras.asp.boxes is not a list of [min x, min y, min z, max x, max y, max z] boxes; ignored".to_string(),
-                ),
+                None => {
+                    problems.push("extras.asp.boxes is not a list of [min x, min y, min z, max x, max y, max z] boxes; ignored".to_string())
+                }
             }
         }
         if let Some(v) = lookup(extras, "grasp_points") {
             match parse_grasps(v) {
                 Some(g) => meta.grasps = g,
-                None => problems.push(
-                    "extras.asp.grasp_points is not a list of {position, orientation, width}; ignored".to_string(),
-                ),
+                None => problems.push("extras.asp.grasp_points is not a list of {position, orientation, width}; ignored".to_string()),
             }
         }
         (meta, problems)

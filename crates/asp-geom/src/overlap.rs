@@ -19,8 +19,8 @@
 //! The test is a sampling of the surfaces, so it is used *together with* the exact (shrunk)
 //! sweep of the pair, never instead of it: a strict pair is blocked when either blocks.
 
-use crate::sample::sample_triangles;
 use crate::math::{Aabb, Vec3};
+use crate::sample::sample_triangles;
 use parry3d::query::{Ray, RayCullingMode};
 use parry3d::shape::TriMesh;
 

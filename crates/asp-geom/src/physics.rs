@@ -47,8 +47,7 @@ use crate::world::World;
 use parry3d::shape::TriMesh;
 use parry3d::transformation::vhacd::{VHACDParameters, VHACD};
 use rapier3d::prelude::{
-    ActiveHooks, ColliderBuilder, ContactModificationContext, PhysicsHooks, PhysicsWorld,
-    RigidBodyBuilder, RigidBodyHandle, SharedShape,
+    ActiveHooks, ColliderBuilder, ContactModificationContext, PhysicsHooks, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle, SharedShape,
 };
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::OnceLock;
@@ -232,11 +231,8 @@ impl PhysicsStability {
     /// like fixed parts: by another gripper or a fixture).
     pub fn stability_holding(&self, world: &World, state: &PartSet, held: &PartSet) -> Stability {
         // a NaN (a blown-up simulation) counts as moved
-        let floating = self
-            .displacements_holding(world, state, held)
-            .into_iter()
-            .filter(|&(_, d)| d.is_nan() || d > self.threshold)
-            .map(|(i, _)| i);
+        let floating =
+            self.displacements_holding(world, state, held).into_iter().filter(|&(_, d)| d.is_nan() || d > self.threshold).map(|(i, _)| i);
         let floating = PartSet::from_indices(self.shapes.len(), floating);
         if floating.is_empty() {
             Stability::Stable
@@ -280,19 +276,12 @@ impl PhysicsStability {
         for &i in &parts {
             let Some(ps) = self.shape(world, i) else { continue };
             let g = group[&i];
-            let body = if is_static(g) {
-                ground
-            } else {
-                *bodies.entry(g).or_insert_with(|| sim.insert_body(RigidBodyBuilder::dynamic()))
-            };
+            let body = if is_static(g) { ground } else { *bodies.entry(g).or_insert_with(|| sim.insert_body(RigidBodyBuilder::dynamic())) };
             if body != ground {
                 dynamic.push((i, body));
             }
-            let collider = ColliderBuilder::new(ps.shape.clone())
-                .position(ps.pose)
-                .density(1.0)
-                .friction(self.config.friction)
-                .user_data(i as u128);
+            let collider =
+                ColliderBuilder::new(ps.shape.clone()).position(ps.pose).density(1.0).friction(self.config.friction).user_data(i as u128);
             colliders.push(sim.insert_collider(collider, Some(body)));
         }
 
@@ -301,11 +290,7 @@ impl PhysicsStability {
         // leave the new bodies out of the next steps' active set)
         sim.step();
         let meshes = parts.iter().filter(|&&i| has_triangle_mesh(world, i)).map(|&i| i as u128);
-        let mut hook = ContactHook {
-            meshes: meshes.collect(),
-            max_depth: 2.0 * self.threshold,
-            ..ContactHook::default()
-        };
+        let mut hook = ContactHook { meshes: meshes.collect(), max_depth: 2.0 * self.threshold, ..ContactHook::default() };
         for pair in sim.narrow_phase.contact_pairs() {
             let part = |h| sim.colliders.get(h).map_or(0, |c| c.user_data);
             let (a, b) = (part(pair.collider1), part(pair.collider2));
@@ -443,8 +428,7 @@ fn part_shape(world: &World, i: usize, config: &PhysicsConfig) -> Option<PartSha
     let shape = if has_triangle_mesh(world, i) {
         static_mesh(mesh)
     } else {
-        convex_shape(mesh, world.is_closed(i), config)
-            .unwrap_or_else(|| thin_box(aabb, world.assembly().diagonal()))
+        convex_shape(mesh, world.is_closed(i), config).unwrap_or_else(|| thin_box(aabb, world.assembly().diagonal()))
     };
     let com = shape.mass_properties(1.0).local_com;
     let com = if com.is_finite() { com } else { centre };
@@ -469,11 +453,8 @@ fn convex_shape(mesh: &TriMesh, closed: bool, config: &PhysicsConfig) -> Option<
     if hull.is_some() && (convex || !config.convex_decomposition) {
         return hull;
     }
-    let params = VHACDParameters {
-        resolution: config.decomposition_resolution,
-        max_convex_hulls: MAX_CONVEX_PIECES,
-        ..VHACDParameters::default()
-    };
+    let params =
+        VHACDParameters { resolution: config.decomposition_resolution, max_convex_hulls: MAX_CONVEX_PIECES, ..VHACDParameters::default() };
     // V-HACD is third-party code on arbitrary CAD meshes: a failure falls back to the hull
     let pieces = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let decomposition = VHACD::decompose(&params, mesh.vertices(), mesh.indices(), true);

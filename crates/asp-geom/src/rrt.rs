@@ -30,12 +30,7 @@ pub struct RrtConfig {
 
 impl Default for RrtConfig {
     fn default() -> Self {
-        RrtConfig {
-            max_iterations: 2000,
-            max_time: Duration::from_secs(5),
-            step_fraction: 0.05,
-            rotate: true,
-        }
+        RrtConfig { max_iterations: 2000, max_time: Duration::from_secs(5), step_fraction: 0.05, rotate: true }
     }
 }
 
@@ -129,8 +124,7 @@ impl Query<'_> {
         let near = tree.nearest(target, self.radius);
         let from = tree.nodes[near];
         let d = distance(&from, target, self.radius);
-        let (to, reached) =
-            if d <= self.step { (*target, true) } else { (interpolate(&from, target, self.step / d), false) };
+        let (to, reached) = if d <= self.step { (*target, true) } else { (interpolate(&from, target, self.step / d), false) };
         self.edge_free(&from, &to).then(|| (tree.push(to, Some(near)), reached))
     }
 
@@ -174,12 +168,8 @@ pub fn plan_removal_path(
     if !config.rotate {
         return rrt_connect(world, part, state, config, seed);
     }
-    let half = RrtConfig {
-        max_iterations: config.max_iterations.div_ceil(2),
-        max_time: config.max_time / 2,
-        rotate: false,
-        ..config.clone()
-    };
+    let half =
+        RrtConfig { max_iterations: config.max_iterations.div_ceil(2), max_time: config.max_time / 2, rotate: false, ..config.clone() };
     rrt_connect(world, part, state, &half, seed).or_else(|mut blockers| {
         let full = RrtConfig {
             max_iterations: config.max_iterations - half.max_iterations,
@@ -194,13 +184,7 @@ pub fn plan_removal_path(
 }
 
 /// One RRT-Connect search within `config`'s budget.
-fn rrt_connect(
-    world: &World,
-    part: usize,
-    state: &PartSet,
-    config: &RrtConfig,
-    seed: u64,
-) -> std::result::Result<Motion, PartSet> {
+fn rrt_connect(world: &World, part: usize, state: &PartSet, config: &RrtConfig, seed: u64) -> std::result::Result<Motion, PartSet> {
     let start_time = Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (part as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
     let bb = *world.aabb(part);
@@ -242,11 +226,7 @@ fn rrt_connect(
         if start_time.elapsed() > config.max_time {
             break;
         }
-        let centre = Vec3::new(
-            rng.random_range(lo.x..=hi.x),
-            rng.random_range(lo.y..=hi.y),
-            rng.random_range(lo.z..=hi.z),
-        );
+        let centre = Vec3::new(rng.random_range(lo.x..=hi.x), rng.random_range(lo.y..=hi.y), rng.random_range(lo.z..=hi.z));
         let r = if config.rotate {
             let u: f32 = rng.random();
             let random = Rot::from_xyzw(

@@ -116,8 +116,7 @@ fn mesh_sweep(moving: &TriMesh, pose: &Pose, dir: Vec3, fixed: &TriMesh, t_max: 
     let limit = || best.get().map_or(t_max, |b| b as f32);
     let mut moving_cache = TriangleCache::new(moving.num_triangles());
     let mut fixed_cache = TriangleCache::new(fixed.num_triangles());
-    let pairs =
-        moving.bvh().leaf_pairs(fixed.bvh(), |a, b| box_path_meets(&place(a.aabb()), dir, &b.aabb(), limit()));
+    let pairs = moving.bvh().leaf_pairs(fixed.bvh(), |a, b| box_path_meets(&place(a.aabb()), dir, &b.aabb(), limit()));
     for (i, j) in pairs {
         let ta = moving_cache.get(i, || triangle(moving, pose, i));
         let tb = fixed_cache.get(j, || triangle(fixed, &Pose::IDENTITY, j));
@@ -163,14 +162,7 @@ impl TriangleCache {
 /// The candidate search before [`mesh_sweep`]'s simultaneous descent, kept as the reference
 /// its tests compare against: the moving triangles whose path meets the fixed mesh's box, then
 /// for each one query of the fixed BVH with its swept box.
-fn mesh_sweep_per_triangle(
-    moving: &TriMesh,
-    pose: &Pose,
-    dir: Vec3,
-    fixed: &TriMesh,
-    t_max: f32,
-    earliest: bool,
-) -> Option<f32> {
+fn mesh_sweep_per_triangle(moving: &TriMesh, pose: &Pose, dir: Vec3, fixed: &TriMesh, t_max: f32, earliest: bool) -> Option<f32> {
     // the moving triangles whose path meets the fixed mesh's box, found in the moving mesh's
     // own frame (the box placed there is a little larger, still a safe cull)
     let inverse = pose.inverse();
@@ -194,13 +186,7 @@ pub fn sweep_hits_at_reference(moving: &TriMesh, pose: &Pose, dir: Vec3, fixed: 
 
 /// [`mesh_sweep`] for moving triangles given one by one: each is swept against the fixed
 /// triangles its path's box culling leaves.
-fn sweep_triangles(
-    moving: impl Iterator<Item = [DVec3; 3]>,
-    dir: Vec3,
-    fixed: &TriMesh,
-    t_max: f32,
-    earliest: bool,
-) -> Option<f32> {
+fn sweep_triangles(moving: impl Iterator<Item = [DVec3; 3]>, dir: Vec3, fixed: &TriMesh, t_max: f32, earliest: bool) -> Option<f32> {
     let d = dir.as_dvec3();
     let mut best: Option<f64> = None;
     for ta in moving {

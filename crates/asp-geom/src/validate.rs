@@ -17,16 +17,11 @@ pub fn check_model(assembly: &Assembly) -> Result<()> {
     let err = |reason: String| GeomError::Assembly { path: assembly.source.clone(), reason };
     for part in &assembly.parts {
         if part.mesh.triangles.is_empty() {
-            return Err(err(format!(
-                "part '{}' has no triangles; remove it from the file or export its surface as triangles",
-                part.name
-            )));
+            return Err(err(format!("part '{}' has no triangles; remove it from the file or export its surface as triangles", part.name)));
         }
     }
     if assembly.parts.iter().all(|p| p.mesh.is_finite()) && assembly.diagonal() <= 0.0 {
-        return Err(err(
-            "the model has zero extent (every vertex lies at one point); check the export's scale and units".into(),
-        ));
+        return Err(err("the model has zero extent (every vertex lies at one point); check the export's scale and units".into()));
     }
     for part in &assembly.parts {
         let triangles = part.mesh.triangles.len();

@@ -58,9 +58,7 @@ fn infer(c: &mut Criterion) {
     for (n, e) in [(40, 160), (100, 500)] {
         let (x, ei, ea) = graph(n, e, 1);
         shipped.score(&x, n, &ei, e, &ea).unwrap();
-        group.bench_function(format!("shipped/n{n}_e{e}"), |b| {
-            b.iter(|| black_box(shipped.score(black_box(&x), n, &ei, e, &ea).unwrap()))
-        });
+        group.bench_function(format!("shipped/n{n}_e{e}"), |b| b.iter(|| black_box(shipped.score(black_box(&x), n, &ei, e, &ea).unwrap())));
     }
     group.finish();
 }

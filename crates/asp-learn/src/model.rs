@@ -173,12 +173,9 @@ impl GraphModel {
 
     fn from_proto(proto: &pb::ModelProto, label: &str, expected: ModelKind) -> Result<Self> {
         let mismatch = |m: String| LearnError::Mismatch { path: label.to_string(), mismatch: m };
-        let metadata: BTreeMap<String, String> =
-            proto.metadata_props.iter().map(|p| (p.key.clone(), p.value.clone())).collect();
+        let metadata: BTreeMap<String, String> = proto.metadata_props.iter().map(|p| (p.key.clone(), p.value.clone())).collect();
         let meta = |key: &str| {
-            metadata
-                .get(key)
-                .ok_or_else(|| mismatch(format!("no metadata property '{key}' (not an asp {} model)", expected.name())))
+            metadata.get(key).ok_or_else(|| mismatch(format!("no metadata property '{key}' (not an asp {} model)", expected.name())))
         };
         let kind = meta("asp.kind")?;
         if kind != expected.name() {
@@ -304,15 +301,7 @@ impl GraphModel {
         self.score_with(self.policy, x, n, edge_index, e, edge_attr)
     }
 
-    fn score_with(
-        &self,
-        policy: ShapePolicy,
-        x: &[f32],
-        n: usize,
-        edge_index: &[i64],
-        e: usize,
-        edge_attr: &[f32],
-    ) -> Result<Vec<f32>> {
+    fn score_with(&self, policy: ShapePolicy, x: &[f32], n: usize, edge_index: &[i64], e: usize, edge_attr: &[f32]) -> Result<Vec<f32>> {
         self.check_input(x, n, edge_index, e, edge_attr)?;
         if n == 0 {
             return Ok(Vec::new());
@@ -495,7 +484,9 @@ fn check_signature(graph: &pb::GraphProto, node_dim: usize, edge_dim: usize, out
             return Err(format!("input 'edge_index' has {d} rows, expected 2"));
         }
     }
-    for (what, dims, axis, size) in [("input 'x'", &x.1, 0, "n"), ("input 'edge_index'", &ei.1, 1, "e"), ("input 'edge_attr'", &ea.1, 0, "e")] {
+    for (what, dims, axis, size) in
+        [("input 'x'", &x.1, 0, "n"), ("input 'edge_index'", &ei.1, 1, "e"), ("input 'edge_attr'", &ea.1, 0, "e")]
+    {
         if let Some(Dim::Fixed(d)) = dims.as_ref().map(|s| s[axis].clone()) {
             return Err(format!("{what} has a fixed size {d} on axis {axis}; {size} must be dynamic"));
         }

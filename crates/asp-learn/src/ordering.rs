@@ -56,7 +56,15 @@ impl GnnOrdering {
     pub fn new(graph: Arc<AssemblyGraph>, model: Arc<RemovabilityModel>) -> Result<Self> {
         model.check_graph(&graph)?;
         let parts = graph.num_parts();
-        Ok(GnnOrdering { tie: None, graph, model, scratch: StateGraph::default(), by_part: vec![f32::NEG_INFINITY; parts], failures: 0, first_failure: None })
+        Ok(GnnOrdering {
+            tie: None,
+            graph,
+            model,
+            scratch: StateGraph::default(),
+            by_part: vec![f32::NEG_INFINITY; parts],
+            failures: 0,
+            first_failure: None,
+        })
     }
 
     /// The predicted removability of every part of the model in `state` (`-inf` for parts

@@ -254,7 +254,13 @@ impl QWorker for OnnxQWorker<'_> {
 /// The ε-greedy rollout policy (thesis 5.4.5, 6.4.4) over the Q models at `paths`, one per
 /// objective in `objectives`' order (each model's `asp.objective` must be that objective), for
 /// maps with `directions` directions, evaluated where `uses` says (rollouts, expansions or both).
-pub fn epsilon_greedy(paths: &[impl AsRef<Path>], objectives: &[&str], epsilon: f64, directions: usize, uses: QUse) -> Result<Arc<dyn Policy>> {
+pub fn epsilon_greedy(
+    paths: &[impl AsRef<Path>],
+    objectives: &[&str],
+    epsilon: f64,
+    directions: usize,
+    uses: QUse,
+) -> Result<Arc<dyn Policy>> {
     let models = open_q_models(paths, objectives)?;
     epsilon_greedy_models(&models, objectives, epsilon, directions, uses)
 }
@@ -267,14 +273,25 @@ pub fn open_q_models(paths: &[impl AsRef<Path>], objectives: &[&str]) -> Result<
         let names = paths.iter().map(|p| p.as_ref().display().to_string()).collect::<Vec<_>>().join(",");
         return Err(LearnError::Mismatch {
             path: names,
-            mismatch: format!("{} Q models for {} objectives ({}): give one per objective, in their order", paths.len(), objectives.len(), objectives.join(",")),
+            mismatch: format!(
+                "{} Q models for {} objectives ({}): give one per objective, in their order",
+                paths.len(),
+                objectives.len(),
+                objectives.join(",")
+            ),
         });
     }
     paths.iter().map(|p| GraphModel::open_kind(p, ModelKind::Q).map(Arc::new)).collect()
 }
 
 /// [`epsilon_greedy`] over models opened by [`open_q_models`].
-pub fn epsilon_greedy_models(models: &[Arc<GraphModel>], objectives: &[&str], epsilon: f64, directions: usize, uses: QUse) -> Result<Arc<dyn Policy>> {
+pub fn epsilon_greedy_models(
+    models: &[Arc<GraphModel>],
+    objectives: &[&str],
+    epsilon: f64,
+    directions: usize,
+    uses: QUse,
+) -> Result<Arc<dyn Policy>> {
     let mut qs: Vec<Arc<dyn QFunction>> = Vec::with_capacity(models.len());
     for (model, objective) in models.iter().zip(objectives) {
         let q = OnnxQ::new(model.clone(), directions)?;
@@ -297,7 +314,10 @@ mod tests {
     #[test]
     fn features_parse_and_refuse() {
         assert_eq!(parse_features("asp-q/1 directions=81 neighbours=8"), Some(QGraphConfig { directions: 81, neighbours: 8 }));
-        assert_eq!(parse_features("asp-q/1 directions=25 neighbours=3").map(|c| c.features()).as_deref(), Some("asp-q/1 directions=25 neighbours=3"));
+        assert_eq!(
+            parse_features("asp-q/1 directions=25 neighbours=3").map(|c| c.features()).as_deref(),
+            Some("asp-q/1 directions=25 neighbours=3")
+        );
         assert_eq!(parse_features("asp-graph/2 radius_bins=8"), None);
         assert_eq!(parse_features("asp-q/1 directions=81"), None);
         assert_eq!(parse_features("asp-q/1 directions=81 neighbours=0"), None);

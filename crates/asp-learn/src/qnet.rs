@@ -93,7 +93,17 @@ fn lanes<S: Simd>() -> usize {
 /// accumulators in registers, so each load of a row of `W` serves `R` rows of `x`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn gemm_rows<S: Simd, const R: usize>(simd: S, x: &[f32], r0: usize, k: usize, w: &[f32], cols: usize, whole: usize, bias: Option<&[f32]>, out: &mut [f32]) {
+fn gemm_rows<S: Simd, const R: usize>(
+    simd: S,
+    x: &[f32],
+    r0: usize,
+    k: usize,
+    w: &[f32],
+    cols: usize,
+    whole: usize,
+    bias: Option<&[f32]>,
+    out: &mut [f32],
+) {
     let tile = 2 * lanes::<S>();
     let xs: [&[f32]; R] = std::array::from_fn(|r| &x[(r0 + r) * k..(r0 + r + 1) * k]);
     for c0 in (0..whole).step_by(tile) {
@@ -360,7 +370,16 @@ impl QNet {
     /// The Q-values of the `wanted` nodes of a graph in the model's input layout (`x [n,
     /// node_dim]`, `edge_index [2, e]`, `edge_attr [e, edge_dim]`), into `out`.
     #[allow(clippy::too_many_arguments)]
-    pub fn forward_graph(&self, x: &[f32], n: usize, edge_index: &[i64], edge_attr: &[f32], wanted: &[usize], out: &mut [f32], s: &mut Scratch) {
+    pub fn forward_graph(
+        &self,
+        x: &[f32],
+        n: usize,
+        edge_index: &[i64],
+        edge_attr: &[f32],
+        wanted: &[usize],
+        out: &mut [f32],
+        s: &mut Scratch,
+    ) {
         let e = edge_index.len() / 2;
         let mut enc = std::mem::take(&mut s.enc);
         let mut rows = std::mem::take(&mut s.rows);
@@ -379,7 +398,17 @@ impl QNet {
     ///
     /// Runs on the widest SIMD instruction set the CPU has (`pulp`, see the module's notes).
     #[allow(clippy::too_many_arguments)]
-    pub fn forward(&self, x: &[f32], n: usize, sources: &[u32], targets: &[u32], edges: &[f32], wanted: &[usize], out: &mut [f32], s: &mut Scratch) {
+    pub fn forward(
+        &self,
+        x: &[f32],
+        n: usize,
+        sources: &[u32],
+        targets: &[u32],
+        edges: &[f32],
+        wanted: &[usize],
+        out: &mut [f32],
+        s: &mut Scratch,
+    ) {
         pulp::Arch::new().dispatch(Forward { net: self, x, n, sources, targets, edges, wanted, out, s });
     }
 
@@ -387,7 +416,18 @@ impl QNet {
     /// contiguous), so every per-edge loop runs over contiguous features and vectorises.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn forward_any<S: Simd>(&self, simd: S, x: &[f32], n: usize, sources: &[u32], targets: &[u32], edges: &[f32], wanted: &[usize], out: &mut [f32], s: &mut Scratch) {
+    fn forward_any<S: Simd>(
+        &self,
+        simd: S,
+        x: &[f32],
+        n: usize,
+        sources: &[u32],
+        targets: &[u32],
+        edges: &[f32],
+        wanted: &[usize],
+        out: &mut [f32],
+        s: &mut Scratch,
+    ) {
         let w = self.width;
         let e = sources.len();
         let nd = self.node_dim;
@@ -426,7 +466,8 @@ impl QNet {
             let (p, b1) = (&s.p[..n * w], &self.e1.b[..w]);
             for (k, z) in s.z[..e * w].chunks_exact_mut(w).enumerate() {
                 let (t, src) = (targets[k] as usize, sources[k] as usize);
-                let (pt, ps, a) = (&p[t * w..(t + 1) * w], &p[src * w..(src + 1) * w], &a_in[k * stride + (stride - w)..k * stride + stride]);
+                let (pt, ps, a) =
+                    (&p[t * w..(t + 1) * w], &p[src * w..(src + 1) * w], &a_in[k * stride + (stride - w)..k * stride + stride]);
                 for ((((z, &pt), &a), &ps), &b1) in z.iter_mut().zip(pt).zip(a).zip(ps).zip(b1) {
                     *z = (pt + a + ps + b1).max(0.0);
                 }
@@ -624,7 +665,11 @@ mod tests {
                         for (path, got) in [("simd", &simd), ("scalar", &scalar)] {
                             for (i, (g, v)) in got.iter().zip(&want).enumerate() {
                                 let err = (f64::from(*g) - v).abs();
-                                assert!(err <= 1e-5 * (k as f64), "{path} rows {rows} k {k} cols {cols} bias {}: [{i}] {g} vs {v}", bias.is_some());
+                                assert!(
+                                    err <= 1e-5 * (k as f64),
+                                    "{path} rows {rows} k {k} cols {cols} bias {}: [{i}] {g} vs {v}",
+                                    bias.is_some()
+                                );
                             }
                         }
                     }

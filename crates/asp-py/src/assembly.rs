@@ -1,14 +1,14 @@
 //! `asp._asp.Assembly`: a loaded model, owned by the handle (no borrow of anything else), and
 //! `asp._asp.load`.
 
+use crate::arrays::GraphArrays;
 use crate::errors::Error;
 use crate::qgraphs::PyQGraphs;
 use crate::search::PySearch;
-use crate::arrays::GraphArrays;
 use crate::settings::GraphSettings;
 use crate::{run, settings};
-use asp_geom::{AssemblyGraph, PartSet, World};
 use asp_app::pipeline;
+use asp_geom::{AssemblyGraph, PartSet, World};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -129,9 +129,7 @@ impl PyAssembly {
         let trace = match &result.search {
             Some(search) => {
                 let mut csv = Vec::new();
-                search
-                    .write_trace_csv(&mut csv)
-                    .map_err(|e| Error::config(format!("cannot write the trace: {e}")).into_py(py))?;
+                search.write_trace_csv(&mut csv).map_err(|e| Error::config(format!("cannot write the trace: {e}")).into_py(py))?;
                 Some(String::from_utf8_lossy(&csv).into_owned())
             }
             None => None,

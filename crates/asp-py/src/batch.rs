@@ -7,12 +7,12 @@
 
 use crate::errors::Error;
 use crate::settings;
-use asp_gen::batch::{self, Batch, Generator};
-use asp_gen::manifest::ManifestEntry;
-use asp_gen::{GenError, ProfileParams};
 use asp_app::bench::{self, BenchRow};
 use asp_app::collect::{self, CollectSettings, CollectedModel, ModelItem};
 use asp_app::PlanSettings;
+use asp_gen::batch::{self, Batch, Generator};
+use asp_gen::manifest::ManifestEntry;
+use asp_gen::{GenError, ProfileParams};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::{Path, PathBuf};
@@ -95,10 +95,7 @@ pub fn gen_manifest(
 #[pyfunction]
 pub fn model_items(py: Python<'_>, paths: Vec<PathBuf>) -> PyResult<Vec<(String, usize, String, String)>> {
     let models = collect::model_paths(&paths).map_err(|e| Error::from(e).into_py(py))?;
-    Ok(collect::model_items(&models)
-        .into_iter()
-        .map(|m| (m.path.display().to_string(), m.index, m.name, m.dir))
-        .collect())
+    Ok(collect::model_items(&models).into_iter().map(|m| (m.path.display().to_string(), m.index, m.name, m.dir)).collect())
 }
 
 /// Plan settings from `asp.Assembly.plan`'s keywords and `asp.load`'s (`load`: `unit`, `up`,
@@ -113,7 +110,8 @@ fn model_settings(dict: &Bound<'_, PyDict>, load: Option<&Bound<'_, PyDict>>) ->
             }
         }
         let l = settings::request(load, true)?;
-        (request.unit, request.up, request.fixed, request.max_triangles, request.max_parts) = (l.unit, l.up, l.fixed, l.max_triangles, l.max_parts);
+        (request.unit, request.up, request.fixed, request.max_triangles, request.max_parts) =
+            (l.unit, l.up, l.fixed, l.max_triangles, l.max_parts);
     }
     Ok(asp_app::resolve(&request)?)
 }

@@ -3,12 +3,12 @@
 //! model's distance maps and the MDP built from them, so a state's graph is the same arrays the
 //! search's Q-function sees.
 
-use crate::errors::Error;
 use crate::arrays::GraphArrays;
+use crate::errors::Error;
 use crate::settings;
+use asp_app::pipeline::{self, OptimiserProblem};
 use asp_geom::distmap::{DirMask, MapState};
 use asp_geom::PartSet;
-use asp_app::pipeline::{self, OptimiserProblem};
 use asp_search::qgraph::{QGraph, QGraphBuilder};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -28,9 +28,8 @@ impl PyQGraphs {
     /// (without the GIL).
     pub fn build(py: Python<'_>, assembly: Arc<asp_geom::Assembly>, dict: &Bound<'_, PyDict>) -> PyResult<Self> {
         let (plan, optimise, neighbours) = settings::q_graph_settings(dict).map_err(|e| e.into_py(py))?;
-        let problem = py
-            .detach(|| pipeline::optimiser_problem(&assembly, &plan, &optimise).map_err(Error::from))
-            .map_err(|e| e.into_py(py))?;
+        let problem =
+            py.detach(|| pipeline::optimiser_problem(&assembly, &plan, &optimise).map_err(Error::from)).map_err(|e| e.into_py(py))?;
         let builder = QGraphBuilder::new(problem.mdp.maps(), neighbours);
         let objectives = problem.mdp.objectives().iter().map(|o| o.name().to_string()).collect();
         let reward_ranges = problem.mdp.objectives().iter().map(|o| o.reward_range(problem.mdp.maps())).collect();

@@ -13,8 +13,8 @@
 //! seen on Python's main thread, as in Python itself.
 
 use crate::errors::Error;
-use asp_geom::Assembly;
 use asp_app::pipeline::{self, PlanResult, PlanSettings};
+use asp_geom::Assembly;
 use asp_search::StopToken;
 use pyo3::prelude::*;
 use std::panic;

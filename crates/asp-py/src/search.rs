@@ -7,9 +7,9 @@
 use crate::errors::Error;
 use crate::run::SIGNAL_INTERVAL;
 use crate::settings;
+use asp_app::catalogue::{PolicySource, QPolicy, DEFAULT_EPSILON};
 use asp_app::collect_q;
 use asp_app::stepped::{Poll, SteppedSearch};
-use asp_app::catalogue::{PolicySource, QPolicy, DEFAULT_EPSILON};
 use asp_search::QUse;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -64,9 +64,8 @@ impl PySearch {
         plan.up = Some(assembly.up);
         plan.fixed = assembly.parts.iter().filter(|p| p.fixed).map(|p| p.name.clone()).collect();
         let path = PathBuf::from(&assembly.source);
-        let search = py
-            .detach(|| SteppedSearch::start_assembly(assembly, &path, &plan, record).map_err(Error::from))
-            .map_err(|e| e.into_py(py))?;
+        let search =
+            py.detach(|| SteppedSearch::start_assembly(assembly, &path, &plan, record).map_err(Error::from)).map_err(|e| e.into_py(py))?;
         let index = serde_json::to_string(search.index()).expect("the index serialises");
         Ok(PySearch { inner: Mutex::new(Some(search)), index, swaps: AtomicUsize::new(0) })
     }

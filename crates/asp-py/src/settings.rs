@@ -49,7 +49,11 @@ fn to_json(key: &str, v: &Bound<'_, PyAny>) -> Result<Value, Error> {
         return Ok(Value::String(s.to_string()));
     }
     if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
-        let items: Vec<Bound<'_, PyAny>> = v.try_iter().map_err(|e| Error::config(format!("{key}: {e}")))?.collect::<PyResult<_>>().map_err(|e| Error::config(format!("{key}: {e}")))?;
+        let items: Vec<Bound<'_, PyAny>> = v
+            .try_iter()
+            .map_err(|e| Error::config(format!("{key}: {e}")))?
+            .collect::<PyResult<_>>()
+            .map_err(|e| Error::config(format!("{key}: {e}")))?;
         return items.iter().map(|item| to_json(key, item)).collect::<Result<Vec<_>, _>>().map(Value::Array);
     }
     // os.PathLike (pathlib.Path): its path
@@ -66,7 +70,10 @@ fn to_json(key: &str, v: &Bound<'_, PyAny>) -> Result<Value, Error> {
 fn dict_json(dict: &Bound<'_, PyDict>) -> Result<Map<String, Value>, Error> {
     let mut map = Map::new();
     for (key, value) in dict.iter() {
-        let key = key.cast::<PyString>().map(|s| s.to_string()).map_err(|_| Error::config(format!("setting names must be strings, got {key}")))?;
+        let key = key
+            .cast::<PyString>()
+            .map(|s| s.to_string())
+            .map_err(|_| Error::config(format!("setting names must be strings, got {key}")))?;
         let value = to_json(&key, &value)?;
         map.insert(key, value);
     }
@@ -137,10 +144,9 @@ fn split(dict: &Bound<'_, PyDict>, request_keys: &[&str], own_keys: &[&str]) -> 
 fn count(own: &Map<String, Value>, key: &str) -> Result<Option<usize>, Error> {
     match own.get(key) {
         None | Some(Value::Null) => Ok(None),
-        Some(v) => v
-            .as_u64()
-            .map(|n| Some(n as usize))
-            .ok_or_else(|| Error::config(format!("{key} must be a non-negative integer, got {v}"))),
+        Some(v) => {
+            v.as_u64().map(|n| Some(n as usize)).ok_or_else(|| Error::config(format!("{key} must be a non-negative integer, got {v}")))
+        }
     }
 }
 

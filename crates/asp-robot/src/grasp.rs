@@ -6,8 +6,8 @@
 //! direction of the fingers, as in [`asp_geom::Grasp`].
 
 use asp_geom::math::{Rot, Vec3};
-use parry3d::math::Mat3;
 use asp_geom::{Grasp, Mesh, Part, PartMeta};
+use parry3d::math::Mat3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -167,9 +167,8 @@ pub fn antipodal_grasps(mesh: &Mesh, cfg: &GraspConfig) -> Vec<Grasp> {
             }
             let x = y.cross(z);
             let orientation = Rot::from_mat3(&Mat3::from_cols(x, y, z)).normalize();
-            let duplicate = out.iter().any(|g| {
-                (g.position - centre).length() < cfg.min_spacing && g.orientation.angle_between(orientation) < 0.3
-            });
+            let duplicate =
+                out.iter().any(|g| (g.position - centre).length() < cfg.min_spacing && g.orientation.angle_between(orientation) < 0.3);
             if !duplicate {
                 out.push(Grasp { position: centre, orientation, width });
                 if out.len() >= cfg.max_grasps {

@@ -206,7 +206,10 @@ impl Robot {
         let wrist = (target * tip.inverse()).translation.vector;
         let bound: f64 = self.joints[first + 1..=last]
             .iter()
-            .map(|j| j.origin.translation.vector.norm() + if j.kind == JointKind::Prismatic { j.limits.0.abs().max(j.limits.1.abs()) } else { 0.0 })
+            .map(|j| {
+                j.origin.translation.vector.norm()
+                    + if j.kind == JointKind::Prismatic { j.limits.0.abs().max(j.limits.1.abs()) } else { 0.0 }
+            })
             .sum();
         Some(((wrist - self.shoulder()).norm(), bound + 1e-9))
     }

@@ -11,13 +11,13 @@ pub mod rrt;
 pub mod search;
 pub mod shape;
 
+pub use checker::{HoldingChecker, RobotChecker};
 pub use error::{Result, RobotError};
 pub use grasp::{antipodal_grasps, grasps_from_meta, part_grasps, GraspConfig};
 pub use ik::{IkConfig, IkOutcome, IkSolution};
 pub use removal::{PlanStats, RemovalConfig, RemovalPlanner, RobotCell, RobotFailure, RobotRemoval};
-pub use checker::{HoldingChecker, RobotChecker};
-pub use search::{CellSetup, RobotExtension, RobotSetup, ROBOT_PATH};
 pub use robot::{ChainSpec, Finger, Joint, JointKind, Link, Robot, RobotFiles};
+pub use search::{CellSetup, RobotExtension, RobotSetup, ROBOT_PATH};
 pub use shape::{LinkShape, ShapeKind};
 
 /// The URDF of the default robot (a Franka-Panda-like arm with a parallel gripper), embedded.

@@ -249,8 +249,8 @@ impl Robot {
 
     /// Loads a URDF file with the given chain ends, its meshes resolved by `files`.
     pub fn from_urdf_file_checked(path: &Path, spec: &ChainSpec, files: &RobotFiles) -> Result<Robot> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| RobotError::Read { path: path.to_path_buf(), message: one_line(&e.to_string()) })?;
+        let text =
+            std::fs::read_to_string(path).map_err(|e| RobotError::Read { path: path.to_path_buf(), message: one_line(&e.to_string()) })?;
         Robot::from_urdf_str_with(&text, path, spec, files)
     }
 
@@ -284,8 +284,7 @@ impl Robot {
                 return Err(RobotError::chain(p(), format!("link '{}' is the child of two joints", j.child.link)));
             }
         }
-        let roots: Vec<&str> =
-            urdf.links.iter().map(|l| l.name.as_str()).filter(|n| !parent_joint.contains_key(n)).collect();
+        let roots: Vec<&str> = urdf.links.iter().map(|l| l.name.as_str()).filter(|n| !parent_joint.contains_key(n)).collect();
         let base = match &spec.base_link {
             Some(b) if link_index.contains_key(b.as_str()) => b.clone(),
             Some(b) => return Err(RobotError::chain(p(), format!("no base link named '{b}'"))),
@@ -320,8 +319,7 @@ impl Robot {
                 match named {
                     Some(n) => n.to_string(),
                     None => {
-                        let has_child: std::collections::HashSet<&str> =
-                            urdf.joints.iter().map(|j| j.parent.link.as_str()).collect();
+                        let has_child: std::collections::HashSet<&str> = urdf.joints.iter().map(|j| j.parent.link.as_str()).collect();
                         let mut best: Option<(usize, &str)> = None;
                         for l in urdf.links.iter().map(|l| l.name.as_str()).filter(|n| !has_child.contains(n)) {
                             if let Some(c) = chain_to(l) {
@@ -336,8 +334,7 @@ impl Robot {
                 }
             }
         };
-        let chain = chain_to(&tip)
-            .ok_or_else(|| RobotError::chain(p(), format!("link '{tip}' does not hang below base link '{base}'")))?;
+        let chain = chain_to(&tip).ok_or_else(|| RobotError::chain(p(), format!("link '{tip}' does not hang below base link '{base}'")))?;
         let mut notes = Vec::new();
         let mut links = vec![Link { name: base.clone(), shapes: shapes_of(&urdf.links[link_index[base.as_str()]], &mut notes) }];
         let mut joints = Vec::new();
@@ -375,7 +372,16 @@ impl Robot {
                 notes.push(format!("joint '{}' branches off the chain and is not used", j.name));
             }
         }
-        Ok(Robot { name: urdf.name.clone(), source: path.to_path_buf(), links, joints, movable, fingers, base: Isometry3::identity(), notes })
+        Ok(Robot {
+            name: urdf.name.clone(),
+            source: path.to_path_buf(),
+            links,
+            joints,
+            movable,
+            fingers,
+            base: Isometry3::identity(),
+            notes,
+        })
     }
 
     /// Checks that the robot can carry a part out at all: it needs a parallel gripper (prismatic
@@ -620,9 +626,16 @@ impl Robot {
         let first = self.movable[0];
         self.joints[first + 1..]
             .iter()
-            .map(|j| j.origin.translation.vector.norm() + if j.kind == JointKind::Prismatic { j.limits.0.abs().max(j.limits.1.abs()) } else { 0.0 })
+            .map(|j| {
+                j.origin.translation.vector.norm()
+                    + if j.kind == JointKind::Prismatic { j.limits.0.abs().max(j.limits.1.abs()) } else { 0.0 }
+            })
             .sum::<f64>()
-            + if self.joints[first].kind == JointKind::Prismatic { self.joints[first].limits.0.abs().max(self.joints[first].limits.1.abs()) } else { 0.0 }
+            + if self.joints[first].kind == JointKind::Prismatic {
+                self.joints[first].limits.0.abs().max(self.joints[first].limits.1.abs())
+            } else {
+                0.0
+            }
     }
 
     /// The world position of the first movable joint (it does not move with any joint).
@@ -656,7 +669,8 @@ mod tests {
     fn fingers_open_to_the_requested_width() {
         let r = Robot::panda();
         let shapes = r.gripper_shapes(&Pose::IDENTITY, 0.06);
-        let fingers: Vec<_> = shapes.iter().filter(|(_, s)| matches!(s.kind, ShapeKind::Box { half_extents } if half_extents.x < 0.011)).collect();
+        let fingers: Vec<_> =
+            shapes.iter().filter(|(_, s)| matches!(s.kind, ShapeKind::Box { half_extents } if half_extents.x < 0.011)).collect();
         assert_eq!(fingers.len(), 2);
         // inner faces 0.06 apart along the tool's y axis
         let inner: Vec<f32> = fingers

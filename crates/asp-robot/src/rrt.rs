@@ -127,12 +127,7 @@ fn extend<P: Space>(space: &P, tree: &mut Tree<P::State>, q: &P::State, step: f6
 
 /// A collision-free path from `start` to `goal` (both included) by RRT-Connect, then shortcut.
 /// Every edge of the answer passed [`Space::edge_valid`].
-pub fn rrt_connect<P: Space>(
-    space: &P,
-    start: &P::State,
-    goal: &P::State,
-    config: &RrtConnectConfig,
-) -> Result<Vec<P::State>, RrtFailure> {
+pub fn rrt_connect<P: Space>(space: &P, start: &P::State, goal: &P::State, config: &RrtConnectConfig) -> Result<Vec<P::State>, RrtFailure> {
     if !space.valid(start) {
         return Err(RrtFailure::InvalidStart);
     }

@@ -24,9 +24,9 @@ use asp_geom::{Assembly, Checker, FeasibilityChecker, Motion, PartSet, World, Wo
 use asp_search::extension::{MdpExtension, ModelContext};
 use asp_search::mdp::{ActionFilter, Verdict};
 use asp_search::objective::Objective;
+use asp_search::report::{RobotEntry, RobotReport, RobotStepEntry};
 use asp_search::step::{StepContext, StepKind};
 use asp_search::CheckerExtension;
-use asp_search::report::{RobotEntry, RobotReport, RobotStepEntry};
 use asp_search::{Mdp, PathLength, PlanOutcome, SearchError};
 
 use crate::checker::{HoldingChecker, RobotChecker};

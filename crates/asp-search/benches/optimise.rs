@@ -24,9 +24,7 @@ fn bench(c: &mut Criterion) {
         let name = format!("{size}x{size}x{size}_{}_parts", cube.len());
         let mut group = c.benchmark_group(format!("distance_maps/{name}"));
         group.sample_size(10);
-        group.bench_function("build", |b| {
-            b.iter(|| DistanceMaps::build(black_box(&cube), &MapConfig::default()).expect("maps"))
-        });
+        group.bench_function("build", |b| b.iter(|| DistanceMaps::build(black_box(&cube), &MapConfig::default()).expect("maps")));
         group.finish();
 
         let maps = Arc::new(DistanceMaps::build(&cube, &MapConfig::default()).expect("maps"));
@@ -36,15 +34,8 @@ fn bench(c: &mut Criterion) {
         group.sample_size(10);
         group.throughput(Throughput::Elements(episodes as u64));
         for threads in [1, 2] {
-            let search = ParetoMcts::builder()
-                .episodes(episodes)
-                .threads(threads)
-                .seed(1)
-                .build()
-                .expect("settings");
-            group.bench_function(format!("{threads}_threads"), |b| {
-                b.iter(|| search.solve(black_box(&mdp)).expect("search"))
-            });
+            let search = ParetoMcts::builder().episodes(episodes).threads(threads).seed(1).build().expect("settings");
+            group.bench_function(format!("{threads}_threads"), |b| b.iter(|| search.solve(black_box(&mdp)).expect("search")));
         }
         group.finish();
     }

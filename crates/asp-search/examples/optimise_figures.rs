@@ -45,8 +45,7 @@ fn main() {
             let (mdp, map_seconds) = mdp(&cube);
             println!("{size}x{size}x{size} Soma cube, {} parts: distance maps in {map_seconds:.3} s", cube.len());
             for threads in [1, 2] {
-                let search =
-                    ParetoMcts::builder().episodes(episodes).threads(threads).seed(1).build().expect("settings");
+                let search = ParetoMcts::builder().episodes(episodes).threads(threads).seed(1).build().expect("settings");
                 let out = search.solve(&mdp).expect("search");
                 let s = out.stats;
                 println!(
@@ -103,8 +102,7 @@ fn main() {
             for (supports, seed) in [(1, 0), (2, 1)] {
                 instances.push((format!("profiles, {supports} supports, seed {seed}"), small_profiles(supports, seed)));
             }
-            let fractions: Vec<f64> =
-                instances.iter().filter_map(|(name, a)| exact_fraction(name, a, 0, None, 1)).collect();
+            let fractions: Vec<f64> = instances.iter().filter_map(|(name, a)| exact_fraction(name, a, 0, None, 1)).collect();
             summary(&fractions);
         }
         "maps" => {
@@ -140,7 +138,12 @@ fn main() {
                     let (mdp, _) = mdp(&cube);
                     let t = Instant::now();
                     let exact = exact_front(&mdp, 5_000_000).expect("exact front");
-                    println!("cube {seed}: exact front {} points, {} states in {:.2} s", exact.solutions.len(), exact.states, t.elapsed().as_secs_f64());
+                    println!(
+                        "cube {seed}: exact front {} points, {} states in {:.2} s",
+                        exact.solutions.len(),
+                        exact.states,
+                        t.elapsed().as_secs_f64()
+                    );
                     (seed, mdp, exact)
                 })
                 .collect();

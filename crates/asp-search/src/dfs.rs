@@ -39,13 +39,7 @@ pub struct DfsBuilder {
 
 impl Default for DfsBuilder {
     fn default() -> Self {
-        DfsBuilder {
-            ordering: Arc::new(BuiltinOrder::Given),
-            bookkeeping: false,
-            no_path_planner: false,
-            no_subassemblies: false,
-            seed: 0,
-        }
+        DfsBuilder { ordering: Arc::new(BuiltinOrder::Given), bookkeeping: false, no_path_planner: false, no_subassemblies: false, seed: 0 }
     }
 }
 
@@ -83,8 +77,7 @@ impl DfsBuilder {
     }
     /// The planner (every combination of settings is valid).
     pub fn build(self) -> Dfs {
-        let ordering: Arc<dyn OrderingFactory> =
-            if self.bookkeeping { Arc::new(WithBookkeeping(self.ordering)) } else { self.ordering };
+        let ordering: Arc<dyn OrderingFactory> = if self.bookkeeping { Arc::new(WithBookkeeping(self.ordering)) } else { self.ordering };
         Dfs { ordering, path_planner: !self.no_path_planner, subassemblies: !self.no_subassemblies, seed: self.seed }
     }
 }
@@ -370,12 +363,7 @@ impl Planner for Dfs {
 impl Dfs {
     /// [`Planner::solve`], calling `visit` with every state the search expands (in order; each
     /// state once). Data collection records these states.
-    pub fn solve_visiting(
-        &self,
-        problem: &Problem,
-        budget: &Budget,
-        visit: Option<&mut dyn FnMut(&PartSet)>,
-    ) -> PlanOutcome {
+    pub fn solve_visiting(&self, problem: &Problem, budget: &Budget, visit: Option<&mut dyn FnMut(&PartSet)>) -> PlanOutcome {
         let started = Instant::now();
         let mut search = Search {
             problem,

@@ -77,9 +77,7 @@ impl<'p> Dp<'p> {
             return Ok(e);
         }
         if self.entries.len() >= self.max_states {
-            return Err(SearchError::TooLarge {
-                reason: format!("more than {} states", self.max_states),
-            });
+            return Err(SearchError::TooLarge { reason: format!("more than {} states", self.max_states) });
         }
         let m = self.problem.num_objectives();
         let problem = self.problem;
@@ -101,8 +99,7 @@ impl<'p> Dp<'p> {
                 let child = self.solve(&present.without(a), &mem)?;
                 let c = &self.entries[child];
                 let mut cand = vec![0.0; m];
-                let points: Vec<(usize, Vec<f64>)> =
-                    c.front.iter().enumerate().map(|(i, (p, _))| (i, p.to_vec())).collect();
+                let points: Vec<(usize, Vec<f64>)> = c.front.iter().enumerate().map(|(i, (p, _))| (i, p.to_vec())).collect();
                 for k in 0..m {
                     if c.worst[k].is_finite() {
                         worst[k] = worst[k].min(rewards[k] + c.worst[k]);
@@ -144,12 +141,8 @@ pub fn exact_front(problem: &Mdp, max_states: usize) -> Result<ExactFront> {
     let mut dp = Dp { problem, memo: HashMap::new(), entries: Vec::new(), max_states, spare: Vec::new() };
     let root = dp.solve(&PartSet::full(maps.num_parts()), &problem.initial_memory())?;
     let e = &dp.entries[root];
-    let mut solutions: Vec<ExactSolution> = e
-        .front
-        .iter()
-        .enumerate()
-        .map(|(i, (p, _))| ExactSolution { values: p.to_vec(), sequence: dp.sequence(root, i) })
-        .collect();
+    let mut solutions: Vec<ExactSolution> =
+        e.front.iter().enumerate().map(|(i, (p, _))| ExactSolution { values: p.to_vec(), sequence: dp.sequence(root, i) }).collect();
     solutions.sort_by(|a, b| {
         for (x, y) in a.values.iter().zip(&b.values) {
             match y.total_cmp(x) {
@@ -171,15 +164,7 @@ pub fn enumerate_sequences(problem: &Mdp, limit: usize) -> Result<Vec<ExactSolut
     let mut out = Vec::new();
     let mut seq = Vec::new();
     let mut totals = vec![0.0; m];
-    enumerate(
-        problem,
-        &PartSet::full(maps.num_parts()),
-        &problem.initial_memory(),
-        &mut seq,
-        &mut totals,
-        &mut out,
-        limit,
-    )?;
+    enumerate(problem, &PartSet::full(maps.num_parts()), &problem.initial_memory(), &mut seq, &mut totals, &mut out, limit)?;
     Ok(out)
 }
 

@@ -63,11 +63,7 @@ pub fn check_objective_names(list: &str, extensions: &[Arc<dyn MdpExtension>]) -
 
 /// The objectives of a comma-separated list on one model: the built-in ones by name, the
 /// others from the first extension that provides them.
-pub fn resolve_objectives(
-    list: &str,
-    extensions: &[Arc<dyn MdpExtension>],
-    model: &ModelContext<'_>,
-) -> Result<Vec<Arc<dyn Objective>>> {
+pub fn resolve_objectives(list: &str, extensions: &[Arc<dyn MdpExtension>], model: &ModelContext<'_>) -> Result<Vec<Arc<dyn Objective>>> {
     let provided: Vec<String> = extensions.iter().flat_map(|e| e.objective_names()).collect();
     collect_objectives(
         list,

@@ -53,11 +53,8 @@ pub fn hypervolume_2d_in_place(points: &mut [[f64; 2]], reference: [f64; 2]) -> 
 /// Exact hypervolume of `points` (each of length `reference.len()`) relative to `reference`.
 pub fn hypervolume(points: &[&[f64]], reference: &[f64]) -> f64 {
     let d = reference.len();
-    let pts: Vec<Vec<f64>> = points
-        .iter()
-        .filter(|p| p.len() == d && p.iter().zip(reference).all(|(x, r)| x > r))
-        .map(|p| p.to_vec())
-        .collect();
+    let pts: Vec<Vec<f64>> =
+        points.iter().filter(|p| p.len() == d && p.iter().zip(reference).all(|(x, r)| x > r)).map(|p| p.to_vec()).collect();
     hso(pts, reference)
 }
 

@@ -28,5 +28,7 @@ pub use mdp::{ActionFilter, FilterCount, Mdp, Verdict};
 pub use objective::{Accessibility, DirHistory, DirectionChanges, Objective, PathLength};
 pub use ordering::{Bookkeeping, BuiltinOrder, OrderingFactory, OrderingSource, PartOrdering, WithBookkeeping};
 pub use policy::{EpsilonGreedy, Policy, PolicyContext, PolicyWorker, QFunction, QUse, QWorker, RandomPolicy};
-pub use problem::{Budget, GroupMove, PlanOutcome, Planner, Problem, Progress, Stats, Status, Step, StopReason, StopToken, Stuck, StuckReason, Subassembly};
+pub use problem::{
+    Budget, GroupMove, PlanOutcome, Planner, Problem, Progress, Stats, Status, Step, StopReason, StopToken, Stuck, StuckReason, Subassembly,
+};
 pub use step::{StepContext, StepKind};

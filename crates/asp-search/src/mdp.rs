@@ -130,10 +130,7 @@ impl Mdp {
     /// A problem over `maps` with `objectives` (1 to [`MAX_OBJECTIVES`]).
     pub fn new(maps: Arc<DistanceMaps>, objectives: Vec<Arc<dyn Objective>>) -> Result<Self> {
         if objectives.is_empty() || objectives.len() > MAX_OBJECTIVES {
-            return Err(SearchError::config(format!(
-                "a problem needs 1 to {MAX_OBJECTIVES} objectives, got {}",
-                objectives.len()
-            )));
+            return Err(SearchError::config(format!("a problem needs 1 to {MAX_OBJECTIVES} objectives, got {}", objectives.len())));
         }
         let mut offsets = vec![0];
         let mut key: Vec<Range<usize>> = Vec::new();
@@ -300,11 +297,7 @@ impl Mdp {
             .iter()
             .zip(&counts.0)
             .filter(|(_, &c)| c > 0)
-            .map(|((f, reason), &count)| FilterCount {
-                filter: self.filters[*f].name().to_string(),
-                reason: reason.clone(),
-                count,
-            })
+            .map(|((f, reason), &count)| FilterCount { filter: self.filters[*f].name().to_string(), reason: reason.clone(), count })
             .collect()
     }
 
@@ -347,14 +340,7 @@ impl Mdp {
         }
     }
 
-    fn apply_filters(
-        &self,
-        state: &mut MapState<'_>,
-        memory: &[u64],
-        kind: StepKind,
-        out: &mut Vec<usize>,
-        counts: &mut FilterCounts,
-    ) {
+    fn apply_filters(&self, state: &mut MapState<'_>, memory: &[u64], kind: StepKind, out: &mut Vec<usize>, counts: &mut FilterCounts) {
         out.retain(|&part| self.admits(state, memory, part, kind, counts));
     }
 
@@ -577,10 +563,7 @@ mod tests {
         mdp.feasible_actions(&mut state, &[], StepKind::Simulation, &mut out, &mut counts);
         assert_eq!(out, all[1..].to_vec());
         let report = mdp.report_filtered(&counts);
-        assert_eq!(
-            report,
-            vec![FilterCount { filter: "not-part".into(), reason: "second reason".into(), count: 1 }]
-        );
+        assert_eq!(report, vec![FilterCount { filter: "not-part".into(), reason: "second reason".into(), count: 1 }]);
         // a sequence through the banned part does not replay
         let why = mdp.why_infeasible(&mut state, &[], banned, StepKind::Replay).unwrap();
         assert!(why.contains("not-part: second reason"), "{why}");

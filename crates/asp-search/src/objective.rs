@@ -216,10 +216,7 @@ pub fn objective_by_name(name: &str) -> Result<Arc<dyn Objective>> {
         "access" | "accessibility" => Ok(Arc::new(Accessibility)),
         "dirchange" | "direction" | "directions" | "dirchanges" => Ok(Arc::new(DirectionChanges)),
         "pathlen" | "path" | "pathlength" | "length" => Ok(Arc::new(PathLength)),
-        _ => Err(SearchError::UnknownObjective {
-            name: name.to_string(),
-            known: OBJECTIVE_NAMES.join(", "),
-        }),
+        _ => Err(SearchError::UnknownObjective { name: name.to_string(), known: OBJECTIVE_NAMES.join(", ") }),
     }
 }
 

@@ -94,7 +94,6 @@ impl OrderingFactory for BuiltinOrder {
         self.as_str().into()
     }
 
-
     fn make(&self, num_parts: usize, seed: u64) -> Box<dyn PartOrdering> {
         match self {
             BuiltinOrder::Given => Box::new(Given),

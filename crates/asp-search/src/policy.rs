@@ -264,18 +264,8 @@ impl EpsilonGreedy {
 
 impl Policy for EpsilonGreedy {
     fn for_worker(&self, thread: usize) -> Result<Box<dyn PolicyWorker + '_>> {
-        let q = self
-            .q_functions
-            .iter()
-            .map(|q| q.for_worker(thread))
-            .collect::<Result<Vec<_>>>()?;
-        Ok(Box::new(EpsilonGreedyWorker {
-            epsilon: self.epsilon,
-            uses: self.uses,
-            q,
-            values: Vec::new(),
-            product: Vec::new(),
-        }))
+        let q = self.q_functions.iter().map(|q| q.for_worker(thread)).collect::<Result<Vec<_>>>()?;
+        Ok(Box::new(EpsilonGreedyWorker { epsilon: self.epsilon, uses: self.uses, q, values: Vec::new(), product: Vec::new() }))
     }
 }
 
@@ -306,12 +296,7 @@ impl EpsilonGreedyWorker<'_> {
 }
 
 impl PolicyWorker for EpsilonGreedyWorker<'_> {
-    fn choose(
-        &mut self,
-        ctx: &mut PolicyContext<'_, '_>,
-        actions: &[usize],
-        rng: &mut SearchRng,
-    ) -> Result<usize> {
+    fn choose(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], rng: &mut SearchRng) -> Result<usize> {
         if !self.uses.rollouts() || rng.random::<f64>() <= self.epsilon {
             return Ok(rng.random_range(0..actions.len()));
         }
@@ -337,21 +322,12 @@ impl PolicyWorker for EpsilonGreedyWorker<'_> {
     }
 
     /// The Q-value products, normalised to sum 1 (uniform when they are all 0 or not finite).
-    fn priors(
-        &mut self,
-        ctx: &mut PolicyContext<'_, '_>,
-        actions: &[usize],
-        out: &mut [f64],
-    ) -> Result<()> {
+    fn priors(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], out: &mut [f64]) -> Result<()> {
         if actions.is_empty() {
             return Ok(());
         }
         self.evaluate(ctx, actions)?;
-        let total: f64 = self
-            .product
-            .iter()
-            .filter(|v| v.is_finite() && **v > 0.0)
-            .sum();
+        let total: f64 = self.product.iter().filter(|v| v.is_finite() && **v > 0.0).sum();
         for (o, &v) in out.iter_mut().zip(&self.product) {
             *o = if total > 0.0 && v.is_finite() && v > 0.0 {
                 v / total

@@ -232,7 +232,8 @@ pub struct AssemblyStep {
     pub subassembly: Option<Box<SubassemblyEntry>>,
     /// Plans with a robot: how the robot takes this part out. Since format 1.5.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub robot: Option<RobotStepEntry>,    /// With `--grippers N`: the parts (at most N-1, already in place) held by another gripper
+    pub robot: Option<RobotStepEntry>,
+    /// With `--grippers N`: the parts (at most N-1, already in place) held by another gripper
     /// or a fixture while this part goes in, because the state before it stands only so. Since
     /// format 1.5.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -445,12 +446,7 @@ impl PlanReport {
             up: assembly.up.to_string(),
             tolerance: u(tolerance),
             status,
-            parts: assembly
-                .parts
-                .iter()
-                .enumerate()
-                .map(|(index, p)| PartEntry { index, name: p.name.clone(), fixed: p.fixed })
-                .collect(),
+            parts: assembly.parts.iter().enumerate().map(|(index, p)| PartEntry { index, name: p.name.clone(), fixed: p.fixed }).collect(),
             assembly_sequence,
             disassembly_sequence: removed,
             partial_assembly_sequence,
@@ -600,14 +596,10 @@ fn insertion(motion: &Motion, u: &dyn Fn(f32) -> f64) -> MotionEntry {
     let v3 = |v: asp_geom::math::Vec3, f: &dyn Fn(f32) -> f64| [f(v.x), f(v.y), f(v.z)];
     let unit = |x: f32| x as f64;
     match motion {
-        Motion::Linear { direction, distance } => {
-            MotionEntry::Linear { direction: v3(-*direction, &unit), distance: u(*distance) }
+        Motion::Linear { direction, distance } => MotionEntry::Linear { direction: v3(-*direction, &unit), distance: u(*distance) },
+        Motion::Screw { axis_point, direction, distance } => {
+            MotionEntry::Screw { direction: v3(-*direction, &unit), distance: u(*distance), axis_point: v3(*axis_point, u) }
         }
-        Motion::Screw { axis_point, direction, distance } => MotionEntry::Screw {
-            direction: v3(-*direction, &unit),
-            distance: u(*distance),
-            axis_point: v3(*axis_point, u),
-        },
         Motion::Path { poses, pivot } => MotionEntry::Path {
             poses: poses
                 .iter()

@@ -44,13 +44,7 @@ impl Debug for StepContext<'_, '_> {
 impl<'s, 'm> StepContext<'s, 'm> {
     /// The removal of present `part` from `state`, in a problem over `assembly` (when it carries
     /// one) with seed `seed` ([`StepContext::new`] takes both from the problem).
-    pub(crate) fn from_parts(
-        assembly: Option<&'s Assembly>,
-        seed: u64,
-        state: &'s mut MapState<'m>,
-        part: usize,
-        kind: StepKind,
-    ) -> Self {
+    pub(crate) fn from_parts(assembly: Option<&'s Assembly>, seed: u64, state: &'s mut MapState<'m>, part: usize, kind: StepKind) -> Self {
         StepContext { assembly, seed, state, part, kind, clearance: None }
     }
 
@@ -132,4 +126,3 @@ fn splitmix(x: u64) -> u64 {
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
 }
-

@@ -139,7 +139,8 @@ fn write_mcap(path: &Path, scene: &Scene, options: &McapOptions, file: std::fs::
         }
         // the poses of `parts` at time `u` of the step's timeline, logged at `t`
         let mut put_poses = |t: u64, u: f32, parts: &[usize]| {
-            let transforms: Vec<Value> = parts.iter().map(|&i| transform(t, FRAME_MODEL, &part_frame(i), &scene.pose_during(k, u, i))).collect();
+            let transforms: Vec<Value> =
+                parts.iter().map(|&i| transform(t, FRAME_MODEL, &part_frame(i), &scene.pose_during(k, u, i))).collect();
             out.put(tf_ch, TOPIC_TRANSFORMS, t, &json!({ "transforms": transforms }))
         };
         if step.motion.is_some() {

@@ -52,9 +52,8 @@ pub struct Front {
 /// Reads the `pareto_front` of a plan JSON.
 pub fn read_front(path: &Path) -> Result<Front> {
     let report = crate::scene::read_plan(path)?;
-    let front = report
-        .pareto_front
-        .ok_or_else(|| VizError::input(path, "the plan has no pareto_front (plan with --objective A,B --pareto)"))?;
+    let front =
+        report.pareto_front.ok_or_else(|| VizError::input(path, "the plan has no pareto_front (plan with --objective A,B --pareto)"))?;
     let dims = front.first().map(|p| p.objectives.len()).unwrap_or(0);
     if front.is_empty() || dims < 2 {
         return Err(VizError::input(path, "the pareto_front needs at least one point with two or more objectives"));
@@ -128,7 +127,10 @@ pub fn read_trace(path: &Path) -> Result<Trace> {
     let mut lines = text.lines().filter(|l| !l.trim().is_empty());
     let header: Vec<&str> = lines.next().ok_or_else(|| VizError::input(path, "empty trace"))?.split(',').map(str::trim).collect();
     let col = |name: &str| {
-        header.iter().position(|h| *h == name).ok_or_else(|| VizError::input(path, format!("the trace has no column '{name}' (columns: {})", header.join(","))))
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| VizError::input(path, format!("the trace has no column '{name}' (columns: {})", header.join(","))))
     };
     let (ce, cs, cv) = (col("episode")?, col("seconds")?, col("value")?);
     let mut trace = Trace {
@@ -153,11 +155,9 @@ pub fn read_trace(path: &Path) -> Result<Trace> {
 
 /// The finite number in column `c` of data row `k` (0-based; the file's row `k + 2`) of a CSV.
 fn number(path: &Path, cells: &[&str], header: &[&str], k: usize, c: usize) -> Result<f64> {
-    cells
-        .get(c)
-        .and_then(|s| s.parse::<f64>().ok())
-        .filter(|v| v.is_finite())
-        .ok_or_else(|| VizError::input(path, format!("row {}: '{}' is not a number in column {}", k + 2, cells.get(c).unwrap_or(&""), header[c])))
+    cells.get(c).and_then(|s| s.parse::<f64>().ok()).filter(|v| v.is_finite()).ok_or_else(|| {
+        VizError::input(path, format!("row {}: '{}' is not a number in column {}", k + 2, cells.get(c).unwrap_or(&""), header[c]))
+    })
 }
 
 /// Reads an `asp bench mcts --csv` (`model,setting,seconds,mean,std,episodes`) as one trace per
@@ -170,7 +170,10 @@ pub fn read_bench(path: &Path) -> Result<Vec<Trace>> {
     let mut lines = text.lines().filter(|l| !l.trim().is_empty());
     let header: Vec<&str> = lines.next().ok_or_else(|| VizError::input(path, "empty CSV"))?.split(',').map(str::trim).collect();
     let col = |name: &str| {
-        header.iter().position(|h| *h == name).ok_or_else(|| VizError::input(path, format!("the bench CSV has no column '{name}' (columns: {})", header.join(","))))
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| VizError::input(path, format!("the bench CSV has no column '{name}' (columns: {})", header.join(","))))
     };
     let (cm, cset, cs, cv, ce) = (col("model")?, col("setting")?, col("seconds")?, col("mean")?, col("episodes")?);
     // (model, setting, seconds, value, episodes)
@@ -178,7 +181,9 @@ pub fn read_bench(path: &Path) -> Result<Vec<Trace>> {
     for (k, line) in lines.enumerate() {
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
         let num = |c: usize| number(path, &cells, &header, k, c);
-        let text = |c: usize| cells.get(c).map(|s| s.to_string()).ok_or_else(|| VizError::input(path, format!("row {}: no column {}", k + 2, header[c])));
+        let text = |c: usize| {
+            cells.get(c).map(|s| s.to_string()).ok_or_else(|| VizError::input(path, format!("row {}: no column {}", k + 2, header[c])))
+        };
         rows.push((text(cm)?, text(cset)?, num(cs)?, num(cv)?, num(ce)?));
     }
     if rows.is_empty() {
@@ -267,9 +272,7 @@ fn front_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, front: &Front,
         .map_err(e)?;
     let stairs = stair_path(&staircase(&front.points, i, j));
     chart.draw_series(LineSeries::new(stairs, RGBColor(230, 81, 0).stroke_width(2))).map_err(e)?;
-    chart
-        .draw_series(xs.iter().zip(&ys).map(|(&x, &y)| Circle::new((x, y), 4, RGBColor(33, 90, 160).filled())))
-        .map_err(e)?;
+    chart.draw_series(xs.iter().zip(&ys).map(|(&x, &y)| Circle::new((x, y), 4, RGBColor(33, 90, 160).filled()))).map_err(e)?;
     Ok(())
 }
 

@@ -191,11 +191,7 @@ fn panel_specs(scene: &Scene) -> Vec<PanelSpec> {
         parts.extend(step.parts.iter().map(|&i| (i, colour, at(i))));
         let (kind, arrow) = match &step.motion {
             Some(m) => {
-                let centre = scene.assembly.parts[step.part]
-                    .mesh
-                    .aabb()
-                    .map(|b| (b.mins + b.maxs) / 2.0)
-                    .unwrap_or(Vec3::ZERO);
+                let centre = scene.assembly.parts[step.part].mesh.aabb().map(|b| (b.mins + b.maxs) / 2.0).unwrap_or(Vec3::ZERO);
                 let kind = match m {
                     crate::Insertion::Linear { .. } => "linear",
                     crate::Insertion::Path { .. } => "path",
@@ -316,7 +312,16 @@ impl Camera {
 
 /// Rasterises one triangle with a depth test (nearer wins); pixels above `top` are the title's.
 #[allow(clippy::too_many_arguments)]
-fn fill_triangle(a: (f32, f32, f32), b: (f32, f32, f32), c: (f32, f32, f32), size: usize, top: f32, depth: &mut [f32], colour: &mut [u8], px: [u8; 3]) {
+fn fill_triangle(
+    a: (f32, f32, f32),
+    b: (f32, f32, f32),
+    c: (f32, f32, f32),
+    size: usize,
+    top: f32,
+    depth: &mut [f32],
+    colour: &mut [u8],
+    px: [u8; 3],
+) {
     let area = (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0);
     if area.abs() < 1e-12 || !area.is_finite() {
         return;
@@ -373,7 +378,8 @@ fn draw_overlay(pixels: &mut [u8], width: u32, height: u32, panels: &[Panel]) {
             let points: Vec<(i32, i32)> = p.arrow.iter().map(|&(px, py)| (px.round() as i32, py.round() as i32)).collect();
             let _ = root.draw(&PathElement::new(points.clone(), ink.stroke_width(2)));
             if let Some(head) = arrow_head(&p.arrow, p.size as f32 * 0.045) {
-                let _ = root.draw(&Polygon::new(head.iter().map(|&(a, b)| (a.round() as i32, b.round() as i32)).collect::<Vec<_>>(), ink.filled()));
+                let _ = root
+                    .draw(&Polygon::new(head.iter().map(|&(a, b)| (a.round() as i32, b.round() as i32)).collect::<Vec<_>>(), ink.filled()));
             }
             let (sx, sy) = points[0];
             let _ = root.draw(&Circle::new((sx, sy), 3, ink.filled()));
@@ -405,7 +411,11 @@ fn arrow_head(curve: &[(f32, f32)], len: f32) -> Option<[(f32, f32); 3]> {
     }
     let (ux, uy) = (dx / l, dy / l);
     let (nx, ny) = (-uy, ux);
-    Some([(ex, ey), (ex - ux * len + nx * len * 0.45, ey - uy * len + ny * len * 0.45), (ex - ux * len - nx * len * 0.45, ey - uy * len - ny * len * 0.45)])
+    Some([
+        (ex, ey),
+        (ex - ux * len + nx * len * 0.45, ey - uy * len + ny * len * 0.45),
+        (ex - ux * len - nx * len * 0.45, ey - uy * len - ny * len * 0.45),
+    ])
 }
 
 /// `pixels` (RGB) encoded as PNG.

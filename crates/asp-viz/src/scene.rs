@@ -13,8 +13,7 @@ use std::path::{Path, PathBuf};
 /// version is refused before its fields are read.
 pub fn read_plan(path: &Path) -> Result<PlanReport> {
     let text = std::fs::read_to_string(path).map_err(|e| VizError::io(path, e))?;
-    let value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| VizError::input(path, format!("not a plan JSON: {e}")))?;
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| VizError::input(path, format!("not a plan JSON: {e}")))?;
     let ours = asp_search::report::FORMAT_VERSION;
     let major = |v: &str| v.split('.').next().map(str::to_string);
     match value.get("format_version").and_then(|v| v.as_str()) {
@@ -49,20 +48,15 @@ pub fn model_path(report: &PlanReport, plan_path: &Path, model: Option<&Path>) -
             }
         }
     }
-    Err(VizError::input(
-        plan_path,
-        format!("the plan's model '{}' does not exist (give the model with --model)", report.model),
-    ))
+    Err(VizError::input(plan_path, format!("the plan's model '{}' does not exist (give the model with --model)", report.model)))
 }
 
 /// Loads the plan's model with the plan's `units`, `up` and fixed parts, and checks that its
 /// parts are the plan's parts.
 pub fn load_model(report: &PlanReport, plan_path: &Path, model: Option<&Path>) -> Result<Assembly> {
     let path = model_path(report, plan_path, model)?;
-    let unit = Units::parse(&report.units)
-        .ok_or_else(|| VizError::input(plan_path, format!("unknown unit '{}'", report.units)))?;
-    let up = Axis::parse(&report.up)
-        .ok_or_else(|| VizError::input(plan_path, format!("'{}' is not an up axis", report.up)))?;
+    let unit = Units::parse(&report.units).ok_or_else(|| VizError::input(plan_path, format!("unknown unit '{}'", report.units)))?;
+    let up = Axis::parse(&report.up).ok_or_else(|| VizError::input(plan_path, format!("'{}' is not an up axis", report.up)))?;
     let fixed = report.parts.iter().filter(|p| p.fixed).map(|p| p.name.clone()).collect();
     let assembly = load(&path, &LoadOptions { unit: Some(unit), up: Some(up), fixed, ..LoadOptions::default() })?;
     check_parts(&assembly, report, &path)?;
@@ -79,10 +73,7 @@ fn check_parts(assembly: &Assembly, report: &PlanReport, model: &Path) -> Result
     }
     for (i, (a, p)) in assembly.parts.iter().zip(&report.parts).enumerate() {
         if a.name != p.name {
-            return Err(VizError::input(
-                model,
-                format!("part {i} of the model is '{}' but the plan calls it '{}'", a.name, p.name),
-            ));
+            return Err(VizError::input(model, format!("part {i} of the model is '{}' but the plan calls it '{}'", a.name, p.name)));
         }
     }
     Ok(())
@@ -258,9 +249,7 @@ impl Scene {
         check_parts(&assembly, &report, source)?;
         let n = assembly.parts.len();
         let bad = |i: usize| VizError::input(source, format!("the plan names part {i}, but the model has {n} parts"));
-        let metres = Units::parse(&report.units)
-            .ok_or_else(|| VizError::input(source, format!("unknown unit '{}'", report.units)))?
-            .metres;
+        let metres = Units::parse(&report.units).ok_or_else(|| VizError::input(source, format!("unknown unit '{}'", report.units)))?.metres;
         let mut order_recorded = true;
         // plans since format 1.3 carry the partial disassembly of a failed search with its motions
         let sequence = if report.status.has_sequence() { &report.assembly_sequence } else { &report.partial_assembly_sequence };
@@ -269,9 +258,7 @@ impl Scene {
                 .iter()
                 .map(|s| {
                     let part = assembly.parts.get(s.part).ok_or_else(|| bad(s.part))?;
-                    let radius = aabb_of(part.mesh.vertices.iter().copied())
-                        .map(|b| (b.maxs - b.mins).length() / 2.0)
-                        .unwrap_or(0.0);
+                    let radius = aabb_of(part.mesh.vertices.iter().copied()).map(|b| (b.maxs - b.mins).length() / 2.0).unwrap_or(0.0);
                     let parts = s.subassembly.as_ref().map_or_else(|| vec![s.part], |g| g.parts.clone());
                     if let Some(&p) = parts.iter().find(|&&p| p >= n) {
                         return Err(bad(p));
@@ -420,11 +407,7 @@ impl Scene {
 pub(crate) fn corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {
     let mut out = [Vec3::ZERO; 8];
     for (k, c) in out.iter_mut().enumerate() {
-        *c = Vec3::new(
-            if k & 1 == 0 { lo.x } else { hi.x },
-            if k & 2 == 0 { lo.y } else { hi.y },
-            if k & 4 == 0 { lo.z } else { hi.z },
-        );
+        *c = Vec3::new(if k & 1 == 0 { lo.x } else { hi.x }, if k & 2 == 0 { lo.y } else { hi.y }, if k & 4 == 0 { lo.z } else { hi.z });
     }
     out
 }

@@ -1,8 +1,8 @@
 //! `asp collect removability` as a library: the data set's files, its labels and its
 //! reproducibility (format: docs/learning.md).
 
-use asp_geom::{Checker, CheckerConfig, FeasibilityChecker, MotionKind, Outcome, PartSet, World, WorldConfig};
 use asp_app::collect::{collect, CollectSettings};
+use asp_geom::{Checker, CheckerConfig, FeasibilityChecker, MotionKind, Outcome, PartSet, World, WorldConfig};
 use std::path::{Path, PathBuf};
 
 fn model(dir: &Path, seed: u64) -> PathBuf {
@@ -59,7 +59,11 @@ fn data_set_files_labels_and_reproducibility() {
             for &p in present.iter().filter(|&&p| !checker.is_fixed(p)) {
                 let free = matches!(checker.test_removal(p, &state, MotionKind::Linear), Outcome::Removed(_));
                 assert_eq!(free, removable.contains(&p), "part {p} in state {present:?}");
-                if free { positives += 1 } else { negatives += 1 }
+                if free {
+                    positives += 1
+                } else {
+                    negatives += 1
+                }
             }
             assert!(removable.iter().all(|p| present.contains(p) && !checker.is_fixed(*p)));
         }

@@ -79,11 +79,14 @@ fn issue_28_a_plan_that_lifts_a_locked_core_in_one_piece_is_partial() {
 fn issue_28_voxel_puzzles_with_a_fixed_piece_get_the_grid_before_the_path_planner() {
     let settings = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
     use asp_geom::puzzles::{burr_level, small_puzzle, two_small_puzzles};
-    for (fixed, puzzle) in [(false, burr_level()), (true, burr_level()), (true, small_puzzle()), (false, two_small_puzzles()), (true, two_small_puzzles())] {
+    for (fixed, puzzle) in
+        [(false, burr_level()), (true, burr_level()), (true, small_puzzle()), (false, two_small_puzzles()), (true, two_small_puzzles())]
+    {
         let mut a = puzzle;
         if fixed {
             // the largest piece (by volume) is the base
-            let largest = (0..a.parts.len()).max_by(|&i, &j| a.parts[i].mesh.signed_volume().total_cmp(&a.parts[j].mesh.signed_volume())).unwrap();
+            let largest =
+                (0..a.parts.len()).max_by(|&i, &j| a.parts[i].mesh.signed_volume().total_cmp(&a.parts[j].mesh.signed_volume())).unwrap();
             a.parts[largest].fixed = true;
         }
         let name = format!("{} (a fixed piece: {fixed})", a.source.display());

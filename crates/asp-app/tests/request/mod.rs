@@ -57,5 +57,8 @@ fn a_setting_of_the_other_search_stops_the_run_before_it_loads() {
     // the model does not exist: the request is refused first, naming the setting
     let request = PlanRequest::from_json(r#"{"objective": "access", "timeout": 10}"#).unwrap();
     let e = asp_app::plan_file(&data("no/such/model.glb"), &request, Hooks::default()).unwrap_err();
-    assert_eq!(e.render(&|k: &str| format!("--{}", k.replace('_', "-"))), "--timeout: applies to the feasibility search only (without --objective); the optimiser's limit is --time-limit");
+    assert_eq!(
+        e.render(&|k: &str| format!("--{}", k.replace('_', "-"))),
+        "--timeout: applies to the feasibility search only (without --objective); the optimiser's limit is --time-limit"
+    );
 }

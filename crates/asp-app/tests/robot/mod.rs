@@ -4,11 +4,11 @@
 
 use std::sync::Arc;
 
+use asp_app::pipeline::{plan_assembly, OptimiseSettings, PlanSettings, StabilitySetting};
 use asp_geom::fixtures::{assemble, box_part};
 use asp_geom::math::{Axis, Pose, Rot, Vec3};
 use asp_geom::{Assembly, Grasp, PartSet, World, WorldConfig};
 use asp_robot::{CellSetup, RobotCell, RobotExtension, RobotRemoval, RobotSetup};
-use asp_app::pipeline::{plan_assembly, OptimiseSettings, PlanSettings, StabilitySetting};
 use asp_search::report::PlanReport;
 
 #[path = "../../../asp-robot/tests/robot/recheck.rs"]
@@ -151,10 +151,7 @@ fn a_second_gripper_holds_the_bar_while_the_post_goes_in() {
     assert!(one.found());
     assert_ne!(one.report.disassembly_sequence[0], 1, "the post cannot go first without holding");
     assert!(one.report.assembly_sequence.iter().all(|s| s.held.is_empty()));
-    let settings = PlanSettings {
-        checker_extension: Some(Arc::new(CellSetup { robot: None, grippers: 2 })),
-        ..PlanSettings::default()
-    };
+    let settings = PlanSettings { checker_extension: Some(Arc::new(CellSetup { robot: None, grippers: 2 })), ..PlanSettings::default() };
     let two = plan_assembly(model(), &settings, None).unwrap();
     assert!(two.found());
     assert_eq!(two.report.disassembly_sequence[0], 1, "{:?}", two.report.disassembly_sequence);
@@ -211,8 +208,8 @@ fn stacks() -> Assembly {
 /// One search of `stacks()` with the robot filter asked lazily or for every candidate: its
 /// best sequence and value, the removals put to the filter, and the robot's path searches.
 fn robot_search(lazy: bool) -> (Vec<usize>, f64, u64, u64) {
-    use asp_search::extension::{MdpExtension, ModelContext};
     use asp_app::pipeline::optimiser_problem;
+    use asp_search::extension::{MdpExtension, ModelContext};
     use asp_search::Mcts;
     let assembly = Arc::new(stacks());
     let ext = Arc::new(RobotExtension::new(RobotSetup::panda()));

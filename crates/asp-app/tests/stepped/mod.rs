@@ -3,10 +3,10 @@
 //! episodes guides exactly the episodes after it.
 
 use crate::fixtures::{maps, problem, soma};
-use asp_geom::distmap::MapState;
 use asp_app::pipeline::{self, OptimiseSettings, PlanSettings};
-use asp_search::policy::{argmax, EpsilonGreedy, ImmediateReward, Policy};
 use asp_app::stepped::SteppedSearch;
+use asp_geom::distmap::MapState;
+use asp_search::policy::{argmax, EpsilonGreedy, ImmediateReward, Policy};
 use asp_search::{EpisodeEnd, Mcts, Mdp, Next, ParetoMcts, SearchOutcome, StepKind, Transition};
 use std::sync::Arc;
 
@@ -118,7 +118,14 @@ fn stepped_search_handle_gives_the_plan_of_asp_plan() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("soma.glb");
     asp_geom::io::write_glb(&soma(4, 8), &path).unwrap();
-    let o = OptimiseSettings { objectives: "access,dirchange".into(), pareto: true, episodes: 6, threads: Some(1), resolution: 5, ..OptimiseSettings::default() };
+    let o = OptimiseSettings {
+        objectives: "access,dirchange".into(),
+        pareto: true,
+        episodes: 6,
+        threads: Some(1),
+        resolution: 5,
+        ..OptimiseSettings::default()
+    };
     let settings = PlanSettings { seed: 4, optimise: Some(o.clone()), ..PlanSettings::default() };
     let mut search = SteppedSearch::start(&path, &settings, true).unwrap();
     assert_eq!(search.index().objectives, vec!["access".to_string(), "dirchange".to_string()]);
@@ -136,7 +143,10 @@ fn stepped_search_handle_gives_the_plan_of_asp_plan() {
     let assembly = Arc::new(pipeline::load(&path, &settings).unwrap());
     let plain = pipeline::optimise(assembly, &settings, &o).unwrap();
     let (a, b) = (stepped.report.optimisation.as_ref().unwrap(), plain.report.optimisation.as_ref().unwrap());
-    assert_eq!((a.episodes, a.iterations, a.tree_nodes, &a.values, a.hypervolume), (b.episodes, b.iterations, b.tree_nodes, &b.values, b.hypervolume));
+    assert_eq!(
+        (a.episodes, a.iterations, a.tree_nodes, &a.values, a.hypervolume),
+        (b.episodes, b.iterations, b.tree_nodes, &b.values, b.hypervolume)
+    );
     assert_eq!(stepped.report.pareto_front, plain.report.pareto_front);
     assert_eq!(stepped.report.disassembly_sequence, plain.report.disassembly_sequence);
     assert!(transitions > 0);

@@ -4,11 +4,11 @@
 //! format says and rebuild the same maps.
 
 use crate::fixtures::{maps, problem, soma};
+use asp_app::collect_q::{collect_transitions, TransitionSettings};
+use asp_app::pipeline::{OptimiseSettings, PlanSettings};
 use asp_geom::distmap::MapState;
 use asp_geom::PartSet;
-use asp_app::collect_q::{collect_transitions, TransitionSettings};
 use asp_search::objective::DirHistory;
-use asp_app::pipeline::{OptimiseSettings, PlanSettings};
 use asp_search::{Mcts, Mdp, ParetoMcts, SearchOutcome, StepKind, Transition};
 use std::path::{Path, PathBuf};
 
@@ -235,12 +235,7 @@ fn the_data_set_has_the_documented_files_and_rebuilds_the_maps() {
     let settings = TransitionSettings {
         seed: 3,
         plan: PlanSettings { tolerance: Some(1e-5), ..PlanSettings::default() },
-        optimise: OptimiseSettings {
-            objectives: "access,dirchange".into(),
-            episodes: 12,
-            resolution: 5,
-            ..OptimiseSettings::default()
-        },
+        optimise: OptimiseSettings { objectives: "access,dirchange".into(), episodes: 12, resolution: 5, ..OptimiseSettings::default() },
         ..TransitionSettings::default()
     };
     let out = dir.path().join("q");
@@ -291,7 +286,8 @@ fn the_data_set_has_the_documented_files_and_rebuilds_the_maps() {
         assert_eq!(entry["capped"], false);
         for l in &lines {
             let keys: Vec<&str> = l.as_object().unwrap().keys().map(|k| k.as_str()).collect();
-            let mut want = ["episode", "kind", "present", "history", "actions", "action", "rewards", "next_history", "next_actions", "complete"];
+            let mut want =
+                ["episode", "kind", "present", "history", "actions", "action", "rewards", "next_history", "next_actions", "complete"];
             want.sort_unstable();
             let mut keys = keys;
             keys.sort_unstable();

@@ -199,4 +199,3 @@ pub struct MctsArgs {
     #[command(flatten)]
     pub load: ModelArgs,
 }
-

@@ -1,8 +1,8 @@
 //! How a model is loaded and its removals tested: the flags shared by `plan`, `collect` and
 //! `bench`. Every flag is optional; a flag left out takes the request's default.
 
-use asp_app::request::{Overlaps, Stability};
 use super::Map;
+use asp_app::request::{Overlaps, Stability};
 use clap::Args;
 
 /// Loading and the removal test.
@@ -77,7 +77,23 @@ pub struct ModelArgs {
 impl ModelArgs {
     /// The request keys these flags set.
     pub fn put(&self, map: &mut Map) {
-        put!(map, self, unit, up, max_triangles, max_parts, tolerance, contact_distance, overlaps, normals, sphere_directions, stability, physics_threshold, rrt_iterations, rrt_time);
+        put!(
+            map,
+            self,
+            unit,
+            up,
+            max_triangles,
+            max_parts,
+            tolerance,
+            contact_distance,
+            overlaps,
+            normals,
+            sphere_directions,
+            stability,
+            physics_threshold,
+            rrt_iterations,
+            rrt_time
+        );
         if !self.fixed.is_empty() {
             map.insert("fixed".into(), self.fixed.clone().into());
         }

@@ -1,9 +1,9 @@
 //! The flags of `asp plan`: the models and outputs, then every setting of the plan request
 //! (loading and testing, the depth-first search, the optimiser, the robot).
 
+use super::Map;
 use super::ModelArgs;
 use asp_app::request::{QUse, Support};
-use super::Map;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -171,7 +171,23 @@ impl PlanArgs {
 impl OptimiseArgs {
     /// The request keys these flags set.
     pub fn put(&self, map: &mut Map) {
-        put!(map, self, objective, episodes, budget, threads, time_limit, exploration, polish, resolution, d_max, support, q, epsilon, q_use);
+        put!(
+            map,
+            self,
+            objective,
+            episodes,
+            budget,
+            threads,
+            time_limit,
+            exploration,
+            polish,
+            resolution,
+            d_max,
+            support,
+            q,
+            epsilon,
+            q_use
+        );
         if self.pareto {
             map.insert("pareto".into(), true.into());
         }

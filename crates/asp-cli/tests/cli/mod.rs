@@ -146,12 +146,7 @@ fn parts_overlapping_far_beyond_the_tolerance_leave_along_the_overlap_or_are_an_
     assert!(err.contains("warning") && err.contains("'lower' and 'top' overlap"), "{err}");
     let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let top_index = plan["parts"].as_array().unwrap().iter().find(|p| p["name"] == "top").expect("a part 'top'")["index"].clone();
-    let top = plan["assembly_sequence"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|s| s["part"] == top_index)
-        .expect("the top box is in the plan");
+    let top = plan["assembly_sequence"].as_array().unwrap().iter().find(|s| s["part"] == top_index).expect("the top box is in the plan");
     let d = &top["motion"]["direction"];
     let (x, y, z) = (d[0].as_f64().unwrap(), d[1].as_f64().unwrap(), d[2].as_f64().unwrap());
     assert!(x.abs() < 1e-6 && y.abs() < 1e-6 && z.abs() > 0.99, "top moves along z only: {d}");
@@ -269,7 +264,18 @@ fn issue_9_one_process_plans_many_models_and_exits_with_the_worst_outcome() {
         let f = f.unwrap();
         std::fs::copy(f.path(), models_dir.join("pump").join(f.file_name())).unwrap();
     }
-    let o = asp(&["plan", "--each", models_dir.to_str().unwrap(), "--unit", "mm", "--up", "z", "--no-subassemblies", "--no-path-planner", "-q"]);
+    let o = asp(&[
+        "plan",
+        "--each",
+        models_dir.to_str().unwrap(),
+        "--unit",
+        "mm",
+        "--up",
+        "z",
+        "--no-subassemblies",
+        "--no-path-planner",
+        "-q",
+    ]);
     assert_eq!(o.status.code(), Some(1), "the pump has no plan without subassemblies: {}", stderr(&o));
     let table = String::from_utf8(o.stdout).unwrap();
     assert!(table.contains("pump: no plan") && table.contains("tube.glb: found"), "{table}");

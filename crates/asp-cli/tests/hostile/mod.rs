@@ -118,7 +118,12 @@ fn models_that_reach_outside_their_folder() {
     let secret = write(dir.path(), "other/secret.bin", triangle_bin(TRIANGLE));
     let nodes = json!([{"name": "a", "mesh": 0}]);
     let up = write(&model, "up.gltf", document(nodes.clone(), json!({"uri": "../other/secret.bin", "byteLength": 36})).to_string());
-    plan_refused(dir.path(), &up, &[], "points outside the model's folder; asp reads only files inside it (allow with --allow-outside-files)");
+    plan_refused(
+        dir.path(),
+        &up,
+        &[],
+        "points outside the model's folder; asp reads only files inside it (allow with --allow-outside-files)",
+    );
     let abs = write(&model, "abs.gltf", document(nodes.clone(), json!({"uri": "/etc/passwd", "byteLength": 36})).to_string());
     plan_refused(dir.path(), &abs, &[], "'/etc/passwd' is an absolute path");
     #[cfg(unix)]
@@ -167,7 +172,11 @@ fn broken_glb_containers_and_accessors() {
     let long = write(dir.path(), "long_name.glb", glb(doc(json!([{"name": "x".repeat(1 << 20), "mesh": 0}])).to_string().as_bytes(), &bin));
     plan_refused(dir.path(), &long, &[], "its name has 1048576 bytes");
     // duplicate names on the same mesh at the same place
-    let twice = write(dir.path(), "duplicate.glb", glb(doc(json!([{"name": "a", "mesh": 0}, {"name": "a", "mesh": 0}])).to_string().as_bytes(), &bin));
+    let twice = write(
+        dir.path(),
+        "duplicate.glb",
+        glb(doc(json!([{"name": "a", "mesh": 0}, {"name": "a", "mesh": 0}])).to_string().as_bytes(), &bin),
+    );
     plan_refused(dir.path(), &twice, &[], "parts 'a' and 'a_2' are the same mesh at the same place");
     // an accessor count past the buffer's end
     let mut over = doc(json!([{"name": "a", "mesh": 0}]));
@@ -178,7 +187,12 @@ fn broken_glb_containers_and_accessors() {
     let mut huge = doc(json!([{"name": "a", "mesh": 0}]));
     huge["accessors"][0]["count"] = json!(1_000_000_000u64);
     let huge = write(dir.path(), "count_huge.glb", glb(huge.to_string().as_bytes(), &bin));
-    plan_refused(dir.path(), &huge, &[], "more than 20000000 triangles (the model announces 333333333; raise the cap with --max-triangles)");
+    plan_refused(
+        dir.path(),
+        &huge,
+        &[],
+        "more than 20000000 triangles (the model announces 333333333; raise the cap with --max-triangles)",
+    );
     // sparse indices out of range
     let mut sparse = doc(json!([{"name": "a", "mesh": 0}]));
     let mut sbin = bin.clone();
@@ -259,7 +273,11 @@ fn robots_that_cannot_work() {
         ("pkg_up.urdf", urdf("package://p/../../secret.stl", ""), "--package-path p=DIR"),
         ("missing_mesh.urdf", urdf("gone.stl", ""), "is missing"),
         ("no_gripper.urdf", urdf("base.stl", ""), "no gripper below tool link 'tool0'"),
-        ("missing_link.urdf", urdf("base.stl", r#"<joint name="j2" type="fixed"><parent link="tool0"/><child link="ghost"/></joint>"#), "unknown child link 'ghost'"),
+        (
+            "missing_link.urdf",
+            urdf("base.stl", r#"<joint name="j2" type="fixed"><parent link="tool0"/><child link="ghost"/></joint>"#),
+            "unknown child link 'ghost'",
+        ),
         ("loop.urdf", urdf("base.stl", r#"<joint name="j2" type="fixed"><parent link="tool0"/><child link="base"/></joint>"#), "root link"),
         ("inverted.urdf", urdf("base.stl", "").replace(r#"lower="-1" upper="1""#, r#"lower="1" upper="-1""#), "need finite lower"),
         ("not_xml.urdf", "<robot name=\"r\"><link".to_string(), "not a valid URDF"),
@@ -355,7 +373,11 @@ fn peak_memory_on_hostile_files_stays_within_ten_times_their_size() {
     for file in [&bomb, &zeros, &stl] {
         let size = std::fs::metadata(file).unwrap().len();
         let out = dir.path().join("plan.json");
-        let Some((peak, code)) = peak_memory(&["plan", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet", "--timeout", "5"]) else { return };
+        let Some((peak, code)) =
+            peak_memory(&["plan", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet", "--timeout", "5"])
+        else {
+            return;
+        };
         assert_eq!(code, Some(2), "{} is refused", file.display());
         assert!(peak <= 10 * size + FIXED, "{}: peak {} MB for a file of {} kB", file.display(), peak >> 20, size >> 10);
     }

@@ -25,8 +25,7 @@ fn jenga(dir: &Path) -> PathBuf {
     let mut parts = Vec::new();
     for z in 0..3 {
         for k in 0..3 {
-            let cells: Vec<[i32; 3]> =
-                (0..3).map(|t| if z % 2 == 0 { [t, k, z] } else { [k, t, z] }).collect();
+            let cells: Vec<[i32; 3]> = (0..3).map(|t| if z % 2 == 0 { [t, k, z] } else { [k, t, z] }).collect();
             parts.push(Part::new(
                 format!("bar_{z}{k}"),
                 Mesh::from_voxels(&cells, Vec3::splat(0.05), Vec3::ZERO),
@@ -47,8 +46,18 @@ fn single_objective_writes_the_best_sequence() {
     let model = jenga(dir.path());
     let out = dir.path().join("plan.json");
     let o = asp(&[
-        "plan", model.to_str().unwrap(), "--objective", "access", "--episodes", "50", "--threads", "1",
-        "--seed", "1", "--out", out.to_str().unwrap(),
+        "plan",
+        model.to_str().unwrap(),
+        "--objective",
+        "access",
+        "--episodes",
+        "50",
+        "--threads",
+        "1",
+        "--seed",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let table = String::from_utf8(o.stdout).unwrap();
@@ -87,8 +96,22 @@ fn pareto_front_trace_and_reproducibility() {
         let out = dir.path().join(format!("front{k}.json"));
         let trace = dir.path().join(format!("hv{k}.csv"));
         let o = asp(&[
-            "plan", model.to_str().unwrap(), "--objective", "access,dirchange", "--pareto", "--episodes", "60",
-            "--budget", "5", "--threads", threads, "--seed", "1", "--out", out.to_str().unwrap(), "--trace",
+            "plan",
+            model.to_str().unwrap(),
+            "--objective",
+            "access,dirchange",
+            "--pareto",
+            "--episodes",
+            "60",
+            "--budget",
+            "5",
+            "--threads",
+            threads,
+            "--seed",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+            "--trace",
             trace.to_str().unwrap(),
         ]);
         assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
@@ -104,8 +127,7 @@ fn pareto_front_trace_and_reproducibility() {
     assert!(!front.is_empty());
     for e in front {
         assert_eq!(e["objectives"].as_array().unwrap().len(), 2);
-        let mut seq: Vec<u64> =
-            e["disassembly_sequence"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+        let mut seq: Vec<u64> = e["disassembly_sequence"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
         seq.sort();
         assert_eq!(seq, (0..9).collect::<Vec<u64>>());
     }
@@ -159,9 +181,8 @@ fn optimiser_results_for_a_seed_are_pinned() {
         assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
         json(&out)
     };
-    let seq = |v: &serde_json::Value| -> Vec<u64> {
-        v["disassembly_sequence"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect()
-    };
+    let seq =
+        |v: &serde_json::Value| -> Vec<u64> { v["disassembly_sequence"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).collect() };
     // the tree search alone (the local search off) is the search these literals were pinned on
     let pareto = plan(&["--objective", "access,dirchange", "--pareto", "--seed", "1", "--polish", "0"]);
     let opt = &pareto["optimisation"];
@@ -201,8 +222,19 @@ fn collect_transitions_writes_the_documented_data_set() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let collect = |out: &Path, extra: &[&str]| {
         let mut args = vec![
-            "collect", "transitions", models.to_str().unwrap(), "--objective", "access,dirchange", "--episodes", "15",
-            "--seed", "2", "--resolution", "5", "--out", out.to_str().unwrap(),
+            "collect",
+            "transitions",
+            models.to_str().unwrap(),
+            "--objective",
+            "access,dirchange",
+            "--episodes",
+            "15",
+            "--seed",
+            "2",
+            "--resolution",
+            "5",
+            "--out",
+            out.to_str().unwrap(),
         ];
         args.extend_from_slice(extra);
         asp(&args)
@@ -303,7 +335,10 @@ fn issue_23_settings_of_the_other_search_are_refused_naming_what_applies() {
             vec!["plan", m, "--time-limit", "10", "--out", o_],
             "error: --time-limit: applies to the optimiser only (with --objective); the feasibility search's limit is --timeout",
         ),
-        (vec!["plan", m, "--objective", "access", "--order", "random", "--out", o_], "error: --order: applies to the feasibility search only (without --objective)"),
+        (
+            vec!["plan", m, "--objective", "access", "--order", "random", "--out", o_],
+            "error: --order: applies to the feasibility search only (without --objective)",
+        ),
         (vec!["plan", m, "--episodes", "5", "--out", o_], "error: --episodes: applies to the optimiser only (with --objective)"),
         (vec!["plan", m, "--physics-threshold", "0.1", "--out", o_], "error: --physics-threshold: needs --stability physics"),
         (vec!["plan", m, "--drop-off", "1,2", "--out", o_], "error: --drop-off: must be three finite numbers x,y,z"),

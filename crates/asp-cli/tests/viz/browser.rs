@@ -124,7 +124,11 @@ impl Browser {
         browser.call(s.as_deref(), "Runtime.enable", json!({}));
         browser.call(s.as_deref(), "Log.enable", json!({}));
         browser.call(s.as_deref(), "Page.enable", json!({}));
-        browser.call(s.as_deref(), "Emulation.setDeviceMetricsOverride", json!({ "width": 1000, "height": 700, "deviceScaleFactor": 1, "mobile": false }));
+        browser.call(
+            s.as_deref(),
+            "Emulation.setDeviceMetricsOverride",
+            json!({ "width": 1000, "height": 700, "deviceScaleFactor": 1, "mobile": false }),
+        );
         Some(browser)
     }
 
@@ -192,7 +196,8 @@ impl Browser {
         let start = Instant::now();
         loop {
             let s = self.session.clone();
-            let r = self.call(Some(&s), "Runtime.evaluate", json!({ "expression": format!("Boolean({condition})"), "returnByValue": true }));
+            let r =
+                self.call(Some(&s), "Runtime.evaluate", json!({ "expression": format!("Boolean({condition})"), "returnByValue": true }));
             if r["result"]["value"] == true {
                 return;
             }

@@ -119,7 +119,11 @@ fn the_viewer_plays_a_found_plan_in_a_headless_browser() {
     browser.eval(&format!("aspViewer.goto({total}); true"));
     let end = browser.screenshot();
     let area = ((end.width - RIGHT_OF_PANEL) * end.height) as usize;
-    assert!(model_pixels(&end, RIGHT_OF_PANEL) > area / 50, "the assembled table is (nearly) blank: {} model pixels", model_pixels(&end, RIGHT_OF_PANEL));
+    assert!(
+        model_pixels(&end, RIGHT_OF_PANEL) > area / 50,
+        "the assembled table is (nearly) blank: {} model pixels",
+        model_pixels(&end, RIGHT_OF_PANEL)
+    );
     assert!(differing(&start, &end, RIGHT_OF_PANEL) > area / 100, "all steps shown looks like no step shown");
 
     // one step: the first part flies in and comes to rest
@@ -286,7 +290,17 @@ fn plan_writes_an_mcap_with_the_foxglove_topics() {
     assert_eq!(topics["/tf"].0, "foxglove.FrameTransforms");
     // optimising runs go through the same pipeline and write it too
     let optimised = dir.path().join("optimised.mcap");
-    let o = asp(&["plan", model.to_str().unwrap(), "--quiet", "--objective", "access", "--threads", "1", "--mcap", optimised.to_str().unwrap()]);
+    let o = asp(&[
+        "plan",
+        model.to_str().unwrap(),
+        "--quiet",
+        "--objective",
+        "access",
+        "--threads",
+        "1",
+        "--mcap",
+        optimised.to_str().unwrap(),
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let bytes = std::fs::read(&optimised).unwrap();
     let paths = mcap::MessageStream::new(&bytes).unwrap().filter(|m| m.as_ref().unwrap().channel.topic == "/asp/paths").count();

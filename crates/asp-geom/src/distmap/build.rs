@@ -1,17 +1,17 @@
 //! Computing the maps: part shapes (voxels, boxes, meshes), the rows of sweeps in parallel, and
 //! the contact graph.
 
-use super::*;
 use super::maps::MapWorld;
+use super::*;
 use crate::assembly::Assembly;
 use crate::boxes::{box_distance, first_overlap, fit_boxes, fit_voxels, single_box};
 use crate::error::{GeomError, Result};
 use crate::math::{Aabb, Vec3};
 use crate::partset::PartSet;
 use crate::world::World;
-use std::sync::Arc;
 use parry3d::shape::TriMesh;
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// One part's geometry prepared for sweeps: boxes in the sweep frame, or meshes.
 enum Shape {
@@ -61,9 +61,7 @@ impl DistanceMaps {
             ("fasteners", have.fasteners != want.fasteners),
         ];
         if let Some((name, _)) = differs.iter().find(|(_, d)| *d) {
-            return Err(GeomError::config(format!(
-                "distance maps: the collision world's {name} differs from the maps' settings"
-            )));
+            return Err(GeomError::config(format!("distance maps: the collision world's {name} differs from the maps' settings")));
         }
         Self::build_with(&world.assembly().clone(), config, Some(world))
     }
@@ -71,10 +69,7 @@ impl DistanceMaps {
     fn build_with(assembly: &Assembly, config: &MapConfig, given: Option<Arc<World>>) -> Result<DistanceMaps> {
         let n = assembly.len();
         if n == 0 {
-            return Err(GeomError::Assembly {
-                path: assembly.source.clone(),
-                reason: "the model has no parts".into(),
-            });
+            return Err(GeomError::Assembly { path: assembly.source.clone(), reason: "the model has no parts".into() });
         }
         if n > MAX_PARTS {
             return Err(GeomError::Assembly {
@@ -89,11 +84,7 @@ impl DistanceMaps {
         let dcount = hemisphere.len();
         let stride = dcount.div_ceil(8) * 8;
         let mut warnings = Vec::new();
-        let aabbs: Vec<Aabb> = assembly
-            .parts
-            .iter()
-            .map(|p| p.mesh.aabb().unwrap_or(Aabb::new(Vec3::ZERO, Vec3::ZERO)))
-            .collect();
+        let aabbs: Vec<Aabb> = assembly.parts.iter().map(|p| p.mesh.aabb().unwrap_or(Aabb::new(Vec3::ZERO, Vec3::ZERO))).collect();
 
         // Geometry: voxels, single boxes, or meshes.
         let mut voxel_fits: Vec<Option<VoxelFit>> = Vec::with_capacity(n);
@@ -102,10 +93,7 @@ impl DistanceMaps {
                 p.meta.cells.as_ref().and_then(|cells| match fit_voxels(cells, &p.mesh) {
                     Some((o, c)) => Some((cells.clone(), o, c)),
                     None => {
-                        warnings.push(format!(
-                            "part '{}': its voxels do not match its mesh; using the mesh",
-                            p.name
-                        ));
+                        warnings.push(format!("part '{}': its voxels do not match its mesh; using the mesh", p.name));
                         None
                     }
                 })
@@ -208,10 +196,7 @@ impl DistanceMaps {
                         }
                     } else {
                         match (&shapes[i], &shapes[j]) {
-                            (
-                                Shape::Boxes { boxes: bi, integer: ii },
-                                Shape::Boxes { boxes: bj, integer: ij },
-                            ) => {
+                            (Shape::Boxes { boxes: bi, integer: ii }, Shape::Boxes { boxes: bj, integer: ij }) => {
                                 let tol = if *ii && *ij { 0.0 } else { frame_tol };
                                 let ai = frame.frame_box(&aabbs[i]);
                                 let aj = frame.frame_box(&aabbs[j]);
@@ -237,11 +222,7 @@ impl DistanceMaps {
                                 let strict = world.is_strict_pair(i, j);
                                 for (d, m) in dirs.iter().enumerate() {
                                     let near = first_overlap(&aabbs[i], *m, &aabbs[j], 0.0).is_some_and(|t| t < d_max);
-                                    let mut v = if !ignored && near {
-                                        cast_distance(&moving, &fixed, *m, d_max, erosion)
-                                    } else {
-                                        d_max
-                                    };
+                                    let mut v = if !ignored && near { cast_distance(&moving, &fixed, *m, d_max, erosion) } else { d_max };
                                     if strict && near && v > 0.0 {
                                         // an input overlap: no sample may enter new material
                                         if let Some(t) = world.strict_entry(i, j, Vec3::ZERO, *m, v, false) {
@@ -292,12 +273,8 @@ impl DistanceMaps {
             } else {
                 for i in 0..n {
                     for j in (i + 1)..n {
-                        if let (Shape::Boxes { boxes: bi, .. }, Shape::Boxes { boxes: bj, .. }) =
-                            (&shapes[i], &shapes[j])
-                        {
-                            let near = bi.iter().any(|a| {
-                                bj.iter().any(|b| box_distance(a, b, frame.cell) <= contact_distance)
-                            });
+                        if let (Shape::Boxes { boxes: bi, .. }, Shape::Boxes { boxes: bj, .. }) = (&shapes[i], &shapes[j]) {
+                            let near = bi.iter().any(|a| bj.iter().any(|b| box_distance(a, b, frame.cell) <= contact_distance));
                             if near {
                                 touch(i, j);
                             }
@@ -351,7 +328,6 @@ impl DistanceMaps {
 fn lowest_along(b: &Aabb, up: Vec3) -> f32 {
     (0..3).map(|k| (b.mins[k] * up[k]).min(b.maxs[k] * up[k])).sum()
 }
-
 
 /// Distance the mesh `moving`, eroded by `erosion`, travels along `dir` before touching `fixed`
 /// (exact triangle sweeps, [`crate::sweep`]), less the erosion (contacts within it read 0), capped at `d_max`.

@@ -1,7 +1,7 @@
 //! How distance maps are computed: limits, defaults, the gravity rule and [`MapConfig`].
 
-use crate::error::{GeomError, Result};
 use crate::assembly::Assembly;
+use crate::error::{GeomError, Result};
 use crate::overlap::OverlapPolicy;
 use crate::world::WorldConfig;
 
@@ -162,9 +162,7 @@ impl MapConfigBuilder {
         let c = self.config;
         let r = c.resolution;
         if !(3..=MAX_RESOLUTION).contains(&r) || r.is_multiple_of(2) {
-            return Err(GeomError::config(format!(
-                "distance map resolution must be odd and within 3..={MAX_RESOLUTION}, got {r}"
-            )));
+            return Err(GeomError::config(format!("distance map resolution must be odd and within 3..={MAX_RESOLUTION}, got {r}")));
         }
         if let Some(d) = c.d_max {
             if !(d.is_finite() && d > 0.0) {

@@ -1,7 +1,7 @@
 //! The sampled half sphere of directions (the hemi-octahedral map).
 
-use crate::error::{GeomError, Result};
 use super::MAX_RESOLUTION;
+use crate::error::{GeomError, Result};
 use crate::math::{Axis, Vec3};
 
 /// The `N_M × N_M` directions sampled on the half sphere around the up axis.

@@ -13,8 +13,7 @@ impl DistanceMaps {
         // after few of them when they are ORed in this order).
         self.blockers = (0..n)
             .map(|i| {
-                let mut b: Vec<u16> =
-                    (0..n).filter(|&j| j != i && !self.blocked(i, j).is_empty()).map(|j| j as u16).collect();
+                let mut b: Vec<u16> = (0..n).filter(|&j| j != i && !self.blocked(i, j).is_empty()).map(|j| j as u16).collect();
                 b.sort_by_key(|&j| std::cmp::Reverse(self.blocked(i, j as usize).len()));
                 b
             })
@@ -55,8 +54,7 @@ impl DistanceMaps {
             .collect();
         let words = self.words;
         self.dominators = dominators.iter().flatten().flat_map(|b| b.0[..words].to_vec()).collect();
-        self.blocker_masks =
-            (0..n).map(|i| self.blockers[i].iter().map(|&j| self.blocked(i, j as usize)).collect()).collect();
+        self.blocker_masks = (0..n).map(|i| self.blockers[i].iter().map(|&j| self.blocked(i, j as usize)).collect()).collect();
         let dcount = self.hemisphere.len();
         self.along = vec![0; n * dcount * words];
         for i in 0..n {
@@ -73,14 +71,8 @@ impl DistanceMaps {
                 self.blocks[j as usize].insert(i);
             }
         }
-        self.supporters = (0..n)
-            .map(|i| {
-                (0..n)
-                    .filter(|&j| j != i && self.map(j, i)[up] <= support_tol)
-                    .map(|j| j as u16)
-                    .collect()
-            })
-            .collect();
+        self.supporters =
+            (0..n).map(|i| (0..n).filter(|&j| j != i && self.map(j, i)[up] <= support_tol).map(|j| j as u16).collect()).collect();
         self.dependents = vec![Vec::new(); n];
         for i in 0..n {
             for &j in &self.supporters[i] {

@@ -231,9 +231,7 @@ impl DistanceMaps {
     /// Whether `i` rests on the floor or a part of `state` directly beneath it (or is fixed):
     /// the [`Support::Below`] rule for one part.
     pub fn is_supported(&self, i: usize, state: &PartSet) -> bool {
-        self.fixed[i]
-            || self.on_floor[i]
-            || self.supporters[i].iter().any(|&j| state.contains(j as usize))
+        self.fixed[i] || self.on_floor[i] || self.supporters[i].iter().any(|&j| state.contains(j as usize))
     }
 
     /// The gravity check on every part of `state`, by the configured [`Support`] rule.
@@ -277,12 +275,7 @@ impl DistanceMaps {
         self.clearance_among(i, state.iter(), free)
     }
 
-    pub(super) fn clearance_among(
-        &self,
-        i: usize,
-        present: impl Iterator<Item = usize>,
-        free: DirMask,
-    ) -> Option<(usize, f32)> {
+    pub(super) fn clearance_among(&self, i: usize, present: impl Iterator<Item = usize>, free: DirMask) -> Option<(usize, f32)> {
         if free.is_empty() {
             return None;
         }
@@ -303,9 +296,7 @@ impl DistanceMaps {
                 Some(r) => clear_distance(&self.aabbs[i], dirs[d], r),
             };
             // shortest travel; among equal travels the most upward direction
-            if best.is_none_or(|(b, t)| {
-                travel < t || (travel == t && dirs[d].dot(up) > dirs[b].dot(up))
-            }) {
+            if best.is_none_or(|(b, t)| travel < t || (travel == t && dirs[d].dot(up) > dirs[b].dot(up))) {
                 best = Some((d, travel));
             }
         }
@@ -314,10 +305,7 @@ impl DistanceMaps {
 
     /// The removal motion of [`DistanceMaps::clearance`] as a [`Motion::Linear`].
     pub fn removal_motion(&self, i: usize, state: &PartSet) -> Option<Motion> {
-        self.clearance(i, state).map(|(d, t)| Motion::Linear {
-            direction: self.hemisphere.directions()[d],
-            distance: t,
-        })
+        self.clearance(i, state).map(|(d, t)| Motion::Linear { direction: self.hemisphere.directions()[d], distance: t })
     }
 
     /// Whether part `i` can be removed from `state` without collision (eq. 6.5).

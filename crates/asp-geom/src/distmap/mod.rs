@@ -50,11 +50,11 @@ mod tests;
 
 pub use checker::MapChecker;
 pub use config::{
-    MapConfig, MapConfigBuilder, Support, DEFAULT_RELATIVE_CONTACT, DEFAULT_RELATIVE_TOLERANCE, DEFAULT_RESOLUTION,
-    MAX_PARTS, MAX_RESOLUTION,
+    MapConfig, MapConfigBuilder, Support, DEFAULT_RELATIVE_CONTACT, DEFAULT_RELATIVE_TOLERANCE, DEFAULT_RESOLUTION, MAX_PARTS,
+    MAX_RESOLUTION,
 };
-pub use dirmask::DirMask;
 use dirmask::Bits;
+pub use dirmask::DirMask;
 pub use hemisphere::Hemisphere;
 pub use maps::{DistanceMaps, PartGeometry};
 pub use state::{MapCounters, MapState};

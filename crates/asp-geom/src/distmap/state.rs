@@ -32,14 +32,7 @@ fn min_rows(values: &[f32], rows: &[usize], init: &[f32], out: &mut [f32]) -> f6
 }
 
 #[inline(always)]
-fn min_block<const W: usize>(
-    values: &[f32],
-    rows: &[usize],
-    init: &[f32],
-    out: &mut [f32],
-    at: usize,
-    lanes: &mut [f64; 8],
-) {
+fn min_block<const W: usize>(values: &[f32], rows: &[usize], init: &[f32], out: &mut [f32], at: usize, lanes: &mut [f64; 8]) {
     let stride = out.len();
     let mut acc: [f32; W] = init[at..at + W].try_into().expect("W values");
     for &r in rows {
@@ -457,9 +450,7 @@ impl<'m> MapState<'m> {
                     }
                 }
             }
-            Support::ContactGraph => {
-                out.extend(candidates.iter().filter(|&a| self.removal_keeps_stable(a)))
-            }
+            Support::ContactGraph => out.extend(candidates.iter().filter(|&a| self.removal_keeps_stable(a))),
         }
         let tested = candidates.len() as u64;
         self.counters.gravity_tests += tested;

@@ -1,12 +1,12 @@
-use super::*;
 use super::maps::clear_distance;
+use super::*;
 use crate::assembly::Assembly;
-use crate::feasibility::Stability;
-use crate::math::{Aabb, Axis, Vec3};
-use crate::partset::PartSet;
 use crate::assembly::Part;
+use crate::feasibility::Stability;
 use crate::fixtures;
+use crate::math::{Aabb, Axis, Vec3};
 use crate::mesh::Mesh;
+use crate::partset::PartSet;
 
 fn part(name: &str, mesh: Mesh) -> Part {
     fixtures::part(name, mesh, false)
@@ -96,7 +96,7 @@ fn stacked_boxes_from_meshes_and_boxes_agree() {
         // bottom vs top: moving up hits immediately; horizontal is free
         assert_eq!(maps.map(0, 1)[up], 0.0);
         assert_eq!(maps.map(0, 1)[h.index(2, 2)], d_max); // +x
-        // top vs bottom: every half-sphere direction is free
+                                                          // top vs bottom: every half-sphere direction is free
         assert!(maps.map(1, 0).iter().all(|&v| v == d_max));
         // the floor supports the bottom, the bottom supports the top
         assert!(maps.on_floor(0) && !maps.on_floor(1));
@@ -106,9 +106,7 @@ fn stacked_boxes_from_meshes_and_boxes_agree() {
         // the bottom slides out sideways, but that drops the top
         assert!(maps.is_collision_free(0, &full));
         assert!(!maps.free_mask(0, &full).contains(up));
-        assert_eq!(maps.stability(&PartSet::from_indices(2, [1])), Stability::Unstable {
-            floating: PartSet::from_indices(2, [1])
-        });
+        assert_eq!(maps.stability(&PartSet::from_indices(2, [1])), Stability::Unstable { floating: PartSet::from_indices(2, [1]) });
     }
 }
 
@@ -144,4 +142,3 @@ fn map_state_tracks_removals() {
     s.remove(0);
     assert!(s.is_complete());
 }
-

@@ -3,9 +3,9 @@
 
 use super::config::{GraphConfig, DIRECTION_BINS};
 use super::descriptor::descriptor_into;
-use crate::sample::{sample_triangles, SurfaceSample};
 use crate::error::{GeomError, Result};
 use crate::math::{Aabb, Vec3};
+use crate::sample::{sample_triangles, SurfaceSample};
 use crate::world::World;
 use parry3d::query::PointQuery;
 use parry3d::shape::TriMesh;
@@ -74,13 +74,10 @@ impl AssemblyGraph {
             .collect();
         let centroids: Vec<Vec3> = samples.iter().map(|s| s.centroid().unwrap_or(Vec3::ZERO)).collect();
         let frame = horizontal_frame(&samples, up);
-        let part_h: Vec<Vec<f32>> = samples
-            .par_iter()
-            .map_init(Vec::new, |scratch, s| region_descriptor(s, None, config, scratch))
-            .collect();
-        let pairs: Vec<(usize, usize)> = (0..n)
-            .flat_map(|i| world.contacts(i).iter().filter(move |&j| j > i && j < n).map(move |j| (i, j)))
-            .collect();
+        let part_h: Vec<Vec<f32>> =
+            samples.par_iter().map_init(Vec::new, |scratch, s| region_descriptor(s, None, config, scratch)).collect();
+        let pairs: Vec<(usize, usize)> =
+            (0..n).flat_map(|i| world.contacts(i).iter().filter(move |&j| j > i && j < n).map(move |j| (i, j))).collect();
         let pair_features: Vec<PairFeatures> = pairs
             .par_iter()
             .map(|&(i, j)| {
@@ -93,10 +90,7 @@ impl AssemblyGraph {
                         region_descriptor(&samples[j], Some(&q_ji), config, &mut scratch),
                     ],
                     normal_up: [normal_up(&samples[i], &q_ij, up), normal_up(&samples[j], &q_ji, up)],
-                    directions: [
-                        contact_directions(&samples[i], &q_ij, frame, up),
-                        contact_directions(&samples[j], &q_ji, frame, up),
-                    ],
+                    directions: [contact_directions(&samples[i], &q_ij, frame, up), contact_directions(&samples[j], &q_ji, frame, up)],
                 }
             })
             .collect();
@@ -132,19 +126,11 @@ impl AssemblyGraph {
     /// A graph from precomputed attributes (tests, data sets read back): `nodes` row-major
     /// `num_parts × node_dim`, `edges` sorted by (source, target) without repeats or loops,
     /// `edge_attr` row-major `edges.len() × edge_dim`. Errors name the first inconsistency.
-    pub fn from_parts(
-        config: &GraphConfig,
-        nodes: Vec<f32>,
-        edges: Vec<(usize, usize)>,
-        edge_attr: Vec<f32>,
-    ) -> Result<AssemblyGraph> {
+    pub fn from_parts(config: &GraphConfig, nodes: Vec<f32>, edges: Vec<(usize, usize)>, edge_attr: Vec<f32>) -> Result<AssemblyGraph> {
         config.validate()?;
         let (nd, ed) = (config.node_dim(), config.edge_dim());
         if !nodes.len().is_multiple_of(nd) {
-            return Err(GeomError::config(format!(
-                "graph nodes hold {} floats, not a multiple of node_dim {nd}",
-                nodes.len()
-            )));
+            return Err(GeomError::config(format!("graph nodes hold {} floats, not a multiple of node_dim {nd}", nodes.len())));
         }
         let n = nodes.len() / nd;
         if edge_attr.len() != edges.len() * ed {
@@ -245,12 +231,7 @@ fn region_descriptor(sample: &SurfaceSample, region: Option<&[u32]>, config: &Gr
     let mut h = vec![0.0; config.descriptor_dim()];
     match region {
         None => descriptor_into(|| sample.points.iter().copied().zip(sample.weights.iter().copied()), config, &mut h, scratch),
-        Some(r) => descriptor_into(
-            || r.iter().map(|&k| (sample.points[k as usize], sample.weights[k as usize])),
-            config,
-            &mut h,
-            scratch,
-        ),
+        Some(r) => descriptor_into(|| r.iter().map(|&k| (sample.points[k as usize], sample.weights[k as usize])), config, &mut h, scratch),
     }
     h
 }
@@ -260,13 +241,8 @@ fn region_descriptor(sample: &SurfaceSample, region: Option<&[u32]>, config: &Gr
 /// the mesh's BVH bounded by `eps`.
 fn contact_region(sample: &SurfaceSample, mesh: &TriMesh, aabb: &Aabb, eps: f32) -> Vec<u32> {
     let (lo, hi) = (aabb.mins - Vec3::splat(eps), aabb.maxs + Vec3::splat(eps));
-    let candidates: Vec<u32> = sample
-        .points
-        .iter()
-        .enumerate()
-        .filter(|(_, p)| p.cmpge(lo).all() && p.cmple(hi).all())
-        .map(|(k, _)| k as u32)
-        .collect();
+    let candidates: Vec<u32> =
+        sample.points.iter().enumerate().filter(|(_, p)| p.cmpge(lo).all() && p.cmple(hi).all()).map(|(k, _)| k as u32).collect();
     let near = |&k: &u32| {
         let p = sample.points[k as usize];
         mesh.project_local_point_with_max_dist(p, false, eps).is_some_and(|proj| (proj.point - p).length() < eps)

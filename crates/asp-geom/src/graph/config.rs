@@ -43,16 +43,10 @@ impl GraphConfig {
     /// Checks the ranges: `1..=64` radius bins, degree `0..=20`, `1..=2^20` points per part.
     pub fn validate(&self) -> Result<()> {
         if !(1..=MAX_RADIUS_BINS).contains(&self.radius_bins) {
-            return Err(GeomError::config(format!(
-                "graph radius_bins must be 1..={MAX_RADIUS_BINS}, got {}",
-                self.radius_bins
-            )));
+            return Err(GeomError::config(format!("graph radius_bins must be 1..={MAX_RADIUS_BINS}, got {}", self.radius_bins)));
         }
         if self.degree > MAX_DEGREE {
-            return Err(GeomError::config(format!(
-                "graph degree must be 0..={MAX_DEGREE}, got {}",
-                self.degree
-            )));
+            return Err(GeomError::config(format!("graph degree must be 0..={MAX_DEGREE}, got {}", self.degree)));
         }
         if !(1..=MAX_POINTS_PER_PART).contains(&self.points_per_part) {
             return Err(GeomError::config(format!(
@@ -169,7 +163,12 @@ mod tests {
         for config in [c, old, GraphConfig::default()] {
             assert_eq!(GraphConfig::from_features(&config.features()), Some(config));
         }
-        for bad in ["asp-graph/3 radius_bins=8 degree=8 points=2048", "asp-graph/2 radius_bins=8 degree=8", "asp-graph/2 radius_bins=0 degree=8 points=2048", "tiny/1"] {
+        for bad in [
+            "asp-graph/3 radius_bins=8 degree=8 points=2048",
+            "asp-graph/2 radius_bins=8 degree=8",
+            "asp-graph/2 radius_bins=0 degree=8 points=2048",
+            "tiny/1",
+        ] {
             assert_eq!(GraphConfig::from_features(bad), None, "{bad}");
         }
     }

@@ -47,9 +47,7 @@ where
     let out = &mut out[..len];
     out.fill(0.0);
     let valid = || {
-        cloud().filter(|(p, w)| p.is_finite() && w.is_finite() && *w > 0.0).map(|(p, w)| {
-            ([p.x as f64, p.y as f64, p.z as f64], w as f64)
-        })
+        cloud().filter(|(p, w)| p.is_finite() && w.is_finite() && *w > 0.0).map(|(p, w)| ([p.x as f64, p.y as f64, p.z as f64], w as f64))
     };
     // 1. weighted centroid and the farthest point
     let (mut total, mut sum) = (0.0f64, [0.0f64; 3]);
@@ -131,11 +129,7 @@ mod tests {
         let same = sh_descriptor(&[Vec3::ONE; 5], &[1.0; 5], &c);
         assert_eq!(same, one);
         // zero, negative and NaN weights and NaN points are ignored
-        let junk = sh_descriptor(
-            &[Vec3::ONE, Vec3::splat(f32::NAN), Vec3::ZERO, Vec3::X],
-            &[1.0, 1.0, 0.0, -2.0],
-            &c,
-        );
+        let junk = sh_descriptor(&[Vec3::ONE, Vec3::splat(f32::NAN), Vec3::ZERO, Vec3::X], &[1.0, 1.0, 0.0, -2.0], &c);
         assert_eq!(junk, one);
         let nan_w = sh_descriptor(&[Vec3::ONE, Vec3::X], &[f32::NAN, f32::INFINITY], &c);
         assert_eq!(nan_w, zero);

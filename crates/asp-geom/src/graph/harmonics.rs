@@ -172,7 +172,13 @@ mod tests {
         for k in 0..200 {
             let a = random_dir(&mut rng);
             // include the poles, where sin θ = 0
-            let b = if k == 0 { [0.0, 0.0, 1.0] } else if k == 1 { [0.0, 0.0, -1.0] } else { random_dir(&mut rng) };
+            let b = if k == 0 {
+                [0.0, 0.0, 1.0]
+            } else if k == 1 {
+                [0.0, 0.0, -1.0]
+            } else {
+                random_dir(&mut rng)
+            };
             real_sh(a, 20, &mut ya);
             real_sh(b, 20, &mut yb);
             let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];

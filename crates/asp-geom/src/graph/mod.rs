@@ -16,11 +16,11 @@ mod descriptor;
 pub mod harmonics;
 mod state;
 
+/// The surface sampler lives in [`crate::sample`] (the removal test's strict rule and the
+/// fastener detector use it too); `graph::sample` stays as its old path.
+pub use crate::sample::{self, sample_surface, SurfaceSample};
 pub use build::{contact_directions, horizontal_frame, AssemblyGraph};
 pub use config::DIRECTION_BINS;
 pub use config::{GraphConfig, GraphConfigBuilder, MAX_DEGREE, MAX_POINTS_PER_PART, MAX_RADIUS_BINS};
 pub use descriptor::sh_descriptor;
-/// The surface sampler lives in [`crate::sample`] (the removal test's strict rule and the
-/// fastener detector use it too); `graph::sample` stays as its old path.
-pub use crate::sample::{self, sample_surface, SurfaceSample};
 pub use state::StateGraph;

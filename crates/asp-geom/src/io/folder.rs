@@ -40,9 +40,8 @@ pub(crate) fn load_folder(dir: &Path, options: &LoadOptions) -> Result<Assembly>
     options.limits.check_parts(files.len()).map_err(|reason| GeomError::format(dir, reason))?;
     for file in &files {
         let name = file.file_name().map(PathBuf::from).unwrap_or_default();
-        refs::resolve_inside(dir, &name, &[], options.allow_outside_files).map_err(|refused| {
-            GeomError::format(dir, refused.describe("file", &name.to_string_lossy()))
-        })?;
+        refs::resolve_inside(dir, &name, &[], options.allow_outside_files)
+            .map_err(|refused| GeomError::format(dir, refused.describe("file", &name.to_string_lossy())))?;
     }
     assemble(dir, &files, options)
 }
@@ -92,13 +91,7 @@ fn assemble(source: &Path, files: &[PathBuf], options: &LoadOptions) -> Result<A
         .collect::<Result<Vec<Part>>>()?;
     let triangles = parts.iter().map(|p| p.mesh.triangles.len()).sum();
     options.limits.check_triangles(triangles).map_err(|reason| GeomError::format(source, reason))?;
-    Ok(Assembly {
-        parts,
-        units,
-        up: options.up.unwrap_or(Axis::Z),
-        source: source.to_path_buf(),
-        warnings: Vec::new(),
-    })
+    Ok(Assembly { parts, units, up: options.up.unwrap_or(Axis::Z), source: source.to_path_buf(), warnings: Vec::new() })
 }
 
 /// The mesh of one file, in the file's units.
@@ -129,9 +122,8 @@ fn read_stl(path: &Path, bytes: &[u8], limits: &Limits) -> Result<Mesh> {
         // Many CAD tools start binary headers with "solid", which stl_io takes for ASCII.
         bytes[..5].fill(0);
     }
-    let stl = stl_io::read_stl(&mut Cursor::new(bytes)).map_err(|e| {
-        GeomError::format(path, format!("invalid stl file: {}", one_line(&lowercase_first(&e.to_string()))))
-    })?;
+    let stl = stl_io::read_stl(&mut Cursor::new(bytes))
+        .map_err(|e| GeomError::format(path, format!("invalid stl file: {}", one_line(&lowercase_first(&e.to_string())))))?;
     let vertices = stl.vertices.iter().map(|v| Vec3::new(v.0[0], v.0[1], v.0[2])).collect();
     let triangles = stl.faces.iter().map(|f| f.vertices.map(|i| i as u32)).collect();
     Ok(Mesh::new(vertices, triangles))
@@ -155,15 +147,9 @@ fn is_binary_stl(bytes: &[u8]) -> bool {
 
 /// An OBJ file, polygons triangulated, all its objects and groups merged; materials are not read.
 fn read_obj(path: &Path, bytes: &[u8]) -> Result<Mesh> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        GeomError::format(path, format!("invalid obj file: not utf-8 text (byte {})", e.valid_up_to()))
-    })?;
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        ignore_points: true,
-        ignore_lines: true,
-        ..Default::default()
-    };
+    let text = std::str::from_utf8(bytes)
+        .map_err(|e| GeomError::format(path, format!("invalid obj file: not utf-8 text (byte {})", e.valid_up_to())))?;
+    let options = tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
     let no_materials = |_: &Path| Err(tobj::LoadError::GenericFailure);
     let positions_only = positions_and_faces(text);
     let (models, _) = tobj::load_obj_buf(&mut BufReader::new(positions_only.as_bytes()), &options, no_materials)
@@ -179,10 +165,7 @@ fn read_obj(path: &Path, bytes: &[u8]) -> Result<Mesh> {
             .chunks_exact(3)
             .map(|t| match [t[0], t[1], t[2]] {
                 t if t.iter().all(|&i| (i as usize) < count) => Ok(t),
-                _ => Err(GeomError::format(
-                    path,
-                    format!("invalid obj file: object '{}' has a face index out of range", model.name),
-                )),
+                _ => Err(GeomError::format(path, format!("invalid obj file: object '{}' has a face index out of range", model.name))),
             })
             .collect::<Result<Vec<_>>>()?;
         mesh.append(&Mesh::new(vertices, triangles));

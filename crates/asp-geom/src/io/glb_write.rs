@@ -74,12 +74,8 @@ struct GltfBuilder {
 impl GltfBuilder {
     fn add_part(&mut self, part: &Part, units: &Units) -> std::result::Result<(), String> {
         check_part(part)?;
-        let positions: Vec<[f32; 3]> = part
-            .mesh
-            .vertices
-            .iter()
-            .map(|v| [v.x, v.y, v.z].map(|c| units.from_metres(f64::from(c)) as f32))
-            .collect();
+        let positions: Vec<[f32; 3]> =
+            part.mesh.vertices.iter().map(|v| [v.x, v.y, v.z].map(|c| units.from_metres(f64::from(c)) as f32)).collect();
         let (min, max) = bounds(&positions);
         let indices: Vec<u32> = part.mesh.triangles.iter().flatten().copied().collect();
         let position = self.add_accessor(
@@ -106,9 +102,7 @@ impl GltfBuilder {
     /// Appends `data` as a new buffer view and an accessor over it; returns the accessor index.
     fn add_accessor(&mut self, data: Vec<u8>, target: u32, mut accessor: Value) -> usize {
         accessor["bufferView"] = json!(self.views.len());
-        self.views.push(
-            json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": data.len(), "target": target}),
-        );
+        self.views.push(json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": data.len(), "target": target}));
         self.bin.extend(data);
         self.accessors.push(accessor);
         self.accessors.len() - 1

@@ -9,8 +9,8 @@ use super::{lowercase_first, refs, Limits, LoadOptions, MAX_ZERO_FILLED};
 use crate::assembly::{Assembly, Part, Units};
 use crate::error::{GeomError, Result};
 use crate::math::{Axis, Pose, Vec3};
-use crate::meta::PartMeta;
 use crate::mesh::Mesh;
+use crate::meta::PartMeta;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 use gltf::scene::Transform;
@@ -71,10 +71,7 @@ fn split_glb(bytes: &[u8]) -> Res<(&[u8], Option<&[u8]>)> {
         return Err(format!("unsupported glb version {version} (expected 2)"));
     }
     if length > bytes.len() {
-        return Err(format!(
-            "truncated glb: the header announces {length} bytes but the file has {}",
-            bytes.len()
-        ));
+        return Err(format!("truncated glb: the header announces {length} bytes but the file has {}", bytes.len()));
     }
     let body = &bytes[..length];
     let mut chunks = Vec::new();
@@ -85,10 +82,7 @@ fn split_glb(bytes: &[u8]) -> Res<(&[u8], Option<&[u8]>)> {
         };
         let start = at + 8;
         let Some(data) = start.checked_add(len as usize).and_then(|end| body.get(start..end)) else {
-            return Err(format!(
-                "truncated glb: a chunk announces {len} bytes but only {} remain",
-                body.len() - start
-            ));
+            return Err(format!("truncated glb: a chunk announces {len} bytes but only {} remain", body.len() - start));
         };
         chunks.push((kind, data));
         at = start + data.len();
@@ -114,10 +108,7 @@ fn parse_document(json: &[u8]) -> Res<Document> {
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             if let Some(bad) = primitive.attributes.values().find(|a| a.value() >= root.accessors.len()) {
-                return Err(format!(
-                    "invalid gltf: meshes[{m}].primitives[{p}] uses accessor {} which does not exist",
-                    bad.value()
-                ));
+                return Err(format!("invalid gltf: meshes[{m}].primitives[{p}] uses accessor {} which does not exist", bad.value()));
             }
         }
     }
@@ -152,12 +143,7 @@ fn load_buffers<'a>(
         .map(|buffer| {
             let data = buffer_data(&buffer, path, blob, allow_outside, external)?;
             if data.len() < buffer.length() {
-                return Err(format!(
-                    "truncated buffer {}: {} bytes, expected {}",
-                    buffer.index(),
-                    data.len(),
-                    buffer.length()
-                ));
+                return Err(format!("truncated buffer {}: {} bytes, expected {}", buffer.index(), data.len(), buffer.length()));
             }
             Ok(data)
         })
@@ -173,17 +159,14 @@ fn buffer_data<'a>(
 ) -> Res<Cow<'a, [u8]>> {
     let index = buffer.index();
     match buffer.source() {
-        gltf::buffer::Source::Bin => blob
-            .map(Cow::Borrowed)
-            .ok_or_else(|| format!("buffer {index} has no uri and the file has no binary chunk")),
-        gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-            gltf::buffer::Data::from_source(buffer.source(), None)
-                .map(|data| Cow::Owned(data.0))
-                .map_err(|e| format!("buffer {index}: invalid data uri ({e})"))
+        gltf::buffer::Source::Bin => {
+            blob.map(Cow::Borrowed).ok_or_else(|| format!("buffer {index} has no uri and the file has no binary chunk"))
         }
+        gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => gltf::buffer::Data::from_source(buffer.source(), None)
+            .map(|data| Cow::Owned(data.0))
+            .map_err(|e| format!("buffer {index}: invalid data uri ({e})")),
         gltf::buffer::Source::Uri(uri) => {
-            let reference =
-                external_file(uri).ok_or_else(|| format!("buffer {index}: unsupported uri '{uri}'"))?;
+            let reference = external_file(uri).ok_or_else(|| format!("buffer {index}: unsupported uri '{uri}'"))?;
             let folder = path.parent().unwrap_or(Path::new(""));
             let file = refs::resolve_inside(folder, &reference, &[], allow_outside)
                 .map_err(|refused| refused.describe(&format!("buffer {index} uri"), uri))?;
@@ -191,11 +174,7 @@ fn buffer_data<'a>(
                 std::io::ErrorKind::NotFound => {
                     format!("buffer file '{}' is missing", file.display())
                 }
-                _ => format!(
-                    "cannot read buffer file '{}': {}",
-                    file.display(),
-                    lowercase_first(&e.to_string())
-                ),
+                _ => format!("cannot read buffer file '{}': {}", file.display(), lowercase_first(&e.to_string())),
             })
         }
     }
@@ -255,15 +234,11 @@ fn scene_settings(scene: &Scene) -> Res<SceneSettings> {
         Some(other) => Err(format!("scene extras.asp.{key} must be a string, not {other}")),
     };
     let unit = match text("unit")? {
-        Some(s) => {
-            Some(Units::parse(&s).ok_or_else(|| format!("scene extras.asp.unit '{s}' is not a known unit"))?)
-        }
+        Some(s) => Some(Units::parse(&s).ok_or_else(|| format!("scene extras.asp.unit '{s}' is not a known unit"))?),
         None => None,
     };
     let up = match text("up")? {
-        Some(s) => Some(
-            Axis::parse(&s).ok_or_else(|| format!("scene extras.asp.up '{s}' is not an axis such as +z"))?,
-        ),
+        Some(s) => Some(Axis::parse(&s).ok_or_else(|| format!("scene extras.asp.up '{s}' is not an axis such as +z"))?),
         None => None,
     };
     Ok(SceneSettings { unit, up })
@@ -272,9 +247,7 @@ fn scene_settings(scene: &Scene) -> Res<SceneSettings> {
 /// A node's `extras.asp` object without its `fixed` key (kept in [`Part::fixed`] instead), and
 /// the fixed flag. An absent or empty object gives `Value::Null`.
 fn node_metadata(node: &Node, label: &str) -> Res<(Value, bool)> {
-    let mut asp = parse_extras(node.extras(), label)?
-        .and_then(|mut e| e.get_mut("asp").map(Value::take))
-        .unwrap_or(Value::Null);
+    let mut asp = parse_extras(node.extras(), label)?.and_then(|mut e| e.get_mut("asp").map(Value::take)).unwrap_or(Value::Null);
     let fixed = match asp.as_object_mut().and_then(|m| m.remove("fixed")) {
         None => false,
         Some(Value::Bool(fixed)) => fixed,
@@ -287,11 +260,7 @@ fn node_metadata(node: &Node, label: &str) -> Res<(Value, bool)> {
 }
 
 fn parse_extras(extras: &gltf::json::Extras, label: &str) -> Res<Option<Value>> {
-    extras
-        .as_ref()
-        .map(|raw| serde_json::from_str(raw.get()))
-        .transpose()
-        .map_err(|e| format!("{label}: invalid extras ({e})"))
+    extras.as_ref().map(|raw| serde_json::from_str(raw.get())).transpose().map_err(|e| format!("{label}: invalid extras ({e})"))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -343,10 +312,7 @@ impl<'a> PartBuilder<'a> {
         stack.reverse();
         while let Some((node, parent)) = stack.pop() {
             if std::mem::replace(&mut seen[node.index()], true) {
-                return Err(format!(
-                    "invalid node hierarchy: node {} is reached twice (a cycle or several parents)",
-                    node.index()
-                ));
+                return Err(format!("invalid node hierarchy: node {} is reached twice (a cycle or several parents)", node.index()));
             }
             let world = parent * local_matrix(&node)?;
             if let Some(mesh) = node.mesh() {
@@ -360,17 +326,9 @@ impl<'a> PartBuilder<'a> {
     }
 
     fn add_instance(&mut self, node: &Node, mesh: &gltf::Mesh, world: &DMat4) -> Res<()> {
-        let name = node
-            .name()
-            .or(mesh.name())
-            .map(str::to_string)
-            .unwrap_or_else(|| format!("part_{}", self.parts.len()));
+        let name = node.name().or(mesh.name()).map(str::to_string).unwrap_or_else(|| format!("part_{}", self.parts.len()));
         if name.len() > MAX_NAME_BYTES {
-            return Err(format!(
-                "node {}: its name has {} bytes (at most {MAX_NAME_BYTES}); shorten it",
-                node.index(),
-                name.len()
-            ));
+            return Err(format!("node {}: its name has {} bytes (at most {MAX_NAME_BYTES}); shorten it", node.index(), name.len()));
         }
         let label = format!("node '{name}'");
         self.limits.check_parts(self.parts.len() + 1)?;
@@ -419,8 +377,7 @@ impl<'a> PartBuilder<'a> {
             self.limits
                 .check_triangles(self.triangles + local.triangles.len() + announced)
                 .map_err(|reason| format!("{context}: {reason}"))?;
-            let (vertices, triangles) =
-                self.read_primitive(&primitive).map_err(|reason| format!("{context}: {reason}"))?;
+            let (vertices, triangles) = self.read_primitive(&primitive).map_err(|reason| format!("{context}: {reason}"))?;
             // the running total is checked below, so the previous one fits in u32
             let base = local.vertices.len() as u32;
             local.vertices.extend(vertices);
@@ -494,9 +451,7 @@ fn is_triangles(mode: Mode) -> bool {
 fn local_matrix(node: &Node) -> Res<DMat4> {
     let finite = match node.transform() {
         Transform::Matrix { matrix } => matrix.iter().flatten().all(|v| v.is_finite()),
-        Transform::Decomposed { translation, rotation, scale } => {
-            translation.iter().chain(&rotation).chain(&scale).all(|v| v.is_finite())
-        }
+        Transform::Decomposed { translation, rotation, scale } => translation.iter().chain(&rotation).chain(&scale).all(|v| v.is_finite()),
     };
     if !finite {
         let name = node.name().map(|n| format!(" ('{n}')")).unwrap_or_default();
@@ -531,8 +486,7 @@ fn bake(local: &LocalMesh, world: &DMat4, scale: f64) -> Mesh {
         })
         .collect();
     let mirrored = world.determinant() < 0.0;
-    let triangles =
-        local.triangles.iter().map(|&[a, b, c]| if mirrored { [a, c, b] } else { [a, b, c] }).collect();
+    let triangles = local.triangles.iter().map(|&[a, b, c]| if mirrored { [a, c, b] } else { [a, b, c] }).collect();
     Mesh::new(vertices, triangles)
 }
 
@@ -548,13 +502,9 @@ fn triangulate(mode: Mode, indices: &[u32]) -> Res<Vec<[u32; 3]>> {
             return Ok(indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect());
         }
         // spec: triangle i of a strip is (p_i, p_{i+1+i%2}, p_{i+2-i%2})
-        Mode::TriangleStrip => (0..n.saturating_sub(2))
-            .map(|i| [indices[i], indices[i + 1 + i % 2], indices[i + 2 - i % 2]])
-            .collect(),
+        Mode::TriangleStrip => (0..n.saturating_sub(2)).map(|i| [indices[i], indices[i + 1 + i % 2], indices[i + 2 - i % 2]]).collect(),
         // spec: triangle i of a fan is (p_{i+1}, p_{i+2}, p_0)
-        Mode::TriangleFan => {
-            (0..n.saturating_sub(2)).map(|i| [indices[i + 1], indices[i + 2], indices[0]]).collect()
-        }
+        Mode::TriangleFan => (0..n.saturating_sub(2)).map(|i| [indices[i + 1], indices[i + 2], indices[0]]).collect(),
         other => return Err(format!("{other:?} is not a triangle mode").to_lowercase()),
     };
     Ok(triangles.into_iter().filter(|[a, b, c]| a != b && b != c && a != c).collect())
@@ -565,12 +515,8 @@ fn triangulate(mode: Mode, indices: &[u32]) -> Res<Vec<[u32; 3]>> {
 
 fn read_positions(accessor: &Accessor, buffers: &[Cow<[u8]>]) -> Res<Vec<DVec3>> {
     if accessor.dimensions() != Dimensions::Vec3 {
-        return Err(format!(
-            "position accessor {} has unsupported type {:?} (expected vec3)",
-            accessor.index(),
-            accessor.dimensions()
-        )
-        .to_lowercase());
+        return Err(format!("position accessor {} has unsupported type {:?} (expected vec3)", accessor.index(), accessor.dimensions())
+            .to_lowercase());
     }
     let flat = read_accessor(accessor, buffers)?;
     Ok(flat.chunks_exact(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect())
@@ -591,10 +537,7 @@ fn read_indices(accessor: &Accessor, buffers: &[Cow<[u8]>], vertex_count: usize)
         .into_iter()
         .map(|i| match i as usize {
             i if i < vertex_count => Ok(i as u32),
-            i => Err(format!(
-                "index accessor {}: index {i} is out of range ({vertex_count} vertices)",
-                accessor.index()
-            )),
+            i => Err(format!("index accessor {}: index {i} is out of range ({vertex_count} vertices)", accessor.index())),
         })
         .collect()
 }
@@ -602,11 +545,8 @@ fn read_indices(accessor: &Accessor, buffers: &[Cow<[u8]>], vertex_count: usize)
 /// Every component of every element, as f64 (exact for all glTF component types), sparse
 /// substitutions applied.
 fn read_accessor(accessor: &Accessor, buffers: &[Cow<[u8]>]) -> Res<Vec<f64>> {
-    let layout = Layout {
-        data_type: accessor.data_type(),
-        components: accessor.dimensions().multiplicity(),
-        normalized: accessor.normalized(),
-    };
+    let layout =
+        Layout { data_type: accessor.data_type(), components: accessor.dimensions().multiplicity(), normalized: accessor.normalized() };
     let count = accessor.count();
     let context = |reason: String| format!("accessor {}: {reason}", accessor.index());
     let mut values = match accessor.view() {
@@ -624,12 +564,7 @@ fn read_accessor(accessor: &Accessor, buffers: &[Cow<[u8]>]) -> Res<Vec<f64>> {
 }
 
 /// Replaces the elements a sparse accessor lists.
-fn apply_sparse(
-    values: &mut [f64],
-    sparse: &gltf::accessor::sparse::Sparse,
-    layout: Layout,
-    buffers: &[Cow<[u8]>],
-) -> Res<()> {
+fn apply_sparse(values: &mut [f64], sparse: &gltf::accessor::sparse::Sparse, layout: Layout, buffers: &[Cow<[u8]>]) -> Res<()> {
     use gltf::accessor::sparse::IndexType;
     let count = sparse.count();
     let (indices, substitutes) = (sparse.indices(), sparse.values());
@@ -643,14 +578,11 @@ fn apply_sparse(
         normalized: false,
     };
     let targets = index_layout.read(view_bytes(&indices.view(), buffers)?, indices.offset(), None, count)?;
-    let substitutes =
-        layout.read(view_bytes(&substitutes.view(), buffers)?, substitutes.offset(), None, count)?;
+    let substitutes = layout.read(view_bytes(&substitutes.view(), buffers)?, substitutes.offset(), None, count)?;
     let n = layout.components;
     for (target, substitute) in targets.iter().zip(substitutes.chunks_exact(n)) {
         let start = *target as usize * n;
-        let slot = values
-            .get_mut(start..start + n)
-            .ok_or_else(|| format!("sparse index {target} is out of range"))?;
+        let slot = values.get_mut(start..start + n).ok_or_else(|| format!("sparse index {target} is out of range"))?;
         slot.copy_from_slice(substitute);
     }
     Ok(())
@@ -658,9 +590,7 @@ fn apply_sparse(
 
 /// The bytes of a buffer view, checked against its buffer.
 fn view_bytes<'b>(view: &gltf::buffer::View, buffers: &'b [Cow<[u8]>]) -> Res<&'b [u8]> {
-    let buffer = buffers
-        .get(view.buffer().index())
-        .ok_or_else(|| format!("buffer view {} has no buffer", view.index()))?;
+    let buffer = buffers.get(view.buffer().index()).ok_or_else(|| format!("buffer view {} has no buffer", view.index()))?;
     view.offset().checked_add(view.length()).and_then(|end| buffer.get(view.offset()..end)).ok_or_else(|| {
         format!(
             "buffer view {} (bytes {}..+{}) lies outside buffer {} ({} bytes)",
@@ -694,15 +624,9 @@ impl Layout {
         if count == 0 {
             return Ok(Vec::new());
         }
-        let end = (count - 1)
-            .checked_mul(stride)
-            .and_then(|n| n.checked_add(element))
-            .and_then(|n| n.checked_add(offset));
+        let end = (count - 1).checked_mul(stride).and_then(|n| n.checked_add(element)).and_then(|n| n.checked_add(offset));
         if end.is_none_or(|end| end > bytes.len()) {
-            return Err(format!(
-                "{count} elements at offset {offset} read past the end of the buffer view ({} bytes)",
-                bytes.len()
-            ));
+            return Err(format!("{count} elements at offset {offset} read past the end of the buffer view ({} bytes)", bytes.len()));
         }
         let mut values = Vec::with_capacity(count * self.components);
         for i in 0..count {

@@ -120,10 +120,7 @@ fn check_extension(path: &Path) -> Result<FileKind> {
     match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
         Some("glb") | Some("gltf") => Ok(FileKind::Gltf),
         Some("obj") | Some("stl") => Ok(FileKind::Mesh),
-        _ => Err(GeomError::format(
-            path,
-            "unknown file type (expected .glb, .gltf, or a folder of .obj/.stl files)",
-        )),
+        _ => Err(GeomError::format(path, "unknown file type (expected .glb, .gltf, or a folder of .obj/.stl files)")),
     }
 }
 
@@ -149,9 +146,7 @@ pub(crate) fn lowercase_first(text: &str) -> String {
     let text = text.trim().trim_end_matches('.');
     let mut chars = text.chars();
     match (chars.next(), chars.next()) {
-        (Some(first), second) if !second.is_some_and(char::is_uppercase) => {
-            first.to_lowercase().chain(text.chars().skip(1)).collect()
-        }
+        (Some(first), second) if !second.is_some_and(char::is_uppercase) => first.to_lowercase().chain(text.chars().skip(1)).collect(),
         _ => text.to_string(),
     }
 }
@@ -162,10 +157,7 @@ mod tests {
 
     #[test]
     fn messages_of_other_libraries_are_lowercased() {
-        assert_eq!(
-            lowercase_first("No such file or directory (os error 2)"),
-            "no such file or directory (os error 2)"
-        );
+        assert_eq!(lowercase_first("No such file or directory (os error 2)"), "no such file or directory (os error 2)");
         assert_eq!(lowercase_first("EOF while expecting facet."), "EOF while expecting facet");
         assert_eq!(lowercase_first(""), "");
     }

@@ -32,7 +32,15 @@ impl Geom {
         let aabb = m.aabb().ok_or_else(|| GeomError::config("empty mesh"))?;
         let mesh = TriMesh::with_flags(m.vertices, m.triangles, TriMeshFlags::ORIENTED)
             .map_err(|e| GeomError::config(format!("cannot build a collision mesh: {e}")))?;
-        let geom = Geom { mesh: Arc::new(mesh), aabb, eroded: Mutex::new(BTreeMap::new()), closed, boxes: None, samples: OnceLock::new(), axis: OnceLock::new() };
+        let geom = Geom {
+            mesh: Arc::new(mesh),
+            aabb,
+            eroded: Mutex::new(BTreeMap::new()),
+            closed,
+            boxes: None,
+            samples: OnceLock::new(),
+            axis: OnceLock::new(),
+        };
         Ok((geom, topology))
     }
 
@@ -54,8 +62,7 @@ impl Geom {
             shrunk.set_vertices(&v);
             return shrunk;
         }
-        TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED)
-            .unwrap_or_else(|_| (*self.mesh).clone())
+        TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED).unwrap_or_else(|_| (*self.mesh).clone())
     }
 
     /// Whether this part shrunk by `amount` still overlaps `other`: surfaces crossing, or one

@@ -22,14 +22,14 @@ use geom::{contains_point, nests, Geom};
 
 use crate::assembly::Assembly;
 use crate::boxes;
-use crate::sweep;
 use crate::error::{GeomError, Result};
+use crate::fastener::{self, SymmetryAxis, Thread};
 use crate::feasibility::{Motion, Stability};
 use crate::math::{aabb_of, sweep_overlap, Aabb, Pose, Vec3};
 use crate::mesh::{Mesh, Topology};
-use crate::fastener::{self, SymmetryAxis, Thread};
 use crate::overlap::{self, OverlapHandling, OverlapKind, OverlapNote, OverlapPolicy};
 use crate::partset::PartSet;
+use crate::sweep;
 use parry3d::query::{self, ClosestPoints, NonlinearRigidMotion, PointQuery};
 use parry3d::shape::{TriMesh, TriMeshFlags};
 use rayon::prelude::*;
@@ -127,10 +127,8 @@ impl World {
         let mut warnings = assembly.warnings.clone();
         let mut geoms = Vec::with_capacity(assembly.len() + 1);
         for p in &assembly.parts {
-            let (mut g, t) = Geom::new(&p.mesh).map_err(|e| GeomError::Assembly {
-                path: assembly.source.clone(),
-                reason: format!("part '{}': {e}", p.name),
-            })?;
+            let (mut g, t) = Geom::new(&p.mesh)
+                .map_err(|e| GeomError::Assembly { path: assembly.source.clone(), reason: format!("part '{}': {e}", p.name) })?;
             g.boxes = match boxes::part_boxes(p).map(|b| b.filter(|_| config.exact_boxes)) {
                 Ok(b) => b,
                 Err(e) => {
@@ -199,9 +197,7 @@ impl World {
                 (0..3).all(|k| a.mins[k] <= b.maxs[k] + m && b.mins[k] <= a.maxs[k] + m)
             })
             .collect();
-        let limit_of = |k: usize| {
-            max_overlap_fraction * (self.geoms[k].aabb.maxs - self.geoms[k].aabb.mins).min_element()
-        };
+        let limit_of = |k: usize| max_overlap_fraction * (self.geoms[k].aabb.maxs - self.geoms[k].aabb.mins).min_element();
         type Found = (usize, usize, bool, Option<f32>, Option<f32>);
         let found: Vec<Found> = pairs
             .par_iter()
@@ -220,8 +216,8 @@ impl World {
                 // parry's mesh-mesh closest points can miss an overlap: measure every candidate
                 let (e_ij, e_ji) = (self.extra_erosion(i, j, limit_of(i)), self.extra_erosion(j, i, limit_of(j)));
                 let overlapping = e_ij != Some(0.0) || e_ji != Some(0.0);
-                let touching = overlapping
-                    || !matches!(query::closest_points(&id, a, &id, b, self.contact_distance), Ok(ClosestPoints::Disjoint));
+                let touching =
+                    overlapping || !matches!(query::closest_points(&id, a, &id, b, self.contact_distance), Ok(ClosestPoints::Disjoint));
                 (i, j, touching, e_ij, e_ji)
             })
             .collect();
@@ -263,7 +259,11 @@ impl World {
                 OverlapKind::Coincident => "overlap (they occupy the same space)".to_string(),
             };
             let measured = if gross {
-                format!("by more than {} (shrinking either by {:.0}% of its thickness does not separate them)", len(depth), max_overlap_fraction * 100.0)
+                format!(
+                    "by more than {} (shrinking either by {:.0}% of its thickness does not separate them)",
+                    len(depth),
+                    max_overlap_fraction * 100.0
+                )
             } else {
                 format!("by about {}", len(depth))
             };
@@ -298,10 +298,8 @@ impl World {
                 OverlapHandling::Ignored => "their collisions with each other are ignored".to_string(),
                 OverlapHandling::Shrunk => format!("their mutual tests shrink '{}' by that much", self.name(self.pair_erosion(i, j).0)),
             };
-            self.warnings.push(format!(
-                "parts '{a}' and '{b}' {what} in the input {measured} (tolerance {}); {consequence}",
-                len(self.tolerance)
-            ));
+            self.warnings
+                .push(format!("parts '{a}' and '{b}' {what} in the input {measured} (tolerance {}); {consequence}", len(self.tolerance)));
             self.notes.push(OverlapNote { parts: (i, j), kind, depth, gross, handling });
         }
         Ok(())
@@ -638,11 +636,9 @@ impl World {
     pub fn blocking_row(&self, p: usize) -> &[PartSet] {
         self.rows[p].get_or_init(|| {
             let count = self.geoms.len();
-            let jobs: Vec<(usize, usize)> = (0..self.directions.len())
-                .flat_map(|k| (0..count).filter(move |&q| q != p).map(move |q| (k, q)))
-                .collect();
-            let blocked: Vec<bool> =
-                jobs.par_iter().map(|&(k, q)| self.pair_blocks(p, q, self.directions[k])).collect();
+            let jobs: Vec<(usize, usize)> =
+                (0..self.directions.len()).flat_map(|k| (0..count).filter(move |&q| q != p).map(move |q| (k, q))).collect();
+            let blocked: Vec<bool> = jobs.par_iter().map(|&(k, q)| self.pair_blocks(p, q, self.directions[k])).collect();
             let mut row = vec![PartSet::empty(count); self.directions.len()];
             for (&(k, q), b) in jobs.iter().zip(blocked) {
                 if b {
@@ -663,25 +659,16 @@ impl World {
     /// [`World::clearance`] of a group of parts moving together: its bounds clear the bounds of
     /// the other present real parts.
     pub fn group_clearance(&self, group: &PartSet, state: &PartSet, dir: Vec3) -> f32 {
-        let bounds = aabb_of(group.iter().flat_map(|q| [self.geoms[q].aabb.mins, self.geoms[q].aabb.maxs]))
-            .expect("a group has parts");
+        let bounds = aabb_of(group.iter().flat_map(|q| [self.geoms[q].aabb.mins, self.geoms[q].aabb.maxs])).expect("a group has parts");
         self.clearance_of(&bounds, state.iter().filter(|&q| !group.contains(q)), dir)
     }
 
     fn clearance_of(&self, a: &Aabb, others: impl Iterator<Item = usize>, dir: Vec3) -> f32 {
-        let others = aabb_of(
-            others.filter(|&q| q < self.num_parts()).flat_map(|q| [self.geoms[q].aabb.mins, self.geoms[q].aabb.maxs]),
-        )
-        .unwrap_or(*a);
+        let others = aabb_of(others.filter(|&q| q < self.num_parts()).flat_map(|q| [self.geoms[q].aabb.mins, self.geoms[q].aabb.maxs]))
+            .unwrap_or(*a);
         let t = (0..3)
             .filter(|&i| dir[i].abs() > 1e-6)
-            .map(|i| {
-                if dir[i] > 0.0 {
-                    (others.maxs[i] - a.mins[i]) / dir[i]
-                } else {
-                    (a.maxs[i] - others.mins[i]) / -dir[i]
-                }
-            })
+            .map(|i| if dir[i] > 0.0 { (others.maxs[i] - a.mins[i]) / dir[i] } else { (a.maxs[i] - others.mins[i]) / -dir[i] })
             .fold(f32::INFINITY, f32::min)
             .max(0.0);
         t + self.contact_distance
@@ -708,7 +695,6 @@ fn significant(x: f64, digits: i32) -> String {
     let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0) as usize;
     format!("{x:.decimals$}")
 }
-
 
 /// A slab under the model whose top face lies at the model's lowest point along `up`.
 fn ground_box(bb: &Aabb, up: Vec3, diag: f32) -> Mesh {

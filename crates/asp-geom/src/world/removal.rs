@@ -84,9 +84,7 @@ impl World {
                 let d = travel(*dir);
                 let better = match best {
                     None => true,
-                    Some((bd, bdir)) => {
-                        d < bd - 1e-6 * bd.max(1e-9) || (d <= bd + 1e-6 * bd && dir.dot(up) > bdir.dot(up) + 1e-6)
-                    }
+                    Some((bd, bdir)) => d < bd - 1e-6 * bd.max(1e-9) || (d <= bd + 1e-6 * bd && dir.dot(up) > bdir.dot(up) + 1e-6),
                 };
                 if better {
                     best = Some((d, *dir));
@@ -178,10 +176,7 @@ impl World {
     /// present part is linked through contacts to a present base part.
     pub fn contact_stability_among(&self, present: &PartSet, base: &PartSet) -> Stability {
         let reached = present.intersection(base).reached_within(present, |i| self.contacts[i].iter());
-        let floating = PartSet::from_indices(
-            self.geoms.len(),
-            present.iter().filter(|&i| !reached.contains(i)),
-        );
+        let floating = PartSet::from_indices(self.geoms.len(), present.iter().filter(|&i| !reached.contains(i)));
         if floating.is_empty() {
             Stability::Stable
         } else {
@@ -261,8 +256,7 @@ impl World {
             let (bs, br) = (shrunk.aabb(&shrunk_pose), raw.aabb(&raw_pose));
             // surfaces crossing (exact triangle tests, `p` placed by `pose`), or one wholly inside
             // the other: only for closed surfaces whose boxes nest
-            let crossing =
-                if k == p { sweep::meshes_cross_at(&shrunk, pose, raw) } else { sweep::meshes_cross_at(raw, pose, &shrunk) };
+            let crossing = if k == p { sweep::meshes_cross_at(&shrunk, pose, raw) } else { sweep::meshes_cross_at(raw, pose, &shrunk) };
             crossing
                 || (raw_closed
                     && nests(&bs, &br)

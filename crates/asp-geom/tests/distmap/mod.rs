@@ -74,10 +74,7 @@ fn floor_map_of_a_raised_box() {
     assert_eq!(maps.supporters(2), &[0, 1]);
     // without one pillar the slab still rests on the other; without both it falls
     assert!(maps.is_supported(2, &PartSet::from_indices(3, [0, 2])));
-    assert_eq!(
-        maps.stability(&PartSet::from_indices(3, [2])),
-        Stability::Unstable { floating: PartSet::from_indices(3, [2]) }
-    );
+    assert_eq!(maps.stability(&PartSet::from_indices(3, [2])), Stability::Unstable { floating: PartSet::from_indices(3, [2]) });
     // the slab blocks both pillars upward
     let full = PartSet::full(3);
     assert!(!maps.free_mask(0, &full).contains(up));
@@ -192,9 +189,7 @@ fn incremental_state_matches_direct_definitions_on_voxel_cubes() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
     use asp_geom::distmap::Support;
     // (more than 64 parts: bitsets of two words)
-    for (size, seed, support) in
-        [(4, 0, Support::Below), (4, 1, Support::Below), (4, 2, Support::ContactGraph), (6, 3, Support::Below)]
-    {
+    for (size, seed, support) in [(4, 0, Support::Below), (4, 1, Support::Below), (4, 2, Support::ContactGraph), (6, 3, Support::Below)] {
         let cube = voxel_cube(size, seed);
         let n = cube.len();
         assert!(size < 6 || n > 64, "{n} parts");
@@ -236,19 +231,18 @@ fn incremental_state_matches_direct_definitions_on_voxel_cubes() {
                 let keeps_support = |p: usize| {
                     let after = present.without(p);
                     let standing = match support {
-                        Support::Below => {
-                            after.iter().all(|i| !maps.is_supported(i, &present) || maps.is_supported(i, &after))
-                        }
+                        Support::Below => after.iter().all(|i| !maps.is_supported(i, &present) || maps.is_supported(i, &after)),
                         Support::ContactGraph => maps.stability(&after) == Stability::Stable,
                     };
                     standing
                 };
-                let direct: Vec<usize> = present
-                    .iter()
-                    .filter(|&p| !maps.is_fixed(p) && maps.is_collision_free(p, &present) && keeps_support(p))
-                    .collect();
+                let direct: Vec<usize> =
+                    present.iter().filter(|&p| !maps.is_fixed(p) && maps.is_collision_free(p, &present) && keeps_support(p)).collect();
                 assert_eq!(actions, direct, "cube {seed} {present:?}");
-                assert_eq!(state.collision_free(), PartSet::from_indices(n, present.iter().filter(|&p| maps.is_collision_free(p, &present))));
+                assert_eq!(
+                    state.collision_free(),
+                    PartSet::from_indices(n, present.iter().filter(|&p| maps.is_collision_free(p, &present)))
+                );
                 for p in present.iter() {
                     let m = maps.min_map(p, &present);
                     assert_eq!(state.min_map(p), m.as_slice(), "cube {seed} part {p} {present:?}");
@@ -349,11 +343,7 @@ fn cells_of(a: &Assembly, p: usize) -> Vec<[i32; 3]> {
 /// cell of `q` lies ahead of a cell of `p` on the same grid line.
 fn voxel_blocks(a: &Assembly, p: usize, q: usize, axis: usize, sign: i32) -> bool {
     let cq = cells_of(a, q);
-    cells_of(a, p).iter().any(|c| {
-        cq.iter().any(|e| {
-            (0..3).all(|k| k == axis || e[k] == c[k]) && (e[axis] - c[axis]) * sign > 0
-        })
-    })
+    cells_of(a, p).iter().any(|c| cq.iter().any(|e| (0..3).all(|k| k == axis || e[k] == c[k]) && (e[axis] - c[axis]) * sign > 0))
 }
 
 #[test]
@@ -398,14 +388,10 @@ fn maps_agree_with_the_collision_world_on_voxel_cubes() {
                 assert_eq!(maps.stability(&state), Stability::Stable);
             }
             for p in state.iter() {
-                let world_free = !matches!(
-                    checker.test_removal(p, &state, MotionKind::Linear),
-                    Outcome::Collision { .. }
-                );
+                let world_free = !matches!(checker.test_removal(p, &state, MotionKind::Linear), Outcome::Collision { .. });
                 let axis_free = axes.iter().any(|(_, _, a)| maps.free_mask(p, &state).contains(dir(&maps, *a)));
-                let exact_free = axes.iter().any(|&(axis, sign, _)| {
-                    state.iter().filter(|&q| q != p).all(|q| !voxel_blocks(&cube, p, q, axis, sign))
-                });
+                let exact_free =
+                    axes.iter().any(|&(axis, sign, _)| state.iter().filter(|&q| q != p).all(|q| !voxel_blocks(&cube, p, q, axis, sign)));
                 assert_eq!(axis_free, exact_free, "cube {seed} part {p} {state:?}");
                 // the world tries the axes; the maps also the diagonals of the half sphere
                 if world_free {

@@ -174,11 +174,7 @@ fn mutate(bytes: &mut Vec<u8>, others: &[Vec<u8>], rng: &mut ChaCha8Rng) {
         // byte set, random or special
         1 if len > 0 => {
             let i = at(rng, len);
-            bytes[i] = if rng.random_bool(0.5) {
-                rng.random()
-            } else {
-                INTERESTING_BYTES[at(rng, INTERESTING_BYTES.len())]
-            };
+            bytes[i] = if rng.random_bool(0.5) { rng.random() } else { INTERESTING_BYTES[at(rng, INTERESTING_BYTES.len())] };
         }
         // truncation
         2 => bytes.truncate(at(rng, len + 1)),
@@ -207,16 +203,13 @@ fn mutate(bytes: &mut Vec<u8>, others: &[Vec<u8>], rng: &mut ChaCha8Rng) {
         }
         // a number in text set to an extreme (OBJ indices, STL coordinates, JSON counts)
         6 | 7 => {
-            let starts: Vec<usize> = (0..len)
-                .filter(|&i| bytes[i].is_ascii_digit() && (i == 0 || !bytes[i - 1].is_ascii_alphanumeric()))
-                .collect();
+            let starts: Vec<usize> =
+                (0..len).filter(|&i| bytes[i].is_ascii_digit() && (i == 0 || !bytes[i - 1].is_ascii_alphanumeric())).collect();
             if starts.is_empty() {
                 return;
             }
             let start = starts[at(rng, starts.len())];
-            let end = (start..len)
-                .find(|&i| !(bytes[i].is_ascii_alphanumeric() || bytes[i] == b'.' || bytes[i] == b'-'))
-                .unwrap_or(len);
+            let end = (start..len).find(|&i| !(bytes[i].is_ascii_alphanumeric() || bytes[i] == b'.' || bytes[i] == b'-')).unwrap_or(len);
             let number = EXTREME_NUMBERS[at(rng, EXTREME_NUMBERS.len())];
             bytes.splice(start..end, number.bytes());
         }
@@ -404,8 +397,8 @@ fn fuzz_binary_stl() {
 fn fuzz_seeds_load_and_bytes_match_files() {
     let none = |_: &Path| -> std::io::Result<Vec<u8>> { Err(std::io::ErrorKind::NotFound.into()) };
     for (k, seed) in glb_seeds().iter().enumerate() {
-        let a = load_bytes_with(Path::new("seed.glb"), seed, &LoadOptions::default(), &none)
-            .unwrap_or_else(|e| panic!("glb seed {k}: {e}"));
+        let a =
+            load_bytes_with(Path::new("seed.glb"), seed, &LoadOptions::default(), &none).unwrap_or_else(|e| panic!("glb seed {k}: {e}"));
         assert!(a.len() >= 3);
     }
     for m in text_meshes() {

@@ -84,7 +84,8 @@ fn random_similarity(rng: &mut ChaCha8Rng, rot: Rot, size: f32) -> Similarity {
 fn random_up_rotation(rng: &mut ChaCha8Rng, up: Axis) -> Rot {
     let turn = Rot::from_axis_angle(up.vector(), rng.random_range(0.0..std::f32::consts::TAU));
     let quarter = |axis: Vec3, k: u32| Rot::from_axis_angle(axis, k as f32 * std::f32::consts::FRAC_PI_2);
-    let cube = quarter(Vec3::X, rng.random_range(0..4)) * quarter(Vec3::Y, rng.random_range(0..4)) * quarter(Vec3::Z, rng.random_range(0..4));
+    let cube =
+        quarter(Vec3::X, rng.random_range(0..4)) * quarter(Vec3::Y, rng.random_range(0..4)) * quarter(Vec3::Z, rng.random_range(0..4));
     cube * turn
 }
 
@@ -229,9 +230,8 @@ fn edge_attributes_follow_the_contract_order_computed_naively() {
     let config = GraphConfig::default();
     let g = AssemblyGraph::build(&w, &config).unwrap();
     assert_eq!(g.edges(), &[(0, 1), (1, 0)]);
-    let samples: Vec<_> = (0..2)
-        .map(|i| asp_geom::graph::sample::sample_triangles(w.mesh(i).vertices(), w.mesh(i).indices(), 2048))
-        .collect();
+    let samples: Vec<_> =
+        (0..2).map(|i| asp_geom::graph::sample::sample_triangles(w.mesh(i).vertices(), w.mesh(i).indices(), 2048)).collect();
     let boxes = [(lo_a, hi_a), (lo_b, hi_b)];
     // Q_i^j, the naive way, as (points, weights, normals)
     let region = |i: usize, j: usize| {
@@ -303,9 +303,8 @@ fn assert_same_graph(g: &AssemblyGraph, h: &AssemblyGraph, tol: f32, what: &str)
         e[d..d + 4].rotate_right(q);
         e
     };
-    let edges = (0..4)
-        .map(|q| (0..g.num_edges()).map(|k| gap(&turned(k, q), h.edge_attr(k))).fold(0.0f32, f32::max))
-        .fold(f32::INFINITY, f32::min);
+    let edges =
+        (0..4).map(|q| (0..g.num_edges()).map(|k| gap(&turned(k, q), h.edge_attr(k))).fold(0.0f32, f32::max)).fold(f32::INFINITY, f32::min);
     assert!(nodes < tol && edges < tol, "{what}: node gap {nodes}, edge gap {edges}");
 }
 
@@ -324,11 +323,15 @@ fn graph_attributes_are_invariant_when_the_model_moves_with_its_up_axis() {
         fixtures::tube(),
         fixtures::arch(),
         fixtures::figure_6_2(0.1),
-        assemble("l_on_box", vec![part("slab", Mesh::cuboid(Vec3::new(-1.0, -1.0, -0.2), Vec3::new(2.0, 2.0, 0.0)), true), {
-            let mut l = voxel_part("l", &[[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [0, 0, 1]], 0.5);
-            l.fixed = false;
-            l
-        }], Axis::Z),
+        assemble(
+            "l_on_box",
+            vec![part("slab", Mesh::cuboid(Vec3::new(-1.0, -1.0, -0.2), Vec3::new(2.0, 2.0, 0.0)), true), {
+                let mut l = voxel_part("l", &[[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [0, 0, 1]], 0.5);
+                l.fixed = false;
+                l
+            }],
+            Axis::Z,
+        ),
     ];
     for a in models {
         let name = a.source.display().to_string();
@@ -340,7 +343,8 @@ fn graph_attributes_are_invariant_when_the_model_moves_with_its_up_axis() {
             let rot = random_up_rotation(&mut rng, a.up);
             let sim = random_similarity(&mut rng, rot, a.diagonal());
             let moved = sim.assembly(&a);
-            let config = WorldConfig { tolerance: Some(tol * sim.scale), contact_distance: Some(eps * sim.scale), ..WorldConfig::default() };
+            let config =
+                WorldConfig { tolerance: Some(tol * sim.scale), contact_distance: Some(eps * sim.scale), ..WorldConfig::default() };
             let h = graph(&world(moved, &config));
             assert_same_graph(&g, &h, 1e-4, &format!("{name} under {sim:?}"));
         }
@@ -488,8 +492,7 @@ fn every_shipped_model_has_finite_consistent_features() {
         assert_eq!(g.edge_attr_flat().len(), g.num_edges() * 152);
         assert!(g.nodes_flat().iter().chain(g.edge_attr_flat()).all(|v| v.is_finite() && (-1.0 - 1e-5..=1.0 + 1e-5).contains(v)), "{name}");
         // edges are the world's contacts between real parts, both ways, sorted
-        let expect: Vec<(usize, usize)> =
-            (0..n).flat_map(|s| w.contacts(s).iter().filter(move |&t| t < n).map(move |t| (s, t))).collect();
+        let expect: Vec<(usize, usize)> = (0..n).flat_map(|s| w.contacts(s).iter().filter(move |&t| t < n).map(move |t| (s, t))).collect();
         assert_eq!(g.edges(), &expect[..], "{name}");
         for &(s, t) in g.edges() {
             assert!(g.edges().binary_search(&(t, s)).is_ok(), "{name}: {s}->{t} without {t}->{s}");

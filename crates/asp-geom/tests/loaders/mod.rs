@@ -23,10 +23,7 @@ fn size(assembly: &Assembly) -> Vec3 {
 }
 
 fn assert_near(actual: Vec3, expected: Vec3, tolerance: f32) {
-    assert!(
-        (actual - expected).abs().max_element() <= tolerance,
-        "{actual:?} != {expected:?} (± {tolerance})"
-    );
+    assert!((actual - expected).abs().max_element() <= tolerance, "{actual:?} != {expected:?} (± {tolerance})");
 }
 
 fn names(assembly: &Assembly) -> Vec<&str> {
@@ -138,9 +135,7 @@ impl Fixture {
 
     fn indices(&mut self, indices: &[u16]) -> usize {
         let view = self.view(indices.iter().flat_map(|i| i.to_le_bytes()).collect());
-        self.accessor(
-            json!({"bufferView": view, "componentType": 5123, "count": indices.len(), "type": "SCALAR"}),
-        )
+        self.accessor(json!({"bufferView": view, "componentType": 5123, "count": indices.len(), "type": "SCALAR"}))
     }
 
     fn accessor(&mut self, accessor: Value) -> usize {
@@ -490,8 +485,7 @@ fn invalid_accessors_are_errors_not_panics() {
                                      "min": [0, 0, 0], "max": [1, 1, 0]}));
     let vec2 = f.accessor(json!({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC2",
                                  "min": [0, 0, 0], "max": [1, 1, 0]}));
-    let float_indices =
-        f.accessor(json!({"bufferView": 0, "componentType": 5126, "count": 3, "type": "SCALAR"}));
+    let float_indices = f.accessor(json!({"bufferView": 0, "componentType": 5126, "count": 3, "type": "SCALAR"}));
     let bad_stride_view = f.views.len();
     f.views.push(json!({"buffer": 0, "byteOffset": 0, "byteLength": 36, "byteStride": 8}));
     let bad_stride = f.accessor(json!({"bufferView": bad_stride_view, "componentType": 5126, "count": 3,
@@ -684,12 +678,7 @@ fn sample_assembly() -> Assembly {
     Assembly {
         parts: vec![
             Part::new("base", base, true, Value::Null),
-            Part::new(
-                "peg",
-                peg,
-                false,
-                json!({"grasp": [[15.0, 12.5, 43.7]], "voxels": {"size": 1.5, "cells": [[0, 0, 1]]}}),
-            ),
+            Part::new("peg", peg, false, json!({"grasp": [[15.0, 12.5, 43.7]], "voxels": {"size": 1.5, "cells": [[0, 0, 1]]}})),
         ],
         units: Units::parse("mm").unwrap(),
         up: Axis::Z,
@@ -779,18 +768,10 @@ fn unwritable_assemblies_are_errors() {
 
     let mut assembly = sample_assembly();
     assembly.parts[1].mesh = Mesh::default();
-    assert_message(
-        &write_glb(&assembly, &path).unwrap_err().to_string(),
-        "bad.glb",
-        "part 'peg' has no triangles",
-    );
+    assert_message(&write_glb(&assembly, &path).unwrap_err().to_string(), "bad.glb", "part 'peg' has no triangles");
 
     let missing_dir = dir.path().join("missing").join("x.glb");
-    assert_message(
-        &write_glb(&sample_assembly(), &missing_dir).unwrap_err().to_string(),
-        "x.glb",
-        "no such file",
-    );
+    assert_message(&write_glb(&sample_assembly(), &missing_dir).unwrap_err().to_string(), "x.glb", "no such file");
     assert!(!path.exists(), "nothing written on error");
 }
 

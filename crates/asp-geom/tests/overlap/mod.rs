@@ -4,7 +4,9 @@
 use crate::removal::free_axes;
 use asp_geom::math::Vec3;
 use asp_geom::overlap::OverlapKind;
-use asp_geom::{fixtures, Checker, CheckerConfig, FeasibilityChecker, Motion, MotionKind, Outcome, OverlapPolicy, PartSet, World, WorldConfig};
+use asp_geom::{
+    fixtures, Checker, CheckerConfig, FeasibilityChecker, Motion, MotionKind, Outcome, OverlapPolicy, PartSet, World, WorldConfig,
+};
 
 fn world(a: asp_geom::Assembly, overlaps: OverlapPolicy) -> asp_geom::Result<World> {
     World::new(a, &WorldConfig { overlaps, ..WorldConfig::default() })

@@ -2,9 +2,8 @@
 
 use asp_geom::math::{Axis, Vec3};
 use asp_geom::{
-    fixtures, Assembly, Checker, CheckerConfig, FeasibilityChecker, Mesh, MotionKind, Outcome,
-    Part, PartSet, PhysicsConfig, PhysicsStability, Stability, StabilityMode, Units, World,
-    WorldConfig,
+    fixtures, Assembly, Checker, CheckerConfig, FeasibilityChecker, Mesh, MotionKind, Outcome, Part, PartSet, PhysicsConfig,
+    PhysicsStability, Stability, StabilityMode, Units, World, WorldConfig,
 };
 
 fn world(a: Assembly) -> World {
@@ -33,21 +32,12 @@ fn cuboid(mins: [f32; 3], maxs: [f32; 3]) -> Mesh {
 
 /// A +Z-up assembly in metres.
 fn assembly(parts: Vec<Part>) -> Assembly {
-    Assembly {
-        parts,
-        units: Units::metres(),
-        up: Axis::Z,
-        source: "test:physics".into(),
-        warnings: Vec::new(),
-    }
+    Assembly { parts, units: Units::metres(), up: Axis::Z, source: "test:physics".into(), warnings: Vec::new() }
 }
 
 /// A fixed base slab with one box on it (`mins`, `maxs` of the box).
 fn box_on_base(mins: [f32; 3], maxs: [f32; 3]) -> Assembly {
-    assembly(vec![
-        part("base", cuboid([-2.0, -2.0, -0.5], [3.0, 3.0, 0.0]), true),
-        part("box", cuboid(mins, maxs), false),
-    ])
+    assembly(vec![part("base", cuboid([-2.0, -2.0, -0.5], [3.0, 3.0, 0.0]), true), part("box", cuboid(mins, maxs), false)])
 }
 
 #[test]
@@ -119,10 +109,7 @@ fn a_pressed_plug_holds_in_a_ring() {
     // into the frame's opening. The interference fit bonds plug and ring; simulated as two
     // bodies, nothing would hold the plug up (the fit's contacts push sideways only)
     let ring = |z: i32, inner: std::ops::Range<i32>| -> Vec<[i32; 3]> {
-        (0..7)
-            .flat_map(|x| (0..7).map(move |y| [x, y, z]))
-            .filter(|c| !inner.contains(&c[0]) || !inner.contains(&c[1]))
-            .collect()
+        (0..7).flat_map(|x| (0..7).map(move |y| [x, y, z])).filter(|c| !inner.contains(&c[0]) || !inner.contains(&c[1])).collect()
     };
     let a = assembly(vec![
         part("frame", Mesh::from_voxels(&ring(-1, 1..6), Vec3::ONE, Vec3::ZERO), true),
@@ -143,10 +130,7 @@ fn a_pressed_plug_holds_in_a_ring() {
 fn cradle(depth: f32) -> Assembly {
     // layers of `depth` thickness, so the notch is one cell deep
     let layers = (2.0 / depth).round() as i32;
-    let cells: Vec<[i32; 3]> = (0..3)
-        .flat_map(|x| (0..layers).map(move |z| [x, 0, z]))
-        .filter(|c| *c != [1, 0, layers - 1])
-        .collect();
+    let cells: Vec<[i32; 3]> = (0..3).flat_map(|x| (0..layers).map(move |z| [x, 0, z])).filter(|c| *c != [1, 0, layers - 1]).collect();
     let floor = 2.0 - depth;
     assembly(vec![
         part("base", cuboid([-2.0, -2.0, -0.5], [5.0, 3.0, 0.0]), true),
@@ -179,10 +163,7 @@ fn the_convex_decomposition_follows_a_deep_notch() {
 
 #[test]
 fn checker_reports_a_removal_that_leaves_the_keystone_cantilevered() {
-    let config = CheckerConfig {
-        stability: StabilityMode::Physics(PhysicsConfig::default()),
-        ..CheckerConfig::default()
-    };
+    let config = CheckerConfig { stability: StabilityMode::Physics(PhysicsConfig::default()), ..CheckerConfig::default() };
     let checker = Checker::new(world(fixtures::arch()), config);
     // pillar_a slides out sideways; the keystone then rests on pillar_b alone and tips over
     match checker.test_removal(1, &PartSet::full(4), MotionKind::Linear) {

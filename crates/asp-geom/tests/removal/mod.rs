@@ -1,8 +1,8 @@
 //! Straight-line removal, path planning and stability on fixtures with known answers.
 
+use asp_geom::feasibility::interpolate_about;
 use asp_geom::math::Vec3;
 use asp_geom::rrt::{plan_removal_path, RrtConfig};
-use asp_geom::feasibility::interpolate_about;
 use asp_geom::{fixtures, Motion, PartSet, Stability, World, WorldConfig};
 
 fn world(a: asp_geom::Assembly) -> World {
@@ -103,10 +103,7 @@ fn arch_keystone_floats_without_pillars() {
     // keystone on one pillar: linked, stable
     assert_eq!(w.contact_stability(&PartSet::from_indices(4, [2, 3])), Stability::Stable);
     // keystone alone: floating
-    assert_eq!(
-        w.contact_stability(&PartSet::from_indices(4, [3])),
-        Stability::Unstable { floating: PartSet::from_indices(4, [3]) }
-    );
+    assert_eq!(w.contact_stability(&PartSet::from_indices(4, [3])), Stability::Unstable { floating: PartSet::from_indices(4, [3]) });
 }
 
 /// A 0.557 m post on a floor, and a ring of 3 mm wall and zero clearance around its top end,
@@ -157,10 +154,6 @@ fn boxes_that_do_not_describe_a_part_are_warned_about_and_its_mesh_is_used() {
     );
 }
 
-
-
-
-
 /// The simultaneous BVH descent of the sweeps gives the answers of the per-triangle candidate
 /// search it replaced: on the large real meshes (chair, lack, beam), for every pair of parts in
 /// contact, the pair's shapes as the removal test uses them, along the candidate directions and
@@ -184,17 +177,20 @@ fn bvh_descent_sweeps_agree_with_the_per_triangle_search() {
                 let (moving, fixed) = w.pair_shapes(p, q);
                 let mut dirs: Vec<Vec3> = w.directions().to_vec();
                 dirs.extend((0..6).map(|_| {
-                    Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0))
-                        .normalize_or_zero()
+                    Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize_or_zero()
                 }));
                 for dir in dirs.into_iter().filter(|d| *d != Vec3::ZERO) {
                     let t_max = diag;
                     let new = sweep::sweep_distance(&moving, dir, &fixed, t_max);
                     let old = sweep::sweep_distance_reference(&moving, dir, &fixed, t_max);
                     assert_eq!(new, old, "{file}: parts {p}, {q} along {dir:?}");
-                    if new.is_some() { hits += 1 } else { misses += 1 }
-                    let shift = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0))
-                        * (0.02 * diag);
+                    if new.is_some() {
+                        hits += 1
+                    } else {
+                        misses += 1
+                    }
+                    let shift =
+                        Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)) * (0.02 * diag);
                     let pose = Pose::from_translation(shift);
                     assert_eq!(
                         sweep::sweep_hits_at(&moving, &pose, dir, &fixed, t_max),

@@ -116,7 +116,8 @@ fn product_of_q_guidance_stays_feasible_and_near_the_exact_front() {
         // same seed, threads and model: the same front
         for threads in [1, 2] {
             let (a, b) = (run(threads), run(threads));
-            let key = |o: &asp_search::SearchOutcome| o.solutions.iter().map(|s| (s.sequence.clone(), s.values.clone())).collect::<Vec<_>>();
+            let key =
+                |o: &asp_search::SearchOutcome| o.solutions.iter().map(|s| (s.sequence.clone(), s.values.clone())).collect::<Vec<_>>();
             assert_eq!(key(&a), key(&b), "soma seed {seed}, {threads} threads");
         }
         checked += 1;

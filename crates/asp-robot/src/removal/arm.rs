@@ -168,4 +168,3 @@ impl<W: Borrow<World>> Space for ArmSpace<'_, W> {
         self.resolution
     }
 }
-

@@ -2,7 +2,6 @@
 
 use super::*;
 
-
 /// Settings of the robot removal test.
 #[derive(Clone, Debug)]
 pub struct RemovalConfig {

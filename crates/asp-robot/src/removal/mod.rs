@@ -44,10 +44,10 @@ mod config;
 mod shapes;
 mod stats;
 
-pub use config::{RemovalConfig, RobotCell, RobotFailure, RobotRemoval};
-pub use stats::PlanStats;
 use arm::ArmSpace;
+pub use config::{RemovalConfig, RobotCell, RobotFailure, RobotRemoval};
 use shapes::{box_gap, lowest, shapes_touch, world_shapes, Prepared};
+pub use stats::PlanStats;
 use stats::{Counters, C};
 
 use std::borrow::Borrow;
@@ -461,7 +461,14 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
     /// reachable one planned (no bound, no cap). The same grasps in the same order with the
     /// same seeds, so its length is the shortest of all of them: the reference `plan` is
     /// tested against.
-    pub fn plan_exhaustive(&self, p: usize, present: &PartSet, direction: Vec3, seed: u64, replans: usize) -> Result<RobotRemoval, RobotFailure> {
+    pub fn plan_exhaustive(
+        &self,
+        p: usize,
+        present: &PartSet,
+        direction: Vec3,
+        seed: u64,
+        replans: usize,
+    ) -> Result<RobotRemoval, RobotFailure> {
         self.plan_grasps(p, present, direction, seed, replans, Mode::Exhaustive)
     }
 
@@ -520,8 +527,9 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
             // 1. the gripper alone at the grasp and lifted poses: no inverse kinematics needed
             if self.config.gripper_precheck
                 && counters.timed(C::Gripper, || {
-                self.gripper_collides(&tool, g.width, &obstacles) || self.gripper_collides(&lifted, g.width, &obstacles)
-            }) {
+                    self.gripper_collides(&tool, g.width, &obstacles) || self.gripper_collides(&lifted, g.width, &obstacles)
+                })
+            {
                 counters.add(C::GripperRejected, 1);
                 colliding += 1;
                 continue;
@@ -575,7 +583,10 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
             counters.add(C::Planned, 1);
             let fine = ArmSpace::new(self, p, &shrunk, grasp_pose, g.width, &obstacles, self.config.check_resolution);
             for r in 0..replans.max(1) {
-                let cfg = RrtConnectConfig { seed: seed ^ ((gi as u64) << 20) ^ (r as u64).wrapping_mul(0x5851_f42d_4c95_7f2d), ..self.config.rrt.clone() };
+                let cfg = RrtConnectConfig {
+                    seed: seed ^ ((gi as u64) << 20) ^ (r as u64).wrapping_mul(0x5851_f42d_4c95_7f2d),
+                    ..self.config.rrt.clone()
+                };
                 let Ok(path) = counters.timed(C::Rrt, || rrt_connect(&space, &ql, &qd, &cfg)) else { continue };
                 let mut joints = vec![qg.clone()];
                 joints.extend(path);

@@ -97,4 +97,3 @@ pub fn recheck(world: &World, cell: &RobotCell, part: usize, present: &PartSet, 
     }
     Ok(())
 }
-

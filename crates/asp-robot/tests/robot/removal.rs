@@ -1,11 +1,11 @@
 //! Robot removability: a profile taken out of a generated frame, re-checked independently; a
 //! part no grasp reaches; a part whose every path is blocked; determinism.
 
+pub use super::recheck::recheck;
 use asp_geom::fixtures::{assemble, box_part};
 use asp_geom::math::{Axis, Vec3};
 use asp_geom::{Motion, PartSet, World, WorldConfig};
 use asp_robot::{RemovalConfig, RemovalPlanner, Robot, RobotCell, RobotFailure};
-pub use super::recheck::recheck;
 
 fn profiles() -> asp_geom::Assembly {
     asp_gen::ProfileAssembly::generate(&asp_gen::ProfileParams::single_layer(), 1).unwrap().to_assembly("p")
@@ -104,10 +104,7 @@ fn a_walled_in_block_has_no_reachable_grasp() {
     // sideways the lift hits a wall
     assert!(matches!(planner.plan(1, &state, Vec3::X, 3, 1), Err(RobotFailure::Blocked { by: Some(3) })));
     // without the walls the same block comes out
-    let parts = vec![
-        box_part("plate", [-0.2, -0.2, -0.02], [0.3, 0.2, 0.0]),
-        box_part("block", [0.08, -0.02, 0.0], [0.12, 0.02, 0.04]),
-    ];
+    let parts = vec![box_part("plate", [-0.2, -0.2, -0.02], [0.3, 0.2, 0.0]), box_part("block", [0.08, -0.02, 0.0], [0.12, 0.02, 0.04])];
     let mut free = assemble("free", parts, Axis::Z);
     free.parts[0].fixed = true;
     let world = World::new(free, &WorldConfig::default()).unwrap();

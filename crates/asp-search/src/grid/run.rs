@@ -8,8 +8,8 @@
 //! the depth-first search could only spend its budget on path planning there), and as the
 //! fallback when the depth-first search ends without a plan.
 
-use crate::problem::{Budget, GroupMove, PlanOutcome, Stats, Status, Step, Stuck, StuckReason, Subassembly};
 use super::solver::{self as grid, GridConfig, GridPlan, GridSolution, GridStatus};
+use crate::problem::{Budget, GroupMove, PlanOutcome, Stats, Status, Step, Stuck, StuckReason, Subassembly};
 use asp_geom::grid::VoxelModel;
 use asp_geom::{Assembly, Motion, PartSet};
 use std::time::Instant;
@@ -68,9 +68,10 @@ impl GridRun {
         if status == Status::Found && !self.model.fixed.iter().any(|f| *f) {
             if let [last] = plan.remaining[..] {
                 let up = assembly.up.vector();
-                let extent = self.model.cells[last].iter().map(|c| self.model.metres(*c).dot(up)).fold((f32::MAX, f32::MIN), |(l, h), x| {
-                    (l.min(x), h.max(x))
-                });
+                let extent = self.model.cells[last]
+                    .iter()
+                    .map(|c| self.model.metres(*c).dot(up))
+                    .fold((f32::MAX, f32::MIN), |(l, h), x| (l.min(x), h.max(x)));
                 let height = extent.1 - extent.0 + self.model.cell.dot(up.abs());
                 removals.push(Step::single(last, Motion::Linear { direction: up, distance: height + margin }));
             }
@@ -89,11 +90,7 @@ fn status(plan: &GridPlan, n: usize) -> Status {
         GridStatus::Budget => Status::BudgetExhausted,
         GridStatus::Stuck => {
             let state = PartSet::from_indices(n, plan.remaining.iter().copied());
-            let stuck = plan
-                .remaining
-                .iter()
-                .map(|&p| Stuck { part: p, reason: StuckReason::Blocked(state.without(p)) })
-                .collect();
+            let stuck = plan.remaining.iter().map(|&p| Stuck { part: p, reason: StuckReason::Blocked(state.without(p)) }).collect();
             Status::NoPlan { stuck, state }
         }
     }
@@ -113,7 +110,11 @@ fn steps(model: &VoxelModel, plan: &GridPlan, n: usize, margin: f32) -> Vec<Step
             let group = (g.parts.len() > 1).then(|| {
                 Box::new(Subassembly {
                     parts: PartSet::from_indices(n, g.parts.iter().copied()),
-                    plan: g.plan.as_ref().map(|p| PlanOutcome { status: status(p, n), removals: steps(model, p, n, margin), stats: Stats::default() }),
+                    plan: g.plan.as_ref().map(|p| PlanOutcome {
+                        status: status(p, n),
+                        removals: steps(model, p, n, margin),
+                        stats: Stats::default(),
+                    }),
                 })
             });
             let part = if group.is_some() { g.base } else { g.parts[0] };

@@ -285,10 +285,8 @@ impl Solver<'_> {
                         *first = Some(moves.len());
                     }
                     let ids = |mask: u64| (0..local.units.len()).filter(move |&i| mask >> i & 1 == 1);
-                    let gmoves: Vec<GridMove> = moves
-                        .iter()
-                        .map(|&(m, delta)| GridMove { parts: self.parts_of(ids(m).map(|i| local.units[i])), delta })
-                        .collect();
+                    let gmoves: Vec<GridMove> =
+                        moves.iter().map(|&(m, delta)| GridMove { parts: self.parts_of(ids(m).map(|i| local.units[i])), delta }).collect();
                     // the side without the reference leaves (the smaller side, when it may)
                     let mut leaving: Vec<usize> = ids(group).collect();
                     let mut staying: Vec<usize> = (0..local.units.len()).filter(|i| group >> i & 1 == 0).collect();

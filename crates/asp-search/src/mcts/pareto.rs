@@ -16,13 +16,13 @@
 //! assert!(ParetoMcts::builder().exploration(f64::NAN).build().is_err());
 //! ```
 
-use crate::error::Result;
-use crate::hypervolume::{hypervolume_2d_in_place, ParetoFront};
-use crate::mdp::{Mdp, MAX_OBJECTIVES};
 use super::graph::{exploration_term, SelectContext, Tree, Variant};
 use super::outcome::{EpisodeHook, SearchOutcome};
 use super::run::run;
 use super::settings::search_type;
+use crate::error::Result;
+use crate::hypervolume::{hypervolume_2d_in_place, ParetoFront};
+use crate::mdp::{Mdp, MAX_OBJECTIVES};
 
 /// Reference coordinate of the normalised hypervolume used by MOUCB.
 const NORMALISED_REFERENCE: f64 = -0.1;

@@ -42,10 +42,7 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings, hook: Op
     let m = problem.num_objectives();
     let reference = match &settings.reference {
         Some(r) if r.len() != m => {
-            return Err(SearchError::config(format!(
-                "the reference point has {} coordinates, the problem {m} objectives",
-                r.len()
-            )))
+            return Err(SearchError::config(format!("the reference point has {} coordinates, the problem {m} objectives", r.len())))
         }
         Some(r) => r.clone(),
         None => problem.reference_point(),
@@ -54,13 +51,7 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings, hook: Op
         return Err(SearchError::config("too many parts"));
     }
     let start = Instant::now();
-    let shared = Mutex::new(Shared {
-        front: ParetoFront::new(m),
-        episodes: 0,
-        iterations: 0,
-        trace: Vec::new(),
-        last_value: None,
-    });
+    let shared = Mutex::new(Shared { front: ParetoFront::new(m), episodes: 0, iterations: 0, trace: Vec::new(), last_value: None });
     let threads = settings.threads;
     let share = |t: usize| share_of(settings.episodes, threads, t);
     let abort = StopToken::new();

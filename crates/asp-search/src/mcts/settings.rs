@@ -275,10 +275,7 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
             return Err(SearchError::config(format!("threads must be in 1..=256, got {}", s.threads)));
         }
         if !(s.exploration.is_finite() && s.exploration >= 0.0) {
-            return Err(SearchError::config(format!(
-                "the exploration constant must be finite and >= 0, got {}",
-                s.exploration
-            )));
+            return Err(SearchError::config(format!("the exploration constant must be finite and >= 0, got {}", s.exploration)));
         }
         if s.max_nodes == 0 {
             return Err(SearchError::config("max_nodes must be at least 1"));
@@ -290,10 +287,7 @@ impl<K: From<SearchSettings>> SearchBuilder<K> {
             return Err(SearchError::config("the time limit must be positive"));
         }
         if !(s.prior_weight.is_finite() && s.prior_weight >= 0.0) {
-            return Err(SearchError::config(format!(
-                "the prior weight must be finite and >= 0, got {}",
-                s.prior_weight
-            )));
+            return Err(SearchError::config(format!("the prior weight must be finite and >= 0, got {}", s.prior_weight)));
         }
         if !(s.polish.is_finite() && s.polish >= 0.0) {
             return Err(SearchError::config(format!("the local search share must be finite and >= 0, got {}", s.polish)));

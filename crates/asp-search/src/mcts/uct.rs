@@ -12,12 +12,12 @@
 //! assert!(Mcts::builder().budget(0).build().is_err());
 //! ```
 
-use crate::error::{Result, SearchError};
-use crate::mdp::Mdp;
 use super::graph::{exploration_term, SelectContext, Tree, Variant};
 use super::outcome::{EpisodeHook, SearchOutcome};
 use super::run::run;
 use super::settings::search_type;
+use crate::error::{Result, SearchError};
+use crate::mdp::Mdp;
 
 search_type!(
     /// Single-objective Monte Carlo tree search with max-backup UCT.

@@ -121,11 +121,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             next_same: NONE,
             untried_left: actions.len() as u16,
         };
-        let root_sets = NodeSets {
-            present: full,
-            free: sim.collision_free(),
-            untried: PartSet::from_indices(n, actions.iter().copied()),
-        };
+        let root_sets = NodeSets { present: full, free: sim.collision_free(), untried: PartSet::from_indices(n, actions.iter().copied()) };
         let mut tree = Tree {
             nodes: vec![root],
             sets: vec![root_sets],
@@ -297,8 +293,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             exploration: self.settings.exploration,
             bounds: &self.bounds,
             prefix: &self.path_prefix[self.path_prefix.len() - m..],
-            priors: (self.priors && self.settings.prior_weight > 0.0)
-                .then_some((self.settings.prior_weight, &self.tree.edge_priors[..])),
+            priors: (self.priors && self.settings.prior_weight > 0.0).then_some((self.settings.prior_weight, &self.tree.edge_priors[..])),
         }
     }
 
@@ -343,9 +338,7 @@ impl<'p, V: Variant> Worker<'p, V> {
         let complete = self.rollout(policy, step.new_child, &mut ret)?;
         self.backup(complete, &ret);
         let leaf = *self.path.last().expect("path");
-        if step.new_child && self.tree.nodes[leaf as usize].status != Status::Open
-            || self.tree.nodes[parent as usize].untried_left == 0
-        {
+        if step.new_child && self.tree.nodes[leaf as usize].status != Status::Open || self.tree.nodes[parent as usize].untried_left == 0 {
             self.refresh_path_status();
         }
         self.truncate(base);
@@ -408,10 +401,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             policy.expand(&mut ctx, &self.untried, untried_priors, &mut self.rng)?
         };
         let Some(&action) = self.untried.get(pick) else {
-            return Err(SearchError::plugin(
-                "expansion policy",
-                format!("chose untried action {pick} of {}", self.untried.len()),
-            ));
+            return Err(SearchError::plugin("expansion policy", format!("chose untried action {pick} of {}", self.untried.len())));
         };
         if let Some(rec) = &mut self.record {
             if rec.active() {
@@ -452,13 +442,7 @@ impl<'p, V: Variant> Worker<'p, V> {
                 existing
             } else {
                 new_child = true;
-                self.problem.feasible_actions(
-                    &mut self.sim,
-                    &self.memory,
-                    StepKind::Expansion,
-                    &mut self.actions,
-                    &mut self.filtered,
-                );
+                self.problem.feasible_actions(&mut self.sim, &self.memory, StepKind::Expansion, &mut self.actions, &mut self.filtered);
                 let status = if self.sim.is_complete() {
                     Status::Solved
                 } else if self.actions.is_empty() {
@@ -467,18 +451,8 @@ impl<'p, V: Variant> Worker<'p, V> {
                     Status::Open
                 };
                 let id = self.tree.nodes.len() as u32;
-                let next_same = if self.settings.transpositions {
-                    self.tree.index.insert(hash, id).unwrap_or(NONE)
-                } else {
-                    NONE
-                };
-                self.tree.nodes.push(Node {
-                    first_edge: NONE,
-                    visits: 0,
-                    status,
-                    next_same,
-                    untried_left: self.actions.len() as u16,
-                });
+                let next_same = if self.settings.transpositions { self.tree.index.insert(hash, id).unwrap_or(NONE) } else { NONE };
+                self.tree.nodes.push(Node { first_edge: NONE, visits: 0, status, next_same, untried_left: self.actions.len() as u16 });
                 self.tree.sets.push(NodeSets {
                     present,
                     free: self.sim.collision_free(),
@@ -534,13 +508,7 @@ impl<'p, V: Variant> Worker<'p, V> {
                 if lazy {
                     self.problem.candidate_actions(&mut self.sim, &mut self.actions);
                 } else {
-                    self.problem.feasible_actions(
-                        &mut self.sim,
-                        &self.memory,
-                        StepKind::Simulation,
-                        &mut self.actions,
-                        &mut self.filtered,
-                    );
+                    self.problem.feasible_actions(&mut self.sim, &self.memory, StepKind::Simulation, &mut self.actions, &mut self.filtered);
                 }
             }
             known = false;
@@ -563,14 +531,9 @@ impl<'p, V: Variant> Worker<'p, V> {
                     policy.choose(&mut ctx, &self.actions, &mut self.rng)?
                 };
                 let Some(&p) = self.actions.get(k) else {
-                    return Err(SearchError::plugin(
-                        "rollout policy",
-                        format!("chose action {k} of {}", self.actions.len()),
-                    ));
+                    return Err(SearchError::plugin("rollout policy", format!("chose action {k} of {}", self.actions.len())));
                 };
-                if filtered
-                    || self.problem.admits(&mut self.sim, &self.memory, p, StepKind::Simulation, &mut self.filtered)
-                {
+                if filtered || self.problem.admits(&mut self.sim, &self.memory, p, StepKind::Simulation, &mut self.filtered) {
                     chosen = Some(p);
                     break;
                 }
@@ -680,13 +643,8 @@ impl<'p, V: Variant> Worker<'p, V> {
             let value = front_value(&s.front, reference);
             if s.last_value != Some(value) && !s.front.is_empty() && at < iterations {
                 s.last_value = Some(value);
-                let point = TracePoint {
-                    episode: s.episodes + 1,
-                    iterations: s.iterations + at,
-                    seconds,
-                    value,
-                    front_size: s.front.len(),
-                };
+                let point =
+                    TracePoint { episode: s.episodes + 1, iterations: s.iterations + at, seconds, value, front_size: s.front.len() };
                 s.trace.push(point);
             }
         }
@@ -718,7 +676,14 @@ impl<'p, V: Variant> Worker<'p, V> {
     /// the settings' policy. With a `hook` (the stepped search) the hook is asked before every
     /// episode after the first, with what the previous one did, whether to go on, swap the
     /// policy or stop, and once more when the search ends.
-    pub fn run(&mut self, episodes: usize, shared: &Mutex<Shared>, reference: &[f64], start: Instant, mut hook: Option<&mut EpisodeHook<'_>>) {
+    pub fn run(
+        &mut self,
+        episodes: usize,
+        shared: &Mutex<Shared>,
+        reference: &[f64],
+        start: Instant,
+        mut hook: Option<&mut EpisodeHook<'_>>,
+    ) {
         let mut current = self.settings.policy.clone();
         let mut policy = match current.for_worker(self.thread) {
             Ok(p) => p,
@@ -792,9 +757,7 @@ impl<'p, V: Variant> Worker<'p, V> {
         let over_checks = move |checks: u64| filters && checks as f64 >= check_cap;
         let over = move |steps: u64, checks: u64| steps as f64 >= cap || over_checks(checks);
         let (deadline, stop, abort) = (self.deadline, self.settings.stop.as_ref(), self.abort);
-        let should_stop = || {
-            deadline.is_some_and(|d| Instant::now() >= d) || stop.is_some_and(StopToken::is_stopped) || abort.is_stopped()
-        };
+        let should_stop = || deadline.is_some_and(|d| Instant::now() >= d) || stop.is_some_and(StopToken::is_stopped) || abort.is_stopped();
         let mut added = 0u64;
         while !over(polisher.steps, polisher.checks()) {
             let Some((seq, seed, from)) = polisher.queue.pop() else { break };

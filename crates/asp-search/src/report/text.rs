@@ -56,7 +56,11 @@ fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
     if !fixed.is_empty() {
         writeln!(out, "base (fixed): {}", fixed.join(", "))?;
     } else if r.grid.is_some() {
-        writeln!(out, "base: none (taken apart in the hand, no gravity; the last part goes down first along -{})", r.up.trim_start_matches(['+', '-']))?;
+        writeln!(
+            out,
+            "base: none (taken apart in the hand, no gravity; the last part goes down first along -{})",
+            r.up.trim_start_matches(['+', '-'])
+        )?;
     } else {
         writeln!(out, "base: ground plane under the lowest point (up {})", r.up)?;
     }
@@ -110,7 +114,9 @@ fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
     }
     if r.status == PlanStatus::BudgetExhausted {
         match r.stats.stopped_by {
-            Some(StopReason::Interrupted) => writeln!(out, "interrupted (Ctrl-C) before a plan was found; the best partial plan so far is above")?,
+            Some(StopReason::Interrupted) => {
+                writeln!(out, "interrupted (Ctrl-C) before a plan was found; the best partial plan so far is above")?
+            }
             _ => writeln!(out, "the budget ran out (--max-tests / --timeout) before a plan was found")?,
         }
     }
@@ -138,9 +144,7 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
                 format!("screw along ({:+.3}, {:+.3}, {:+.3}) over {:.4}", d[0], d[1], d[2], distance)
             }
         };
-        let robot = step.robot.as_ref().map_or(String::new(), |rs| {
-            format!("; robot path {:.3}", rs.path_length)
-        });
+        let robot = step.robot.as_ref().map_or(String::new(), |rs| format!("; robot path {:.3}", rs.path_length));
         let robot = if step.held.is_empty() {
             robot
         } else {
@@ -177,11 +181,7 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
 }
 
 /// Prints the Pareto front (or the best value) under the plan table.
-fn write_summary(
-    out: &mut impl std::io::Write,
-    summary: &OptimisationEntry,
-    front: Option<&[ParetoEntry]>,
-) -> std::io::Result<()> {
+fn write_summary(out: &mut impl std::io::Write, summary: &OptimisationEntry, front: Option<&[ParetoEntry]>) -> std::io::Result<()> {
     let names = summary.objectives.join(", ");
     writeln!(
         out,
@@ -195,12 +195,7 @@ fn write_summary(
     )?;
     match front {
         Some(front) => {
-            writeln!(
-                out,
-                "Pareto front ({names}): {} sequences, hypervolume {:.6}",
-                front.len(),
-                summary.hypervolume.unwrap_or(0.0)
-            )?;
+            writeln!(out, "Pareto front ({names}): {} sequences, hypervolume {:.6}", front.len(), summary.hypervolume.unwrap_or(0.0))?;
             for (k, e) in front.iter().enumerate() {
                 let v: Vec<String> = e.objectives.iter().map(|x| format!("{x:.4}")).collect();
                 writeln!(out, "{:>4}  ({})  removal order {:?}", k + 1, v.join(", "), e.disassembly_sequence)?;
@@ -213,4 +208,3 @@ fn write_summary(
     }
     Ok(())
 }
-

@@ -118,9 +118,7 @@ fn issue_8_bookkeeping_never_makes_a_run_worse() {
         let assembly = asp_gen::ProfileAssembly::generate(&asp_gen::ProfileParams::double_layer(), 4242 + seed)
             .expect("profiles")
             .to_assembly("double-layer");
-        let checker = |a: &Assembly| {
-            Checker::new(World::new(a.clone(), &WorldConfig::default()).unwrap(), CheckerConfig::default())
-        };
+        let checker = |a: &Assembly| Checker::new(World::new(a.clone(), &WorldConfig::default()).unwrap(), CheckerConfig::default());
         let (plain_checker, bk_checker) = (checker(&assembly), checker(&assembly));
         for order in [BuiltinOrder::Given, BuiltinOrder::Shuffled, BuiltinOrder::Random] {
             for run in 0..3 {
@@ -131,7 +129,12 @@ fn issue_8_bookkeeping_never_makes_a_run_worse() {
                 assert_eq!(plain.status, Status::Found, "{label}");
                 assert_eq!(bk.removals, plain.removals, "{label}: bookkeeping changed the search");
                 let (p, b) = (plain.stats.counters, bk.stats.counters);
-                assert!(b.removal_tests <= p.removal_tests, "{label}: {} tests with bookkeeping, {} without", b.removal_tests, p.removal_tests);
+                assert!(
+                    b.removal_tests <= p.removal_tests,
+                    "{label}: {} tests with bookkeeping, {} without",
+                    b.removal_tests,
+                    p.removal_tests
+                );
                 assert_eq!(b.failed_gravity, p.failed_gravity, "{label}: bookkeeping skips only collisions");
                 assert_eq!(p.removal_tests - b.removal_tests, p.failed_collision - b.failed_collision, "{label}");
                 saved += p.removal_tests - b.removal_tests;
@@ -150,7 +153,6 @@ fn shuffled_orders_are_reproducible_per_seed() {
     let (x, y) = (run(1), run(1));
     assert_eq!(x.removals, y.removals);
     assert_eq!(x.stats.counters, y.stats.counters);
-    let orders: std::collections::HashSet<Vec<usize>> =
-        (0..5).map(|s| run(s).removals.iter().map(|s| s.part).collect()).collect();
+    let orders: std::collections::HashSet<Vec<usize>> = (0..5).map(|s| run(s).removals.iter().map(|s| s.part).collect()).collect();
     assert!(orders.len() > 1, "five seeds gave one removal order");
 }

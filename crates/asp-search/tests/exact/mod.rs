@@ -37,9 +37,10 @@ fn dynamic_programme_equals_enumeration() {
             }
             // nothing enumerated beats the front; the worst point bounds everything from below
             for s in &all {
-                assert!(exact.solutions.iter().any(|e| {
-                    e.values.iter().zip(&s.values).all(|(a, b)| *a >= *b - 1e-9 * b.abs().max(1.0))
-                }));
+                assert!(exact
+                    .solutions
+                    .iter()
+                    .any(|e| { e.values.iter().zip(&s.values).all(|(a, b)| *a >= *b - 1e-9 * b.abs().max(1.0)) }));
                 assert!(weakly_dominates(&s.values, &exact.worst.iter().map(|w| w - 1e-9 * w.abs().max(1.0)).collect::<Vec<_>>()));
             }
             for k in 0..p.num_objectives() {

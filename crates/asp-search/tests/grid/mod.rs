@@ -3,9 +3,9 @@
 //! separation's move count is checked against a brute-force BFS over every subset of pieces.
 
 use asp_geom::grid::{Cell, VoxelModel};
-use asp_search::grid::{self, GridConfig, GridPlan, GridSolution, GridStatus, DIRECTIONS};
 use asp_geom::mesh::Mesh;
 use asp_geom::{fixtures, puzzles, Assembly, Part};
+use asp_search::grid::{self, GridConfig, GridPlan, GridSolution, GridStatus, DIRECTIONS};
 use std::collections::{HashMap, HashSet, VecDeque};
 
 fn solve(model: &VoxelModel) -> GridSolution {
@@ -20,9 +20,8 @@ fn shifted(cells: &[Cell], d: Cell) -> impl Iterator<Item = Cell> + '_ {
 /// parts off every other present part, and each removal must end with the group's bounds clear
 /// of the rest. Parts of `present` not in a move stay; `reference` parts never move.
 fn replay(plan: &GridPlan, pos: &mut HashMap<usize, Vec<Cell>>, present: &mut Vec<usize>, fixed: &[usize]) {
-    let occupied = |pos: &HashMap<usize, Vec<Cell>>, parts: &[usize]| -> HashSet<Cell> {
-        parts.iter().flat_map(|p| pos[p].iter().copied()).collect()
-    };
+    let occupied =
+        |pos: &HashMap<usize, Vec<Cell>>, parts: &[usize]| -> HashSet<Cell> { parts.iter().flat_map(|p| pos[p].iter().copied()).collect() };
     for step in &plan.steps {
         for m in &step.moves {
             assert!(m.parts.iter().all(|p| present.contains(p) && !fixed.contains(p)), "move {m:?} of absent or fixed parts");
@@ -116,7 +115,9 @@ pub(crate) fn brute_force_first_separation(pieces: &[Vec<Cell>], max_states: usi
                 let mut k = 1;
                 while k <= far {
                     let dk = d.map(|x| x * k);
-                    let hit = (0..n).filter(|&p| inside(p)).any(|p| world[p].iter().any(|c| rest.contains(&[c[0] + dk[0], c[1] + dk[1], c[2] + dk[2]])));
+                    let hit = (0..n)
+                        .filter(|&p| inside(p))
+                        .any(|p| world[p].iter().any(|c| rest.contains(&[c[0] + dk[0], c[1] + dk[1], c[2] + dk[2]])));
                     if hit {
                         break;
                     }
@@ -238,7 +239,11 @@ fn issue_9_non_voxel_meshes_are_not_voxel_models() {
     // an open box (one face missing) is not a closed polycube
     let mut open = Mesh::from_voxels(&[[0, 0, 0], [1, 0, 0]], asp_geom::math::Vec3::splat(0.01), asp_geom::math::Vec3::ZERO);
     open.triangles.truncate(open.triangles.len() - 2);
-    let a = fixtures::assemble("open", vec![fixtures::part("open", open, false), fixtures::voxel_part("b", &[[0, 1, 0]], 0.01)], asp_geom::math::Axis::Z);
+    let a = fixtures::assemble(
+        "open",
+        vec![fixtures::part("open", open, false), fixtures::voxel_part("b", &[[0, 1, 0]], 0.01)],
+        asp_geom::math::Axis::Z,
+    );
     assert!(VoxelModel::of(&a).is_none());
 }
 
@@ -332,7 +337,6 @@ fn connected(cells: &[Cell]) -> bool {
     seen.len() == cells.len()
 }
 
-
 /// A random polycube puzzle of `n` pieces: a box of cells (some left empty) split into
 /// connected pieces grown from random seeds, in random order. Every other puzzle is closed by
 /// a frame piece with a one-cell exit (so that pieces must move before one leaves).
@@ -424,11 +428,15 @@ fn issue_28_random_polycube_puzzles_replay_and_match_the_brute_force() {
             // the same puzzle as polycube meshes (no cells metadata) and with cells: the same model
             let a = fixtures::assemble(
                 "random",
-                pieces.iter().enumerate().map(|(i, c)| {
-                    let mut p = fixtures::voxel_part(&format!("p{i}"), c, 0.01);
-                    p.fixed = fixed[i];
-                    p
-                }).collect(),
+                pieces
+                    .iter()
+                    .enumerate()
+                    .map(|(i, c)| {
+                        let mut p = fixtures::voxel_part(&format!("p{i}"), c, 0.01);
+                        p.fixed = fixed[i];
+                        p
+                    })
+                    .collect(),
                 asp_geom::math::Axis::Z,
             );
             let with_cells = VoxelModel::of(&a).expect("cells");
@@ -560,10 +568,7 @@ fn issue_9_find_puzzles() {
         let mut rng = Rng(seed.wrapping_mul(0xd1b5_4a32_d192_ed03) | 1);
         let exit: Cell = [4, 1, 1 + rng.below(3) as i32];
         let mut cavity: Vec<Cell> = (0..9).map(|i| [1 + i % 3, 1, 1 + i / 3]).collect();
-        let frame: Vec<Cell> = (0..75)
-            .map(|i| [i % 5, i / 5 % 3, i / 15])
-            .filter(|c| !cavity.contains(c) && *c != exit)
-            .collect();
+        let frame: Vec<Cell> = (0..75).map(|i| [i % 5, i / 5 % 3, i / 15]).filter(|c| !cavity.contains(c) && *c != exit).collect();
         if rng.below(2) == 0 {
             cavity.push(exit);
         }

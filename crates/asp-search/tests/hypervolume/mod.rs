@@ -56,8 +56,7 @@ fn three_and_four_d_equal_inclusion_exclusion() {
     for d in [3, 4] {
         for _ in 0..100 {
             let n = r.random_range(1..9);
-            let pts: Vec<Vec<f64>> =
-                (0..n).map(|_| (0..d).map(|_| r.random_range(0.0..3.0)).collect()).collect();
+            let pts: Vec<Vec<f64>> = (0..n).map(|_| (0..d).map(|_| r.random_range(0.0..3.0)).collect()).collect();
             let reference = vec![0.5; d];
             let refs: Vec<&[f64]> = pts.iter().map(|p| p.as_slice()).collect();
             let a = hypervolume(&refs, &reference);

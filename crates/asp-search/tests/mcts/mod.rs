@@ -140,12 +140,7 @@ fn a_guided_rollout_policy_plugs_in() {
 struct LargestIndex(std::sync::atomic::AtomicUsize);
 
 impl asp_search::QFunction for LargestIndex {
-    fn q_values(
-        &self,
-        _: &mut asp_search::PolicyContext<'_, '_>,
-        actions: &[usize],
-        out: &mut [f64],
-    ) -> asp_search::Result<()> {
+    fn q_values(&self, _: &mut asp_search::PolicyContext<'_, '_>, actions: &[usize], out: &mut [f64]) -> asp_search::Result<()> {
         self.0.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         for (o, &a) in out.iter_mut().zip(actions) {
             *o = 1.0 + a as f64;
@@ -165,9 +160,7 @@ fn q_guided_expansions_follow_the_priors_and_leave_rollouts_random() {
     let p = problem(&maps, "access");
     let run = |uses: QUse| {
         let q = Arc::new(LargestIndex::default());
-        let policy = EpsilonGreedy::new(0.0, vec![q.clone()])
-            .unwrap()
-            .using(uses);
+        let policy = EpsilonGreedy::new(0.0, vec![q.clone()]).unwrap().using(uses);
         // one episode, one iteration per step: every expansion is its node's first
         let out = Mcts::builder()
             .policy(Arc::new(policy))
@@ -183,62 +176,23 @@ fn q_guided_expansions_follow_the_priors_and_leave_rollouts_random() {
     };
     let greedy = |t: &asp_search::Transition| t.action == *t.actions.iter().max().unwrap();
     let (out, calls) = run(QUse::Expansions);
-    let expansions: Vec<_> = out
-        .transitions
-        .iter()
-        .filter(|t| t.kind == StepKind::Expansion)
-        .collect();
-    let rollouts: Vec<_> = out
-        .transitions
-        .iter()
-        .filter(|t| t.kind == StepKind::Simulation)
-        .collect();
+    let expansions: Vec<_> = out.transitions.iter().filter(|t| t.kind == StepKind::Expansion).collect();
+    let rollouts: Vec<_> = out.transitions.iter().filter(|t| t.kind == StepKind::Simulation).collect();
     assert!(!expansions.is_empty() && !rollouts.is_empty());
-    assert!(
-        expansions.iter().all(|t| greedy(t)),
-        "every expansion adds the removal with the largest prior"
-    );
-    assert!(
-        !rollouts
-            .iter()
-            .filter(|t| t.actions.len() > 1)
-            .all(|t| greedy(t)),
-        "rollouts stay random"
-    );
+    assert!(expansions.iter().all(|t| greedy(t)), "every expansion adds the removal with the largest prior");
+    assert!(!rollouts.iter().filter(|t| t.actions.len() > 1).all(|t| greedy(t)), "rollouts stay random");
     // one evaluation per node added (the root's included), none per rollout step
-    assert!(
-        calls <= expansions.len() + 1,
-        "{calls} evaluations for {} expansions",
-        expansions.len()
-    );
-    assert!(
-        rollouts.len() > calls,
-        "{} rollout steps, {calls} evaluations",
-        rollouts.len()
-    );
+    assert!(calls <= expansions.len() + 1, "{calls} evaluations for {} expansions", expansions.len());
+    assert!(rollouts.len() > calls, "{} rollout steps, {calls} evaluations", rollouts.len());
     // rollouts: the other way round
     let (out, calls) = run(QUse::Rollouts);
-    let rollouts: Vec<_> = out
-        .transitions
-        .iter()
-        .filter(|t| t.kind == StepKind::Simulation)
-        .collect();
-    assert!(rollouts
-        .iter()
-        .filter(|t| t.actions.len() > 1)
-        .all(|t| greedy(t)));
+    let rollouts: Vec<_> = out.transitions.iter().filter(|t| t.kind == StepKind::Simulation).collect();
+    assert!(rollouts.iter().filter(|t| t.actions.len() > 1).all(|t| greedy(t)));
     assert!(calls >= rollouts.iter().filter(|t| t.actions.len() > 1).count());
     // both: greedy everywhere
     let (out, _) = run(QUse::Both);
-    assert!(out
-        .transitions
-        .iter()
-        .filter(|t| t.actions.len() > 1)
-        .all(greedy));
-    assert!(
-        "expansions".parse::<QUse>().unwrap() == QUse::Expansions
-            && "sideways".parse::<QUse>().is_err()
-    );
+    assert!(out.transitions.iter().filter(|t| t.actions.len() > 1).all(greedy));
+    assert!("expansions".parse::<QUse>().unwrap() == QUse::Expansions && "sideways".parse::<QUse>().is_err());
 }
 
 /// A random rollout policy whose first choice on each thread waits (up to 20 s) until every
@@ -264,7 +218,12 @@ impl asp_search::Policy for MeetingPolicy {
 }
 
 impl asp_search::PolicyWorker for MeetingWorker<'_> {
-    fn choose(&mut self, _: &mut asp_search::PolicyContext<'_, '_>, actions: &[usize], rng: &mut asp_search::policy::SearchRng) -> asp_search::Result<usize> {
+    fn choose(
+        &mut self,
+        _: &mut asp_search::PolicyContext<'_, '_>,
+        actions: &[usize],
+        rng: &mut asp_search::policy::SearchRng,
+    ) -> asp_search::Result<usize> {
         if !std::mem::replace(&mut self.waited, true) {
             let p = self.policy;
             let mut arrived = p.arrived.lock().unwrap();
@@ -289,7 +248,8 @@ fn search_threads_run_at_the_same_time() {
     let maps = maps(&cube, 5);
     for pareto in [false, true] {
         let p = problem(&maps, if pareto { "access,dirchange" } else { "access" });
-        let policy = Arc::new(MeetingPolicy { threads: 2, arrived: Default::default(), all: Default::default(), alone: Default::default() });
+        let policy =
+            Arc::new(MeetingPolicy { threads: 2, arrived: Default::default(), all: Default::default(), alone: Default::default() });
         let out = if pareto {
             asp_search::ParetoMcts::builder().threads(2).episodes(8).seed(1).policy(policy.clone()).build().unwrap().solve(&p)
         } else {
@@ -297,6 +257,9 @@ fn search_threads_run_at_the_same_time() {
         };
         assert!(out.is_ok());
         assert_eq!(*policy.arrived.lock().unwrap(), 2, "pareto {pareto}: both threads made rollouts");
-        assert!(!policy.alone.load(std::sync::atomic::Ordering::SeqCst), "pareto {pareto}: one thread ran its rollouts while the other waited");
+        assert!(
+            !policy.alone.load(std::sync::atomic::Ordering::SeqCst),
+            "pareto {pareto}: one thread ran its rollouts while the other waited"
+        );
     }
 }

@@ -4,8 +4,8 @@
 use crate::fixtures::{close, exact_instances, figure_6_2, maps, problem, soma};
 use asp_search::exact::exact_front;
 use asp_search::hypervolume::dominates;
-use asp_search::SearchStatus;
 use asp_search::ParetoMcts;
+use asp_search::SearchStatus;
 
 #[test]
 fn figure_6_2_front() {
@@ -30,15 +30,8 @@ fn reaches_99_percent_of_the_exact_hypervolume_on_instances_with_exact_reference
                 continue;
             }
             // a tight reference: just below the worst total of every objective
-            let reference: Vec<f64> =
-                exact.worst.iter().map(|w| w - 1e-3 * w.abs().max(1.0)).collect();
-            let out = ParetoMcts::builder()
-                .seed(seed as u64)
-                .reference(reference.clone())
-                .build()
-                .unwrap()
-                .solve(&p)
-                .unwrap();
+            let reference: Vec<f64> = exact.worst.iter().map(|w| w - 1e-3 * w.abs().max(1.0)).collect();
+            let out = ParetoMcts::builder().seed(seed as u64).reference(reference.clone()).build().unwrap().solve(&p).unwrap();
             let hv_exact = exact.hypervolume(&reference);
             assert!(
                 out.value >= 0.99 * hv_exact,
@@ -56,11 +49,7 @@ fn reaches_99_percent_of_the_exact_hypervolume_on_instances_with_exact_reference
                     assert!(!dominates(&s.values, &t.values) && !dominates(&t.values, &s.values));
                 }
                 // no answer lies beyond the exact front
-                assert!(exact.solutions.iter().any(|e| e
-                    .values
-                    .iter()
-                    .zip(&s.values)
-                    .all(|(a, b)| *a >= *b - 1e-9 * b.abs().max(1.0))));
+                assert!(exact.solutions.iter().any(|e| e.values.iter().zip(&s.values).all(|(a, b)| *a >= *b - 1e-9 * b.abs().max(1.0))));
             }
             checked += 1;
         }
@@ -73,9 +62,7 @@ fn threads_are_reproducible_and_merge_fronts() {
     let cube = soma(4, 21);
     let maps = maps(&cube, 5);
     let p = problem(&maps, "access,dirchange");
-    let run = |threads| {
-        ParetoMcts::builder().episodes(20).threads(threads).seed(9).build().unwrap().solve(&p).unwrap()
-    };
+    let run = |threads| ParetoMcts::builder().episodes(20).threads(threads).seed(9).build().unwrap().solve(&p).unwrap();
     let (a, b) = (run(1), run(1));
     assert_eq!(a.solutions, b.solutions);
     let (c, d) = (run(2), run(2));
@@ -122,9 +109,7 @@ fn local_search_lifts_the_front_and_its_answers_replay() {
     let cube = soma(4, 21);
     let maps = maps(&cube, 5);
     let p = problem(&maps, "access,dirchange");
-    let run = |share: f64| {
-        ParetoMcts::builder().episodes(100).seed(3).polish(share).build().unwrap().solve(&p).unwrap()
-    };
+    let run = |share: f64| ParetoMcts::builder().episodes(100).seed(3).polish(share).build().unwrap().solve(&p).unwrap();
     let (plain, polished) = (run(0.0), run(0.25));
     assert_eq!(plain.stats.polish_steps, 0);
     assert!(polished.stats.polished > 0 && polished.stats.polish_steps > 0);

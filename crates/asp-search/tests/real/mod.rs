@@ -107,10 +107,9 @@ fn pump_without_subassemblies_ends_in_no_plan_with_its_stuck_core_explained_and_
     assert_eq!(stuck.len(), state.len());
     for s in stuck {
         match &s.reason {
-            StuckReason::Blocked(blockers) => assert!(
-                !blockers.is_empty() && blockers.iter().all(|b| b == checker.num_parts() || state.contains(b)),
-                "{s:?}"
-            ),
+            StuckReason::Blocked(blockers) => {
+                assert!(!blockers.is_empty() && blockers.iter().all(|b| b == checker.num_parts() || state.contains(b)), "{s:?}")
+            }
             StuckReason::WouldLeaveUnsupported(parts) => {
                 assert!(name(s.part).starts_with("LargeScrew"), "{s:?}");
                 assert!(!parts.is_empty() && parts.iter().all(|b| state.contains(b)), "{s:?}");
@@ -237,8 +236,6 @@ fn issue_9_interlocking_cubes_come_apart_in_halves_and_every_step_rechecks() {
     }
 }
 
-
-
 /// Every removal of a plan, its subassemblies' own plans included: (part, motion).
 fn all_steps(removals: &[asp_search::Step]) -> Vec<(usize, asp_geom::Motion)> {
     let mut out = Vec::new();
@@ -259,7 +256,8 @@ fn issue_9_pump_threaded_bolts_leave_by_screwing_and_every_step_rechecks() {
     // Threads are modelled as rings; bolt and nut overlap by a millimetre at their crests
     let w = world("pump-threaded", Some("mm"), OverlapPolicy::Strict).unwrap();
     let find = |n: &str| (0..w.num_parts()).find(|&i| w.name(i).ends_with(&format!(" - {n}"))).unwrap();
-    let (pump, lid, backlid, bolt1, bolt11, nut1) = (find("Pump"), find("Lid"), find("Backlid"), find("Bolt1"), find("Bolt11L"), find("Nut1"));
+    let (pump, lid, backlid, bolt1, bolt11, nut1) =
+        (find("Pump"), find("Lid"), find("Backlid"), find("Bolt1"), find("Bolt11L"), find("Nut1"));
     // the axes: the M5 bolt along y, the M16 bolt and its nut along z
     let y = asp_geom::math::Vec3::Y;
     let z = asp_geom::math::Vec3::Z;
@@ -302,7 +300,8 @@ fn issue_9_pump_threaded_bolts_leave_by_screwing_and_every_step_rechecks() {
     // without the screw rule the bolts leave by straight lines (the M16 one only out of the
     // nut it overlaps... if at all): no screw motion anywhere
     let options = LoadOptions { unit: Units::parse("mm"), up: Some(Axis::Z), fixed: vec![], ..LoadOptions::default() };
-    let plain = World::new(load(&data("pump-threaded"), &options).unwrap(), &WorldConfig { fasteners: false, ..WorldConfig::default() }).unwrap();
+    let plain =
+        World::new(load(&data("pump-threaded"), &options).unwrap(), &WorldConfig { fasteners: false, ..WorldConfig::default() }).unwrap();
     let (_, outcome) = plan(plain, &Dfs::builder().build());
     eprintln!("pump-threaded without the screw rule: {:?}", outcome.status);
     assert!(all_steps(&outcome.removals).iter().all(|(_, m)| !matches!(m, asp_geom::Motion::Screw { .. })));

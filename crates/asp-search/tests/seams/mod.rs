@@ -8,9 +8,7 @@ use asp_search::exact::exact_front;
 use asp_search::objective::parse_objectives;
 use asp_search::policy::{PolicyContext, PolicyWorker, SearchRng};
 use asp_search::StopToken;
-use asp_search::{
-    ActionFilter, Mcts, Mdp, Objective, ParetoMcts, Policy, SearchError, StepContext, StepKind, Verdict,
-};
+use asp_search::{ActionFilter, Mcts, Mdp, Objective, ParetoMcts, Policy, SearchError, StepContext, StepKind, Verdict};
 use rand::RngExt;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -147,7 +145,8 @@ fn objectives_learn_which_step_of_the_search_calls_them() {
     let best = out.best().unwrap();
     assert!(close(pathlen.evaluate(&best.sequence).unwrap().0[0], best.values[0]));
     // the local search evaluates its moves by replay steps, never as expansions or simulations
-    let before = (counter.expansion.load(Ordering::Relaxed), counter.simulation.load(Ordering::Relaxed), counter.replay.load(Ordering::Relaxed));
+    let before =
+        (counter.expansion.load(Ordering::Relaxed), counter.simulation.load(Ordering::Relaxed), counter.replay.load(Ordering::Relaxed));
     let polished = Mcts::builder().episodes(30).seed(2).build().unwrap().solve(&p).unwrap();
     assert!(polished.stats.polish_steps > 0);
     assert_eq!(counter.expansion.load(Ordering::Relaxed) - before.0, expansions);
@@ -349,15 +348,7 @@ fn priors_order_expansions_and_weigh_in_the_tree_policy() {
     let p = problem(&maps, "access,dirchange");
     let run = |weight: f64| {
         let probe = Arc::new(Probe { priors: true, ..Probe::default() });
-        let out = ParetoMcts::builder()
-            .policy(probe.clone())
-            .prior_weight(weight)
-            .episodes(20)
-            .seed(1)
-            .build()
-            .unwrap()
-            .solve(&p)
-            .unwrap();
+        let out = ParetoMcts::builder().policy(probe.clone()).prior_weight(weight).episodes(20).seed(1).build().unwrap().solve(&p).unwrap();
         assert!(probe.expansions.load(Ordering::Relaxed) > 0);
         for s in &out.solutions {
             p.evaluate(&s.sequence).unwrap();
@@ -424,8 +415,8 @@ fn a_stop_token_ends_a_search_early_with_its_answer_so_far() {
 
 #[test]
 fn objectives_from_an_extension_resolve_by_name() {
-    use asp_search::extension::{MdpExtension, ModelContext};
     use asp_search::extension::{check_objective_names, resolve_objectives};
+    use asp_search::extension::{MdpExtension, ModelContext};
     #[derive(Debug)]
     struct Parity;
     impl MdpExtension for Parity {

@@ -5,9 +5,9 @@
 use asp_geom::erode::eroded_mesh;
 use asp_geom::feasibility::interpolate_about;
 use asp_geom::math::{Pose, Vec3};
+use asp_geom::sweep::meshes_cross_at;
 use asp_geom::{Motion, PartSet, Stability, World};
 use asp_search::{PlanOutcome, Status};
-use asp_geom::sweep::meshes_cross_at;
 use parry3d::query::PointQuery;
 use parry3d::shape::{TriMesh, TriMeshFlags};
 use std::collections::HashMap;
@@ -23,7 +23,14 @@ fn shrunk(world: &World, p: usize, amount: f32) -> TriMesh {
 /// chose for it (the moving part, or for input overlaps the one that separates more easily).
 /// A screw step's threaded partners are not tested here (their threads are invariant under the
 /// screw motion, which is not a translation); `screw` says whether the step is one.
-fn penetrates(world: &World, p: usize, pose: &Pose, present: &PartSet, shrunk_cache: &mut HashMap<(usize, u32), TriMesh>, screw: bool) -> Option<usize> {
+fn penetrates(
+    world: &World,
+    p: usize,
+    pose: &Pose,
+    present: &PartSet,
+    shrunk_cache: &mut HashMap<(usize, u32), TriMesh>,
+    screw: bool,
+) -> Option<usize> {
     present.iter().filter(|&q| q != p && !world.ignores(p, q) && !(screw && world.thread(p, q).is_some())).find(|&q| {
         let (k, amount) = world.pair_erosion(p, q);
         let shrunk_k = shrunk_cache.entry((k, amount.to_bits())).or_insert_with(|| shrunk(world, k, amount)).clone();
@@ -77,7 +84,15 @@ fn inner_points(world: &World, p: usize) -> Vec<Vec3> {
 /// thread's radius, where the threads turn in each other): a bolt's head, a nut's faces, the
 /// material around a tapped hole may enter nothing, whether the pair overlaps in the input or
 /// only touches. Every other pair of a screw step is checked as for a straight line.
-fn check_strict(world: &World, k: usize, movers: &[usize], others: &PartSet, poses: &[Pose], samples: &mut HashMap<usize, Vec<Vec3>>, screw: Option<Vec3>) {
+fn check_strict(
+    world: &World,
+    k: usize,
+    movers: &[usize],
+    others: &PartSet,
+    poses: &[Pose],
+    samples: &mut HashMap<usize, Vec<Vec3>>,
+    screw: Option<Vec3>,
+) {
     for &p in movers {
         for q in others.iter() {
             let thread = screw.and_then(|_| world.thread(p, q));
@@ -105,8 +120,7 @@ fn check_strict(world: &World, k: usize, movers: &[usize], others: &PartSet, pos
                 // at the start and outside later: touching is not entering
                 let depth = |x: Vec3| (mesh.project_local_point(x, false).point - x).length();
                 let half = 0.5 * world.tolerance();
-                let start: Vec<bool> =
-                    pts.iter().map(|&x| near(x) && (mesh.contains_local_point(x) || depth(x) <= half)).collect();
+                let start: Vec<bool> = pts.iter().map(|&x| near(x) && (mesh.contains_local_point(x) || depth(x) <= half)).collect();
                 for pose in &poses[1..] {
                     if let Some(x) = pts.iter().zip(&start).find(|(x, inside)| {
                         let y = place(pose, **x);

@@ -30,12 +30,15 @@ pub fn stuck_tube() -> Scene {
     report.remaining = Some(vec![stick, receptacle, cap]);
     report.assembly_sequence.clear();
     report.disassembly_sequence = vec![handle];
-    report.explanation = vec![Explanation {
-        part: stick,
-        name: "stick".into(),
-        reason: asp_search::report::ExplanationReason::Blocked,
-        parts: vec![NamedPart { part: receptacle, name: "receptacle".into() }, NamedPart { part: cap, name: "cap".into() }],
-    }, Explanation { part: cap, name: "cap".into(), reason: asp_search::report::ExplanationReason::DeadEnd, parts: vec![] }];
+    report.explanation = vec![
+        Explanation {
+            part: stick,
+            name: "stick".into(),
+            reason: asp_search::report::ExplanationReason::Blocked,
+            parts: vec![NamedPart { part: receptacle, name: "receptacle".into() }, NamedPart { part: cap, name: "cap".into() }],
+        },
+        Explanation { part: cap, name: "cap".into(), reason: asp_search::report::ExplanationReason::DeadEnd, parts: vec![] },
+    ];
     Scene::new(scene.assembly.clone(), report, Path::new("fixture")).unwrap()
 }
 

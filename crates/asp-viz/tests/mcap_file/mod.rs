@@ -21,11 +21,11 @@ fn read(path: &std::path::Path) -> Read {
     for m in mcap::MessageStream::new(&bytes).unwrap() {
         let m = m.unwrap();
         let schema = m.channel.schema.as_ref().expect("every channel has a schema");
-        schemas.insert(
-            m.channel.topic.clone(),
-            (schema.name.clone(), schema.encoding.clone(), m.channel.message_encoding.clone()),
+        schemas.insert(m.channel.topic.clone(), (schema.name.clone(), schema.encoding.clone(), m.channel.message_encoding.clone()));
+        assert_eq!(
+            String::from_utf8_lossy(&schema.data),
+            if schema.name == "foxglove.SceneUpdate" { SCENE_UPDATE_SCHEMA } else { FRAME_TRANSFORMS_SCHEMA }
         );
-        assert_eq!(String::from_utf8_lossy(&schema.data), if schema.name == "foxglove.SceneUpdate" { SCENE_UPDATE_SCHEMA } else { FRAME_TRANSFORMS_SCHEMA });
         messages.push((m.channel.topic.clone(), m.log_time, serde_json::from_slice(&m.data).unwrap()));
     }
     Read { messages, schemas }
@@ -112,11 +112,18 @@ fn a_found_plan_animates_every_part_along_its_motion() {
             .flat_map(|m| m.2["transforms"].as_array().unwrap())
             .filter(|t| t["child_frame_id"] == frame.as_str())
             .collect();
-        let v = |t: &Value| [t["translation"]["x"].as_f64().unwrap(), t["translation"]["y"].as_f64().unwrap(), t["translation"]["z"].as_f64().unwrap()];
+        let v = |t: &Value| {
+            [t["translation"]["x"].as_f64().unwrap(), t["translation"]["y"].as_f64().unwrap(), t["translation"]["z"].as_f64().unwrap()]
+        };
         let Some(Insertion::Linear { direction, distance }) = &step.motion else { panic!("the tube moves in straight lines") };
         let start = v(poses[0]);
         let expected = -*direction * *distance;
-        assert!((start[0] - expected.x as f64).abs() < 1e-5 && (start[1] - expected.y as f64).abs() < 1e-5 && (start[2] - expected.z as f64).abs() < 1e-5, "{frame}: {start:?}");
+        assert!(
+            (start[0] - expected.x as f64).abs() < 1e-5
+                && (start[1] - expected.y as f64).abs() < 1e-5
+                && (start[2] - expected.z as f64).abs() < 1e-5,
+            "{frame}: {start:?}"
+        );
         assert!(v(poses.last().unwrap()).iter().all(|c| c.abs() < 1e-6), "{frame} does not end assembled");
     }
     let path = r.messages.iter().find(|m| m.0 == TOPIC_PATHS).unwrap();

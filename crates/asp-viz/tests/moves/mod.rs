@@ -2,10 +2,10 @@
 //! piece of an interlocking puzzle passes through another at any time of the animation, and
 //! every picture (storyboard, MCAP, page data) shows the same poses as `Scene::pose_during`.
 
+use asp_app::pipeline::{plan_assembly, PlanSettings};
 use asp_geom::grid::VoxelModel;
 use asp_geom::math::Vec3;
 use asp_geom::puzzles;
-use asp_app::pipeline::{plan_assembly, PlanSettings};
 use asp_viz::{Scene, MOVE_TIME};
 use std::path::Path;
 
@@ -38,7 +38,11 @@ fn assert_no_piece_passes_through_another(scene: &Scene, voxels: &VoxelModel) {
             for a in 0..placed.len() {
                 for b in a + 1..placed.len() {
                     let hit = cells[a].iter().any(|&x| cells[b].iter().any(|&y| cubes_overlap(x, y)));
-                    assert!(!hit, "step {k} at u = {u}: {} and {} share volume", scene.assembly.parts[placed[a]].name, scene.assembly.parts[placed[b]].name);
+                    assert!(
+                        !hit,
+                        "step {k} at u = {u}: {} and {} share volume",
+                        scene.assembly.parts[placed[a]].name, scene.assembly.parts[placed[b]].name
+                    );
                 }
             }
         }
@@ -97,7 +101,10 @@ fn pictures_show_the_poses_of_the_moves() {
         let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
         for t in v["transforms"].as_array().unwrap() {
             let tr = &t["translation"];
-            last.insert(t["child_frame_id"].as_str().unwrap().to_string(), ["x", "y", "z"].iter().map(|c| tr[c].as_f64().unwrap()).collect());
+            last.insert(
+                t["child_frame_id"].as_str().unwrap().to_string(),
+                ["x", "y", "z"].iter().map(|c| tr[c].as_f64().unwrap()).collect(),
+            );
         }
     }
     for i in 0..scene.assembly.parts.len() {

@@ -64,7 +64,11 @@ fn traces_plot_every_row_of_every_file() {
     let dir = tempfile::tempdir().unwrap();
     let a = dir.path().join("run-a.csv");
     let b = dir.path().join("run-b.csv");
-    std::fs::write(&a, "episode,iterations,seconds,value,front_size\n1,10,0.01,0.5,2\n5,50,0.05,0.7,3\n9,90,0.09,0.8,3\n12,120,0.12,0.8,3\n").unwrap();
+    std::fs::write(
+        &a,
+        "episode,iterations,seconds,value,front_size\n1,10,0.01,0.5,2\n5,50,0.05,0.7,3\n9,90,0.09,0.8,3\n12,120,0.12,0.8,3\n",
+    )
+    .unwrap();
     std::fs::write(&b, "episode,iterations,seconds,value,front_size\n1,10,0.02,0.4,1\n7,70,0.08,0.9,4\n10,100,0.1,0.9,4\n").unwrap();
     let traces = vec![read_trace(&a).unwrap(), read_trace(&b).unwrap()];
     assert_eq!(traces[0].label, "run-a");
@@ -129,8 +133,11 @@ fn bad_inputs_are_one_line_errors_naming_the_file() {
     std::fs::write(&plan, serde_json::to_string(&crate::common::planned(asp_geom::fixtures::tube()).report).unwrap()).unwrap();
     let e = read_front(&plan).unwrap_err().to_string();
     assert!(e.contains("plain.json") && e.contains("pareto_front"), "{e}");
-    let e = write_front(&dir.path().join("x.gif"), &asp_viz::plot::Front { objectives: vec!["a".into(), "b".into()], points: vec![vec![1.0, 2.0]] })
-        .unwrap_err()
-        .to_string();
+    let e = write_front(
+        &dir.path().join("x.gif"),
+        &asp_viz::plot::Front { objectives: vec!["a".into(), "b".into()], points: vec![vec![1.0, 2.0]] },
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("x.gif"), "{e}");
 }
