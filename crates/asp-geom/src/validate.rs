@@ -3,8 +3,12 @@
 //! same place). Called once after loading ([`crate::io::load`]); every message names the file
 //! (the error's path) and the part and says what to do.
 //!
-//! A part wholly inside another is not refused here: the collision world reports such pairs as
-//! nested overlaps ([`crate::overlap::OverlapKind::Nested`]) and the overlap policy decides.
+//! A part embedded in another's material — every vertex of it strictly inside the other's closed
+//! surface, deeper than a thousandth of the model's diagonal — is refused too: no motion takes it
+//! out, so it is an export's artefact (a duplicate body, a simplified envelope). A part that
+//! overlaps another only in part (a press fit, a dowel) or sits in a cavity (outside the material)
+//! is not: the collision world reports such pairs as overlaps
+//! ([`crate::overlap::OverlapKind::Nested`] among them) and the overlap policy decides.
 
 use crate::assembly::Assembly;
 use crate::error::{GeomError, Result};
@@ -48,7 +52,56 @@ pub fn check_model(assembly: &Assembly) -> Result<()> {
             seen.insert(key, i);
         }
     }
+    if let Some((inner, outer)) = embedded_part(assembly) {
+        let (inner, outer) = (&assembly.parts[inner].name, &assembly.parts[outer].name);
+        return Err(err(format!(
+            "part '{inner}' lies wholly inside the material of part '{outer}' (no motion can take it out); \
+             delete one of the two bodies in the file, or export '{outer}' with the hole '{inner}' sits in"
+        )));
+    }
     Ok(())
+}
+
+/// The first part (`inner`, `outer`) whose every vertex lies inside `outer`'s closed surface by
+/// more than a thousandth of the model's diagonal; only pairs whose boxes nest are looked at, and
+/// only closed containers (an open surface has no inside).
+fn embedded_part(assembly: &Assembly) -> Option<(usize, usize)> {
+    use parry3d::query::PointQuery;
+    use parry3d::shape::{TriMesh, TriMeshFlags};
+    let depth = 1e-3 * assembly.diagonal();
+    if !(depth > 0.0) {
+        return None;
+    }
+    let boxes: Vec<_> = assembly.parts.iter().map(|p| p.mesh.aabb()).collect();
+    let nests = |i: usize, o: usize| match (&boxes[i], &boxes[o]) {
+        (Some(a), Some(b)) => (0..3).all(|k| a.mins[k] > b.mins[k] + depth && a.maxs[k] < b.maxs[k] - depth),
+        _ => false,
+    };
+    for outer in 0..assembly.parts.len() {
+        let candidates: Vec<usize> = (0..assembly.parts.len()).filter(|&i| i != outer && nests(i, outer)).collect();
+        if candidates.is_empty() {
+            continue;
+        }
+        let mut m = assembly.parts[outer].mesh.clone();
+        m.weld();
+        m.orient_outward();
+        if !m.topology().is_closed_manifold() {
+            continue;
+        }
+        let Ok(solid) = TriMesh::with_flags(m.vertices, m.triangles, TriMeshFlags::ORIENTED) else { continue };
+        for inner in candidates {
+            let vertices = &assembly.parts[inner].mesh.vertices;
+            let embedded = !vertices.is_empty()
+                && vertices.iter().all(|&v| {
+                    let p = solid.project_local_point(v, true);
+                    p.is_inside && (p.point - v).length() > depth
+                });
+            if embedded {
+                return Some((inner, outer));
+            }
+        }
+    }
+    None
 }
 
 /// Triangles with three distinct corners and a non-zero normal (what welding keeps).
@@ -120,5 +173,18 @@ mod tests {
         assert!(message(&twice).contains("parts 'a' and 'a_2' are the same mesh at the same place"), "{}", message(&twice));
         // the same mesh elsewhere is not a duplicate
         assert!(check_model(&assembly(vec![("a", cube(0.0)), ("a_2", cube(1.0))])).is_ok());
+        // a small cube embedded in a big one's material; in a hollow one (a cavity) it is not
+        let big = Mesh::cuboid(Vec3::ZERO, Vec3::splat(4.0));
+        let inner = Mesh::cuboid(Vec3::splat(1.0), Vec3::splat(2.0));
+        let embedded = assembly(vec![("block", big.clone()), ("pin", inner.clone())]);
+        assert!(message(&embedded).contains("part 'pin' lies wholly inside the material of part 'block'"), "{}", message(&embedded));
+        let mut hollow = big.clone();
+        let mut cavity = Mesh::cuboid(Vec3::splat(0.5), Vec3::splat(3.5));
+        cavity.triangles.iter_mut().for_each(|t| t.swap(1, 2)); // facing inwards: the cavity's walls
+        hollow.append(&cavity);
+        assert!(check_model(&assembly(vec![("box", hollow), ("pin", inner.clone())])).is_ok());
+        // a pin only half in (a press fit) is the overlap policy's, not refused here
+        let half = Mesh::cuboid(Vec3::new(1.0, 1.0, 3.0), Vec3::new(2.0, 2.0, 5.0));
+        assert!(check_model(&assembly(vec![("block", big), ("pin", half)])).is_ok());
     }
 }
