@@ -26,6 +26,7 @@ __all__ = [
     "bench_item",
     "bench_table",
     "mcts_table",
+    "plan_text",
 ]
 
 __version__: str
