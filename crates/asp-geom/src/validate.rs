@@ -69,7 +69,7 @@ fn embedded_part(assembly: &Assembly) -> Option<(usize, usize)> {
     use parry3d::query::PointQuery;
     use parry3d::shape::{TriMesh, TriMeshFlags};
     let depth = 1e-3 * assembly.diagonal();
-    if !(depth > 0.0) {
+    if depth.is_nan() || depth <= 0.0 {
         return None;
     }
     let boxes: Vec<_> = assembly.parts.iter().map(|p| p.mesh.aabb()).collect();
