@@ -221,7 +221,7 @@ pub struct PlanRequest {
 pub const LOAD_KEYS: [&str; 5] = ["unit", "up", "fixed", "max_triangles", "max_parts"];
 
 impl PlanRequest {
-    /// Every key of a request, in declaration order.
+    /// Every key of a request, in alphabetical order.
     pub fn keys() -> Vec<String> {
         match serde_json::to_value(PlanRequest::default()) {
             Ok(serde_json::Value::Object(map)) => map.keys().cloned().collect(),
@@ -284,63 +284,16 @@ impl PlanRequest {
         self.objective.is_some()
     }
 
-    /// The settings given, by key.
-    pub fn given(&self) -> Vec<&'static str> {
-        let mut keys = Vec::new();
-        macro_rules! given {
-            ($($field:ident),+) => {$(if self.$field.is_some() { keys.push(stringify!($field)); })+};
+    /// The settings given, by key, in alphabetical order (every field that is not left out: not
+    /// `None`, not an empty list). Read off the serialised request, so a new field is counted
+    /// without being listed here.
+    pub fn given(&self) -> Vec<String> {
+        match serde_json::to_value(self) {
+            Ok(serde_json::Value::Object(map)) => {
+                map.into_iter().filter(|(_, v)| !v.is_null() && !v.as_array().is_some_and(Vec::is_empty)).map(|(k, _)| k).collect()
+            }
+            _ => Vec::new(),
         }
-        given!(
-            unit,
-            up,
-            max_triangles,
-            max_parts,
-            allow_outside_files,
-            tolerance,
-            contact_distance,
-            normals,
-            sphere_directions,
-            overlaps,
-            stability,
-            physics_threshold,
-            path_planner,
-            subassemblies,
-            grid,
-            rrt_iterations,
-            rrt_time,
-            order,
-            model,
-            bookkeeping,
-            seed,
-            max_tests,
-            timeout,
-            objective,
-            pareto,
-            episodes,
-            budget,
-            threads,
-            time_limit,
-            exploration,
-            polish,
-            resolution,
-            d_max,
-            support,
-            q,
-            epsilon,
-            q_use,
-            robot,
-            robot_base,
-            drop_off,
-            replans,
-            grippers
-        );
-        if !self.fixed.is_empty() {
-            keys.push("fixed");
-        }
-        if !self.package_path.is_empty() {
-            keys.push("package_path");
-        }
-        keys
     }
 }
 
@@ -447,7 +400,7 @@ mod tests {
             ..PlanRequest::default()
         };
         assert_eq!(PlanRequest::from_json(&r.to_json()).unwrap(), r);
-        assert_eq!(r.given(), vec!["overlaps", "objective", "q_use", "robot_base", "fixed"]);
+        assert_eq!(r.given(), ["fixed", "objective", "overlaps", "q_use", "robot_base"]);
     }
 
     #[test]

@@ -60,13 +60,14 @@ const OPTIMISER_ONLY: &[(&str, &str)] = &[
 /// Each setting does something in the search the request asks for.
 fn check_applies(r: &PlanRequest) -> Result<()> {
     let given = r.given();
+    let is_given = |key: &str| given.iter().any(|g| g == key);
     let (table, search, switch) = if r.optimises() {
         (FEASIBILITY_ONLY, "the feasibility search", "without `objective`")
     } else {
         (OPTIMISER_ONLY, "the optimiser", "with `objective`")
     };
     for (key, instead) in table {
-        if given.contains(key) {
+        if is_given(key) {
             let mut reason = format!("applies to {search} only ({switch})");
             if !instead.is_empty() {
                 reason.push_str("; ");
@@ -76,7 +77,7 @@ fn check_applies(r: &PlanRequest) -> Result<()> {
         }
     }
     let needs = |key: &str, on: bool, what: &str| -> Result<()> {
-        if given.contains(&key) && !on {
+        if is_given(key) && !on {
             return Err(AppError::setting(key, format!("needs {what}")));
         }
         Ok(())
