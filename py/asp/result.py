@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy as _copy
 import json as _json
 import os
 from typing import Any
@@ -55,12 +56,20 @@ class Plan:
         """For ``"partial"`` plans, the parts asp could not take apart, one dict per core:
         ``base``, ``parts``, ``names``, ``status`` (why: ``"no_plan"``, ``"budget_exhausted"``
         or ``"unplanned"``) and ``explanation`` (what holds each part); empty otherwise."""
-        return self.to_dict().get("locked_cores", [])
+        return self._copy("locked_cores", [])
 
     def table(self) -> str:
         """The plan as text, exactly as ``asp plan`` prints it for the same run: the table and,
         for optimising runs, the optimiser's summary."""
         return _asp.plan_text(self._json)
+
+    def _copy(self, key: str, default: Any = KeyError) -> Any:
+        """A fresh copy of one entry of the plan (the JSON is parsed once, in the constructor)."""
+        if key not in self._dict:
+            if default is KeyError:
+                raise KeyError(key)
+            return default
+        return _copy.deepcopy(self._dict[key])
 
     def to_dict(self) -> dict[str, Any]:
         """The plan JSON as a fresh dict (changing it does not change the plan)."""
@@ -84,13 +93,13 @@ class Plan:
     @property
     def parts(self) -> list[dict[str, Any]]:
         """Every part: ``{"index", "name", "fixed"}``."""
-        return self.to_dict()["parts"]
+        return self._copy("parts")
 
     @property
     def assembly_sequence(self) -> list[dict[str, Any]]:
         """One entry per non-fixed part in assembly order: ``{"part", "name", "motion"}``
         (empty unless found)."""
-        return self.to_dict()["assembly_sequence"]
+        return self._copy("assembly_sequence")
 
     @property
     def disassembly_sequence(self) -> list[int]:
@@ -102,7 +111,7 @@ class Plan:
     def partial_assembly_sequence(self) -> list[dict[str, Any]]:
         """When not found: the parts that did come off, in assembly order onto
         :attr:`remaining`, entries as in :attr:`assembly_sequence` (empty when found)."""
-        return self.to_dict().get("partial_assembly_sequence", [])
+        return self._copy("partial_assembly_sequence", [])
 
     @property
     def remaining(self) -> list[int] | None:
@@ -120,7 +129,7 @@ class Plan:
     def explanation(self) -> list[dict[str, Any]]:
         """For ``no_plan``: each part of the deepest dead end, why it is stuck and which parts
         hold it (empty otherwise)."""
-        return self.to_dict().get("explanation", [])
+        return self._copy("explanation", [])
 
     @property
     def warnings(self) -> list[str]:
@@ -130,12 +139,12 @@ class Plan:
     @property
     def optimisation(self) -> dict[str, Any] | None:
         """For optimising runs (``objective=``): objectives, values and the search's settings."""
-        return self.to_dict().get("optimisation")
+        return self._copy("optimisation", None)
 
     @property
     def pareto_front(self) -> list[dict[str, Any]] | None:
         """For Pareto runs: every non-dominated sequence with its objective vector."""
-        return self.to_dict().get("pareto_front")
+        return self._copy("pareto_front", None)
 
     @property
     def trace_csv(self) -> str | None:
