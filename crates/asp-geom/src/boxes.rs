@@ -13,20 +13,78 @@ use crate::assembly::Part;
 use crate::math::{Aabb, Vec3};
 use crate::mesh::Mesh;
 
-/// The boxes of a part, in world coordinates (metres), when the part is a known union of boxes:
-/// from its metadata's cells or boxes ([`crate::PartMeta`]), or its mesh being one box.
-/// `Err` names the problem when the extras declare boxes that do not describe the mesh (the
-/// caller warns and falls back to the mesh).
+/// How a part's geometry is tested: the one classification the collision world
+/// ([`crate::World`]) and the distance maps ([`crate::distmap::DistanceMaps`]) share.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PartShape {
+    /// Voxels (`extras.asp.cells`) fitted to the mesh: distinct cells, sorted, of the grid
+    /// `world = origin + cell * grid`.
+    Voxels {
+        /// The distinct cells, sorted.
+        cells: Vec<[i32; 3]>,
+        /// The world position of grid point (0, 0, 0).
+        origin: Vec3,
+        /// The size of one cell per axis.
+        cell: Vec3,
+    },
+    /// A union of axis-aligned boxes in world coordinates: `extras.asp.boxes` fitted to the
+    /// mesh, or the mesh itself being one box.
+    Boxes(Vec<Aabb>),
+    /// A general triangle mesh.
+    Mesh,
+}
+
+impl PartShape {
+    /// Classifies `part`: its voxels, else its listed boxes, else its mesh as one box, else a
+    /// mesh. Extras that do not describe the mesh are not used: the mesh decides (a single box
+    /// or a mesh), and the returned warning names the part and the extras. With `exact` false
+    /// every part is a mesh (the setting `WorldConfig::exact_boxes`).
+    pub fn classify(part: &Part, exact: bool) -> (PartShape, Option<String>) {
+        if !exact {
+            return (PartShape::Mesh, None);
+        }
+        let mut warning = None;
+        if let Some(cells) = &part.meta.cells {
+            let unique = distinct(cells);
+            match fit(&unit_boxes(&unique), &part.mesh) {
+                Some((_, cell, origin)) => return (PartShape::Voxels { cells: unique, origin, cell }, None),
+                None => {
+                    warning =
+                        Some(format!("part '{}': its voxels (extras.asp.cells) do not match its mesh; its tests use the mesh", part.name))
+                }
+            }
+        } else if let Some(boxes) = &part.meta.boxes {
+            match fit_boxes(boxes, &part.mesh) {
+                Some(fitted) => return (PartShape::Boxes(fitted), None),
+                None => {
+                    warning =
+                        Some(format!("part '{}': its boxes (extras.asp.boxes) do not match its mesh; its tests use the mesh", part.name))
+                }
+            }
+        }
+        let shape = single_box(&part.mesh).map_or(PartShape::Mesh, |b| PartShape::Boxes(vec![b]));
+        (shape, warning)
+    }
+
+    /// The part's boxes in world coordinates (`None` for a mesh).
+    pub fn boxes(&self) -> Option<Vec<Aabb>> {
+        match self {
+            PartShape::Voxels { cells, origin, cell } => {
+                Some(unit_boxes(cells).iter().map(|b| Aabb::new(b.mins * *cell + *origin, b.maxs * *cell + *origin)).collect())
+            }
+            PartShape::Boxes(boxes) => Some(boxes.clone()),
+            PartShape::Mesh => None,
+        }
+    }
+}
+
+/// The boxes of a part in world coordinates, when [`PartShape::classify`] finds it a union of
+/// boxes; `Err` names the extras that do not describe the mesh.
 pub fn part_boxes(part: &Part) -> Result<Option<Vec<Aabb>>, String> {
-    if let Some(cells) = &part.meta.cells {
-        return fit_boxes(&unit_boxes(cells), &part.mesh)
-            .map(Some)
-            .ok_or_else(|| "its voxels (extras.asp.cells) do not match its mesh".to_string());
+    match PartShape::classify(part, true) {
+        (_, Some(warning)) => Err(warning),
+        (shape, None) => Ok(shape.boxes()),
     }
-    if let Some(boxes) = &part.meta.boxes {
-        return fit_boxes(boxes, &part.mesh).map(Some).ok_or_else(|| "its boxes (extras.asp.boxes) do not match its mesh".to_string());
-    }
-    Ok(single_box(&part.mesh).map(|b| vec![b]))
 }
 
 /// Fits the voxel grid of a part to its mesh: the integer bounds of the cells span the mesh's
@@ -41,12 +99,17 @@ pub fn fit_boxes(boxes: &[Aabb], mesh: &Mesh) -> Option<Vec<Aabb>> {
     fit(boxes, mesh).map(|(fitted, _, _)| fitted)
 }
 
-/// Distinct cells as unit boxes of the grid.
-fn unit_boxes(cells: &[[i32; 3]]) -> Vec<Aabb> {
+/// The distinct cells, sorted.
+fn distinct(cells: &[[i32; 3]]) -> Vec<[i32; 3]> {
     let mut unique: Vec<[i32; 3]> = cells.to_vec();
     unique.sort_unstable();
     unique.dedup();
     unique
+}
+
+/// Distinct cells as unit boxes of the grid.
+fn unit_boxes(cells: &[[i32; 3]]) -> Vec<Aabb> {
+    distinct(cells)
         .iter()
         .map(|c| {
             let lo = Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32);

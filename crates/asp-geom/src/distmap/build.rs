@@ -4,7 +4,7 @@
 use super::maps::MapWorld;
 use super::*;
 use crate::assembly::Assembly;
-use crate::boxes::{box_distance, first_overlap, fit_boxes, fit_voxels, single_box};
+use crate::boxes::{box_distance, first_overlap, PartShape};
 use crate::error::{GeomError, Result};
 use crate::math::{Aabb, Vec3};
 use crate::partset::PartSet;
@@ -18,9 +18,6 @@ enum Shape {
     Boxes { boxes: Vec<Aabb>, integer: bool },
     Mesh,
 }
-
-/// A part's voxels with the origin and cell size fitted to its mesh.
-type VoxelFit = (Vec<[i32; 3]>, Vec3, Vec3);
 
 /// The frame box sweeps run in: world = origin + grid * cell.
 #[derive(Clone, Copy, Debug)]
@@ -86,66 +83,67 @@ impl DistanceMaps {
         let mut warnings = Vec::new();
         let aabbs: Vec<Aabb> = assembly.parts.iter().map(|p| p.mesh.aabb().unwrap_or(Aabb::new(Vec3::ZERO, Vec3::ZERO))).collect();
 
-        // Geometry: voxels, single boxes, or meshes.
-        let mut voxel_fits: Vec<Option<VoxelFit>> = Vec::with_capacity(n);
-        for p in &assembly.parts {
-            let fit = if config.use_voxels {
-                p.meta.cells.as_ref().and_then(|cells| match fit_voxels(cells, &p.mesh) {
-                    Some((o, c)) => Some((cells.clone(), o, c)),
-                    None => {
-                        warnings.push(format!("part '{}': its voxels do not match its mesh; using the mesh", p.name));
-                        None
-                    }
-                })
-            } else {
-                None
-            };
-            voxel_fits.push(fit);
-        }
+        // Geometry: the one classification of the collision world (voxels, boxes or a mesh).
+        let classified: Vec<PartShape> = assembly
+            .parts
+            .iter()
+            .map(|p| {
+                let (shape, warning) = PartShape::classify(p, config.exact_boxes);
+                warnings.extend(warning);
+                shape
+            })
+            .collect();
         // A shared grid when every voxel part agrees on origin and cell size.
         let mut frame = SweepFrame { origin: Vec3::ZERO, cell: Vec3::ONE };
         let mut shared_grid = false;
-        if let Some((_, o0, c0)) = voxel_fits.iter().flatten().next() {
-            let agree = voxel_fits.iter().flatten().all(|(_, o, c)| {
+        let voxel_grids = || {
+            classified.iter().filter_map(|s| match s {
+                PartShape::Voxels { origin, cell, .. } => Some((*origin, *cell)),
+                _ => None,
+            })
+        };
+        if let Some((o0, c0)) = voxel_grids().next() {
+            let agree = voxel_grids().all(|(o, c)| {
                 let eps = 1e-3 * c0.min_element();
-                (*c - *c0).abs().max_element() <= eps && {
+                (c - c0).abs().max_element() <= eps && {
                     // origins may differ by whole cells
-                    let k = (*o - *o0) / *c0;
+                    let k = (o - o0) / c0;
                     (k - k.round()).abs().max_element() * c0.min_element() <= eps
                 }
             });
             if agree {
-                frame = SweepFrame { origin: *o0, cell: *c0 };
+                frame = SweepFrame { origin: o0, cell: c0 };
                 shared_grid = true;
             }
         }
         let mut geometry = Vec::with_capacity(n);
         let mut shapes = Vec::with_capacity(n);
-        for (i, p) in assembly.parts.iter().enumerate() {
-            if let Some((cells, o, c)) = &voxel_fits[i] {
-                let boxes = cells
-                    .iter()
-                    .map(|v| {
-                        let lo = Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32);
-                        if shared_grid {
-                            let shift = ((*o - frame.origin) / frame.cell).round();
-                            Aabb::new(lo + shift, lo + shift + Vec3::ONE)
-                        } else {
-                            Aabb::new(*o + lo * *c, *o + (lo + Vec3::ONE) * *c)
-                        }
-                    })
-                    .collect();
-                geometry.push(PartGeometry::Voxels);
-                shapes.push(Shape::Boxes { boxes, integer: shared_grid });
-            } else if let Some(boxes) = p.meta.boxes.as_ref().and_then(|b| fit_boxes(b, &p.mesh)) {
-                geometry.push(PartGeometry::Box);
-                shapes.push(Shape::Boxes { boxes: boxes.iter().map(|b| frame.frame_box(b)).collect(), integer: false });
-            } else if let Some(b) = single_box(&p.mesh) {
-                geometry.push(PartGeometry::Box);
-                shapes.push(Shape::Boxes { boxes: vec![frame.frame_box(&b)], integer: false });
-            } else {
-                geometry.push(PartGeometry::Mesh);
-                shapes.push(Shape::Mesh);
+        for shape in &classified {
+            match shape {
+                PartShape::Voxels { cells, origin: o, cell: c } => {
+                    let boxes = cells
+                        .iter()
+                        .map(|v| {
+                            let lo = Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32);
+                            if shared_grid {
+                                let shift = ((*o - frame.origin) / frame.cell).round();
+                                Aabb::new(lo + shift, lo + shift + Vec3::ONE)
+                            } else {
+                                Aabb::new(*o + lo * *c, *o + (lo + Vec3::ONE) * *c)
+                            }
+                        })
+                        .collect();
+                    geometry.push(PartGeometry::Voxels);
+                    shapes.push(Shape::Boxes { boxes, integer: shared_grid });
+                }
+                PartShape::Boxes(boxes) => {
+                    geometry.push(PartGeometry::Box);
+                    shapes.push(Shape::Boxes { boxes: boxes.iter().map(|b| frame.frame_box(b)).collect(), integer: false });
+                }
+                PartShape::Mesh => {
+                    geometry.push(PartGeometry::Mesh);
+                    shapes.push(Shape::Mesh);
+                }
             }
         }
         // The collision world (welded, oriented meshes; eroded copies; contacts), only when a
@@ -159,7 +157,9 @@ impl DistanceMaps {
             None => (Some(Arc::new(World::new(assembly.clone(), &config.world_config(assembly))?)), None),
         };
         if let Some(world) = &world {
-            warnings.extend(world.warnings().iter().cloned());
+            // the world classified the parts the same way: its warnings repeat the maps'
+            let fresh: Vec<String> = world.warnings().iter().filter(|w| !warnings.contains(w)).cloned().collect();
+            warnings.extend(fresh);
         }
 
         let dirs = hemisphere.directions().to_vec();

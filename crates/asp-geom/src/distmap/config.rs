@@ -35,7 +35,7 @@ pub struct MapConfig {
     pub(super) tolerance: Option<f32>,
     pub(super) contact_distance: Option<f32>,
     pub(super) support: Support,
-    pub(super) use_voxels: bool,
+    pub(super) exact_boxes: bool,
     pub(super) overlaps: OverlapPolicy,
 }
 
@@ -47,7 +47,7 @@ impl Default for MapConfig {
             tolerance: None,
             contact_distance: None,
             support: Support::Below,
-            use_voxels: true,
+            exact_boxes: true,
             overlaps: OverlapPolicy::Strict,
         }
     }
@@ -65,6 +65,7 @@ impl MapConfig {
             tolerance: Some(tolerance.max(f32::MIN_POSITIVE)),
             contact_distance: Some(contact_distance.max(f32::MIN_POSITIVE)),
             overlaps: self.overlaps,
+            exact_boxes: self.exact_boxes,
             ..WorldConfig::default()
         }
     }
@@ -151,9 +152,11 @@ impl MapConfigBuilder {
         self
     }
 
-    /// Whether voxels in `extras.asp.voxels` are used for exact box sweeps (default true).
-    pub fn use_voxels(mut self, yes: bool) -> Self {
-        self.config.use_voxels = yes;
+    /// Whether parts that are unions of boxes (voxels, listed boxes, one-box meshes) are swept
+    /// as exact boxes; off, every part is swept as a mesh. The collision world's
+    /// `WorldConfig::exact_boxes`, one flag for both (default true).
+    pub fn exact_boxes(mut self, yes: bool) -> Self {
+        self.config.exact_boxes = yes;
         self
     }
 

@@ -142,3 +142,49 @@ fn map_state_tracks_removals() {
     s.remove(0);
     assert!(s.is_complete());
 }
+
+#[test]
+fn the_world_and_the_maps_classify_parts_alike_under_one_flag() {
+    use crate::boxes::PartShape;
+    use crate::world::World;
+    // "wrong" declares boxes its mesh is not (twice as tall); its mesh is one box. "cells"
+    // is two voxels that match; "mesh" is a pyramid.
+    let mut wrong = part("wrong", Mesh::cuboid(Vec3::new(2.0, 0.0, 0.0), Vec3::new(3.0, 1.0, 1.0)));
+    wrong.meta.boxes =
+        Some(vec![Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 1.0)), Aabb::new(Vec3::new(5.0, 0.0, 0.0), Vec3::new(6.0, 1.0, 1.0))]);
+    let mut cells = part("cells", Mesh::cuboid(Vec3::ZERO, Vec3::new(2.0, 1.0, 1.0)));
+    cells.meta.cells = Some(vec![[0, 0, 0], [1, 0, 0], [0, 0, 0]]);
+    let mut pyramid = Mesh::cuboid(Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 1.0, 2.0));
+    let apex = pyramid.vertices.len() as u32;
+    pyramid.vertices.push(Vec3::new(0.5, 0.5, 2.5));
+    let top = pyramid.triangles.iter().position(|t| t.iter().all(|&v| pyramid.vertices[v as usize].z == 2.0)).unwrap();
+    let [a, b, c] = pyramid.triangles.remove(top);
+    pyramid.triangles.extend([[a, b, apex], [b, c, apex], [c, a, apex]]);
+    let asm = assembly(vec![wrong.clone(), cells.clone(), part("mesh", pyramid)]);
+
+    let (shape, warning) = PartShape::classify(&wrong, true);
+    assert_eq!(shape, PartShape::Boxes(vec![Aabb::new(Vec3::new(2.0, 0.0, 0.0), Vec3::new(3.0, 1.0, 1.0))]));
+    assert!(warning.is_some_and(|w| w.contains("'wrong'") && w.contains("extras.asp.boxes")));
+    let (shape, warning) = PartShape::classify(&cells, true);
+    assert!(matches!(&shape, PartShape::Voxels { cells, .. } if cells.len() == 2), "{shape:?}");
+    assert!(warning.is_none());
+    assert_eq!(PartShape::classify(&cells, false), (PartShape::Mesh, None));
+
+    let config = MapConfig::builder().resolution(3).build().unwrap();
+    let world = std::sync::Arc::new(World::new(asm.clone(), &config.world_config(&asm)).unwrap());
+    let maps = DistanceMaps::build_on(world.clone(), &config).unwrap();
+    let kinds: Vec<PartGeometry> = (0..3).map(|i| maps.geometry(i)).collect();
+    assert_eq!(kinds, [PartGeometry::Box, PartGeometry::Voxels, PartGeometry::Mesh]);
+    assert_eq!(world.boxes(0).map(<[Aabb]>::len), Some(1));
+    assert_eq!(world.boxes(1).map(<[Aabb]>::len), Some(2));
+    assert!(world.boxes(2).is_none());
+    // the mismatch is said once, though the maps and the world both classified the part
+    assert_eq!(maps.warnings().iter().filter(|w| w.contains("extras.asp.boxes")).count(), 1, "{:?}", maps.warnings());
+
+    // one flag: off, the maps and the world both test meshes
+    let meshes = MapConfig::builder().resolution(3).exact_boxes(false).build().unwrap();
+    let world = std::sync::Arc::new(World::new(asm.clone(), &meshes.world_config(&asm)).unwrap());
+    let maps = DistanceMaps::build_on(world.clone(), &meshes).unwrap();
+    assert!((0..3).all(|i| maps.geometry(i) == PartGeometry::Mesh && world.boxes(i).is_none()));
+    assert!(DistanceMaps::build_on(world, &config).is_err(), "a world with the other setting is refused");
+}

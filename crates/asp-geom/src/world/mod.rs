@@ -21,7 +21,7 @@ pub use directions::candidate_directions;
 use geom::{contains_point, nests, Geom};
 
 use crate::assembly::Assembly;
-use crate::boxes;
+use crate::boxes::{self, PartShape};
 use crate::error::{GeomError, Result};
 use crate::fastener::{self, SymmetryAxis, Thread};
 use crate::feasibility::{Motion, Stability};
@@ -129,13 +129,9 @@ impl World {
         for p in &assembly.parts {
             let (mut g, t) = Geom::new(&p.mesh)
                 .map_err(|e| GeomError::Assembly { path: assembly.source.clone(), reason: format!("part '{}': {e}", p.name) })?;
-            g.boxes = match boxes::part_boxes(p).map(|b| b.filter(|_| config.exact_boxes)) {
-                Ok(b) => b,
-                Err(e) => {
-                    warnings.push(format!("part '{}': {e}; its tests use the mesh", p.name));
-                    None
-                }
-            };
+            let (shape, warning) = PartShape::classify(p, config.exact_boxes);
+            warnings.extend(warning);
+            g.boxes = shape.boxes();
             if !t.is_closed_manifold() {
                 warnings.push(format!(
                     "part '{}': mesh is not closed and manifold ({} open, {} non-manifold, {} misoriented edges); its removal tests may be conservative",
