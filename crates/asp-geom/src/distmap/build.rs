@@ -63,6 +63,9 @@ impl DistanceMaps {
         Self::build_with(&world.assembly().clone(), config, Some(world))
     }
 
+    /// The build in its steps: each part's shape in the sweep frame, the collision world when a
+    /// pair needs triangle sweeps, the rows of sweeps (in parallel), the contact graph, the
+    /// indexes.
     fn build_with(assembly: &Assembly, config: &MapConfig, given: Option<Arc<World>>) -> Result<DistanceMaps> {
         let n = assembly.len();
         if n == 0 {
@@ -78,17 +81,116 @@ impl DistanceMaps {
         let diag = assembly.diagonal();
         let d_max = config.d_max.unwrap_or(diag).max(f32::MIN_POSITIVE);
         let tolerance = config.tolerance.unwrap_or(DEFAULT_RELATIVE_TOLERANCE * diag);
-        let dcount = hemisphere.len();
-        let stride = dcount.div_ceil(8) * 8;
+        let contact_distance = config.contact_distance.unwrap_or(DEFAULT_RELATIVE_CONTACT * diag);
+        let stride = hemisphere.len().div_ceil(8) * 8;
         let mut warnings = Vec::new();
         let aabbs: Vec<Aabb> = assembly.parts.iter().map(|p| p.mesh.aabb().unwrap_or(Aabb::new(Vec3::ZERO, Vec3::ZERO))).collect();
 
-        // Geometry: the one classification of the collision world (voxels, boxes or a mesh).
+        // 1. Shapes: the one classification of the collision world (voxels, boxes or a mesh).
+        let shapes = SweepShapes::classify(assembly, config.exact_boxes, &mut warnings);
+
+        // 2. The collision world (welded, oriented meshes; eroded copies; contacts), only when a
+        // pair needs triangle sweeps or the contact graph needs mesh contacts; a given world is
+        // kept for the robot even when no pair reads it.
+        let need_mesh = shapes.shapes.iter().any(|s| matches!(s, Shape::Mesh));
+        let (world, kept) = match given {
+            _ if !need_mesh => (None, given),
+            Some(world) => (Some(world), None),
+            None => (Some(Arc::new(World::new(assembly.clone(), &config.world_config(assembly))?)), None),
+        };
+        if let Some(world) = &world {
+            // the world classified the parts the same way: its warnings repeat the maps'
+            let fresh: Vec<String> = world.warnings().iter().filter(|w| !warnings.contains(w)).cloned().collect();
+            warnings.extend(fresh);
+        }
+
+        // 3. The rows: M(p_i, p_j) for every ordered pair and the floor, in parallel.
+        let upv = hemisphere.up();
+        let low: Vec<f32> = aabbs.iter().map(|b| lowest_along(b, upv)).collect();
+        let floor_level = low.iter().copied().fold(f32::INFINITY, f32::min);
+        let sweeps = RowSweeps {
+            n,
+            stride,
+            d_max,
+            tolerance,
+            dirs: hemisphere.directions().to_vec(),
+            frame_dirs: hemisphere.directions().iter().map(|d| *d / shapes.frame.cell).collect(),
+            frame_tol: tolerance / shapes.frame.cell.min_element(),
+            up: upv,
+            low: &low,
+            floor_level,
+            aabbs: &aabbs,
+            shapes: &shapes,
+            world: world.as_deref(),
+        };
+        let (values, blocked) = sweeps.all();
+
+        // 4. The bases and, for the contact-graph support rule, the contact graph.
+        let fixed: Vec<bool> = assembly.parts.iter().map(|p| p.fixed).collect();
+        let floor_is_base = !fixed.iter().any(|&f| f);
+        let mut bases = PartSet::from_indices(n + 1, (0..n).filter(|&i| fixed[i]));
+        if floor_is_base {
+            bases.insert(n);
+        }
+        let contacts = if config.support == Support::ContactGraph {
+            contact_graph(n, world.as_deref(), &shapes, contact_distance, floor_is_base.then_some((&low[..], floor_level)))
+        } else {
+            Vec::new()
+        };
+
+        // 5. The indexes the incremental state reads.
+        let mut maps = DistanceMaps {
+            n,
+            hemisphere,
+            diagonal: diag,
+            contact_distance,
+            d_max,
+            tolerance,
+            stride,
+            values,
+            blocked,
+            fixed,
+            aabbs,
+            geometry: shapes.geometry,
+            blockers: Vec::new(),
+            blocker_set: Vec::new(),
+            init_row: Vec::new(),
+            words: n.div_ceil(64),
+            dominators: Vec::new(),
+            blocker_masks: Vec::new(),
+            along: Vec::new(),
+            blocks: Vec::new(),
+            supporters: Vec::new(),
+            dependents: Vec::new(),
+            on_floor: Vec::new(),
+            support: config.support,
+            contacts: contacts.iter().map(Bits::from_set).collect(),
+            bases: Bits::from_set(&bases),
+            warnings,
+            world: MapWorld(world.or(kept)),
+        };
+        maps.index();
+        Ok(maps)
+    }
+}
+
+/// Every part's shape for sweeps, in the frame they run in.
+struct SweepShapes {
+    /// The sweep frame: a shared voxel grid when every voxel part agrees on it, else the world.
+    frame: SweepFrame,
+    shapes: Vec<Shape>,
+    geometry: Vec<PartGeometry>,
+}
+
+impl SweepShapes {
+    /// Classifies every part ([`PartShape::classify`]) and puts its boxes in the sweep frame:
+    /// voxels on a shared grid are swept in integer grid coordinates.
+    fn classify(assembly: &Assembly, exact: bool, warnings: &mut Vec<String>) -> SweepShapes {
         let classified: Vec<PartShape> = assembly
             .parts
             .iter()
             .map(|p| {
-                let (shape, warning) = PartShape::classify(p, config.exact_boxes);
+                let (shape, warning) = PartShape::classify(p, exact);
                 warnings.extend(warning);
                 shape
             })
@@ -116,8 +218,8 @@ impl DistanceMaps {
                 shared_grid = true;
             }
         }
-        let mut geometry = Vec::with_capacity(n);
-        let mut shapes = Vec::with_capacity(n);
+        let mut geometry = Vec::with_capacity(classified.len());
+        let mut shapes = Vec::with_capacity(classified.len());
         for shape in &classified {
             match shape {
                 PartShape::Voxels { cells, origin: o, cell: c } => {
@@ -146,182 +248,170 @@ impl DistanceMaps {
                 }
             }
         }
-        // The collision world (welded, oriented meshes; eroded copies; contacts), only when a
-        // pair needs triangle sweeps or the contact graph needs mesh contacts.
-        let need_mesh = shapes.iter().any(|s| matches!(s, Shape::Mesh));
-        let contact_distance = config.contact_distance.unwrap_or(DEFAULT_RELATIVE_CONTACT * diag);
-        // a given world is kept for the robot even when no pair reads it
-        let (world, kept) = match given {
-            _ if !need_mesh => (None, given),
-            Some(world) => (Some(world), None),
-            None => (Some(Arc::new(World::new(assembly.clone(), &config.world_config(assembly))?)), None),
-        };
-        if let Some(world) = &world {
-            // the world classified the parts the same way: its warnings repeat the maps'
-            let fresh: Vec<String> = world.warnings().iter().filter(|w| !warnings.contains(w)).cloned().collect();
-            warnings.extend(fresh);
-        }
+        SweepShapes { frame, shapes, geometry }
+    }
+}
 
-        let dirs = hemisphere.directions().to_vec();
-        let frame_dirs: Vec<Vec3> = dirs.iter().map(|d| *d / frame.cell).collect();
-        let frame_tol = tolerance / frame.cell.min_element();
-        let upv = hemisphere.up();
-        let low: Vec<f32> = aabbs.iter().map(|b| lowest_along(b, upv)).collect();
-        let floor_level = low.iter().copied().fold(f32::INFINITY, f32::min);
-        let n1 = n + 1;
+/// The sweeps of every row of the maps, with what they read.
+struct RowSweeps<'a> {
+    n: usize,
+    stride: usize,
+    d_max: f32,
+    tolerance: f32,
+    /// The candidate directions, in the world and in the sweep frame.
+    dirs: Vec<Vec3>,
+    frame_dirs: Vec<Vec3>,
+    /// The tolerance in the sweep frame.
+    frame_tol: f32,
+    up: Vec3,
+    /// Each part's lowest point along `up`, and the lowest of all (the floor).
+    low: &'a [f32],
+    floor_level: f32,
+    aabbs: &'a [Aabb],
+    shapes: &'a SweepShapes,
+    world: Option<&'a World>,
+}
 
-        // Row i: M(p_i, p_j) for j in 0..=n (j = n is the floor).
-        let rows: Vec<(Vec<f32>, Vec<DirMask>)> = (0..n1)
-            .into_par_iter()
-            .map(|i| {
-                let mut vals = vec![0.0f32; n1 * stride];
-                let mut masks = vec![DirMask::EMPTY; n1];
-                for j in 0..n1 {
-                    if i == j {
-                        continue;
-                    }
-                    let row = &mut vals[j * stride..j * stride + dcount];
-                    if j == n {
-                        // Parts never move into the floor along the half sphere.
-                        row.fill(d_max);
-                        continue;
-                    }
-                    if i == n {
-                        // The floor rises along m until it touches p_j's lowest point.
-                        let gap = low[j] - floor_level;
-                        let gap = if gap <= tolerance { 0.0 } else { gap };
-                        for (d, m) in dirs.iter().enumerate() {
-                            let c = m.dot(upv);
-                            row[d] = if c > 1e-6 { (gap / c).min(d_max) } else { d_max };
-                        }
-                    } else {
-                        match (&shapes[i], &shapes[j]) {
-                            (Shape::Boxes { boxes: bi, integer: ii }, Shape::Boxes { boxes: bj, integer: ij }) => {
-                                let tol = if *ii && *ij { 0.0 } else { frame_tol };
-                                let ai = frame.frame_box(&aabbs[i]);
-                                let aj = frame.frame_box(&aabbs[j]);
-                                for (d, m) in frame_dirs.iter().enumerate() {
-                                    let mut best = d_max;
-                                    if first_overlap(&ai, *m, &aj, tol).is_some_and(|t| t < d_max) {
-                                        for a in bi {
-                                            for b in bj {
-                                                if let Some(t) = first_overlap(a, *m, b, tol) {
-                                                    best = best.min(t);
-                                                }
-                                            }
-                                        }
-                                    }
-                                    row[d] = best;
-                                }
-                            }
-                            _ => {
-                                let world = world.as_ref().expect("built when a part is a mesh");
-                                let (_, erosion) = world.pair_erosion(i, j);
-                                let (moving, fixed) = world.pair_shapes(i, j);
-                                let ignored = world.ignores(i, j);
-                                let strict = world.is_strict_pair(i, j);
-                                for (d, m) in dirs.iter().enumerate() {
-                                    let near = first_overlap(&aabbs[i], *m, &aabbs[j], 0.0).is_some_and(|t| t < d_max);
-                                    let mut v = if !ignored && near { cast_distance(&moving, &fixed, *m, d_max, erosion) } else { d_max };
-                                    if strict && near && v > 0.0 {
-                                        // an input overlap: no sample may enter new material
-                                        if let Some(t) = world.strict_entry(i, j, Vec3::ZERO, *m, v, false) {
-                                            v = v.min(if t <= erosion { 0.0 } else { t });
-                                        }
-                                    }
-                                    row[d] = v;
-                                }
-                            }
-                        }
-                    }
-                    let mut mask = DirMask::EMPTY;
-                    for (d, v) in row.iter().enumerate() {
-                        if *v < d_max {
-                            mask.insert(d);
-                        }
-                    }
-                    masks[j] = mask;
-                }
-                (vals, masks)
-            })
-            .collect();
-        let mut values = Vec::with_capacity(n1 * n1 * stride);
+impl RowSweeps<'_> {
+    /// Every row, in parallel: the values (`stride` floats per pair) and the blocked directions.
+    fn all(&self) -> (Vec<f32>, Vec<DirMask>) {
+        let n1 = self.n + 1;
+        let rows: Vec<(Vec<f32>, Vec<DirMask>)> = (0..n1).into_par_iter().map(|i| self.row(i)).collect();
+        let mut values = Vec::with_capacity(n1 * n1 * self.stride);
         let mut blocked = Vec::with_capacity(n1 * n1);
         for (v, m) in rows {
             values.extend(v);
             blocked.extend(m);
         }
-        let fixed: Vec<bool> = assembly.parts.iter().map(|p| p.fixed).collect();
-        let floor_is_base = !fixed.iter().any(|&f| f);
-        let mut bases = PartSet::from_indices(n1, (0..n).filter(|&i| fixed[i]));
-        if floor_is_base {
-            bases.insert(n);
-        }
-        let contacts = if config.support == Support::ContactGraph {
-            let mut contacts = vec![PartSet::empty(n1); n1];
-            let mut touch = |i: usize, j: usize| {
-                contacts[i].insert(j);
-                contacts[j].insert(i);
-            };
-            if let Some(w) = &world {
-                // the world's contact graph (its ground, when present, is index n)
-                for i in 0..w.num_parts() + usize::from(w.ground().is_some()) {
-                    for j in w.contacts(i).iter().filter(|&j| j > i) {
-                        touch(i, j);
-                    }
+        (values, blocked)
+    }
+
+    /// Row i: M(p_i, p_j) for j in 0..=n (j = n is the floor).
+    fn row(&self, i: usize) -> (Vec<f32>, Vec<DirMask>) {
+        let (n, d_max) = (self.n, self.d_max);
+        let n1 = n + 1;
+        let dcount = self.dirs.len();
+        let mut vals = vec![0.0f32; n1 * self.stride];
+        let mut masks = vec![DirMask::EMPTY; n1];
+        for j in 0..n1 {
+            if i == j {
+                continue;
+            }
+            let row = &mut vals[j * self.stride..j * self.stride + dcount];
+            if j == n {
+                // Parts never move into the floor along the half sphere.
+                row.fill(d_max);
+                continue;
+            }
+            if i == n {
+                // The floor rises along m until it touches p_j's lowest point.
+                let gap = self.low[j] - self.floor_level;
+                let gap = if gap <= self.tolerance { 0.0 } else { gap };
+                for (d, m) in self.dirs.iter().enumerate() {
+                    let c = m.dot(self.up);
+                    row[d] = if c > 1e-6 { (gap / c).min(d_max) } else { d_max };
                 }
             } else {
-                for i in 0..n {
-                    for j in (i + 1)..n {
-                        if let (Shape::Boxes { boxes: bi, .. }, Shape::Boxes { boxes: bj, .. }) = (&shapes[i], &shapes[j]) {
-                            let near = bi.iter().any(|a| bj.iter().any(|b| box_distance(a, b, frame.cell) <= contact_distance));
-                            if near {
-                                touch(i, j);
+                self.pair(i, j, row);
+            }
+            let mut mask = DirMask::EMPTY;
+            for (d, v) in row.iter().enumerate() {
+                if *v < d_max {
+                    mask.insert(d);
+                }
+            }
+            masks[j] = mask;
+        }
+        (vals, masks)
+    }
+
+    /// M(p_i, p_j) along every direction into `row`: box sweeps when both are boxes, else
+    /// triangle sweeps of the world's eroded meshes.
+    fn pair(&self, i: usize, j: usize, row: &mut [f32]) {
+        let d_max = self.d_max;
+        let frame = &self.shapes.frame;
+        match (&self.shapes.shapes[i], &self.shapes.shapes[j]) {
+            (Shape::Boxes { boxes: bi, integer: ii }, Shape::Boxes { boxes: bj, integer: ij }) => {
+                let tol = if *ii && *ij { 0.0 } else { self.frame_tol };
+                let ai = frame.frame_box(&self.aabbs[i]);
+                let aj = frame.frame_box(&self.aabbs[j]);
+                for (d, m) in self.frame_dirs.iter().enumerate() {
+                    let mut best = d_max;
+                    if first_overlap(&ai, *m, &aj, tol).is_some_and(|t| t < d_max) {
+                        for a in bi {
+                            for b in bj {
+                                if let Some(t) = first_overlap(a, *m, b, tol) {
+                                    best = best.min(t);
+                                }
                             }
                         }
                     }
-                    if floor_is_base && low[i] - floor_level <= contact_distance {
-                        touch(i, n);
+                    row[d] = best;
+                }
+            }
+            _ => {
+                let world = self.world.expect("built when a part is a mesh");
+                let (_, erosion) = world.pair_erosion(i, j);
+                let (moving, fixed) = world.pair_shapes(i, j);
+                let ignored = world.ignores(i, j);
+                let strict = world.is_strict_pair(i, j);
+                for (d, m) in self.dirs.iter().enumerate() {
+                    let near = first_overlap(&self.aabbs[i], *m, &self.aabbs[j], 0.0).is_some_and(|t| t < d_max);
+                    let mut v = if !ignored && near { cast_distance(&moving, &fixed, *m, d_max, erosion) } else { d_max };
+                    if strict && near && v > 0.0 {
+                        // an input overlap: no sample may enter new material
+                        if let Some(t) = world.strict_entry(i, j, Vec3::ZERO, *m, v, false) {
+                            v = v.min(if t <= erosion { 0.0 } else { t });
+                        }
+                    }
+                    row[d] = v;
+                }
+            }
+        }
+    }
+}
+
+/// The contact graph over the parts and the floor (index `n`): the world's contacts when there
+/// is a world, else box pairs within `contact_distance`, and with `floor` (each part's lowest
+/// point and the floor's level, when the floor is the base) parts within it of the floor.
+fn contact_graph(
+    n: usize,
+    world: Option<&World>,
+    shapes: &SweepShapes,
+    contact_distance: f32,
+    floor: Option<(&[f32], f32)>,
+) -> Vec<PartSet> {
+    let n1 = n + 1;
+    let mut contacts = vec![PartSet::empty(n1); n1];
+    let mut touch = |i: usize, j: usize| {
+        contacts[i].insert(j);
+        contacts[j].insert(i);
+    };
+    if let Some(w) = world {
+        // the world's contact graph (its ground, when present, is index n)
+        for i in 0..w.num_parts() + usize::from(w.ground().is_some()) {
+            for j in w.contacts(i).iter().filter(|&j| j > i) {
+                touch(i, j);
+            }
+        }
+    } else {
+        for i in 0..n {
+            for j in (i + 1)..n {
+                if let (Shape::Boxes { boxes: bi, .. }, Shape::Boxes { boxes: bj, .. }) = (&shapes.shapes[i], &shapes.shapes[j]) {
+                    let near = bi.iter().any(|a| bj.iter().any(|b| box_distance(a, b, shapes.frame.cell) <= contact_distance));
+                    if near {
+                        touch(i, j);
                     }
                 }
             }
-            contacts
-        } else {
-            Vec::new()
-        };
-        let mut maps = DistanceMaps {
-            n,
-            hemisphere,
-            diagonal: diag,
-            contact_distance,
-            d_max,
-            tolerance,
-            stride,
-            values,
-            blocked,
-            fixed,
-            aabbs,
-            geometry,
-            blockers: Vec::new(),
-            blocker_set: Vec::new(),
-            init_row: Vec::new(),
-            words: n.div_ceil(64),
-            dominators: Vec::new(),
-            blocker_masks: Vec::new(),
-            along: Vec::new(),
-            blocks: Vec::new(),
-            supporters: Vec::new(),
-            dependents: Vec::new(),
-            on_floor: Vec::new(),
-            support: config.support,
-            contacts: contacts.iter().map(Bits::from_set).collect(),
-            bases: Bits::from_set(&bases),
-            warnings,
-            world: MapWorld(world.or(kept)),
-        };
-        maps.index();
-        Ok(maps)
+            if let Some((low, floor_level)) = floor {
+                if low[i] - floor_level <= contact_distance {
+                    touch(i, n);
+                }
+            }
+        }
     }
+    contacts
 }
 
 /// The smallest `p · up` over the corners of box `b`.
