@@ -21,6 +21,7 @@ from asp.qgraphs import QGraphs
 from asp.result import ORDERS, Plan
 from asp.search import Episode, Search
 from asp.settings import PlanSettings
+from asp.steps import Motion, Move, RobotStep, Step, Subassembly
 
 __all__ = [
     "Assembly",
@@ -29,13 +30,18 @@ __all__ = [
     "Episode",
     "Graph",
     "LoadError",
+    "Motion",
+    "Move",
     "ORDERS",
     "PLAN_FORMAT_VERSION",
     "Part",
     "Plan",
     "PlanSettings",
     "QGraphs",
+    "RobotStep",
     "Search",
+    "Step",
+    "Subassembly",
     "__version__",
     "load",
     "plan",

@@ -8,6 +8,7 @@ import os
 from typing import Any
 
 from asp import _asp
+from asp.steps import Step, steps_of
 
 __all__ = ["ORDERS", "Plan"]
 
@@ -26,13 +27,14 @@ class Plan:
     ``"partial"``, with its :attr:`locked_cores`; :attr:`found` is then False.
     """
 
-    __slots__ = ("_json", "_found", "_trace", "_dict")
+    __slots__ = ("_json", "_found", "_trace", "_dict", "_steps")
 
     def __init__(self, json: str, found: bool, trace_csv: str | None = None) -> None:
         self._json = json
         self._found = bool(found)
         self._trace = trace_csv
         self._dict: dict[str, Any] = _json.loads(json)
+        self._steps: dict[str, tuple[Step, ...]] = {}
 
     @property
     def json(self) -> str:
@@ -100,6 +102,22 @@ class Plan:
         """One entry per non-fixed part in assembly order: ``{"part", "name", "motion"}``
         (empty unless found)."""
         return self._copy("assembly_sequence")
+
+    @property
+    def steps(self) -> tuple[Step, ...]:
+        """:attr:`assembly_sequence` as typed, frozen :class:`asp.Step` objects (motions,
+        subassemblies with their own steps, grid moves, the robot's part)."""
+        return self._typed("assembly_sequence")
+
+    @property
+    def partial_steps(self) -> tuple[Step, ...]:
+        """:attr:`partial_assembly_sequence` as typed, frozen :class:`asp.Step` objects."""
+        return self._typed("partial_assembly_sequence")
+
+    def _typed(self, key: str) -> tuple[Step, ...]:
+        if key not in self._steps:
+            self._steps[key] = steps_of(self._dict.get(key, []))
+        return self._steps[key]
 
     @property
     def disassembly_sequence(self) -> list[int]:

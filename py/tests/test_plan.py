@@ -202,3 +202,43 @@ def test_a_plan_with_a_locked_core_is_partial(root, asp_cli):
     # a plan that takes every part apart has none
     lack = asp.plan(LACK, up="z")
     assert lack.status == "found" and lack.found and lack.locked_cores == []
+
+
+def test_steps_are_typed_frozen_views_of_the_sequence(root):
+    import dataclasses
+
+    # a real plan: linear motions and a subassembly whose own plan is a locked core
+    plan = asp.load(PUMP, unit="mm", up="z").plan()
+    steps = plan.steps
+    assert len(steps) == len(plan.assembly_sequence)
+    for step, entry in zip(steps, plan.assembly_sequence):
+        assert (step.part, step.name, step.motion.kind) == (entry["part"], entry["name"], entry["motion"]["kind"])
+        if step.motion.kind == "linear":
+            assert step.motion.direction == tuple(entry["motion"]["direction"])
+            assert step.motion.distance == entry["motion"]["distance"]
+    subs = [s for s in steps if s.subassembly is not None]
+    assert [sorted(s.subassembly.parts) for s in subs] == [sorted(plan.locked_cores[0]["parts"])]
+    assert subs[0].subassembly.status == "no_plan"
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        steps[0].part = 99  # type: ignore[misc]
+    assert plan.partial_steps == ()
+
+    # every motion kind and step key the format documents, read from a hand-written plan
+    d = json.loads(plan.json)
+    d["assembly_sequence"] = [
+        {"part": 1, "name": "bolt", "motion": {"kind": "screw", "direction": [0, 0, -1], "distance": 2.5,
+                                               "axis_point": [1, 2, 3]}, "held": [4]},
+        {"part": 2, "name": "hook", "motion": {"kind": "path", "pivot": [0, 0, 1],
+                                               "poses": [[0, 0, 1, 0, 0, 0, 1], [0, 0, 0, 0, 0, 0, 1]]},
+         "moves": [{"parts": [2, 3], "translation": [0, 0, -0.01]}],
+         "robot": {"grasp": [0, 0, 0, 0, 0, 0, 1], "grasp_width": 0.02, "joint_trajectory": [[0.1, 0.2], [0.3, 0.4]],
+                   "gripper_path": [[0, 0, 0], [0, 0, 0.05]], "path_length": 0.05},
+         "a_key_of_a_newer_format": True},
+    ]
+    screw, hook = asp.Plan(json.dumps(d), found=True).steps
+    assert screw.motion == asp.Motion("screw", direction=(0.0, 0.0, -1.0), distance=2.5, axis_point=(1.0, 2.0, 3.0))
+    assert screw.held == (4,) and screw.moves == () and screw.robot is None
+    assert hook.motion.kind == "path" and hook.motion.pivot == (0.0, 0.0, 1.0) and len(hook.motion.poses) == 2
+    assert hook.moves == (asp.Move((2, 3), (0.0, 0.0, -0.01)),)
+    assert hook.robot is not None and hook.robot.joint_trajectory == ((0.1, 0.2), (0.3, 0.4))
+    assert hook.robot.path_length == 0.05
