@@ -1,4 +1,5 @@
-//! Every planner configuration on every fixture with a known answer; every found plan is
+//! Every planner configuration (the depth-first search and the optimisers) on every fixture with a
+//! known answer; every found plan is
 //! re-checked by the independent sweep.
 
 use crate::verify::verify_plan;
@@ -155,4 +156,51 @@ fn shuffled_orders_are_reproducible_per_seed() {
     assert_eq!(x.stats.counters, y.stats.counters);
     let orders: std::collections::HashSet<Vec<usize>> = (0..5).map(|s| run(s).removals.iter().map(|s| s.part).collect()).collect();
     assert!(orders.len() > 1, "five seeds gave one removal order");
+}
+
+/// The optimisers on the same fixtures: MCTS for each objective and Pareto-MCTS, every answer
+/// re-checked by the same independent sweep on a collision world of the maps' settings. The
+/// L-shaped path needs a path no straight removal gives: no optimiser may claim it.
+#[test]
+fn the_optimisers_solve_every_straight_line_fixture_and_every_answer_rechecks() {
+    use asp_geom::distmap::{DistanceMaps, MapConfig};
+    use asp_search::{Mdp, SearchOutcome, SearchStatus, Step};
+    use std::sync::Arc;
+
+    fn recheck(label: &str, world: &World, out: &SearchOutcome) {
+        assert_eq!(out.status, SearchStatus::Found, "{label}");
+        assert!(!out.solutions.is_empty(), "{label}");
+        for s in &out.solutions {
+            let removals: Vec<Step> = s
+                .sequence
+                .iter()
+                .zip(&s.motions)
+                .map(|(&part, motion)| Step { part, motion: motion.clone(), group: None, moves: Vec::new() })
+                .collect();
+            let rest = crate::verify::verify_removals(world, &removals);
+            assert!(rest.iter().all(|p| world.fixed().contains(p)), "{label}: parts left: {rest:?}");
+        }
+    }
+
+    let config = MapConfig::builder().resolution(5).build().unwrap();
+    for assembly in [fixtures::stacked_boxes(), fixtures::peg_in_hole(), fixtures::tube(), fixtures::arch(), fixtures::l_path()] {
+        let source = format!("{:?}", assembly.source);
+        let world = World::new(assembly.clone(), &config.world_config(&assembly)).unwrap();
+        let maps = Arc::new(DistanceMaps::build(&assembly, &config).unwrap());
+        let straight = !source.contains("l_path");
+        for objectives in ["access", "dirchange", "pathlen", "access,dirchange"] {
+            let mdp = Mdp::new(maps.clone(), asp_search::objective::parse_objectives(objectives).unwrap()).unwrap();
+            let out = if objectives.contains(',') {
+                asp_search::ParetoMcts::builder().episodes(60).seed(2).build().unwrap().solve(&mdp).unwrap()
+            } else {
+                asp_search::Mcts::builder().episodes(60).seed(2).build().unwrap().solve(&mdp).unwrap()
+            };
+            let label = format!("{objectives} on {source}");
+            if straight {
+                recheck(&label, &world, &out);
+            } else {
+                assert_ne!(out.status, SearchStatus::Found, "{label}: claims a straight-line plan");
+            }
+        }
+    }
 }
