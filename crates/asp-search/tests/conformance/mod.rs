@@ -1,6 +1,5 @@
 //! Every planner configuration (the depth-first search and the optimisers) on every fixture with a
-//! known answer; every found plan is
-//! re-checked by the independent sweep.
+//! known answer; every found plan is re-checked by the independent sweep.
 
 use crate::verify::verify_plan;
 use asp_geom::{fixtures, Assembly, Checker, CheckerConfig, FeasibilityChecker, World, WorldConfig};
