@@ -15,6 +15,7 @@ use asp_geom::math::Axis;
 use asp_geom::physics::PhysicsConfig;
 use asp_geom::rrt::RrtConfig;
 use asp_geom::{Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, OverlapPolicy, StabilityMode, Units, World, WorldConfig};
+use asp_search::dead_end::deepest_dead_end;
 use asp_search::extension::resolve_objectives;
 use asp_search::grid::GridConfig;
 use asp_search::grid::GridRun;
@@ -549,12 +550,15 @@ pub fn optimise_problem(
         (true, Some(h)) => configure!(ParetoMcts::builder()).solve_stepped(&mdp, h)?,
         (false, Some(h)) => configure!(Mcts::builder()).solve_stepped(&mdp, h)?,
     };
-    let plan = adapt(&maps, &outcome);
+    let (plan, rejected) = adapt(&mdp, &outcome);
     let mut warnings = assembly.warnings.clone();
     for w in maps.warnings() {
         if !warnings.contains(w) {
             warnings.push(w.clone());
         }
+    }
+    for (part, why) in rejected {
+        warnings.push(format!("part '{}' {why} in the deepest dead end", assembly.parts[part].name));
     }
     let mut report = PlanReport::new(&assembly, &plan, maps.tolerance(), &warnings);
     report.stats.checker = CheckerName::DistanceMaps;
@@ -594,34 +598,41 @@ pub fn optimise_problem(
 }
 
 /// The optimiser's outcome as a plan outcome: motions get the maps' contact margin (the plan
-/// format's removal ends that far beyond the remaining bounds).
-fn adapt(maps: &DistanceMaps, outcome: &SearchOutcome) -> PlanOutcome {
+/// format's removal ends that far beyond the remaining bounds). When the whole tree holds no
+/// complete sequence, the explanation is its deepest dead end on the maps
+/// ([`asp_search::dead_end`]); the second value lists the parts there that the maps let out but
+/// a feasibility filter rejected, with the filter's words.
+fn adapt(mdp: &Mdp, outcome: &SearchOutcome) -> (PlanOutcome, Vec<(usize, String)>) {
+    let maps = mdp.maps();
     let margin = maps.contact_distance();
-    let removals = outcome
-        .best()
-        .map(|s| {
-            s.sequence
-                .iter()
-                .zip(&s.motions)
-                .map(|(&part, m)| {
-                    Step::single(
-                        part,
-                        match m {
-                            Motion::Linear { direction, distance } => Motion::Linear { direction: *direction, distance: distance + margin },
-                            other => other.clone(),
-                        },
-                    )
-                })
-                .collect()
-        })
-        .unwrap_or_default();
+    let with_margin = |part: usize, m: &Motion| {
+        Step::single(
+            part,
+            match m {
+                Motion::Linear { direction, distance } => Motion::Linear { direction: *direction, distance: distance + margin },
+                other => other.clone(),
+            },
+        )
+    };
+    let mut removals: Vec<Step> =
+        outcome.best().map(|s| s.sequence.iter().zip(&s.motions).map(|(&part, m)| with_margin(part, m)).collect()).unwrap_or_default();
+    let mut rejected = Vec::new();
     let status = match outcome.status {
         SearchStatus::Found => Status::Found,
-        SearchStatus::NoPlan => Status::NoPlan { stuck: Vec::new(), state: asp_geom::PartSet::full(maps.num_parts()) },
+        SearchStatus::NoPlan => match deepest_dead_end(mdp, DEAD_END_STATES) {
+            Some(end) => {
+                removals = end.removals.iter().map(|(part, m)| with_margin(*part, m)).collect();
+                rejected = end.rejected;
+                Status::NoPlan { stuck: end.stuck, state: end.state }
+            }
+            // the tree search saw no complete sequence where the dead-end search finds one
+            // within its bound (it cannot: both walk the same removals): nothing to explain
+            None => Status::NoPlan { stuck: Vec::new(), state: asp_geom::PartSet::full(maps.num_parts()) },
+        },
         SearchStatus::BudgetExhausted => Status::BudgetExhausted,
     };
     let s = &outcome.stats;
-    PlanOutcome {
+    let plan = PlanOutcome {
         status,
         removals,
         stats: Stats {
@@ -629,10 +640,16 @@ fn adapt(maps: &DistanceMaps, outcome: &SearchOutcome) -> PlanOutcome {
                 removal_tests: s.removal_tests,
                 failed_collision: s.failed_collision,
                 failed_gravity: s.failed_gravity,
+                // the optimiser moves parts along straight lines only
                 path_planner_calls: 0,
             },
             seconds: s.seconds,
             ..Stats::default()
         },
-    }
+    };
+    (plan, rejected)
 }
+
+/// States the dead-end search of an optimiser's `no_plan` visits at most (a tree the optimiser
+/// exhausted is far smaller).
+const DEAD_END_STATES: usize = 200_000;

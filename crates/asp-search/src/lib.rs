@@ -2,6 +2,7 @@
 
 pub mod annotation;
 pub mod checker_extension;
+pub mod dead_end;
 pub mod dfs;
 pub mod error;
 pub mod exact;

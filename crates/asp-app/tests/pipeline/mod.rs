@@ -98,3 +98,34 @@ fn issue_28_voxel_puzzles_with_a_fixed_piece_get_the_grid_before_the_path_planne
         assert!(started.elapsed().as_secs_f64() < 10.0, "{name}: {:?}", started.elapsed());
     }
 }
+
+/// Issue 23: an optimiser's `no_plan` is explained like the feasibility search's, by its deepest
+/// dead end on the maps (not an empty explanation over the whole model): the lid comes off, then
+/// the block at the end of the L-shaped channel cannot leave along any straight line.
+#[test]
+fn an_optimisers_no_plan_is_explained_by_its_deepest_dead_end() {
+    use asp_app::pipeline::OptimiseSettings;
+    use asp_search::report::{ExplanationReason, PlanStatus};
+    let mut parts = asp_geom::fixtures::l_path().parts;
+    parts.push(asp_geom::fixtures::box_part("lid", [0.0, 0.0, 5.0], [5.0, 3.0, 6.0]));
+    let a = asp_geom::fixtures::assemble("l_path_under_a_lid", parts, asp_geom::math::Axis::Z);
+    for objectives in ["access", "dirchange"] {
+        let o = OptimiseSettings { objectives: objectives.into(), episodes: 50, ..OptimiseSettings::default() };
+        let settings = PlanSettings { optimise: Some(o), ..PlanSettings::default() };
+        let r = plan_assembly(a.clone(), &settings, None).unwrap();
+        let json = r.report.to_json();
+        assert_eq!(r.report.status, PlanStatus::NoPlan, "{json}");
+        let names = |steps: &[asp_search::report::AssemblyStep]| steps.iter().map(|s| s.name.clone()).collect::<Vec<_>>();
+        assert_eq!(names(&r.report.partial_assembly_sequence), ["lid"], "{json}");
+        assert_eq!(r.report.remaining, Some(vec![0, 1]), "{json}");
+        assert_eq!(r.report.explanation.len(), 1, "{json}");
+        let e = &r.report.explanation[0];
+        assert_eq!((e.name.as_str(), e.reason), ("block", ExplanationReason::Blocked), "{json}");
+        assert_eq!(e.parts.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(), ["housing"], "{json}");
+        let mut text = Vec::new();
+        r.report.write_text(&mut text).unwrap();
+        let text = String::from_utf8(text).unwrap();
+        assert!(text.contains("the search space was exhausted: no complete sequence exists"), "{text}");
+        assert!(text.contains("none (no complete sequence)"), "{text}");
+    }
+}

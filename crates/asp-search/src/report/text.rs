@@ -117,6 +117,9 @@ fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
             Some(StopReason::Interrupted) => {
                 writeln!(out, "interrupted (Ctrl-C) before a plan was found; the best partial plan so far is above")?
             }
+            _ if r.optimisation.is_some() => {
+                writeln!(out, "the optimiser's budget ran out (--episodes / --time-limit) before a complete sequence was found")?
+            }
             _ => writeln!(out, "the budget ran out (--max-tests / --timeout) before a plan was found")?,
         }
     }
@@ -191,7 +194,11 @@ fn write_summary(out: &mut impl std::io::Write, summary: &OptimisationEntry, fro
         summary.iterations,
         summary.search_seconds,
         summary.threads,
-        if summary.exhaustive { "; the search space was exhausted: the answer is exact" } else { "" }
+        match (summary.exhaustive, summary.values.is_empty()) {
+            (true, false) => "; the search space was exhausted: the answer is exact",
+            (true, true) => "; the search space was exhausted: no complete sequence exists",
+            (false, _) => "",
+        }
     )?;
     match front {
         Some(front) => {
@@ -202,8 +209,12 @@ fn write_summary(out: &mut impl std::io::Write, summary: &OptimisationEntry, fro
             }
         }
         None => {
-            let v: Vec<String> = summary.values.iter().map(|x| format!("{x:.4}")).collect();
-            writeln!(out, "best {names}: {}", v.join(", "))?;
+            if summary.values.is_empty() {
+                writeln!(out, "best {names}: none (no complete sequence)")?;
+            } else {
+                let v: Vec<String> = summary.values.iter().map(|x| format!("{x:.4}")).collect();
+                writeln!(out, "best {names}: {}", v.join(", "))?;
+            }
         }
     }
     Ok(())

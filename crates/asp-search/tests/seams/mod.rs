@@ -476,3 +476,25 @@ fn every_reward_lies_in_its_objectives_range() {
         assert!(highest[k] - lowest[k] > 0.05 * (ranges[k].1 - ranges[k].0), "{k}: {lowest:?} {highest:?} {ranges:?}");
     }
 }
+
+#[test]
+fn a_dead_end_a_filter_makes_names_the_filter_not_the_geometry() {
+    // figure 6.2 comes apart as 2, 1, 0 or 1, 2, 0; filters that keep the top (1) while the
+    // ball (2) is present and the ball while the top is present leave no sequence: the dead end
+    // is the assembled state, where the maps let both out and the filters do not, and the base
+    // would leave them floating
+    let maps = maps(&crate::fixtures::figure_6_2(), 3);
+    let p =
+        problem(&maps, "access").with_filter(Arc::new(After { first: 1, later: 2 })).with_filter(Arc::new(After { first: 2, later: 1 }));
+    let out = Mcts::builder().seed(1).build().unwrap().solve(&p).unwrap();
+    assert_eq!(out.status, asp_search::SearchStatus::NoPlan);
+    let end = asp_search::dead_end::deepest_dead_end(&p, 1_000).expect("a dead end");
+    assert!(end.complete && end.removals.is_empty());
+    let why = "is rejected by after: its predecessor is present".to_string();
+    assert_eq!(end.rejected, vec![(1, why.clone()), (2, why)]);
+    assert_eq!(end.stuck.len(), 1, "{:?}", end.stuck);
+    assert_eq!(end.stuck[0].part, 0);
+    assert_eq!(end.stuck[0].reason, asp_search::StuckReason::WouldLeaveUnsupported(asp_geom::PartSet::from_indices(3, [1, 2])));
+    // without the filters there is a sequence: nothing to explain
+    assert!(asp_search::dead_end::deepest_dead_end(&problem(&maps, "access"), 1_000).is_none());
+}
