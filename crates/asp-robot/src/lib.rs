@@ -7,7 +7,6 @@ pub mod grasp;
 pub mod ik;
 pub mod removal;
 pub mod robot;
-pub mod rrt;
 pub mod search;
 pub mod shape;
 

@@ -10,7 +10,7 @@
 //!    the lifted pose succeed, and neither the arm's links nor the gripper collide with the
 //!    parts still present, go below the floor or collide with each other.
 //! 3. **Path**: a collision-free joint-space path of arm, gripper and held part from the lifted
-//!    pose to the drop-off pose: RRT-Connect with shortcutting ([`crate::rrt`]), seeded, the
+//!    pose to the drop-off pose: RRT-Connect with shortcutting ([`asp_geom::rrt`]), seeded, the
 //!    whole trajectory re-validated at [`RemovalConfig::check_resolution`].
 //!
 //! The path length is the sum of the tool centre's translations between consecutive poses of
@@ -56,6 +56,7 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 use asp_geom::math::{Pose, Rot, Vec3};
+use asp_geom::rrt::{rrt_connect, RrtConnectConfig, Space};
 use asp_geom::{Assembly, Grasp, PartSet, World};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::query;
@@ -66,7 +67,6 @@ use rand_chacha::ChaCha8Rng;
 use crate::grasp::{part_grasps, GraspConfig};
 use crate::ik::IkConfig;
 use crate::robot::Robot;
-use crate::rrt::{rrt_connect, RrtConnectConfig, Space};
 use crate::shape::{LinkShape, ShapeKind};
 
 /// How far [`RemovalPlanner::plan_grasps`] searches.
