@@ -204,3 +204,43 @@ fn bvh_descent_sweeps_agree_with_the_per_triangle_search() {
     // both answers occur, so the comparison means something
     assert!(hits > 20 && misses > 20, "{hits} hits, {misses} misses");
 }
+
+/// Issue 28 item 5 (found by the planners' fuzz test, `asp-app/tests/fuzz`, case 103): a part
+/// of zero thickness (a flat box: a sheet drawn as a closed surface with no volume) lying on the
+/// floor left downward through the ground, and a sheet between two boxes left through them: the
+/// tolerance's erosion turned the sheet inside out (its two faces swapped sides), so nothing
+/// touching it blocked it. A part thinner than twice the tolerance keeps its shape; its pair
+/// tests shrink the other part instead.
+#[test]
+fn issue_28_a_sheet_of_zero_thickness_leaves_neither_through_the_floor_nor_through_parts() {
+    use asp_geom::fixtures::{assemble, box_part};
+    use asp_geom::math::Axis;
+    // a box, a flat sheet on the floor beside it, no part fixed (the virtual ground under both)
+    let a = assemble(
+        "sheet_on_floor",
+        vec![box_part("box", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]), box_part("sheet", [1.5, 0.0, 0.0], [2.0, 1.0, 0.0])],
+        Axis::Z,
+    );
+    let w = world(a);
+    let all = PartSet::full(2);
+    assert!(!free_axes(&w, 1, &all).contains(&"-z"), "the sheet goes down through the ground: {:?}", free_axes(&w, 1, &all));
+    match w.linear_removal(1, &all).unwrap() {
+        Motion::Linear { direction, .. } => assert!(direction.z >= 0.0, "the sheet leaves along {direction:?}"),
+        other => panic!("{other:?}"),
+    }
+    // a sheet pressed between two boxes (a gasket) leaves sideways only, never through either
+    let a = assemble(
+        "gasket",
+        vec![
+            box_part("below", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
+            box_part("gasket", [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]),
+            box_part("above", [0.0, 0.0, 1.0], [1.0, 1.0, 2.0]),
+        ],
+        Axis::Z,
+    );
+    let w = world(a);
+    let all = PartSet::full(3);
+    assert_eq!(free_axes(&w, 1, &all), vec!["+x", "-x", "+y", "-y"]);
+    // and the boxes do not pass through the sheet either
+    assert!(!free_axes(&w, 2, &all).contains(&"-z") && !free_axes(&w, 0, &all).contains(&"+z"));
+}
