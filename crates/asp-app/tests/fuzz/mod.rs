@@ -190,7 +190,12 @@ fn boxes(rng: &mut ChaCha8Rng, rotated: bool) -> Vec<Part> {
 /// Degenerations of a model, each a way real exports go wrong.
 fn degenerate(rng: &mut ChaCha8Rng, parts: &mut Vec<Part>) -> &'static str {
     let k = rng.random_range(0..parts.len());
-    match rng.random_range(0..9u32) {
+    match rng.random_range(0..10u32) {
+        9 => {
+            // a part with no triangles at all (its vertices kept)
+            parts[k].mesh.triangles.clear();
+            "a part without triangles"
+        }
         0 => {
             // zero-area triangles: repeated vertices and collinear triples
             let m = &mut parts[k].mesh;
@@ -340,6 +345,10 @@ fn model(rng: &mut ChaCha8Rng) -> (Assembly, String) {
             what += ", on a fixed slab";
         }
         _ => {}
+    }
+    if rng.random_bool(0.005) {
+        parts.clear();
+        what += ", every part taken out";
     }
     let up = if rng.random_bool(0.8) { Axis::Z } else { Axis::parse("-y").unwrap() };
     let mut a = assemble("fuzz", parts, up);
@@ -575,11 +584,15 @@ fn check(case: u64, assembly: &Assembly, request: &PlanRequest, result: asp_app:
 
 /// Writes `assembly` as a GLB file or as a folder of OBJ files (one per part, named after it;
 /// fixed parts and cells are lost, so the request names the fixed parts) under `dir`.
-fn write_model(assembly: &Assembly, dir: &Path, glb: bool, request: &mut PlanRequest) -> std::path::PathBuf {
+fn write_model(assembly: &Assembly, dir: &Path, glb: bool, request: &mut PlanRequest) -> Option<std::path::PathBuf> {
     if glb {
         let path = dir.join("model.glb");
-        asp_geom::io::write_glb(assembly, &path).unwrap();
-        return path;
+        // the writer refuses what it cannot write (a part without triangles), in one line
+        if let Err(e) = asp_geom::io::write_glb(assembly, &path) {
+            assert!(!e.to_string().contains('\n'), "the GLB writer's error is not one line: {e}");
+            return None;
+        }
+        return Some(path);
     }
     let folder = dir.join("parts");
     std::fs::create_dir_all(&folder).unwrap();
@@ -594,11 +607,16 @@ fn write_model(assembly: &Assembly, dir: &Path, glb: bool, request: &mut PlanReq
         std::fs::write(folder.join(format!("{}.obj", p.name)), text).unwrap();
     }
     request.fixed = assembly.parts.iter().filter(|p| p.fixed).map(|p| p.name.clone()).collect();
+    // now and then in another unit (the coordinates read as millimetres or inches)
+    let k = assembly.parts.len() % 5;
+    if k > 2 {
+        request.unit = Some(["mm", "in"][k - 3].into());
+    }
     // OBJ files are read in metres with +z up unless told
     if assembly.up != Axis::Z {
         request.up = Some(assembly.up.to_string());
     }
-    folder
+    Some(folder)
 }
 
 /// Runs case `case`: a model and a request from its own generator, planned in memory, and one
@@ -624,7 +642,10 @@ fn run_case(case: u64, verbose: bool, seen: &mut std::collections::BTreeMap<Stri
     *seen.entry(format!("memory: {outcome}")).or_default() += 1;
     if from_file {
         let dir = tempfile::tempdir().unwrap();
-        let path = write_model(&assembly, dir.path(), glb, &mut request);
+        let Some(path) = write_model(&assembly, dir.path(), glb, &mut request) else {
+            *seen.entry("file: not written".into()).or_default() += 1;
+            return;
+        };
         let what = format!("{what}; from {}", if glb { "GLB" } else { "OBJ files" });
         let result = asp_app::plan_file(&path, &request, Hooks::default());
         // what the loader gave the planners: re-loaded for the checks
