@@ -21,7 +21,7 @@ use parry3d::shape::TriMesh;
 /// The first time `t` in `[0, t_max]` at which triangle `a` moved by `t * dir` overlaps
 /// triangle `b` (interiors, strictly), or `None`. Parallel triangles that the motion carries
 /// through each other's plane overlap at the one instant they are coplanar, when their
-/// interiors overlap in that plane ([`coplanar_passage`]).
+/// interiors overlap in that plane.
 pub fn triangle_sweep(a: &[DVec3; 3], dir: DVec3, b: &[DVec3; 3], t_max: f64) -> Option<f64> {
     crossing_sweep(a, dir, b, t_max).or_else(|| coplanar_passage(a, dir, b, t_max))
 }
