@@ -244,3 +244,23 @@ fn issue_28_a_sheet_of_zero_thickness_leaves_neither_through_the_floor_nor_throu
     // and the boxes do not pass through the sheet either
     assert!(!free_axes(&w, 2, &all).contains(&"-z") && !free_axes(&w, 0, &all).contains(&"+z"));
 }
+
+/// Issue 28 item 5 (the planners' fuzz test, `asp-app/tests/fuzz`): a model built in memory with
+/// a part whose triangles all have zero area (collapsed onto a line) was refused with parry's
+/// words ("invalid configuration: cannot build a collision mesh: A triangle mesh must contain
+/// at least one triangle"); it is refused as the loader refuses it, naming the part and saying
+/// what to do.
+#[test]
+fn issue_28_a_part_collapsed_onto_a_line_is_refused_in_the_loaders_words() {
+    use asp_geom::fixtures::{assemble, box_part, part};
+    use asp_geom::math::Axis;
+    use asp_geom::mesh::Mesh;
+    let line = Mesh::new(vec![Vec3::ZERO, Vec3::splat(1.0), Vec3::splat(2.0)], vec![[0, 1, 2], [2, 1, 0]]);
+    let a = assemble("collapsed", vec![box_part("box", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]), part("line", line, false)], Axis::Z);
+    let e = World::new(a, &WorldConfig::default()).err().expect("refused").to_string();
+    assert_eq!(
+        e,
+        "fixture:collapsed: part 'line': all its 2 triangles have zero area (its vertices collapse to a point or a line); \
+         check the export's scale and units or remove the part"
+    );
+}
