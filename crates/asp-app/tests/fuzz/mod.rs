@@ -521,6 +521,7 @@ fn check(case: u64, assembly: &Assembly, request: &PlanRequest, result: asp_app:
         Err(e) => {
             let message = e.to_string();
             assert!(!message.is_empty() && !message.contains('\n'), "case {case} ({what}): an error not of one line: {message:?}");
+            eprintln!("  error: {message}");
             return "error";
         }
         Ok(r) => r.report,
