@@ -3,8 +3,12 @@
 #[path = "../../asp-search/tests/fixtures/mod.rs"]
 #[allow(dead_code)]
 mod fixtures;
+#[path = "../../asp-search/tests/verify/mod.rs"]
+#[allow(dead_code)]
+mod verify;
 
 mod collect;
+mod fuzz;
 mod pipeline;
 mod request;
 mod robot;

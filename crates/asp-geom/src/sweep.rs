@@ -19,8 +19,59 @@ use parry3d::glamx::DVec3;
 use parry3d::shape::TriMesh;
 
 /// The first time `t` in `[0, t_max]` at which triangle `a` moved by `t * dir` overlaps
-/// triangle `b` (interiors, strictly), or `None`.
+/// triangle `b` (interiors, strictly), or `None`. Parallel triangles that the motion carries
+/// through each other's plane overlap at the one instant they are coplanar, when their
+/// interiors overlap in that plane.
 pub fn triangle_sweep(a: &[DVec3; 3], dir: DVec3, b: &[DVec3; 3], t_max: f64) -> Option<f64> {
+    crossing_sweep(a, dir, b, t_max).or_else(|| coplanar_passage(a, dir, b, t_max))
+}
+
+/// When triangle `a`, moved by `t * dir`, passes through the plane of the parallel triangle `b`
+/// at a time `t` in `(0, t_max]` with their interiors overlapping in that plane: that time.
+///
+/// Interiors that meet in one plane at one instant are no strict overlap at any time, so the
+/// separating-axis sweep ([`crossing_sweep`]) never reports them. A solid moving into another
+/// also crosses its side faces, but a part of no thickness (a sheet drawn as a closed surface
+/// of no volume) has none: without this it went through a floor, or a box through it, along
+/// the sheet's normal (issue 28 item 5).
+fn coplanar_passage(a: &[DVec3; 3], dir: DVec3, b: &[DVec3; 3], t_max: f64) -> Option<f64> {
+    let na = (a[1] - a[0]).cross(a[2] - a[1]);
+    let nb = (b[1] - b[0]).cross(b[2] - b[1]);
+    let (la, lb) = (na.length(), nb.length());
+    if !(la > 0.0 && lb > 0.0) || na.cross(nb).length() > 1e-9 * la * lb {
+        return None;
+    }
+    let n = na / la;
+    let v = dir.dot(n);
+    if v.abs() <= 1e-9 * dir.length() {
+        return None;
+    }
+    // when `a` reaches `b`'s plane (from the mean of each triangle's offsets along the normal)
+    let offset = |t: &[DVec3; 3]| (t[0].dot(n) + t[1].dot(n) + t[2].dot(n)) / 3.0;
+    let t = (offset(b) - offset(a)) / v;
+    if !(t > 0.0 && t <= t_max) {
+        return None;
+    }
+    // the in-plane separating axes at that instant: strict overlap on every one, by more than
+    // rounding (triangles that only share an edge or a corner in the plane do not overlap)
+    let moved = a.map(|p| p + dir * t);
+    let edges = [a[1] - a[0], a[2] - a[1], a[0] - a[2], b[1] - b[0], b[2] - b[1], b[0] - b[2]];
+    let size = edges.iter().map(|e| e.length()).fold(0.0, f64::max);
+    edges
+        .iter()
+        .all(|e| {
+            let l = n.cross(*e);
+            let slack = 1e-9 * l.length() * size;
+            let (a0, a1) = project(&moved, l);
+            let (b0, b1) = project(b, l);
+            a1 > b0 + slack && b1 > a0 + slack
+        })
+        .then_some(t)
+}
+
+/// [`triangle_sweep`] by the separating axes alone: the first time the interiors overlap
+/// strictly, with a nonzero volume of contact times.
+fn crossing_sweep(a: &[DVec3; 3], dir: DVec3, b: &[DVec3; 3], t_max: f64) -> Option<f64> {
     let ea = [a[1] - a[0], a[2] - a[1], a[0] - a[2]];
     let eb = [b[1] - b[0], b[2] - b[1], b[0] - b[2]];
     let na = ea[0].cross(ea[1]);
@@ -251,6 +302,31 @@ mod tests {
 
     fn cube(lo: Vec3, hi: Vec3) -> TriMesh {
         trimesh(Mesh::cuboid(lo, hi))
+    }
+
+    /// Issue 28 item 5: parallel triangles carried through each other's plane meet at the
+    /// instant they are coplanar when their interiors overlap there (a sheet of no thickness
+    /// has no side faces whose crossing would say so); sliding in the plane, passing beside the
+    /// other or only sharing an edge with it in the plane is no hit.
+    #[test]
+    fn parallel_triangles_passing_through_each_others_plane_meet() {
+        let d = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let sheet = [d(0.0, 0.0, 1.0), d(1.0, 0.0, 1.0), d(0.0, 1.0, 1.0)];
+        let floor = [d(-5.0, -5.0, 0.0), d(5.0, -5.0, 0.0), d(0.0, 5.0, 0.0)];
+        let t = triangle_sweep(&sheet, d(0.0, 0.0, -1.0), &floor, 10.0).expect("the sheet goes through the floor");
+        assert!((t - 1.0).abs() < 1e-12, "{t}");
+        // slanted: at the instant the sheet reaches the plane
+        let slant = d(0.6, 0.0, -0.8);
+        assert!((triangle_sweep(&sheet, slant, &floor, 10.0).unwrap() - 1.25).abs() < 1e-12);
+        // not far enough, away from it, in the plane, beside it, or sharing only an edge
+        assert_eq!(triangle_sweep(&sheet, d(0.0, 0.0, -1.0), &floor, 0.9), None);
+        assert_eq!(triangle_sweep(&sheet, d(0.0, 0.0, 1.0), &floor, 10.0), None);
+        let beside = [d(20.0, 0.0, 1.0), d(21.0, 0.0, 1.0), d(20.0, 1.0, 1.0)];
+        assert_eq!(triangle_sweep(&beside, d(0.0, 0.0, -1.0), &floor, 10.0), None);
+        let on_floor = sheet.map(|p| p - d(0.0, 0.0, 1.0));
+        assert_eq!(triangle_sweep(&on_floor, d(1.0, 0.0, 0.0), &floor, 10.0), None);
+        let neighbour = [d(1.0, 0.0, 0.0), d(0.0, 1.0, 0.0), d(1.0, 1.0, 0.0)];
+        assert_eq!(triangle_sweep(&sheet, d(0.0, 0.0, -1.0), &neighbour, 10.0), None);
     }
 
     #[test]

@@ -28,13 +28,8 @@ pub fn check_model(assembly: &Assembly) -> Result<()> {
         return Err(err("the model has zero extent (every vertex lies at one point); check the export's scale and units".into()));
     }
     for part in &assembly.parts {
-        let triangles = part.mesh.triangles.len();
-        if proper_triangles(&part.mesh) == 0 {
-            return Err(err(format!(
-                "part '{}': all its {triangles} triangles have zero area (its vertices collapse to a point or a line); \
-                 check the export's scale and units or remove the part",
-                part.name
-            )));
+        if let Some(reason) = collapsed(part) {
+            return Err(err(reason));
         }
     }
     let mut seen: HashMap<u64, usize> = HashMap::new();
@@ -105,6 +100,19 @@ fn embedded_part(assembly: &Assembly) -> Option<(usize, usize)> {
 }
 
 /// Triangles with three distinct corners and a non-zero normal (what welding keeps).
+/// Why `part` cannot be planned when every triangle of it has zero area (what welding its
+/// surface leaves: none), naming it and saying what to do; `None` when some triangle has area.
+pub(crate) fn collapsed(part: &crate::assembly::Part) -> Option<String> {
+    (proper_triangles(&part.mesh) == 0).then(|| {
+        format!(
+            "part '{}': all its {} triangles have zero area (its vertices collapse to a point or a line); \
+             check the export's scale and units or remove the part",
+            part.name,
+            part.mesh.triangles.len()
+        )
+    })
+}
+
 fn proper_triangles(mesh: &Mesh) -> usize {
     let bits = |i: u32| mesh.vertices[i as usize].to_array().map(|c| (c + 0.0).to_bits());
     mesh.triangles

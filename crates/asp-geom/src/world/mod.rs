@@ -127,6 +127,11 @@ impl World {
         let mut warnings = assembly.warnings.clone();
         let mut geoms = Vec::with_capacity(assembly.len() + 1);
         for p in &assembly.parts {
+            // a part whose welded surface keeps no triangle (models built in memory; the loader
+            // refuses them in the same words)
+            if let Some(reason) = crate::validate::collapsed(p) {
+                return Err(GeomError::Assembly { path: assembly.source.clone(), reason });
+            }
             let (mut g, t) = Geom::new(&p.mesh)
                 .map_err(|e| GeomError::Assembly { path: assembly.source.clone(), reason: format!("part '{}': {e}", p.name) })?;
             let (shape, warning) = PartShape::classify(p, config.exact_boxes);

@@ -204,3 +204,63 @@ fn bvh_descent_sweeps_agree_with_the_per_triangle_search() {
     // both answers occur, so the comparison means something
     assert!(hits > 20 && misses > 20, "{hits} hits, {misses} misses");
 }
+
+/// Issue 28 item 5 (found by the planners' fuzz test, `asp-app/tests/fuzz`, case 103): a part
+/// of zero thickness (a flat box: a sheet drawn as a closed surface with no volume) lying on the
+/// floor left downward through the ground, and a sheet between two boxes left through them: the
+/// tolerance's erosion turned the sheet inside out (its two faces swapped sides), so nothing
+/// touching it blocked it. A part thinner than twice the tolerance keeps its shape; its pair
+/// tests shrink the other part instead.
+#[test]
+fn issue_28_a_sheet_of_zero_thickness_leaves_neither_through_the_floor_nor_through_parts() {
+    use asp_geom::fixtures::{assemble, box_part};
+    use asp_geom::math::Axis;
+    // a box, a flat sheet on the floor beside it, no part fixed (the virtual ground under both)
+    let a = assemble(
+        "sheet_on_floor",
+        vec![box_part("box", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]), box_part("sheet", [1.5, 0.0, 0.0], [2.0, 1.0, 0.0])],
+        Axis::Z,
+    );
+    let w = world(a);
+    let all = PartSet::full(2);
+    assert!(!free_axes(&w, 1, &all).contains(&"-z"), "the sheet goes down through the ground: {:?}", free_axes(&w, 1, &all));
+    match w.linear_removal(1, &all).unwrap() {
+        Motion::Linear { direction, .. } => assert!(direction.z >= 0.0, "the sheet leaves along {direction:?}"),
+        other => panic!("{other:?}"),
+    }
+    // a sheet pressed between two boxes (a gasket) leaves sideways only, never through either
+    let a = assemble(
+        "gasket",
+        vec![
+            box_part("below", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
+            box_part("gasket", [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]),
+            box_part("above", [0.0, 0.0, 1.0], [1.0, 1.0, 2.0]),
+        ],
+        Axis::Z,
+    );
+    let w = world(a);
+    let all = PartSet::full(3);
+    assert_eq!(free_axes(&w, 1, &all), vec!["+x", "-x", "+y", "-y"]);
+    // and the boxes do not pass through the sheet either
+    assert!(!free_axes(&w, 2, &all).contains(&"-z") && !free_axes(&w, 0, &all).contains(&"+z"));
+}
+
+/// Issue 28 item 5 (the planners' fuzz test, `asp-app/tests/fuzz`): a model built in memory with
+/// a part whose triangles all have zero area (collapsed onto a line) was refused with parry's
+/// words ("invalid configuration: cannot build a collision mesh: A triangle mesh must contain
+/// at least one triangle"); it is refused as the loader refuses it, naming the part and saying
+/// what to do.
+#[test]
+fn issue_28_a_part_collapsed_onto_a_line_is_refused_in_the_loaders_words() {
+    use asp_geom::fixtures::{assemble, box_part, part};
+    use asp_geom::math::Axis;
+    use asp_geom::mesh::Mesh;
+    let line = Mesh::new(vec![Vec3::ZERO, Vec3::splat(1.0), Vec3::splat(2.0)], vec![[0, 1, 2], [2, 1, 0]]);
+    let a = assemble("collapsed", vec![box_part("box", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]), part("line", line, false)], Axis::Z);
+    let e = World::new(a, &WorldConfig::default()).err().expect("refused").to_string();
+    assert_eq!(
+        e,
+        "fixture:collapsed: part 'line': all its 2 triangles have zero area (its vertices collapse to a point or a line); \
+         check the export's scale and units or remove the part"
+    );
+}
