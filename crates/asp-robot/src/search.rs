@@ -20,7 +20,7 @@ use std::sync::{Arc, Mutex};
 
 use asp_geom::distmap::{DistanceMaps, MapState};
 use asp_geom::math::{Pose, Vec3};
-use asp_geom::{Assembly, Checker, FeasibilityChecker, Motion, MotionKind, PartSet, World, WorldConfig};
+use asp_geom::{Assembly, Checker, FeasibilityChecker, Motion, PartSet, World, WorldConfig};
 use asp_search::extension::{MdpExtension, ModelContext};
 use asp_search::mdp::{ActionFilter, Verdict};
 use asp_search::objective::Objective;
@@ -156,20 +156,18 @@ impl CheckerExtension for CellSetup {
 
 /// Puts the robot's reasons into a `no_plan` outcome: each part of the dead end that the search
 /// saw blocked by every other part because the robot refused it (the geometry lets it out)
-/// gets the robot's reason instead ([`StuckReason::Refused`]). A part whose test the search
-/// skipped in that state (bookkeeping: blockers known from an earlier state) is tested there
-/// once more; a part the geometry blocks keeps its blockers.
+/// gets the robot's reason instead ([`StuckReason::Refused`]); a part the geometry blocks keeps
+/// its blockers. Every such part was tested in the dead-end state itself: bookkeeping skips a
+/// test only in a state holding all the recorded blockers, and a refusal's blockers are every
+/// other part of its state, so the skipping state would hold the refusing one, which is then
+/// no smaller and no deeper dead end.
 fn explain_refusals(outcome: &mut PlanOutcome, robot: &RobotChecker<'_>, assembly: &Assembly) {
     let Status::NoPlan { stuck, state } = &mut outcome.status else { return };
     for s in stuck.iter_mut() {
         if !matches!(s.reason, StuckReason::Blocked(_)) {
             continue;
         }
-        let failure = robot.refusal(s.part, state).or_else(|| {
-            robot.test_removal(s.part, state, MotionKind::Linear);
-            robot.refusal(s.part, state)
-        });
-        if let Some(f) = failure {
+        if let Some(f) = robot.refusal(s.part, state) {
             s.reason = StuckReason::Refused(f.refusal(assembly));
         }
     }
