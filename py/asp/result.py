@@ -146,7 +146,11 @@ class Plan:
     @property
     def explanation(self) -> list[dict[str, Any]]:
         """For ``no_plan``: each part of the deepest dead end, why it is stuck and which parts
-        hold it (empty otherwise)."""
+        hold it (empty otherwise): ``{"part", "name", "reason", "parts"}``. With a robot, a part
+        the geometry lets out but the arm cannot take out is ``"blocked"`` with empty ``parts``
+        and a ``"robot"`` key ``{"reason", "detail"}`` (format 1.9; ``reason`` one of
+        ``"no_reachable_grasp"``, ``"blocked_lift"``, ``"no_straight_lift"``,
+        ``"no_drop_off"``, ``"no_path"``; ``detail`` one line in words)."""
         return self._copy("explanation", [])
 
     @property

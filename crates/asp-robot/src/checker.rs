@@ -10,7 +10,9 @@
 //!
 //! Every successful plan is kept by state and part, so the plan's steps can be annotated with
 //! the robot's grasp, gripper path and joint trajectory ([`RobotChecker::removal`]); every
-//! failure is counted by reason and the last one per part is kept ([`RobotChecker::failure`]).
+//! failure is counted by reason, the last one per part is kept ([`RobotChecker::failure`]), and
+//! so is the first one per state and part ([`RobotChecker::refusal`]): the robot's reason for a
+//! dead end, which the search saw only as a collision with every part.
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -44,6 +46,7 @@ pub struct RobotChecker<'c> {
     replans: usize,
     plans: Mutex<HashMap<(Vec<u64>, usize), RobotRemoval>>,
     failures: Mutex<HashMap<usize, RobotFailure>>,
+    refusals: Mutex<HashMap<(Vec<u64>, usize), RobotFailure>>,
     counts: [AtomicU64; 3],
 }
 
@@ -63,6 +66,7 @@ impl<'c> RobotChecker<'c> {
             replans,
             plans: Mutex::new(HashMap::new()),
             failures: Mutex::new(HashMap::new()),
+            refusals: Mutex::new(HashMap::new()),
             counts: Default::default(),
         }
     }
@@ -82,6 +86,13 @@ impl<'c> RobotChecker<'c> {
         self.failures.lock().expect("not poisoned").get(&part).cloned()
     }
 
+    /// Why the robot refused to take `part` out of `state`, when the inner checker let it out
+    /// and the robot did not: the first refusal in that state (a straight lift's reason outlasts
+    /// the later refusal of a path motion, [`RobotFailure::Blocked`] without a part).
+    pub fn refusal(&self, part: usize, state: &PartSet) -> Option<RobotFailure> {
+        self.refusals.lock().expect("not poisoned").get(&(state.words().to_vec(), part)).cloned()
+    }
+
     /// Robot failures so far by reason ([`RobotFailure::REASONS`] order).
     pub fn failure_counts(&self) -> [u64; 3] {
         [0, 1, 2].map(|i| self.counts[i].load(Ordering::Relaxed))
@@ -89,6 +100,7 @@ impl<'c> RobotChecker<'c> {
 
     fn refuse(&self, part: usize, state: &PartSet, failure: RobotFailure) -> Outcome {
         self.counts[failure.index()].fetch_add(1, Ordering::Relaxed);
+        self.refusals.lock().expect("not poisoned").entry((state.words().to_vec(), part)).or_insert_with(|| failure.clone());
         self.failures.lock().expect("not poisoned").insert(part, failure);
         let mut blockers = state.without(part);
         for p in state.iter() {

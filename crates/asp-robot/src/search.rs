@@ -24,10 +24,10 @@ use asp_geom::{Assembly, Checker, FeasibilityChecker, Motion, PartSet, World, Wo
 use asp_search::extension::{MdpExtension, ModelContext};
 use asp_search::mdp::{ActionFilter, Verdict};
 use asp_search::objective::Objective;
-use asp_search::report::{RobotEntry, RobotReport, RobotStepEntry};
+use asp_search::report::{RobotEntry, RobotReason, RobotRefusal, RobotReport, RobotStepEntry};
 use asp_search::step::{StepContext, StepKind};
 use asp_search::CheckerExtension;
-use asp_search::{Mdp, PathLength, PlanOutcome, SearchError};
+use asp_search::{Mdp, PathLength, PlanOutcome, SearchError, Status, StuckReason};
 
 use crate::checker::{HoldingChecker, RobotChecker};
 use crate::removal::{RemovalConfig, RemovalPlanner, RobotCell, RobotFailure, RobotRemoval};
@@ -129,10 +129,13 @@ impl CheckerExtension for CellSetup {
             let planner = RemovalPlanner::new(world, cell.clone(), r.config.clone());
             (cell, RobotChecker::new(base, planner, seed, r.config.replans))
         });
-        let outcome = match &robot {
+        let mut outcome = match &robot {
             Some((_, rc)) => search(rc),
             None => search(base),
         };
+        if let Some((_, rc)) = &robot {
+            explain_refusals(&mut outcome, rc, world.assembly());
+        }
         let mut state = PartSet::full(checker.num_parts());
         let (mut steps, mut held) = (Vec::new(), Vec::new());
         for s in &outcome.removals {
@@ -148,6 +151,54 @@ impl CheckerExtension for CellSetup {
         };
         report.held = held;
         Ok((outcome, Some(report)))
+    }
+}
+
+/// Puts the robot's reasons into a `no_plan` outcome: each part of the dead end that the search
+/// saw blocked by every other part because the robot refused it (the geometry lets it out)
+/// gets the robot's reason instead ([`StuckReason::Refused`]); a part the geometry blocks keeps
+/// its blockers. Every such part was tested in the dead-end state itself: bookkeeping skips a
+/// test only in a state holding all the recorded blockers, and a refusal's blockers are every
+/// other part of its state, so the skipping state would hold the refusing one, which is then
+/// no smaller and no deeper dead end.
+fn explain_refusals(outcome: &mut PlanOutcome, robot: &RobotChecker<'_>, assembly: &Assembly) {
+    let Status::NoPlan { stuck, state } = &mut outcome.status else { return };
+    for s in stuck.iter_mut() {
+        if !matches!(s.reason, StuckReason::Blocked(_)) {
+            continue;
+        }
+        if let Some(f) = robot.refusal(s.part, state) {
+            s.reason = StuckReason::Refused(f.refusal(assembly));
+        }
+    }
+}
+
+impl RobotFailure {
+    /// The plan JSON's words for this failure (`explanation[].robot`), parts of `assembly` by
+    /// name.
+    pub fn refusal(&self, assembly: &Assembly) -> RobotRefusal {
+        let name = |p: usize| assembly.parts.get(p).map_or_else(|| "the ground".to_string(), |p| format!("'{}'", p.name));
+        let (reason, detail) = match *self {
+        RobotFailure::Blocked { by: Some(by) } => (RobotReason::BlockedLift, format!("the lift along its removal direction hits {}", name(by))),
+        RobotFailure::Blocked { by: None } => {
+            (RobotReason::NoStraightLift, "it leaves only along a path of several moves; the arm lifts along a straight line".to_string())
+        }
+        RobotFailure::NoReachableGrasp { grasps: 0, .. } => (RobotReason::NoReachableGrasp, "no grasp fits the gripper".to_string()),
+        RobotFailure::NoReachableGrasp { grasps, unreachable, colliding } => {
+            (RobotReason::NoReachableGrasp, format!("of {grasps} grasps {unreachable} are out of reach, {colliding} collide"))
+        }
+        RobotFailure::NoPath { drop_off_blocked, grasps_tried: 0, .. } => (
+            RobotReason::NoDropOff,
+            format!("with none of its {drop_off_blocked} reachable grasps can the part be put down at the drop-off"),
+        ),
+        RobotFailure::NoPath { reachable, drop_off_blocked, grasps_tried } => (
+            RobotReason::NoPath,
+            format!(
+                "{reachable} reachable grasps, {drop_off_blocked} cannot put the part down at the drop-off, no collision-free path from the other {grasps_tried}"
+            ),
+        ),
+    };
+        RobotRefusal { reason, detail }
     }
 }
 

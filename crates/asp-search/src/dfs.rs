@@ -340,7 +340,7 @@ fn locked_core(reasons: &[Stuck], is_fixed: impl Fn(usize) -> bool) -> Option<Pa
         core.retain(|(_, reason)| match reason {
             StuckReason::Blocked(b) => b.iter().all(|q| is_fixed(q) || members.contains(&q)),
             StuckReason::WouldLeaveUnsupported(f) => f.iter().any(|q| members.contains(&q)),
-            StuckReason::DeadEnd => false,
+            StuckReason::DeadEnd | StuckReason::Refused(_) => false,
         });
         if core.len() == before {
             break;

@@ -1,5 +1,6 @@
 //! What every planner gets (a [`Problem`] and a [`Budget`]) and gives back (a [`PlanOutcome`]).
 
+use crate::report::RobotRefusal;
 use asp_geom::{CounterSnapshot, FeasibilityChecker, Motion, PartSet};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -204,6 +205,10 @@ pub enum StuckReason {
     WouldLeaveUnsupported(PartSet),
     /// It could leave, but every state after that is a dead end.
     DeadEnd,
+    /// The geometry lets it leave, but a robot cannot take it out, and why. The search itself
+    /// saw a collision with every other present part (any of them may be what the arm hits); a
+    /// [`crate::CheckerExtension`] puts the robot's reason in its place in the outcome.
+    Refused(RobotRefusal),
 }
 
 /// A part of the deepest dead-end state, with why it could not leave.

@@ -15,7 +15,7 @@ pub mod text;
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.8";
+pub const FORMAT_VERSION: &str = "1.9";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -349,8 +349,22 @@ pub struct Explanation {
     /// `blocked` (every motion collides), `unsupported` (its removal leaves parts without
     /// support) or `dead_end` (it can leave, but nothing after that works).
     pub reason: ExplanationReason,
-    /// The parts involved: blockers, or parts left unsupported.
+    /// The parts involved: blockers, or parts left unsupported (empty when `robot` says why).
     pub parts: Vec<NamedPart>,
+    /// With a robot: the geometry lets the part out, but the robot cannot take it out, and why
+    /// (`reason` is then `blocked` and `parts` empty). Since format 1.9.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot: Option<RobotRefusal>,
+}
+
+/// Why a robot cannot take out a part that the geometry lets out (`explanation[].robot`,
+/// format 1.9).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RobotRefusal {
+    /// The robot's reason.
+    pub reason: RobotReason,
+    /// What the robot found, one line in words (grasps out of reach, colliding, ...).
+    pub detail: String,
 }
 
 /// A part reference with its name (`ground` for the virtual ground plane).
@@ -579,12 +593,13 @@ fn explain(status: &Status, name: &dyn Fn(usize) -> String, named: &dyn Fn(&Part
         Status::NoPlan { stuck, .. } => stuck
             .iter()
             .map(|s| {
-                let (reason, parts) = match &s.reason {
-                    StuckReason::Blocked(b) => (ExplanationReason::Blocked, named(b)),
-                    StuckReason::WouldLeaveUnsupported(f) => (ExplanationReason::Unsupported, named(f)),
-                    StuckReason::DeadEnd => (ExplanationReason::DeadEnd, Vec::new()),
+                let (reason, parts, robot) = match &s.reason {
+                    StuckReason::Blocked(b) => (ExplanationReason::Blocked, named(b), None),
+                    StuckReason::WouldLeaveUnsupported(f) => (ExplanationReason::Unsupported, named(f), None),
+                    StuckReason::DeadEnd => (ExplanationReason::DeadEnd, Vec::new(), None),
+                    StuckReason::Refused(r) => (ExplanationReason::Blocked, Vec::new(), Some(r.clone())),
                 };
-                Explanation { part: s.part, name: name(s.part), reason, parts }
+                Explanation { part: s.part, name: name(s.part), reason, parts, robot }
             })
             .collect(),
         _ => Vec::new(),
@@ -735,6 +750,40 @@ vocabulary! {
         Unsupported => "unsupported",
         /// It can leave, but nothing after that works.
         DeadEnd => "dead_end",
+    }
+}
+
+vocabulary! {
+    /// Why a robot cannot take out a part the geometry lets out (`explanation[].robot.reason`;
+    /// format 1.9).
+    RobotReason {
+        /// Lifting the part along its removal direction hits a part.
+        BlockedLift => "blocked_lift",
+        /// The part leaves only along a path of several moves; the robot lifts along a straight
+        /// line.
+        NoStraightLift => "no_straight_lift",
+        /// No grasp of the part is reachable without collision (out of the arm's reach, or the
+        /// gripper or arm collides there).
+        NoReachableGrasp => "no_reachable_grasp",
+        /// Grasps are reachable, but with none of them can the part be put down at the
+        /// drop-off (its pose there is out of reach or collides).
+        NoDropOff => "no_drop_off",
+        /// Grasps are reachable and the part can be put down at the drop-off, but no
+        /// collision-free joint path to it was found.
+        NoPath => "no_path",
+    }
+}
+
+impl RobotReason {
+    /// The reason in words, for the text table and the viewer.
+    pub fn words(self) -> &'static str {
+        match self {
+            RobotReason::BlockedLift => "blocked lift",
+            RobotReason::NoStraightLift => "no straight lift",
+            RobotReason::NoReachableGrasp => "no reachable grasp",
+            RobotReason::NoDropOff => "cannot put it down at the drop-off",
+            RobotReason::NoPath => "no path to the drop-off",
+        }
     }
 }
 

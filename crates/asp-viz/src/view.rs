@@ -126,10 +126,11 @@ fn page_data(scene: &Scene) -> Value {
         .iter()
         .map(|e| {
             let names: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
-            let text = match e.reason {
-                ExplanationReason::Blocked => format!("{}: blocked by {}", e.name, names.join(", ")),
-                ExplanationReason::Unsupported => format!("{}: removing it leaves {} unsupported", e.name, names.join(", ")),
-                ExplanationReason::DeadEnd => format!("{}: can leave, but every state after that is stuck", e.name),
+            let text = match (e.reason, &e.robot) {
+                (_, Some(r)) => format!("{}: the arm cannot take it out: {} ({})", e.name, r.reason.words(), r.detail),
+                (ExplanationReason::Blocked, None) => format!("{}: blocked by {}", e.name, names.join(", ")),
+                (ExplanationReason::Unsupported, None) => format!("{}: removing it leaves {} unsupported", e.name, names.join(", ")),
+                (ExplanationReason::DeadEnd, None) => format!("{}: can leave, but every state after that is stuck", e.name),
             };
             json!({ "part": e.part, "name": e.name, "reason": e.reason, "text": text })
         })

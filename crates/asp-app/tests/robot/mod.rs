@@ -262,3 +262,68 @@ fn the_robot_reuses_the_maps_world() {
     let model = RobotExtension::new(RobotSetup::panda()).model(&ModelContext { assembly: &boxes, maps: &maps, seed: 7 }).unwrap();
     assert_eq!(model.planner().world().num_parts(), boxes.len());
 }
+
+/// A block near the robot, and a stack of two out of its reach (1.7 m from its base), all on a
+/// fixed plate: every block lifts off freely, but the arm reaches only the near one.
+fn near_and_far() -> Assembly {
+    let mut plate = box_part("plate", [-0.1, -0.25, -0.02], [1.5, 0.25, 0.0]);
+    plate.fixed = true;
+    assemble(
+        "near_and_far",
+        vec![
+            plate,
+            box_part("near", [0.1, -0.02, 0.0], [0.14, 0.02, 0.04]),
+            box_part("far_low", [1.28, -0.02, 0.0], [1.32, 0.02, 0.04]),
+            box_part("far_top", [1.28, -0.02, 0.04], [1.32, 0.02, 0.08]),
+        ],
+        Axis::Z,
+    )
+}
+
+fn robot_plan(setup: RobotSetup) -> PlanReport {
+    let settings = PlanSettings {
+        checker_extension: Some(Arc::new(CellSetup { robot: Some(setup), grippers: 1 })),
+        seed: 3,
+        ..PlanSettings::default()
+    };
+    plan_assembly(near_and_far(), &settings, None).unwrap().report
+}
+
+/// Issue 25 item 4, issue 24 item 4: when the robot, not the geometry, keeps a part in, the
+/// explanation gives the robot's reason and lists no parts as blockers; a part the geometry
+/// holds (the low far block would leave the top one unsupported) keeps its own reason.
+#[test]
+fn the_explanation_names_the_robot_reason_not_parts_that_do_not_block() {
+    use asp_search::report::{ExplanationReason, PlanStatus, RobotReason};
+    let base = Vec3::new(-0.4, 0.0, 0.0);
+    let report = robot_plan(RobotSetup { base: Some(base), ..RobotSetup::panda() });
+    assert_eq!(report.status, PlanStatus::NoPlan, "{:?}", report.explanation);
+    assert_eq!(report.disassembly_sequence, vec![1], "the near block comes off");
+    let why = |name: &str| report.explanation.iter().find(|e| e.name == name).unwrap_or_else(|| panic!("{name}: {:?}", report.explanation));
+    let top = why("far_top");
+    assert_eq!(top.reason, ExplanationReason::Blocked);
+    assert!(top.parts.is_empty(), "no part blocks it: {top:?}");
+    let robot = top.robot.as_ref().expect("the robot's reason");
+    assert_eq!(robot.reason, RobotReason::NoReachableGrasp);
+    assert!(robot.detail.contains("out of reach"), "{}", robot.detail);
+    let low = why("far_low");
+    assert!(low.robot.is_none(), "the geometry holds it: {low:?}");
+    assert_eq!(low.reason, ExplanationReason::Unsupported, "{low:?}");
+    assert_eq!(low.parts.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(), ["far_top"]);
+    // the JSON and the text table say the same
+    let json: serde_json::Value = serde_json::from_str(&report.to_json()).unwrap();
+    let entry = json["explanation"].as_array().unwrap().iter().find(|e| e["name"] == "far_top").unwrap().clone();
+    assert_eq!(entry["robot"]["reason"], "no_reachable_grasp", "{entry}");
+    assert_eq!(entry["parts"], serde_json::json!([]));
+    let text = report.to_text();
+    let line = text.lines().find(|l| l.trim_start().starts_with("far_top")).unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("arm: no reachable grasp") && !line.contains("blocked by"), "{line}");
+
+    // a drop-off out of reach: every block is reachable but none can be put down
+    let report = robot_plan(RobotSetup { base: Some(base), drop_off: Some(Vec3::new(-3.0, 0.0, 0.4)), ..RobotSetup::panda() });
+    assert_eq!(report.status, PlanStatus::NoPlan);
+    assert!(report.disassembly_sequence.is_empty(), "{:?}", report.disassembly_sequence);
+    let near = report.explanation.iter().find(|e| e.name == "near").unwrap();
+    assert!(near.parts.is_empty(), "{near:?}");
+    assert_eq!(near.robot.as_ref().map(|r| r.reason), Some(RobotReason::NoDropOff), "{near:?}");
+}

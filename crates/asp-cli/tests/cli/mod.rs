@@ -38,7 +38,7 @@ fn plans_a_fixture_prints_a_table_and_writes_the_json() {
     assert!(table.contains("found"), "{table}");
     assert!(table.contains("stick") && table.contains("handle") && table.contains("cap"), "{table}");
     let plan = json(&out);
-    assert_eq!(plan["format_version"], "1.8");
+    assert_eq!(plan["format_version"], "1.9");
     assert_eq!(plan["stats"]["checker"], "collision_world");
     assert_eq!(plan["status"], "found");
     assert_eq!(plan["up"], "+z");
@@ -96,6 +96,40 @@ fn no_plan_exits_1_and_explains() {
         assert_eq!(plan["stats"]["path_planner_calls"], 0, "{flags:?}");
         assert_eq!(plan["assembly_sequence"][0]["moves"].as_array().unwrap().len(), 1, "{flags:?}");
     }
+}
+
+/// Issue 25 item 4, issue 24 item 4: with `--robot`, a part the geometry lets out but the arm
+/// cannot take out is explained by the arm's reason, not "blocked by" parts that do not block
+/// it: a block out of reach of the base `--robot-base` puts (no reachable grasp), and the L's
+/// block, which leaves its housing only along a path (the arm lifts along a straight line).
+#[test]
+fn issue_25_a_robot_refusal_is_explained_by_the_arms_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut plate = fixtures::box_part("plate", [-0.1, -0.25, -0.02], [1.5, 0.25, 0.0]);
+    plate.fixed = true;
+    let near = fixtures::box_part("near", [0.1, -0.02, 0.0], [0.14, 0.02, 0.04]);
+    let far = fixtures::box_part("far", [1.28, -0.02, 0.0], [1.32, 0.02, 0.04]);
+    let model = fixture_file(dir.path(), &fixtures::assemble("reach", vec![plate, near, far], asp_geom::math::Axis::Z), "reach.glb");
+    let out = dir.path().join("reach.json");
+    let o = asp(&["plan", model.to_str().unwrap(), "--robot", "panda", "--robot-base=-0.4,0,0", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let table = String::from_utf8(o.stdout).unwrap();
+    let line = table.lines().find(|l| l.trim_start().starts_with("far ")).unwrap_or_else(|| panic!("{table}"));
+    assert!(line.contains("arm: no reachable grasp (of ") && !line.contains("blocked by"), "{table}");
+    let plan = json(&out);
+    assert_eq!(plan["status"], "no_plan");
+    assert_eq!(plan["disassembly_sequence"], serde_json::json!([1]), "the near block comes off");
+    let why = &plan["explanation"][0];
+    assert_eq!((&why["name"], &why["reason"], &why["parts"]), (&"far".into(), &"blocked".into(), &serde_json::json!([])), "{why}");
+    assert_eq!(why["robot"]["reason"], "no_reachable_grasp", "{why}");
+
+    let model = fixture_file(dir.path(), &fixtures::l_path(), "l.glb");
+    let o = asp(&["plan", model.to_str().unwrap(), "--robot", "panda", "--json"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let why = &plan["explanation"][0];
+    assert_eq!((&why["name"], &why["parts"]), (&"block".into(), &serde_json::json!([])), "{why}");
+    assert_eq!(why["robot"]["reason"], "no_straight_lift", "{why}");
 }
 
 /// Asserts a one-line error naming `needle`, exit code 2, no panic.
@@ -341,7 +375,7 @@ fn issue_9_plans_an_interlocking_burr_by_grid_moves() {
     let table = String::from_utf8(o.stdout).unwrap();
     assert!(table.contains("grid plan") && table.contains("move piece"), "{table}");
     let plan = json(&out);
-    assert_eq!(plan["format_version"], "1.8");
+    assert_eq!(plan["format_version"], "1.9");
     assert_eq!(plan["status"], "found");
     assert_eq!(plan["grid"]["reason"], "needs_moves");
     assert_eq!(plan["grid"]["first_separation_moves"], asp_geom::puzzles::BURR_LEVEL_MOVES);

@@ -104,10 +104,11 @@ fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
         writeln!(out, "stuck with {} parts left; none can leave:", r.explanation.len())?;
         for e in &r.explanation {
             let others: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
-            let why = match e.reason {
-                ExplanationReason::Blocked => format!("blocked by {}", others.join(", ")),
-                ExplanationReason::Unsupported => format!("would leave {} unsupported", others.join(", ")),
-                ExplanationReason::DeadEnd => "can leave, but every state after that is a dead end".into(),
+            let why = match (e.reason, &e.robot) {
+                (_, Some(r)) => format!("arm: {} ({})", r.reason.words(), r.detail),
+                (ExplanationReason::Blocked, None) => format!("blocked by {}", others.join(", ")),
+                (ExplanationReason::Unsupported, None) => format!("would leave {} unsupported", others.join(", ")),
+                (ExplanationReason::DeadEnd, None) => "can leave, but every state after that is a dead end".into(),
             };
             writeln!(out, "  {:<width$}  {why}", e.name)?;
         }

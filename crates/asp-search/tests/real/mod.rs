@@ -114,7 +114,7 @@ fn pump_without_subassemblies_ends_in_no_plan_with_its_stuck_core_explained_and_
                 assert!(name(s.part).starts_with("LargeScrew"), "{s:?}");
                 assert!(!parts.is_empty() && parts.iter().all(|b| state.contains(b)), "{s:?}");
             }
-            StuckReason::DeadEnd => panic!("{s:?}"),
+            StuckReason::DeadEnd | StuckReason::Refused(_) => panic!("{s:?}"),
         }
     }
     // issue 9: the three parts are a locked core (two blocked only by each other and the

@@ -36,8 +36,9 @@ pub fn stuck_tube() -> Scene {
             name: "stick".into(),
             reason: asp_search::report::ExplanationReason::Blocked,
             parts: vec![NamedPart { part: receptacle, name: "receptacle".into() }, NamedPart { part: cap, name: "cap".into() }],
+            robot: None,
         },
-        Explanation { part: cap, name: "cap".into(), reason: asp_search::report::ExplanationReason::DeadEnd, parts: vec![] },
+        Explanation { part: cap, name: "cap".into(), reason: asp_search::report::ExplanationReason::DeadEnd, parts: vec![], robot: None },
     ];
     Scene::new(scene.assembly.clone(), report, Path::new("fixture")).unwrap()
 }
