@@ -8,6 +8,7 @@
 
 use crate::catalogue::PolicySource;
 use crate::error::{AppError, Result};
+use crate::why::{explain_cores, GridRan};
 use asp_geom::distmap::{DistanceMaps, MapConfig, Support};
 use asp_geom::grid::VoxelModel;
 use asp_geom::io::LoadOptions;
@@ -337,7 +338,7 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
     if let (Some(model), true) = (&voxels, probe.as_ref().is_some_and(GridRun::needs_moves)) {
         let run = GridRun::new(model.clone(), &GridConfig::default(), &budget, grid_started);
         if run.found() {
-            return Ok(grid_result(&checker, &run, GridReason::NeedsMoves, None, world_seconds));
+            return Ok(grid_result(&checker, settings, &run, GridReason::NeedsMoves, None, world_seconds));
         }
         grid = Some(run);
     }
@@ -367,13 +368,15 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
             if !stuck.is_empty() && stuck.iter().all(|s| matches!(s.reason, StuckReason::WouldLeaveUnsupported(_))));
         (!found && !gravity_only) || (found && !taken_apart(outcome))
     };
+    let mut grid_ran = GridRan::No;
     if wants_grid(&outcome) {
         if let Some(model) = voxels {
             let found = outcome.status == Status::Found;
             let run = grid.unwrap_or_else(|| GridRun::new(model, &GridConfig::default(), &budget, Instant::now()));
             if (!found && run.found()) || run.solution.complete() {
-                return Ok(grid_result(&checker, &run, GridReason::Fallback, Some(&outcome), world_seconds));
+                return Ok(grid_result(&checker, settings, &run, GridReason::Fallback, Some(&outcome), world_seconds));
             }
+            grid_ran = GridRan::of(&run.solution.plan);
             if grid_first && !budget_spent(&outcome) {
                 // neither straight lines nor grid moves: the path planner's turn
                 (outcome, robot) = run_dfs(true)?;
@@ -386,6 +389,7 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
         report.attach_robot(r);
     }
     finish_report(&mut report, world, &outcome, world_seconds);
+    explain_cores(&mut report, world, settings, grid_ran);
     Ok(PlanResult { report, status: outcome.status, search: None })
 }
 
@@ -413,7 +417,14 @@ fn taken_apart(outcome: &PlanOutcome) -> bool {
 
 /// The plan of a grid search (after the depth-first search's `before`, whose counters and time
 /// it keeps).
-fn grid_result(checker: &Checker, run: &GridRun, reason: GridReason, before: Option<&PlanOutcome>, world_seconds: f64) -> PlanResult {
+fn grid_result(
+    checker: &Checker,
+    settings: &PlanSettings,
+    run: &GridRun,
+    reason: GridReason,
+    before: Option<&PlanOutcome>,
+    world_seconds: f64,
+) -> PlanResult {
     let world = checker.world();
     let assembly = world.assembly();
     let mut outcome = run.outcome(assembly);
@@ -433,6 +444,7 @@ fn grid_result(checker: &Checker, run: &GridRun, reason: GridReason, before: Opt
         seconds: run.solution.seconds,
     });
     finish_report(&mut report, world, &outcome, world_seconds);
+    explain_cores(&mut report, world, settings, GridRan::of(&run.solution.plan));
     PlanResult { report, status: outcome.status, search: None }
 }
 

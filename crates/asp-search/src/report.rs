@@ -15,7 +15,7 @@ pub mod text;
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.8";
+pub const FORMAT_VERSION: &str = "1.9";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -96,6 +96,10 @@ pub struct LockedCore {
     /// The subassembly's own explanation: the parts of its dead end and what holds each.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub explanation: Vec<Explanation>,
+    /// Why it is locked: overlaps, blocking pairs, the grid planner, what `--overlaps lenient`
+    /// would free (feasibility plans; format 1.9).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub why: Option<CoreWhy>,
 }
 
 /// The grid search behind a plan (format 1.6).
@@ -539,6 +543,7 @@ fn locked_cores(steps: &[AssemblyStep], name: &dyn Fn(usize) -> String) -> Vec<L
                 parts,
                 status: g.status,
                 explanation: g.explanation.clone(),
+                why: None,
             });
         }
         cores.extend(locked_cores(&g.assembly_sequence, name));
@@ -747,3 +752,46 @@ vocabulary! {
         ParetoMcts => "pareto_mcts",
     }
 }
+
+vocabulary! {
+    /// Whether and why the grid planner ran on a locked core (`locked_cores[].why.grid.reason`,
+    /// format 1.9).
+    CoreGridReason {
+        /// It ran on the model and every grid state it reached still holds the core together
+        /// (the core cannot come apart by moves on the grid either).
+        Stuck => "stuck",
+        /// It ran, but its state budget or the time ran out first.
+        Budget => "budget",
+        /// Not tried: it was turned off (`--no-grid`).
+        Off => "off",
+        /// Not tried: the plan was made with a robot (the grid planner plans no arm).
+        Robot => "robot",
+        /// Not tried: the model has more parts than the grid planner takes (64).
+        TooManyParts => "too_many_parts",
+        /// Not tried: the model's parts are not all unions of cells of one common grid.
+        NotOnGrid => "not_on_grid",
+    }
+}
+
+vocabulary! {
+    /// What the core's own plan on its base gives under `--overlaps lenient`
+    /// (`locked_cores[].why.lenient.status`, format 1.9).
+    LenientStatus {
+        /// Not rerun: no two parts of the core overlap beyond the tolerance (or the plan's policy
+        /// already tests them as `lenient` does), so its tests would be the same.
+        Unchanged => "unchanged",
+        /// Every part of the core comes off its base.
+        Found => "found",
+        /// A complete sequence, but a smaller core in it still goes in as one unit.
+        Partial => "partial",
+        /// Some parts (`frees`) or none come off before it is stuck again.
+        NoPlan => "no_plan",
+        /// The rerun's budget ran out (`frees` is what came off by then: a lower bound).
+        BudgetExhausted => "budget_exhausted",
+        /// The rerun could not be made (its checker could not be set up as the plan's).
+        Unknown => "unknown",
+    }
+}
+
+pub mod why;
+pub use why::{CoreBlocker, CoreBlocks, CoreGrid, CoreLenient, CoreOverlap, CoreWhy};

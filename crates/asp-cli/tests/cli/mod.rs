@@ -38,7 +38,7 @@ fn plans_a_fixture_prints_a_table_and_writes_the_json() {
     assert!(table.contains("found"), "{table}");
     assert!(table.contains("stick") && table.contains("handle") && table.contains("cap"), "{table}");
     let plan = json(&out);
-    assert_eq!(plan["format_version"], "1.8");
+    assert_eq!(plan["format_version"], "1.9");
     assert_eq!(plan["stats"]["checker"], "collision_world");
     assert_eq!(plan["status"], "found");
     assert_eq!(plan["up"], "+z");
@@ -341,7 +341,7 @@ fn issue_9_plans_an_interlocking_burr_by_grid_moves() {
     let table = String::from_utf8(o.stdout).unwrap();
     assert!(table.contains("grid plan") && table.contains("move piece"), "{table}");
     let plan = json(&out);
-    assert_eq!(plan["format_version"], "1.8");
+    assert_eq!(plan["format_version"], "1.9");
     assert_eq!(plan["status"], "found");
     assert_eq!(plan["grid"]["reason"], "needs_moves");
     assert_eq!(plan["grid"]["first_separation_moves"], asp_geom::puzzles::BURR_LEVEL_MOVES);
@@ -389,6 +389,14 @@ fn issue_28_a_plan_with_a_locked_core_is_partial_with_exit_code_1() {
     assert!(!cores[0]["explanation"].as_array().unwrap().is_empty(), "{plan}");
     let line = format!("planned 0 of 6 parts; 6 stay in 1 locked core: {}", names.join(", "));
     assert_eq!(lines.next(), Some(line.as_str()), "{table}");
+    // and why (format 1.9): no overlaps, the grid planner turned off, lenient changes nothing
+    let why = &cores[0]["why"];
+    assert!(why["overlaps"].is_null(), "{plan}");
+    assert_eq!(why["grid"], serde_json::json!({ "tried": false, "reason": "off" }), "{plan}");
+    assert_eq!(why["lenient"], serde_json::json!({ "status": "unchanged", "frees": 0 }), "{plan}");
+    assert_eq!(why["blocks"].as_array().unwrap().len(), 5, "{plan}");
+    assert!(lines.next().unwrap().starts_with("  why the core on "), "{table}");
+    assert!(table.contains("\n    grid planner: not tried (--no-grid)\n"), "{table}");
     // --each counts partial plans apart; the exit code is the worst (1)
     let o = asp(&["plan", "--each", models.to_str().unwrap(), off[0], off[1]]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
