@@ -210,6 +210,14 @@ def test_a_plan_with_a_locked_core_is_partial(root, asp_cli):
     assert table.splitlines()[1].startswith(f"planned {len(plan.parts) - 6} of {len(plan.parts)} parts; 6 stay in 1 locked core: ")
     assert table.splitlines()[2] == "  why the core on PumpAssembly - Pump-1 (6 parts) is locked:"
     assert "    --overlaps lenient: would free all 5 of its other parts\n" in table
+    # declared one unit on purpose, the same core makes the plan found (issue 28 item 2)
+    core = plan.locked_cores[0]  # a fresh copy (the one above had its names cleared)
+    unit = asp.load(PUMP, unit="mm", up="z").plan(unit_group=[core["names"]])
+    assert unit.status == "found" and unit.found and unit.locked_cores == []
+    step = next(s for s in unit.to_dict()["assembly_sequence"] if "subassembly" in s)
+    assert step["subassembly"]["status"] == "unit" and sorted(step["subassembly"]["parts"]) == sorted(core["parts"])
+    with pytest.raises(asp.ConfigError, match="unit_group: no part is named 'nope'"):
+        asp.load(PUMP, unit="mm", up="z").plan(unit_group="nope,PumpAssembly - Pump-1")
     # a plan that takes every part apart has none
     lack = asp.plan(LACK, up="z")
     assert lack.status == "found" and lack.found and lack.locked_cores == []

@@ -15,7 +15,9 @@ use asp_geom::io::LoadOptions;
 use asp_geom::math::Axis;
 use asp_geom::physics::PhysicsConfig;
 use asp_geom::rrt::RrtConfig;
-use asp_geom::{Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, OverlapPolicy, StabilityMode, Units, World, WorldConfig};
+use asp_geom::{
+    Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, OverlapPolicy, PartSet, StabilityMode, Units, World, WorldConfig,
+};
 use asp_search::extension::resolve_objectives;
 use asp_search::grid::GridConfig;
 use asp_search::grid::GridRun;
@@ -23,6 +25,7 @@ use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES};
 use asp_search::report::{
     Checker as CheckerName, GridEntry, GridReason, OptimisationEntry, OptimisationMethod, ParetoEntry, PlanReport, Timings,
 };
+use asp_search::units::UnitChecker;
 use asp_search::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
 use asp_search::{BuiltinOrder, OrderingSource};
 use asp_search::{CheckerExtension, MdpExtension, ModelContext};
@@ -87,6 +90,8 @@ pub struct PlanSettings {
     pub path_planner: bool,
     /// Let groups of parts leave together as rigid subassemblies when no single part can.
     pub subassemblies: bool,
+    /// Groups of parts (by name) planned as one part each, on purpose ([`asp_search::units`]).
+    pub unit_groups: Vec<Vec<String>>,
     /// Plan voxel models by moves of parts and groups on their grid ([`asp_search::grid`]) when
     /// several parts must move in turn before anything can leave, or when the depth-first
     /// search finds no plan.
@@ -128,6 +133,7 @@ impl Default for PlanSettings {
             seed: 0,
             path_planner: true,
             subassemblies: true,
+            unit_groups: Vec::new(),
             grid: true,
             rrt_iterations: RrtConfig::default().max_iterations,
             rrt_time: RrtConfig::default().max_time.as_secs_f64(),
@@ -328,7 +334,9 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
         return self::optimise(Arc::new(assembly), settings, optimise);
     }
     let budget = budget(settings)?;
-    let voxels = (settings.grid && settings.checker_extension.is_none()).then(|| VoxelModel::of(&assembly)).flatten();
+    let units = unit_sets(&assembly, &settings.unit_groups)?;
+    // the grid planner does not keep declared units together
+    let voxels = (settings.grid && settings.checker_extension.is_none() && units.is_empty()).then(|| VoxelModel::of(&assembly)).flatten();
     let grid_started = Instant::now();
     let probe = voxels.clone().map(|m| GridRun::probe(m, &budget, grid_started));
     let started = Instant::now();
@@ -349,6 +357,13 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
     let run_dfs = |path_planner: bool| -> Result<(PlanOutcome, Option<asp_search::report::RobotReport>)> {
         let dfs = planner(&PlanSettings { path_planner, ..settings.clone() }, checker.world())?;
         let mut search = |c: &dyn asp_geom::FeasibilityChecker| {
+            let with_units;
+            let c: &dyn asp_geom::FeasibilityChecker = if units.is_empty() {
+                c
+            } else {
+                with_units = UnitChecker::new(c, units.clone());
+                &with_units
+            };
             let mut problem = Problem::full(c);
             problem.progress = progress;
             dfs.solve(&problem, &budget)
@@ -389,8 +404,23 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
         report.attach_robot(r);
     }
     finish_report(&mut report, world, &outcome, world_seconds);
-    explain_cores(&mut report, world, settings, grid_ran);
+    explain_cores(&mut report, world, settings, grid_ran, &units);
     Ok(PlanResult { report, status: outcome.status, search: None })
+}
+
+/// The declared units ([`PlanSettings::unit_groups`]) as sets of part indices.
+fn unit_sets(assembly: &Assembly, groups: &[Vec<String>]) -> Result<Vec<PartSet>> {
+    let n = assembly.len();
+    groups
+        .iter()
+        .map(|g| {
+            let parts = g
+                .iter()
+                .map(|name| assembly.part_index(name).ok_or_else(|| AppError::setting("unit_group", format!("no part is named '{name}'"))))
+                .collect::<Result<Vec<usize>>>()?;
+            Ok(PartSet::from_indices(n + 1, parts))
+        })
+        .collect()
 }
 
 /// What every feasibility plan's report carries besides its steps: the overlapping pairs and
@@ -444,7 +474,7 @@ fn grid_result(
         seconds: run.solution.seconds,
     });
     finish_report(&mut report, world, &outcome, world_seconds);
-    explain_cores(&mut report, world, settings, GridRan::of(&run.solution.plan));
+    explain_cores(&mut report, world, settings, GridRan::of(&run.solution.plan), &[]);
     PlanResult { report, status: outcome.status, search: None }
 }
 

@@ -8,6 +8,7 @@ use asp_geom::grid::VoxelModel;
 use asp_geom::{Assembly, Checker, FeasibilityChecker, PartSet, World};
 use asp_search::grid::solver::{GridPlan, GridStatus};
 use asp_search::report::{CoreGrid, CoreGridReason, CoreLenient, CoreWhy, LenientStatus, PlanReport};
+use asp_search::units::UnitChecker;
 use asp_search::{Budget, Planner, Problem};
 use std::time::Duration;
 
@@ -44,7 +45,7 @@ impl GridRan {
 }
 
 /// Adds `why` to every locked core of `report`, planned in `world` with `settings`.
-pub(crate) fn explain_cores(report: &mut PlanReport, world: &World, settings: &PlanSettings, grid: GridRan) {
+pub(crate) fn explain_cores(report: &mut PlanReport, world: &World, settings: &PlanSettings, grid: GridRan, units: &[PartSet]) {
     if report.locked_cores.is_empty() {
         return;
     }
@@ -55,7 +56,7 @@ pub(crate) fn explain_cores(report: &mut PlanReport, world: &World, settings: &P
         let mut lenient = |base: usize, parts: &[usize]| {
             let checker = lenient_checker.get_or_insert_with(|| lenient_world(world, settings));
             match checker {
-                Some(c) => rerun(c, settings, base, parts),
+                Some(c) => rerun(c, settings, base, parts, units),
                 None => CoreLenient { status: LenientStatus::Unknown, frees: 0 },
             }
         };
@@ -77,6 +78,9 @@ fn core_grid(assembly: &Assembly, settings: &PlanSettings, ran: GridRan, parts: 
     }
     if settings.checker_extension.is_some() {
         return not_tried(CoreGridReason::Robot, None);
+    }
+    if !settings.unit_groups.is_empty() {
+        return not_tried(CoreGridReason::UnitGroups, None);
     }
     let core = Assembly {
         parts: parts.iter().filter_map(|&p| assembly.parts.get(p).cloned()).collect(),
@@ -101,11 +105,12 @@ fn lenient_world(world: &World, settings: &PlanSettings) -> Option<Checker> {
 
 /// The core of `parts` planned on its `base` in the lenient `checker`, as the plan planned it
 /// (the same ordering and seed, straight lines and subassemblies, no path planner).
-fn rerun(checker: &Checker, settings: &PlanSettings, base: usize, parts: &[usize]) -> CoreLenient {
+fn rerun(checker: &Checker, settings: &PlanSettings, base: usize, parts: &[usize], units: &[PartSet]) -> CoreLenient {
     let unknown = CoreLenient { status: LenientStatus::Unknown, frees: 0 };
     let n = checker.num_parts();
     let start = PartSet::from_indices(n + 1, parts.iter().copied().filter(|&p| p < n));
-    let Some((b, sub)) = checker.subassembly(&start) else { return unknown };
+    let with_units = UnitChecker::new(checker, units.to_vec());
+    let Some((b, sub)) = with_units.subassembly(&start) else { return unknown };
     let Ok(dfs) = planner(&PlanSettings { path_planner: false, ..settings.clone() }, checker.world()) else { return unknown };
     if b != base {
         return unknown; // the base is the largest part of the group, and so of its core

@@ -490,6 +490,7 @@ fn assembly_steps(removals: &[Step], name: &dyn Fn(usize) -> String, u: &dyn Fn(
             subassembly: s.group.as_ref().map(|g| {
                 let named = |set: &PartSet| set.iter().map(|part| NamedPart { part, name: name(part) }).collect();
                 let (status, assembly_sequence, explanation) = match &g.plan {
+                    None if g.unit => (SubassemblyStatus::Unit, Vec::new(), Vec::new()),
                     None => (SubassemblyStatus::Unplanned, Vec::new(), Vec::new()),
                     Some(plan) => {
                         let steps = assembly_steps(&plan.removals, name, u);
@@ -514,9 +515,12 @@ fn assembly_steps(removals: &[Step], name: &dyn Fn(usize) -> String, u: &dyn Fn(
 }
 
 /// `found` only when every part gets its own motion: a found sequence holding a subassembly
-/// whose own plan is not `found` (recursively) is `partial`.
+/// whose own plan is not `found` (recursively) is `partial`. A unit the user declared counts as
+/// one part.
 fn complete(status: PlanStatus, steps: &[AssemblyStep]) -> PlanStatus {
-    let locked = steps.iter().any(|s| s.subassembly.as_ref().is_some_and(|g| g.status != SubassemblyStatus::Found));
+    let locked = steps
+        .iter()
+        .any(|s| s.subassembly.as_ref().is_some_and(|g| !matches!(g.status, SubassemblyStatus::Found | SubassemblyStatus::Unit)));
     if status == PlanStatus::Found && locked {
         PlanStatus::Partial
     } else {
@@ -530,7 +534,7 @@ fn locked_cores(steps: &[AssemblyStep], name: &dyn Fn(usize) -> String) -> Vec<L
     let mut cores = Vec::new();
     for step in steps {
         let Some(g) = &step.subassembly else { continue };
-        if !matches!(g.status, SubassemblyStatus::Found | SubassemblyStatus::Partial) {
+        if !matches!(g.status, SubassemblyStatus::Found | SubassemblyStatus::Partial | SubassemblyStatus::Unit) {
             let placed: Vec<usize> = g
                 .assembly_sequence
                 .iter()
@@ -676,6 +680,9 @@ vocabulary! {
         BudgetExhausted => "budget_exhausted",
         /// Its own plan was not tried.
         Unplanned => "unplanned",
+        /// Declared one unit (`--unit-group`): planned as one part on purpose, not taken apart
+        /// (format 1.9).
+        Unit => "unit",
     }
 }
 
@@ -770,6 +777,9 @@ vocabulary! {
         TooManyParts => "too_many_parts",
         /// Not tried: the model's parts are not all unions of cells of one common grid.
         NotOnGrid => "not_on_grid",
+        /// Not tried: units were declared (`--unit-group`), which the grid planner does not keep
+        /// together.
+        UnitGroups => "unit_groups",
     }
 }
 

@@ -248,3 +248,63 @@ fn issue_28_a_locked_core_says_whether_the_grid_planner_tried_it() {
     assert!(!grid.tried && grid.reason == CoreGridReason::Off, "{}", r.report.to_json());
     assert!(r.report.to_text().contains("    grid planner: not tried (--no-grid)\n"));
 }
+
+/// Issue 28 item 2: parts declared one unit (`--unit-group`) are planned as one part on purpose:
+/// the locked post's core goes in whole as a `unit` step and the plan is `found`, not `partial`;
+/// a unit with a fixed part is part of the base; an unknown name is an error naming the setting.
+#[test]
+fn issue_28_a_declared_unit_is_planned_as_one_part_and_the_plan_is_found() {
+    use asp_search::report::{PlanStatus, SubassemblyStatus};
+    let unit = |names: &[&str]| vec![names.iter().map(|n| n.to_string()).collect::<Vec<_>>()];
+    let settings = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
+    let r = plan_assembly(asp_geom::fixtures::ring_on_locked_post(), &settings, None).unwrap();
+    assert_eq!(r.report.status, PlanStatus::Partial, "without the unit: {}", r.report.to_json());
+    let declared = PlanSettings { unit_groups: unit(&["base", "post", "ring"]), ..settings.clone() };
+    let r = plan_assembly(asp_geom::fixtures::ring_on_locked_post(), &declared, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Found, "{json}");
+    assert!(r.found() && r.report.locked_cores.is_empty() && r.report.grid.is_none(), "{json}");
+    let steps = &r.report.assembly_sequence;
+    assert_eq!(steps.len(), 2, "the unit, then the cap: {json}");
+    let g = steps[0].subassembly.as_ref().expect("the unit's step");
+    assert_eq!((g.parts.clone(), g.status, steps[0].part), (vec![0, 1, 2], SubassemblyStatus::Unit, 0), "{json}");
+    assert!(g.assembly_sequence.is_empty() && g.explanation.is_empty());
+    assert_eq!((steps[1].name.as_str(), steps[1].subassembly.is_none()), ("cap", true));
+    assert!(json.contains("\"status\": \"unit\""));
+    let text = r.report.to_text();
+    assert!(text.contains("base + 2 more (unit)") && text.contains("declared one unit (--unit-group), not taken apart"), "{text}");
+    // a unit with the fixed part is part of the base: the dowel never moves, the board comes off
+    let fixed = PlanSettings { unit_groups: unit(&["lower", "dowel"]), ..settings.clone() };
+    let r = plan_assembly(asp_geom::fixtures::dowel_in_two_boards(), &fixed, None).unwrap();
+    assert_eq!(r.report.status, PlanStatus::Found, "{}", r.report.to_json());
+    assert_eq!(r.report.assembly_sequence.iter().map(|s| s.name.as_str()).collect::<Vec<_>>(), ["upper"]);
+    // names are checked against the model
+    let wrong = PlanSettings { unit_groups: unit(&["base", "nope"]), ..settings };
+    let e = plan_assembly(asp_geom::fixtures::ring_on_locked_post(), &wrong, None).unwrap_err();
+    assert_eq!(e.to_string(), "unit_group: no part is named 'nope'");
+}
+
+/// Issue 28 item 2 on the shared pump: its locked core declared one unit makes the plan `found`
+/// with the core's step a `unit`; a unit inside a larger locked core keeps that core `partial`
+/// and its lenient rerun keeps the unit whole (it frees only the parts outside the unit).
+#[test]
+fn issue_28_the_pumps_core_declared_one_unit_is_found() {
+    use asp_search::report::{LenientStatus, PlanStatus, SubassemblyStatus};
+    let p = |n: &str| format!("PumpAssembly - {n}");
+    let core = ["BackLid2-1", "LargeScrew1-1", "LargeScrew2-1", "Pump-1", "Ring-1", "Shaft-1"];
+    let mm = PlanSettings { unit: Some(asp_geom::Units::parse("mm").unwrap()), ..PlanSettings::default() };
+    let declared = PlanSettings { unit_groups: vec![core.iter().map(|n| p(n)).collect()], ..mm.clone() };
+    let r = asp_app::pipeline::plan_file(&pump(), &declared, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Found, "{json}");
+    let units: Vec<_> = r.report.assembly_sequence.iter().filter_map(|s| s.subassembly.as_ref()).collect();
+    assert_eq!(units.len(), 1, "{json}");
+    assert_eq!((units[0].status, units[0].parts.len()), (SubassemblyStatus::Unit, 6), "{json}");
+    let pair = PlanSettings { unit_groups: vec![vec![p("Pump-1"), p("Shaft-1")]], ..mm };
+    let r = asp_app::pipeline::plan_file(&pump(), &pair, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Partial, "{json}");
+    let why = r.report.locked_cores[0].why.as_ref().unwrap();
+    assert_eq!(why.grid.reason, asp_search::report::CoreGridReason::UnitGroups, "{json}");
+    assert_eq!((why.lenient.status, why.lenient.frees), (LenientStatus::NoPlan, 3), "the shaft stays with the body: {json}");
+}

@@ -444,3 +444,29 @@ fn gen_profiles_attaches_connectors_on_request() {
     let bad = asp(&["gen", "profiles", "--connectors", "glued", "--out", dir.path().to_str().unwrap()]);
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// Issue 28 item 2: `--unit-group` plans the named parts as one part on purpose: the locked
+/// post's core goes in whole, the plan is `found` (exit 0); a name the model lacks is an error
+/// naming the flag (exit 2).
+#[test]
+fn issue_28_unit_group_plans_named_parts_as_one_unit() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = fixture_file(dir.path(), &fixtures::ring_on_locked_post(), "post.glb");
+    let model = model.to_str().unwrap();
+    let o = asp(&["plan", model, "--json"]);
+    assert_eq!(o.status.code(), Some(1), "without the unit the plan is partial: {}", stderr(&o));
+    let o = asp(&["plan", model, "--json", "--unit-group", "base,post,ring"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(plan["status"], "found", "{plan}");
+    assert!(plan["locked_cores"].is_null(), "{plan}");
+    let unit = &plan["assembly_sequence"][0]["subassembly"];
+    assert_eq!(unit["status"], "unit", "{plan}");
+    assert_eq!(unit["parts"], serde_json::json!([0, 1, 2]));
+    let o = asp(&["plan", model, "--unit-group", "base,nope"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--unit-group: no part is named 'nope'"), "{}", stderr(&o));
+    let o = asp(&["plan", model, "--unit-group", "base"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--unit-group: a unit needs at least two parts"), "{}", stderr(&o));
+}

@@ -136,6 +136,7 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
     let name = |i: usize| r.parts.get(i).map_or("?", |p| p.name.as_str());
     let label = |step: &AssemblyStep| match &step.subassembly {
         None => step.name.clone(),
+        Some(g) if g.status == SubassemblyStatus::Unit => format!("{} + {} more (unit)", step.name, g.parts.len() - 1),
         Some(g) => format!("{} + {} more (subassembly)", step.name, g.parts.len() - 1),
     };
     let width = sequence.iter().map(|s| label(s).len()).fold(width, usize::max);
@@ -167,6 +168,7 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
                 SubassemblyStatus::Partial => "built on its base in this order, but not all of it part by part:".to_string(),
                 SubassemblyStatus::NoPlan => "cannot be taken apart (it goes in as one unit):".to_string(),
                 SubassemblyStatus::Unplanned => "not planned".to_string(),
+                SubassemblyStatus::Unit => "declared one unit (--unit-group), not taken apart".to_string(),
                 other => format!("{} before its own plan was found; the parts that come off:", other.as_str().replace('_', " ")),
             };
             writeln!(out, "{inner}subassembly {} on base {}: {how}", members.join(", "), step.name)?;
@@ -251,6 +253,7 @@ fn write_why(out: &mut impl Write, r: &PlanReport, core: &LockedCore, why: &Core
         CoreGridReason::Budget => "tried: its budget ran out first".to_string(),
         CoreGridReason::Off => "not tried (--no-grid)".to_string(),
         CoreGridReason::Robot => "not tried (planned with a robot)".to_string(),
+        CoreGridReason::UnitGroups => "not tried (units declared with --unit-group)".to_string(),
         CoreGridReason::TooManyParts => format!("not tried (more than 64 parts){}", on_grid(why.grid.core_on_grid)),
         CoreGridReason::NotOnGrid => format!("not tried (the model's parts are not all on one grid){}", on_grid(why.grid.core_on_grid)),
     };
@@ -269,6 +272,7 @@ fn write_why(out: &mut impl Write, r: &PlanReport, core: &LockedCore, why: &Core
         LenientStatus::Unknown => "not known (the rerun could not be set up)".to_string(),
     };
     writeln!(out, "    --overlaps lenient: {lenient}")?;
+    writeln!(out, "    if it is one component (bought or pressed together), declare it one unit: --unit-group NAME,NAME,...")?;
     let d = why.directions;
     for b in why.blocks.iter().take(WHY_PARTS) {
         let by: Vec<String> =
