@@ -157,6 +157,10 @@ fn issue_28_the_pumps_locked_core_says_why() {
     assert!(text.contains("    --overlaps lenient: would free all 5 of its other parts\n"), "{text}");
     assert!(text
         .contains(&format!("    PumpAssembly - Shaft-1: blocked along all {} directions; by PumpAssembly - Pump-1 along", why.directions)));
+    // and the whole pump planned with lenient overlaps is taken apart: the rerun told the truth
+    let lenient = PlanSettings { overlaps: asp_geom::OverlapPolicy::Lenient, ..settings };
+    let r = asp_app::pipeline::plan_file(&pump(), &lenient, None).unwrap();
+    assert_eq!(r.report.status, PlanStatus::Found, "{}", r.report.to_json());
 }
 
 /// Two bars drawn through each other (a halving joint with no notches modelled: an overlap no
