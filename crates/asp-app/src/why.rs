@@ -10,10 +10,10 @@ use asp_search::grid::solver::{GridPlan, GridStatus};
 use asp_search::report::{CoreGrid, CoreGridReason, CoreLenient, CoreWhy, LenientStatus, PlanReport};
 use asp_search::units::UnitChecker;
 use asp_search::{Budget, Planner, Problem};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
-/// The longest a core's lenient rerun may take, seconds (less when the plan's own `timeout` is
-/// shorter).
+/// The longest the lenient reruns of a plan's cores may take together, seconds (less when the
+/// plan's own `timeout` is shorter); a rerun that finds the time spent ends `budget_exhausted`.
 pub const LENIENT_SECONDS: f64 = 10.0;
 
 /// The most parts the grid planner takes (as [`VoxelModel::of`]).
@@ -50,13 +50,15 @@ pub(crate) fn explain_cores(report: &mut PlanReport, world: &World, settings: &P
         return;
     }
     let mut lenient_checker: Option<Option<Checker>> = None;
+    let seconds = settings.timeout.map_or(LENIENT_SECONDS, |t| t.min(LENIENT_SECONDS)).max(0.0);
+    let deadline = Instant::now() + Duration::from_secs_f64(seconds);
     let mut cores = std::mem::take(&mut report.locked_cores);
     for core in &mut cores {
         let grid = core_grid(world.assembly(), settings, grid, &core.parts);
         let mut lenient = |base: usize, parts: &[usize]| {
             let checker = lenient_checker.get_or_insert_with(|| lenient_world(world, settings));
             match checker {
-                Some(c) => rerun(c, settings, base, parts, units),
+                Some(c) => rerun(c, settings, base, parts, units, deadline),
                 None => CoreLenient { status: LenientStatus::Unknown, frees: 0 },
             }
         };
@@ -105,7 +107,7 @@ fn lenient_world(world: &World, settings: &PlanSettings) -> Option<Checker> {
 
 /// The core of `parts` planned on its `base` in the lenient `checker`, as the plan planned it
 /// (the same ordering and seed, straight lines and subassemblies, no path planner).
-fn rerun(checker: &Checker, settings: &PlanSettings, base: usize, parts: &[usize], units: &[PartSet]) -> CoreLenient {
+fn rerun(checker: &Checker, settings: &PlanSettings, base: usize, parts: &[usize], units: &[PartSet], deadline: Instant) -> CoreLenient {
     let unknown = CoreLenient { status: LenientStatus::Unknown, frees: 0 };
     let n = checker.num_parts();
     let start = PartSet::from_indices(n + 1, parts.iter().copied().filter(|&p| p < n));
@@ -115,8 +117,8 @@ fn rerun(checker: &Checker, settings: &PlanSettings, base: usize, parts: &[usize
     if b != base {
         return unknown; // the base is the largest part of the group, and so of its core
     }
-    let seconds = settings.timeout.map_or(LENIENT_SECONDS, |t| t.min(LENIENT_SECONDS)).max(0.0);
-    let budget = Budget { max_tests: settings.max_tests, timeout: Some(Duration::from_secs_f64(seconds)), cancel: settings.cancel.clone() };
+    let left = deadline.saturating_duration_since(Instant::now());
+    let budget = Budget { max_tests: settings.max_tests, timeout: Some(left), cancel: settings.cancel.clone() };
     let plan = dfs.solve(&Problem { checker: &*sub, start, progress: None }, &budget);
     CoreLenient::of(&plan, parts.len())
 }

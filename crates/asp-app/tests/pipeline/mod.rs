@@ -311,4 +311,7 @@ fn issue_28_the_pumps_core_declared_one_unit_is_found() {
     let why = r.report.locked_cores[0].why.as_ref().unwrap();
     assert_eq!(why.grid.reason, asp_search::report::CoreGridReason::UnitGroups, "{json}");
     assert_eq!((why.lenient.status, why.lenient.frees), (LenientStatus::NoPlan, 3), "the shaft stays with the body: {json}");
+    let text = r.report.to_text();
+    assert!(text.contains("\n    --overlaps lenient: would free 3 of its 5 other parts\n"), "{text}");
+    assert!(text.contains("\n    grid planner: not tried (units declared with --unit-group)\n"), "{text}");
 }

@@ -192,3 +192,44 @@ fn blocks_of(world: &World, p: usize, core: &PartSet) -> CoreBlocks {
         .collect();
     CoreBlocks { part: p, name: world.name(p).to_string(), free, by }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::problem::{Stats, Subassembly};
+    use asp_geom::math::Vec3;
+    use asp_geom::Motion;
+
+    fn single(part: usize) -> Step {
+        Step::single(part, Motion::Linear { direction: Vec3::Z, distance: 1.0 })
+    }
+
+    fn outcome(status: Status, removals: Vec<Step>) -> PlanOutcome {
+        PlanOutcome { status, removals, stats: Stats::default() }
+    }
+
+    /// What a lenient rerun frees: each part with its own motion, a subassembly's base with what
+    /// its own plan takes off it, a declared unit's base alone; the status from the rerun's end.
+    #[test]
+    fn a_rerun_frees_the_parts_it_gives_their_own_motion() {
+        let all = outcome(Status::Found, vec![single(1), single(2), single(3)]);
+        assert_eq!(CoreLenient::of(&all, 4), CoreLenient { status: LenientStatus::Found, frees: 3 });
+        // a group of 2 and 3 whose own plan is stuck: 3 comes off the group's base 2 or not at all
+        let stuck = outcome(Status::NoPlan { stuck: Vec::new(), state: PartSet::empty(4) }, Vec::new());
+        let group = |plan: Option<PlanOutcome>, unit: bool| Step {
+            group: Some(Box::new(Subassembly { parts: PartSet::from_indices(4, [2, 3]), plan, unit })),
+            ..single(2)
+        };
+        let locked = outcome(Status::Found, vec![single(1), group(Some(stuck.clone()), false)]);
+        assert_eq!(CoreLenient::of(&locked, 4), CoreLenient { status: LenientStatus::Partial, frees: 2 });
+        let opened = outcome(Status::Found, vec![single(1), group(Some(outcome(Status::Found, vec![single(3)])), false)]);
+        assert_eq!(CoreLenient::of(&opened, 4), CoreLenient { status: LenientStatus::Found, frees: 3 });
+        assert_eq!(own_motions(&[group(None, true)]), 1, "a unit moves as one part");
+        // stuck after one part, or out of budget after one: what came off, a lower bound
+        let partial = outcome(Status::NoPlan { stuck: Vec::new(), state: PartSet::empty(4) }, vec![single(1)]);
+        assert_eq!(CoreLenient::of(&partial, 4), CoreLenient { status: LenientStatus::NoPlan, frees: 1 });
+        let spent = outcome(Status::BudgetExhausted, vec![single(1)]);
+        assert_eq!(CoreLenient::of(&spent, 4), CoreLenient { status: LenientStatus::BudgetExhausted, frees: 1 });
+        assert_eq!(CoreLenient::of(&stuck, 4).frees, 0);
+    }
+}
