@@ -143,6 +143,7 @@ class Assembly:
         path_planner: bool | None = None,
         subassemblies: bool | None = None,
         grid: bool | None = None,
+        unit_group: str | Sequence[str | Sequence[str]] | None = None,
         rrt_iterations: int | None = None,
         rrt_time: float | None = None,
         max_tests: int | None = None,
@@ -194,6 +195,11 @@ class Assembly:
         :param subassemblies: let groups of parts leave together as one rigid subassembly when
             no single part can (True).
         :param grid: plan voxel models by grid moves (True).
+        :param unit_group: parts planned as one part each, on purpose (a purchased motor, a
+            pressed-in bearing): a list of groups, each a comma-separated string or a list of
+            part names (one string is one group). A unit goes in whole as a subassembly step whose
+            status is ``"unit"``, and the plan is still ``"found"``; a unit with a fixed part is
+            part of the base.
         :param rrt_iterations: path planner iterations per call (2000).
         :param rrt_time: path planner wall-time cap per call, seconds (5).
         :param max_tests: stop after this many removal tests (status ``budget_exhausted``).

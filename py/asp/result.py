@@ -57,7 +57,15 @@ class Plan:
     def locked_cores(self) -> list[dict[str, Any]]:
         """For ``"partial"`` plans, the parts asp could not take apart, one dict per core:
         ``base``, ``parts``, ``names``, ``status`` (why: ``"no_plan"``, ``"budget_exhausted"``
-        or ``"unplanned"``) and ``explanation`` (what holds each part); empty otherwise."""
+        or ``"unplanned"``), ``explanation`` (what holds each part) and ``why`` (format 1.9): a
+        dict with ``overlaps`` (the core's overlapping pairs: ``parts``, ``names``, ``depth``,
+        ``gross``, ``artefact``, the last true when deeper than ``artefact_depth``, a modelling
+        artefact rather than a fit), ``directions`` (the candidate directions), ``blocks`` (per
+        part but the base: ``free`` directions and ``by``, the parts that block it with their
+        ``directions`` and ``only`` counts), ``grid`` (``tried``, ``reason``, ``core_on_grid``)
+        and ``lenient`` (``status`` and ``frees``: the parts the core's own plan frees under
+        ``overlaps="lenient"``); ``docs/plan-format.md``, "Why a core is locked". Empty
+        otherwise."""
         return self._copy("locked_cores", [])
 
     def table(self) -> str:

@@ -39,6 +39,7 @@ class PlanSettings(TypedDict, total=False):
     path_planner: bool
     subassemblies: bool
     grid: bool
+    unit_group: str | Sequence[str | Sequence[str]]
     rrt_iterations: int
     rrt_time: float
     order: Order

@@ -191,6 +191,15 @@ def test_a_plan_with_a_locked_core_is_partial(root, asp_cli):
     assert names == ["BackLid2-1", "LargeScrew1-1", "LargeScrew2-1", "Pump-1", "Ring-1", "Shaft-1"]
     assert core["status"] == "no_plan" and core["explanation"]
     assert core["base"] in core["parts"]
+    # why it is locked (issue 28 item 2, format 1.9): fits, not artefacts; every part blocked
+    # by the others; no grid; lenient overlaps would free the five parts on the body
+    why = core["why"]
+    assert len(why["overlaps"]) == 5 and not any(o["artefact"] for o in why["overlaps"])
+    assert all(o["depth"] < why["artefact_depth"] for o in why["overlaps"])
+    assert sorted(b["part"] for b in why["blocks"]) == sorted(p for p in core["parts"] if p != core["base"])
+    assert all(b["free"] == 0 and b["by"] for b in why["blocks"])
+    assert why["grid"] == {"tried": False, "reason": "not_on_grid", "core_on_grid": False}
+    assert why["lenient"] == {"status": "found", "frees": 5}
     cores[0]["names"] = []
     assert plan.locked_cores[0]["names"], "locked_cores returns a copy"
     code, out, err = asp_cli("plan", PUMP, "--unit", "mm", "--up", "z", "--json")
@@ -199,6 +208,16 @@ def test_a_plan_with_a_locked_core_is_partial(root, asp_cli):
     table = plan.table()
     assert ": partial in " in table.splitlines()[0]
     assert table.splitlines()[1].startswith(f"planned {len(plan.parts) - 6} of {len(plan.parts)} parts; 6 stay in 1 locked core: ")
+    assert table.splitlines()[2] == "  why the core on PumpAssembly - Pump-1 (6 parts) is locked:"
+    assert "    --overlaps lenient: would free all 5 of its other parts\n" in table
+    # declared one unit on purpose, the same core makes the plan found (issue 28 item 2)
+    core = plan.locked_cores[0]  # a fresh copy (the one above had its names cleared)
+    unit = asp.load(PUMP, unit="mm", up="z").plan(unit_group=[core["names"]])
+    assert unit.status == "found" and unit.found and unit.locked_cores == []
+    step = next(s for s in unit.to_dict()["assembly_sequence"] if "subassembly" in s)
+    assert step["subassembly"]["status"] == "unit" and sorted(step["subassembly"]["parts"]) == sorted(core["parts"])
+    with pytest.raises(asp.ConfigError, match="unit_group: no part is named 'nope'"):
+        asp.load(PUMP, unit="mm", up="z").plan(unit_group="nope,PumpAssembly - Pump-1")
     # a plan that takes every part apart has none
     lack = asp.plan(LACK, up="z")
     assert lack.status == "found" and lack.found and lack.locked_cores == []

@@ -10,6 +10,7 @@ pub mod pipeline;
 pub mod request;
 pub mod resolve;
 pub mod stepped;
+pub mod why;
 
 pub use catalogue::{PolicySource, QPolicy};
 pub use error::{AppError, Result};

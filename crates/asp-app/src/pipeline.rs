@@ -8,13 +8,16 @@
 
 use crate::catalogue::PolicySource;
 use crate::error::{AppError, Result};
+use crate::why::{explain_cores, GridRan};
 use asp_geom::distmap::{DistanceMaps, MapConfig, Support};
 use asp_geom::grid::VoxelModel;
 use asp_geom::io::LoadOptions;
 use asp_geom::math::Axis;
 use asp_geom::physics::PhysicsConfig;
 use asp_geom::rrt::RrtConfig;
-use asp_geom::{Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, OverlapPolicy, StabilityMode, Units, World, WorldConfig};
+use asp_geom::{
+    Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, OverlapPolicy, PartSet, StabilityMode, Units, World, WorldConfig,
+};
 use asp_search::dead_end::deepest_dead_end;
 use asp_search::extension::resolve_objectives;
 use asp_search::grid::GridConfig;
@@ -23,6 +26,7 @@ use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES};
 use asp_search::report::{
     Checker as CheckerName, GridEntry, GridReason, OptimisationEntry, OptimisationMethod, ParetoEntry, PlanReport, Timings,
 };
+use asp_search::units::UnitChecker;
 use asp_search::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
 use asp_search::{BuiltinOrder, OrderingSource};
 use asp_search::{CheckerExtension, MdpExtension, ModelContext};
@@ -87,6 +91,8 @@ pub struct PlanSettings {
     pub path_planner: bool,
     /// Let groups of parts leave together as rigid subassemblies when no single part can.
     pub subassemblies: bool,
+    /// Groups of parts (by name) planned as one part each, on purpose ([`asp_search::units`]).
+    pub unit_groups: Vec<Vec<String>>,
     /// Plan voxel models by moves of parts and groups on their grid ([`asp_search::grid`]) when
     /// several parts must move in turn before anything can leave, or when the depth-first
     /// search finds no plan.
@@ -128,6 +134,7 @@ impl Default for PlanSettings {
             seed: 0,
             path_planner: true,
             subassemblies: true,
+            unit_groups: Vec::new(),
             grid: true,
             rrt_iterations: RrtConfig::default().max_iterations,
             rrt_time: RrtConfig::default().max_time.as_secs_f64(),
@@ -328,7 +335,9 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
         return self::optimise(Arc::new(assembly), settings, optimise);
     }
     let budget = budget(settings)?;
-    let voxels = (settings.grid && settings.checker_extension.is_none()).then(|| VoxelModel::of(&assembly)).flatten();
+    let units = unit_sets(&assembly, &settings.unit_groups)?;
+    // the grid planner does not keep declared units together
+    let voxels = (settings.grid && settings.checker_extension.is_none() && units.is_empty()).then(|| VoxelModel::of(&assembly)).flatten();
     let grid_started = Instant::now();
     let probe = voxels.clone().map(|m| GridRun::probe(m, &budget, grid_started));
     let started = Instant::now();
@@ -338,7 +347,7 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
     if let (Some(model), true) = (&voxels, probe.as_ref().is_some_and(GridRun::needs_moves)) {
         let run = GridRun::new(model.clone(), &GridConfig::default(), &budget, grid_started);
         if run.found() {
-            return Ok(grid_result(&checker, &run, GridReason::NeedsMoves, None, world_seconds));
+            return Ok(grid_result(&checker, settings, &run, GridReason::NeedsMoves, None, world_seconds));
         }
         grid = Some(run);
     }
@@ -349,6 +358,13 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
     let run_dfs = |path_planner: bool| -> Result<(PlanOutcome, Option<asp_search::report::RobotReport>)> {
         let dfs = planner(&PlanSettings { path_planner, ..settings.clone() }, checker.world())?;
         let mut search = |c: &dyn asp_geom::FeasibilityChecker| {
+            let with_units;
+            let c: &dyn asp_geom::FeasibilityChecker = if units.is_empty() {
+                c
+            } else {
+                with_units = UnitChecker::new(c, units.clone());
+                &with_units
+            };
             let mut problem = Problem::full(c);
             problem.progress = progress;
             dfs.solve(&problem, &budget)
@@ -368,13 +384,15 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
             if !stuck.is_empty() && stuck.iter().all(|s| matches!(s.reason, StuckReason::WouldLeaveUnsupported(_))));
         (!found && !gravity_only) || (found && !taken_apart(outcome))
     };
+    let mut grid_ran = GridRan::No;
     if wants_grid(&outcome) {
         if let Some(model) = voxels {
             let found = outcome.status == Status::Found;
             let run = grid.unwrap_or_else(|| GridRun::new(model, &GridConfig::default(), &budget, Instant::now()));
             if (!found && run.found()) || run.solution.complete() {
-                return Ok(grid_result(&checker, &run, GridReason::Fallback, Some(&outcome), world_seconds));
+                return Ok(grid_result(&checker, settings, &run, GridReason::Fallback, Some(&outcome), world_seconds));
             }
+            grid_ran = GridRan::of(&run.solution.plan);
             if grid_first && !budget_spent(&outcome) {
                 // neither straight lines nor grid moves: the path planner's turn
                 (outcome, robot) = run_dfs(true)?;
@@ -387,7 +405,23 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
         report.attach_robot(r);
     }
     finish_report(&mut report, world, &outcome, world_seconds);
+    explain_cores(&mut report, world, settings, grid_ran, &units);
     Ok(PlanResult { report, status: outcome.status, search: None })
+}
+
+/// The declared units ([`PlanSettings::unit_groups`]) as sets of part indices.
+fn unit_sets(assembly: &Assembly, groups: &[Vec<String>]) -> Result<Vec<PartSet>> {
+    let n = assembly.len();
+    groups
+        .iter()
+        .map(|g| {
+            let parts = g
+                .iter()
+                .map(|name| assembly.part_index(name).ok_or_else(|| AppError::setting("unit_group", format!("no part is named '{name}'"))))
+                .collect::<Result<Vec<usize>>>()?;
+            Ok(PartSet::from_indices(n + 1, parts))
+        })
+        .collect()
 }
 
 /// What every feasibility plan's report carries besides its steps: the overlapping pairs and
@@ -414,7 +448,14 @@ fn taken_apart(outcome: &PlanOutcome) -> bool {
 
 /// The plan of a grid search (after the depth-first search's `before`, whose counters and time
 /// it keeps).
-fn grid_result(checker: &Checker, run: &GridRun, reason: GridReason, before: Option<&PlanOutcome>, world_seconds: f64) -> PlanResult {
+fn grid_result(
+    checker: &Checker,
+    settings: &PlanSettings,
+    run: &GridRun,
+    reason: GridReason,
+    before: Option<&PlanOutcome>,
+    world_seconds: f64,
+) -> PlanResult {
     let world = checker.world();
     let assembly = world.assembly();
     let mut outcome = run.outcome(assembly);
@@ -434,6 +475,7 @@ fn grid_result(checker: &Checker, run: &GridRun, reason: GridReason, before: Opt
         seconds: run.solution.seconds,
     });
     finish_report(&mut report, world, &outcome, world_seconds);
+    explain_cores(&mut report, world, settings, GridRan::of(&run.solution.plan), &[]);
     PlanResult { report, status: outcome.status, search: None }
 }
 

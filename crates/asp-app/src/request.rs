@@ -166,6 +166,11 @@ pub struct PlanRequest {
     pub max_tests: Option<u64>,
     /// Stop after this many seconds with the best partial plan (0: no limit; default 60).
     pub timeout: Option<f64>,
+    /// Groups of parts planned as one part each, on purpose (a purchased motor, a pressed-in
+    /// bearing): by name, each group a comma-separated string or a list of names; a plan that
+    /// moves each group whole is `found`, not `partial` (feasibility search).
+    #[serde(deserialize_with = "groups")]
+    pub unit_group: Vec<Vec<String>>,
 
     // --- the optimiser (present when `objective` is) ---
     /// Optimise for these objectives (a comma-separated string or a list).
@@ -357,6 +362,36 @@ fn names<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<Stri
     )
 }
 
+/// Groups of names: a list whose items are each a comma-separated string or a list of names, or
+/// one comma-separated string (one group).
+fn groups<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Vec<Vec<String>>, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Group {
+        Text(String),
+        Names(Vec<String>),
+    }
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Groups {
+        One(String),
+        Many(Vec<Group>),
+    }
+    let split = |s: &str| s.split(',').map(str::trim).filter(|n| !n.is_empty()).map(String::from).collect::<Vec<_>>();
+    let bad = || serde::de::Error::custom("must be a list of groups, each a comma-separated string or a list of part names");
+    Ok(match Option::<Groups>::deserialize(d).map_err(|_| bad())? {
+        None => Vec::new(),
+        Some(Groups::One(s)) => vec![split(&s)],
+        Some(Groups::Many(v)) => v
+            .into_iter()
+            .map(|g| match g {
+                Group::Text(s) => split(&s),
+                Group::Names(names) => names.into_iter().map(|n| n.trim().to_string()).filter(|n| !n.is_empty()).collect(),
+            })
+            .collect(),
+    })
+}
+
 /// [`names`] as paths.
 fn paths<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<PathBuf>>, D::Error> {
     Ok(names(d)?.map(|v| v.into_iter().map(PathBuf::from).collect()))
@@ -389,7 +424,7 @@ mod tests {
     #[test]
     fn keys_are_every_field_and_json_round_trips() {
         let keys = PlanRequest::keys();
-        assert_eq!(keys.len(), 44, "{keys:?}");
+        assert_eq!(keys.len(), 45, "{keys:?}");
         assert!(keys.iter().any(|k| k == "time_limit") && keys.iter().any(|k| k == "robot_base"));
         let r = PlanRequest {
             objective: Some(vec!["access".into()]),
@@ -397,10 +432,11 @@ mod tests {
             overlaps: Some(Overlaps::Lenient),
             robot_base: Some([1.0, 2.0, 3.0]),
             fixed: vec!["base".into()],
+            unit_group: vec![vec!["motor".into(), "fan".into()]],
             ..PlanRequest::default()
         };
         assert_eq!(PlanRequest::from_json(&r.to_json()).unwrap(), r);
-        assert_eq!(r.given(), ["fixed", "objective", "overlaps", "q_use", "robot_base"]);
+        assert_eq!(r.given(), ["fixed", "objective", "overlaps", "q_use", "robot_base", "unit_group"]);
     }
 
     #[test]

@@ -29,6 +29,7 @@ const FEASIBILITY_ONLY: &[(&str, &str)] = &[
     ("physics_threshold", ""),
     ("path_planner", ""),
     ("subassemblies", ""),
+    ("unit_group", ""),
     ("grid", ""),
     ("rrt_iterations", ""),
     ("rrt_time", ""),
@@ -85,6 +86,7 @@ fn check_applies(r: &PlanRequest) -> Result<()> {
     needs("physics_threshold", r.stability == Some(Stability::Physics), "`stability` physics")?;
     needs("epsilon", r.q.is_some(), "learned Q-functions (`q`)")?;
     needs("q_use", r.q.is_some(), "learned Q-functions (`q`)")?;
+    needs("unit_group", r.subassemblies != Some(false), "`subassemblies` (a unit leaves as one rigid group)")?;
     for key in ["robot_base", "drop_off", "replans", "package_path"] {
         needs(key, r.robot.is_some(), "a robot (`robot`)")?;
     }
@@ -174,6 +176,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         seed: r.seed.unwrap_or(0),
         path_planner: r.path_planner.unwrap_or(d.path_planner),
         subassemblies: r.subassemblies.unwrap_or(d.subassemblies),
+        unit_groups: unit_groups(&r.unit_group)?,
         grid: r.grid.unwrap_or(d.grid),
         rrt_iterations: at_least_one("rrt_iterations", r.rrt_iterations)?.unwrap_or(d.rrt_iterations),
         rrt_time: positive("rrt_time", r.rrt_time)?.unwrap_or(d.rrt_time),
@@ -183,6 +186,23 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         cancel: None,
         checker_extension,
     })
+}
+
+/// The unit groups, checked: each of at least two names, no name twice.
+fn unit_groups(groups: &[Vec<String>]) -> Result<Vec<Vec<String>>> {
+    let mut seen: Vec<&str> = Vec::new();
+    for g in groups {
+        if g.len() < 2 {
+            return Err(AppError::setting("unit_group", format!("a unit needs at least two parts, got [{}]", g.join(", "))));
+        }
+        for name in g {
+            if seen.contains(&name.as_str()) {
+                return Err(AppError::setting("unit_group", format!("part '{name}' is named twice (a part belongs to one unit at most)")));
+            }
+            seen.push(name);
+        }
+    }
+    Ok(groups.to_vec())
 }
 
 /// The loaders' caps.
@@ -279,7 +299,7 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
 /// `asp._asp.default_settings()` and the docs show these.
 pub fn defaults() -> serde_json::Map<String, Value> {
     let d = PlanSettings::default();
-    let defaults: [(&str, Value); 44] = [
+    let defaults: [(&str, Value); 45] = [
         ("unit", Value::Null),
         ("up", Value::Null),
         ("fixed", json!([])),
@@ -296,6 +316,7 @@ pub fn defaults() -> serde_json::Map<String, Value> {
         ("path_planner", json!(d.path_planner)),
         ("subassemblies", json!(d.subassemblies)),
         ("grid", json!(d.grid)),
+        ("unit_group", json!([])),
         ("rrt_iterations", json!(d.rrt_iterations)),
         ("rrt_time", json!(d.rrt_time)),
         ("order", json!(catalogue::ORDERINGS[0].name)),
@@ -375,6 +396,28 @@ mod tests {
             err(r#"{"objective": "access", "grippers": 2}"#),
             "grippers: applies to the feasibility search only (without `objective`)"
         );
+    }
+
+    /// Issue 28 item 2: unit groups are lists of names (or comma-separated strings), each of at
+    /// least two parts, no part in two, and they need subassemblies.
+    #[test]
+    fn unit_groups_are_checked() {
+        let ok = |json: &str| resolve(&PlanRequest::from_json(json).unwrap()).unwrap().unit_groups;
+        assert_eq!(ok(r#"{"unit_group": ["a, b", ["c", "d", "e"]]}"#), [vec!["a", "b"], vec!["c", "d", "e"]]);
+        assert_eq!(ok(r#"{"unit_group": "a,b"}"#), [vec!["a", "b"]]);
+        assert!(ok("{}").is_empty());
+        assert_eq!(err(r#"{"unit_group": ["a"]}"#), "unit_group: a unit needs at least two parts, got [a]");
+        assert_eq!(err(r#"{"unit_group": ["a,b", "b,c"]}"#), "unit_group: part 'b' is named twice (a part belongs to one unit at most)");
+        assert_eq!(
+            err(r#"{"unit_group": ["a,b"], "subassemblies": false}"#),
+            "unit_group: needs `subassemblies` (a unit leaves as one rigid group)"
+        );
+        assert_eq!(
+            err(r#"{"unit_group": ["a,b"], "objective": "access"}"#),
+            "unit_group: applies to the feasibility search only (without `objective`)"
+        );
+        let typed = PlanRequest::from_json(r#"{"unit_group": 3}"#).unwrap_err().to_string();
+        assert!(typed.starts_with("unit_group: must be a list of groups"), "{typed}");
     }
 
     #[test]

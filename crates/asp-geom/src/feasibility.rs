@@ -216,4 +216,11 @@ pub trait FeasibilityChecker: Send + Sync {
         let _ = group;
         None
     }
+
+    /// Whether `group` is a unit declared by the user (a purchased component: planned as one
+    /// part on purpose, never taken apart). Default: `false`.
+    fn is_unit(&self, group: &PartSet) -> bool {
+        let _ = group;
+        false
+    }
 }

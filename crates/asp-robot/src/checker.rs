@@ -271,6 +271,10 @@ impl FeasibilityChecker for HoldingChecker<'_> {
         self.inner.subassembly(group)
     }
 
+    fn is_unit(&self, group: &PartSet) -> bool {
+        self.inner.is_unit(group)
+    }
+
     fn stability(&self, state: &PartSet) -> Stability {
         self.inner.stability(state)
     }

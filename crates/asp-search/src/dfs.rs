@@ -223,7 +223,8 @@ impl Search<'_, '_, '_> {
                         rest.remove(p);
                     }
                     let part = group.iter().next().expect("a group has parts");
-                    let group = Some(Box::new(Subassembly { parts: group, plan: None }));
+                    let unit = self.problem.checker.is_unit(&group);
+                    let group = Some(Box::new(Subassembly { parts: group, plan: None, unit }));
                     if self.descend(Step { part, motion, group, moves: Vec::new() }, &rest) {
                         return true;
                     }
@@ -422,6 +423,9 @@ impl Dfs {
             let Some(group) = step.group.as_mut() else { continue };
             let Some((base, checker)) = problem.checker.subassembly(&group.parts) else { continue };
             step.part = base;
+            if group.unit {
+                continue; // declared one unit: not taken apart
+            }
             let stats = &outcome.stats;
             let left = budget.remaining(stats.counters.removal_tests, started);
             if left.exhausted(0, Instant::now()) {

@@ -19,6 +19,7 @@ pub mod problem;
 pub mod qgraph;
 pub mod report;
 pub mod step;
+pub mod units;
 
 pub use checker_extension::CheckerExtension;
 pub use dfs::Dfs;

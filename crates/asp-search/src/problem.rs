@@ -194,6 +194,9 @@ pub struct Subassembly {
     /// core: its explanation says what holds what), or was not planned (`None`: the checker
     /// cannot plan subassemblies, or the budget ran out first).
     pub plan: Option<PlanOutcome>,
+    /// A unit the user declared ([`crate::units`]): planned as one part on purpose, never taken
+    /// apart (`plan` is `None`).
+    pub unit: bool,
 }
 
 /// Why a part could not leave the state where the search got stuck.

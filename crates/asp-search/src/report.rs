@@ -96,6 +96,10 @@ pub struct LockedCore {
     /// The subassembly's own explanation: the parts of its dead end and what holds each.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub explanation: Vec<Explanation>,
+    /// Why it is locked: overlaps, blocking pairs, the grid planner, what `--overlaps lenient`
+    /// would free (feasibility plans; format 1.9).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub why: Option<CoreWhy>,
 }
 
 /// The grid search behind a plan (format 1.6).
@@ -500,6 +504,7 @@ fn assembly_steps(removals: &[Step], name: &dyn Fn(usize) -> String, u: &dyn Fn(
             subassembly: s.group.as_ref().map(|g| {
                 let named = |set: &PartSet| set.iter().map(|part| NamedPart { part, name: name(part) }).collect();
                 let (status, assembly_sequence, explanation) = match &g.plan {
+                    None if g.unit => (SubassemblyStatus::Unit, Vec::new(), Vec::new()),
                     None => (SubassemblyStatus::Unplanned, Vec::new(), Vec::new()),
                     Some(plan) => {
                         let steps = assembly_steps(&plan.removals, name, u);
@@ -524,9 +529,12 @@ fn assembly_steps(removals: &[Step], name: &dyn Fn(usize) -> String, u: &dyn Fn(
 }
 
 /// `found` only when every part gets its own motion: a found sequence holding a subassembly
-/// whose own plan is not `found` (recursively) is `partial`.
+/// whose own plan is not `found` (recursively) is `partial`. A unit the user declared counts as
+/// one part.
 fn complete(status: PlanStatus, steps: &[AssemblyStep]) -> PlanStatus {
-    let locked = steps.iter().any(|s| s.subassembly.as_ref().is_some_and(|g| g.status != SubassemblyStatus::Found));
+    let locked = steps
+        .iter()
+        .any(|s| s.subassembly.as_ref().is_some_and(|g| !matches!(g.status, SubassemblyStatus::Found | SubassemblyStatus::Unit)));
     if status == PlanStatus::Found && locked {
         PlanStatus::Partial
     } else {
@@ -540,7 +548,7 @@ fn locked_cores(steps: &[AssemblyStep], name: &dyn Fn(usize) -> String) -> Vec<L
     let mut cores = Vec::new();
     for step in steps {
         let Some(g) = &step.subassembly else { continue };
-        if !matches!(g.status, SubassemblyStatus::Found | SubassemblyStatus::Partial) {
+        if !matches!(g.status, SubassemblyStatus::Found | SubassemblyStatus::Partial | SubassemblyStatus::Unit) {
             let placed: Vec<usize> = g
                 .assembly_sequence
                 .iter()
@@ -553,6 +561,7 @@ fn locked_cores(steps: &[AssemblyStep], name: &dyn Fn(usize) -> String) -> Vec<L
                 parts,
                 status: g.status,
                 explanation: g.explanation.clone(),
+                why: None,
             });
         }
         cores.extend(locked_cores(&g.assembly_sequence, name));
@@ -686,6 +695,9 @@ vocabulary! {
         BudgetExhausted => "budget_exhausted",
         /// Its own plan was not tried.
         Unplanned => "unplanned",
+        /// Declared one unit (`--unit-group`): planned as one part on purpose, not taken apart
+        /// (format 1.9).
+        Unit => "unit",
     }
 }
 
@@ -796,3 +808,49 @@ vocabulary! {
         ParetoMcts => "pareto_mcts",
     }
 }
+
+vocabulary! {
+    /// Whether and why the grid planner ran on a locked core (`locked_cores[].why.grid.reason`,
+    /// format 1.9).
+    CoreGridReason {
+        /// It ran on the model and every grid state it reached still holds the core together
+        /// (the core cannot come apart by moves on the grid either).
+        Stuck => "stuck",
+        /// It ran, but its state budget or the time ran out first.
+        Budget => "budget",
+        /// Not tried: it was turned off (`--no-grid`).
+        Off => "off",
+        /// Not tried: the plan was made with a robot (the grid planner plans no arm).
+        Robot => "robot",
+        /// Not tried: the model has more parts than the grid planner takes (64).
+        TooManyParts => "too_many_parts",
+        /// Not tried: the model's parts are not all unions of cells of one common grid.
+        NotOnGrid => "not_on_grid",
+        /// Not tried: units were declared (`--unit-group`), which the grid planner does not keep
+        /// together.
+        UnitGroups => "unit_groups",
+    }
+}
+
+vocabulary! {
+    /// What the core's own plan on its base gives under `--overlaps lenient`
+    /// (`locked_cores[].why.lenient.status`, format 1.9).
+    LenientStatus {
+        /// Not rerun: no two parts of the core overlap beyond the tolerance (or the plan's policy
+        /// already tests them as `lenient` does), so its tests would be the same.
+        Unchanged => "unchanged",
+        /// Every part of the core comes off its base.
+        Found => "found",
+        /// A complete sequence, but a smaller core in it still goes in as one unit.
+        Partial => "partial",
+        /// Some parts (`frees`) or none come off before it is stuck again.
+        NoPlan => "no_plan",
+        /// The rerun's budget ran out (`frees` is what came off by then: a lower bound).
+        BudgetExhausted => "budget_exhausted",
+        /// The rerun could not be made (its checker could not be set up as the plan's).
+        Unknown => "unknown",
+    }
+}
+
+pub mod why;
+pub use why::{CoreBlocker, CoreBlocks, CoreGrid, CoreLenient, CoreOverlap, CoreWhy};

@@ -268,6 +268,9 @@ impl Scene {
                         Some(g) if matches!(g.status, SubassemblyStatus::Found | SubassemblyStatus::Partial) => {
                             format!("{} + {} parts (subassembly)", part.name, g.parts.len() - 1)
                         }
+                        Some(g) if g.status == SubassemblyStatus::Unit => {
+                            format!("{} + {} parts (declared one unit)", part.name, g.parts.len() - 1)
+                        }
                         Some(g) => format!("{} + {} parts (subassembly, locked core: goes in as one unit)", part.name, g.parts.len() - 1),
                     };
                     let mut moves = Vec::with_capacity(s.moves.len());

@@ -498,7 +498,7 @@ fn removals(steps: &[AssemblyStep], n: usize) -> Vec<Step> {
             let group = s.subassembly.as_ref().map(|g| {
                 let status = match g.status {
                     SubassemblyStatus::Found => Some(Status::Found),
-                    SubassemblyStatus::Unplanned => None,
+                    SubassemblyStatus::Unplanned | SubassemblyStatus::Unit => None,
                     _ => Some(Status::BudgetExhausted),
                 };
                 Box::new(Subassembly {
@@ -508,6 +508,7 @@ fn removals(steps: &[AssemblyStep], n: usize) -> Vec<Step> {
                         removals: removals(&g.assembly_sequence, n),
                         stats: Default::default(),
                     }),
+                    unit: g.status == SubassemblyStatus::Unit,
                 })
             });
             Step { part: s.part, motion, group, moves: Vec::new() }

@@ -129,3 +129,220 @@ fn an_optimisers_no_plan_is_explained_by_its_deepest_dead_end() {
         assert!(text.contains("none (no complete sequence)"), "{text}");
     }
 }
+
+/// The shared pump (tests/data/pump, millimetres).
+fn pump() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/pump")
+}
+
+/// Issue 28 item 2: the pump's locked core says why it is locked. Its five overlapping pairs are
+/// all fits (a tenth of a millimetre or less, far below the artefact depth), every part but the
+/// base is blocked along every candidate direction by the core's other parts, the shaft among
+/// them by the body, the grid planner could not run (the pump is no voxel model), and the core's
+/// own plan rerun with `--overlaps lenient` takes all five parts off the body — the strict
+/// overlap rule on those fits is what locks it.
+#[test]
+fn issue_28_the_pumps_locked_core_says_why() {
+    use asp_search::report::{CoreGridReason, LenientStatus, PlanStatus};
+    let settings = PlanSettings { unit: Some(asp_geom::Units::parse("mm").unwrap()), ..PlanSettings::default() };
+    let r = asp_app::pipeline::plan_file(&pump(), &settings, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Partial, "{json}");
+    assert_eq!(r.report.locked_cores.len(), 1, "{json}");
+    let core = &r.report.locked_cores[0];
+    let name = |p: usize| r.report.parts[p].name.as_str();
+    assert_eq!(name(core.base), "PumpAssembly - Pump-1");
+    let why = core.why.as_ref().expect("a locked core says why");
+    // overlaps: every pair of the core that the plan's `overlaps` lists, none an artefact
+    let listed: Vec<[usize; 2]> = r.report.overlaps.as_ref().unwrap().pairs.iter().map(|p| p.parts).collect();
+    let inside: Vec<[usize; 2]> = listed.iter().copied().filter(|[a, b]| core.parts.contains(a) && core.parts.contains(b)).collect();
+    assert_eq!(why.overlaps.iter().map(|o| o.parts).collect::<Vec<_>>(), inside, "{json}");
+    assert_eq!(why.overlaps.len(), 5, "{json}");
+    let diagonal = 1e4 * r.report.tolerance; // the default tolerance is 1e-4 of the diagonal
+    assert!((why.artefact_depth - 5e-3 * diagonal).abs() < 1e-6 * diagonal, "{json}");
+    let shaft = why.overlaps.iter().find(|o| o.names[1] == "PumpAssembly - Shaft-1").expect("the shaft's fit");
+    assert!(shaft.depth > 0.1 && shaft.depth < 0.15 && !shaft.gross && !shaft.artefact, "{json}");
+    assert!(why.overlaps.iter().all(|o| !o.artefact && o.depth < why.artefact_depth));
+    // blocks: every part but the base, each blocked along every direction by the core's parts
+    assert_eq!(why.blocks.len(), core.parts.len() - 1);
+    assert!(why.blocks.iter().all(|b| b.part != core.base && core.parts.contains(&b.part)));
+    assert!(why.blocks.iter().all(|b| b.free == 0 && !b.by.is_empty()), "{json}");
+    assert!(why.blocks.iter().flat_map(|b| &b.by).all(|q| core.parts.contains(&q.part) && q.directions <= why.directions));
+    let shaft_blocks = why.blocks.iter().find(|b| b.name == "PumpAssembly - Shaft-1").unwrap();
+    assert_eq!(shaft_blocks.by[0].name, "PumpAssembly - Pump-1", "the body blocks the shaft most: {json}");
+    assert_eq!(shaft_blocks.by[0].directions, why.directions);
+    // the grid planner: not tried, the pump is not a voxel model, nor is its core
+    assert!(!why.grid.tried && why.grid.reason == CoreGridReason::NotOnGrid && why.grid.core_on_grid == Some(false), "{json}");
+    // lenient overlaps free all five other parts
+    assert_eq!((why.lenient.status, why.lenient.frees), (LenientStatus::Found, 5), "{json}");
+    assert!(json.contains("\"why\": {") && json.contains("\"lenient\": {"));
+    // the table says so under the locked-core line
+    let text = r.report.to_text();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[2], "  why the core on PumpAssembly - Pump-1 (6 parts) is locked:", "{text}");
+    assert!(text.contains("    overlap PumpAssembly - Pump-1 / PumpAssembly - Shaft-1: 0.1200 deep, within 1.29"), "{text}");
+    assert!(
+        text.contains("    grid planner: not tried (the model's parts are not all on one grid); nor are the core's own parts"),
+        "{text}"
+    );
+    assert!(text.contains("    --overlaps lenient: would free all 5 of its other parts\n"), "{text}");
+    assert!(text
+        .contains(&format!("    PumpAssembly - Shaft-1: blocked along all {} directions; by PumpAssembly - Pump-1 along", why.directions)));
+    // and the whole pump planned with lenient overlaps is taken apart: the rerun told the truth
+    let lenient = PlanSettings { overlaps: asp_geom::OverlapPolicy::Lenient, ..settings };
+    let r = asp_app::pipeline::plan_file(&pump(), &lenient, None).unwrap();
+    assert_eq!(r.report.status, PlanStatus::Found, "{}", r.report.to_json());
+}
+
+/// Two bars drawn through each other (a halving joint with no notches modelled: an overlap no
+/// shrinking separates) beside issue 9's ring on a locked post (a real interlock of cells): two
+/// locked cores, each with its own reason.
+fn crossed_bars_beside_a_locked_post() -> asp_geom::Assembly {
+    use asp_geom::fixtures::box_part;
+    let mut a = asp_geom::fixtures::ring_on_locked_post();
+    // bar (along x) through the middle of a thicker bar (along y), 20 cm away from the post
+    a.parts.push(box_part("bar", [0.20, 0.01, 0.005], [0.23, 0.02, 0.01]));
+    a.parts.push(box_part("cross", [0.21, 0.0, 0.0], [0.22, 0.03, 0.015]));
+    a
+}
+
+/// Issue 28 item 2 on a generated case: the crossed bars are locked by a modelling artefact
+/// (their overlap is deeper than any fit) that `--overlaps lenient` frees; the ring, post and
+/// base are locked by their shapes (each blocked along every direction, no overlap), which
+/// nothing frees; the model is no voxel model (the bars share cells), but the post's core alone is.
+#[test]
+fn issue_28_an_artefact_and_an_interlock_are_told_apart() {
+    use asp_search::report::{CoreGridReason, LenientStatus, PlanStatus};
+    let settings = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
+    let r = plan_assembly(crossed_bars_beside_a_locked_post(), &settings, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Partial, "{json}");
+    let mut cores: Vec<_> = r.report.locked_cores.iter().collect();
+    cores.sort_by_key(|c| c.parts.clone());
+    assert_eq!(cores.iter().map(|c| c.names.clone()).collect::<Vec<_>>(), [vec!["base", "post", "ring"], vec!["bar", "cross"]], "{json}");
+    // the bars: one gross overlap, an artefact; the bar blocked by the cross along every direction
+    let bars = cores[1].why.as_ref().unwrap();
+    assert_eq!(cores[1].base, 5, "the larger bar is the base");
+    assert_eq!(bars.overlaps.len(), 1, "{json}");
+    let o = &bars.overlaps[0];
+    assert_eq!((o.parts, o.gross, o.artefact), ([4, 5], true, true), "{json}");
+    assert!(o.depth > bars.artefact_depth, "{json}");
+    assert_eq!(bars.blocks.len(), 1);
+    assert_eq!((bars.blocks[0].name.as_str(), bars.blocks[0].free), ("bar", 0), "{json}");
+    assert_eq!(bars.blocks[0].by.len(), 1);
+    assert_eq!(
+        (bars.blocks[0].by[0].part, bars.blocks[0].by[0].directions, bars.blocks[0].by[0].only),
+        (5, bars.directions, bars.directions)
+    );
+    assert_eq!((bars.lenient.status, bars.lenient.frees), (LenientStatus::Found, 1), "{json}");
+    assert!(!bars.grid.tried && bars.grid.reason == CoreGridReason::NotOnGrid && bars.grid.core_on_grid == Some(false), "{json}");
+    // the post: no overlap, ring and post held by each other and the base, lenient changes nothing
+    let post = cores[0].why.as_ref().unwrap();
+    assert_eq!(cores[0].base, 0, "the base is the post's core's base");
+    assert!(post.overlaps.is_empty(), "{json}");
+    assert_eq!(post.blocks.iter().map(|b| b.name.as_str()).collect::<Vec<_>>(), ["post", "ring"]);
+    assert!(post.blocks.iter().all(|b| b.free == 0), "{json}");
+    let ring = &post.blocks[1];
+    let mut by: Vec<&str> = ring.by.iter().map(|q| q.name.as_str()).collect();
+    by.sort_unstable();
+    assert_eq!(by, ["base", "post"], "{json}");
+    assert_eq!((post.lenient.status, post.lenient.frees), (LenientStatus::Unchanged, 0), "{json}");
+    assert!(!post.grid.tried && post.grid.core_on_grid == Some(true), "the post's core alone is on one grid: {json}");
+    let text = r.report.to_text();
+    assert!(text.contains("    overlap bar / cross: more than "), "{text}");
+    assert!(text.contains(": a modelling artefact, not an interlock\n"), "{text}");
+    assert!(text.contains("    --overlaps lenient: would free its other part\n"), "{text}");
+    assert!(text.contains("    --overlaps lenient: changes nothing (no two of its parts overlap)\n"), "{text}");
+    assert!(text.contains("not all on one grid); the core's own parts are\n"), "{text}");
+    // planned with lenient overlaps, the bars come apart: the rerun told the truth
+    let lenient = PlanSettings { overlaps: asp_geom::OverlapPolicy::Lenient, ..settings.clone() };
+    let r = plan_assembly(crossed_bars_beside_a_locked_post(), &lenient, None).unwrap();
+    assert_eq!(
+        r.report.locked_cores.iter().map(|c| c.names.clone()).collect::<Vec<_>>(),
+        [vec!["base", "post", "ring"]],
+        "{}",
+        r.report.to_json()
+    );
+}
+
+/// Issue 28 item 2: on a voxel model the grid planner runs on a locked core (and finds no moves
+/// that take it apart); with `--no-grid` the core says it was not tried, and why.
+#[test]
+fn issue_28_a_locked_core_says_whether_the_grid_planner_tried_it() {
+    use asp_search::report::CoreGridReason;
+    let on = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
+    let r = plan_assembly(asp_geom::fixtures::ring_on_locked_post(), &on, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.locked_cores.len(), 1, "{json}");
+    let grid = &r.report.locked_cores[0].why.as_ref().unwrap().grid;
+    assert!(grid.tried && grid.reason == CoreGridReason::Stuck && grid.core_on_grid.is_none(), "{json}");
+    assert!(r.report.to_text().contains("    grid planner: tried: no moves on the grid take it apart\n"));
+    let off = PlanSettings { grid: false, ..on };
+    let r = plan_assembly(asp_geom::fixtures::ring_on_locked_post(), &off, None).unwrap();
+    let grid = &r.report.locked_cores[0].why.as_ref().unwrap().grid;
+    assert!(!grid.tried && grid.reason == CoreGridReason::Off, "{}", r.report.to_json());
+    assert!(r.report.to_text().contains("    grid planner: not tried (--no-grid)\n"));
+}
+
+/// Issue 28 item 2: parts declared one unit (`--unit-group`) are planned as one part on purpose:
+/// the locked post's core goes in whole as a `unit` step and the plan is `found`, not `partial`;
+/// a unit with a fixed part is part of the base; an unknown name is an error naming the setting.
+#[test]
+fn issue_28_a_declared_unit_is_planned_as_one_part_and_the_plan_is_found() {
+    use asp_search::report::{PlanStatus, SubassemblyStatus};
+    let unit = |names: &[&str]| vec![names.iter().map(|n| n.to_string()).collect::<Vec<_>>()];
+    let settings = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
+    let r = plan_assembly(asp_geom::fixtures::ring_on_locked_post(), &settings, None).unwrap();
+    assert_eq!(r.report.status, PlanStatus::Partial, "without the unit: {}", r.report.to_json());
+    let declared = PlanSettings { unit_groups: unit(&["base", "post", "ring"]), ..settings.clone() };
+    let r = plan_assembly(asp_geom::fixtures::ring_on_locked_post(), &declared, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Found, "{json}");
+    assert!(r.found() && r.report.locked_cores.is_empty() && r.report.grid.is_none(), "{json}");
+    let steps = &r.report.assembly_sequence;
+    assert_eq!(steps.len(), 2, "the unit, then the cap: {json}");
+    let g = steps[0].subassembly.as_ref().expect("the unit's step");
+    assert_eq!((g.parts.clone(), g.status, steps[0].part), (vec![0, 1, 2], SubassemblyStatus::Unit, 0), "{json}");
+    assert!(g.assembly_sequence.is_empty() && g.explanation.is_empty());
+    assert_eq!((steps[1].name.as_str(), steps[1].subassembly.is_none()), ("cap", true));
+    assert!(json.contains("\"status\": \"unit\""));
+    let text = r.report.to_text();
+    assert!(text.contains("base + 2 more (unit)") && text.contains("declared one unit (--unit-group), not taken apart"), "{text}");
+    // a unit with the fixed part is part of the base: the dowel never moves, the board comes off
+    let fixed = PlanSettings { unit_groups: unit(&["lower", "dowel"]), ..settings.clone() };
+    let r = plan_assembly(asp_geom::fixtures::dowel_in_two_boards(), &fixed, None).unwrap();
+    assert_eq!(r.report.status, PlanStatus::Found, "{}", r.report.to_json());
+    assert_eq!(r.report.assembly_sequence.iter().map(|s| s.name.as_str()).collect::<Vec<_>>(), ["upper"]);
+    // names are checked against the model
+    let wrong = PlanSettings { unit_groups: unit(&["base", "nope"]), ..settings };
+    let e = plan_assembly(asp_geom::fixtures::ring_on_locked_post(), &wrong, None).unwrap_err();
+    assert_eq!(e.to_string(), "unit_group: no part is named 'nope'");
+}
+
+/// Issue 28 item 2 on the shared pump: its locked core declared one unit makes the plan `found`
+/// with the core's step a `unit`; a unit inside a larger locked core keeps that core `partial`
+/// and its lenient rerun keeps the unit whole (it frees only the parts outside the unit).
+#[test]
+fn issue_28_the_pumps_core_declared_one_unit_is_found() {
+    use asp_search::report::{LenientStatus, PlanStatus, SubassemblyStatus};
+    let p = |n: &str| format!("PumpAssembly - {n}");
+    let core = ["BackLid2-1", "LargeScrew1-1", "LargeScrew2-1", "Pump-1", "Ring-1", "Shaft-1"];
+    let mm = PlanSettings { unit: Some(asp_geom::Units::parse("mm").unwrap()), ..PlanSettings::default() };
+    let declared = PlanSettings { unit_groups: vec![core.iter().map(|n| p(n)).collect()], ..mm.clone() };
+    let r = asp_app::pipeline::plan_file(&pump(), &declared, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Found, "{json}");
+    let units: Vec<_> = r.report.assembly_sequence.iter().filter_map(|s| s.subassembly.as_ref()).collect();
+    assert_eq!(units.len(), 1, "{json}");
+    assert_eq!((units[0].status, units[0].parts.len()), (SubassemblyStatus::Unit, 6), "{json}");
+    let pair = PlanSettings { unit_groups: vec![vec![p("Pump-1"), p("Shaft-1")]], ..mm };
+    let r = asp_app::pipeline::plan_file(&pump(), &pair, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Partial, "{json}");
+    let why = r.report.locked_cores[0].why.as_ref().unwrap();
+    assert_eq!(why.grid.reason, asp_search::report::CoreGridReason::UnitGroups, "{json}");
+    assert_eq!((why.lenient.status, why.lenient.frees), (LenientStatus::NoPlan, 3), "the shaft stays with the body: {json}");
+    let text = r.report.to_text();
+    assert!(text.contains("\n    --overlaps lenient: would free 3 of its 5 other parts\n"), "{text}");
+    assert!(text.contains("\n    grid planner: not tried (units declared with --unit-group)\n"), "{text}");
+}

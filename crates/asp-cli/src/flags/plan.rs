@@ -46,6 +46,11 @@ pub struct PlanArgs {
     /// Bookkeeping on top of any ordering (implied by `--order bookkeeping`).
     #[arg(long)]
     pub bookkeeping: bool,
+    /// Plan these parts (comma-separated names) as one part, on purpose: a purchased motor, a
+    /// pressed-in bearing. The unit goes in whole and the plan is still `found`. Repeat for
+    /// several units.
+    #[arg(long, value_name = "NAME,NAME...")]
+    pub unit_group: Vec<String>,
     /// Seed of every random choice (random order, path planner, optimisation).
     #[arg(long)]
     pub seed: Option<u64>,
@@ -162,6 +167,9 @@ impl PlanArgs {
         put!(map, self, order, model, seed, max_tests, timeout);
         if self.bookkeeping {
             map.insert("bookkeeping".into(), true.into());
+        }
+        if !self.unit_group.is_empty() {
+            map.insert("unit_group".into(), self.unit_group.clone().into());
         }
         self.optimise.put(map);
         self.robot.put(map);

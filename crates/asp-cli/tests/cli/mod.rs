@@ -423,6 +423,14 @@ fn issue_28_a_plan_with_a_locked_core_is_partial_with_exit_code_1() {
     assert!(!cores[0]["explanation"].as_array().unwrap().is_empty(), "{plan}");
     let line = format!("planned 0 of 6 parts; 6 stay in 1 locked core: {}", names.join(", "));
     assert_eq!(lines.next(), Some(line.as_str()), "{table}");
+    // and why (format 1.9): no overlaps, the grid planner turned off, lenient changes nothing
+    let why = &cores[0]["why"];
+    assert!(why["overlaps"].is_null(), "{plan}");
+    assert_eq!(why["grid"], serde_json::json!({ "tried": false, "reason": "off" }), "{plan}");
+    assert_eq!(why["lenient"], serde_json::json!({ "status": "unchanged", "frees": 0 }), "{plan}");
+    assert_eq!(why["blocks"].as_array().unwrap().len(), 5, "{plan}");
+    assert!(lines.next().unwrap().starts_with("  why the core on "), "{table}");
+    assert!(table.contains("\n    grid planner: not tried (--no-grid)\n"), "{table}");
     // --each counts partial plans apart; the exit code is the worst (1)
     let o = asp(&["plan", "--each", models.to_str().unwrap(), off[0], off[1]]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
@@ -469,4 +477,30 @@ fn gen_profiles_attaches_connectors_on_request() {
     assert_eq!(parts(&[], "s"), (29 + connectors, connectors), "separate by default");
     let bad = asp(&["gen", "profiles", "--connectors", "glued", "--out", dir.path().to_str().unwrap()]);
     assert_eq!(bad.status.code(), Some(2));
+}
+
+/// Issue 28 item 2: `--unit-group` plans the named parts as one part on purpose: the locked
+/// post's core goes in whole, the plan is `found` (exit 0); a name the model lacks is an error
+/// naming the flag (exit 2).
+#[test]
+fn issue_28_unit_group_plans_named_parts_as_one_unit() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = fixture_file(dir.path(), &fixtures::ring_on_locked_post(), "post.glb");
+    let model = model.to_str().unwrap();
+    let o = asp(&["plan", model, "--json"]);
+    assert_eq!(o.status.code(), Some(1), "without the unit the plan is partial: {}", stderr(&o));
+    let o = asp(&["plan", model, "--json", "--unit-group", "base,post,ring"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(plan["status"], "found", "{plan}");
+    assert!(plan["locked_cores"].is_null(), "{plan}");
+    let unit = &plan["assembly_sequence"][0]["subassembly"];
+    assert_eq!(unit["status"], "unit", "{plan}");
+    assert_eq!(unit["parts"], serde_json::json!([0, 1, 2]));
+    let o = asp(&["plan", model, "--unit-group", "base,nope"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--unit-group: no part is named 'nope'"), "{}", stderr(&o));
+    let o = asp(&["plan", model, "--unit-group", "base"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--unit-group: a unit needs at least two parts"), "{}", stderr(&o));
 }

@@ -44,6 +44,20 @@ impl Geom {
         Ok((geom, topology))
     }
 
+    /// A copy sharing the meshes, with the caches made so far (for a world that tests the same
+    /// geometry under another overlap policy).
+    pub(super) fn share(&self) -> Geom {
+        Geom {
+            mesh: self.mesh.clone(),
+            aabb: self.aabb,
+            eroded: Mutex::new(self.eroded.lock().unwrap_or_else(|e| e.into_inner()).clone()),
+            closed: self.closed,
+            boxes: self.boxes.clone(),
+            samples: self.samples.clone(),
+            axis: self.axis.clone(),
+        }
+    }
+
     pub(super) fn eroded_cached(&self, amount: f32) -> bool {
         self.eroded.lock().unwrap_or_else(|e| e.into_inner()).contains_key(&amount.to_bits())
     }

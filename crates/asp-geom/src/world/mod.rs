@@ -186,6 +186,39 @@ impl World {
         Ok(world)
     }
 
+    /// This world under the lenient overlap policy ([`OverlapPolicy::Lenient`]): the same
+    /// geometry, directions, contacts, threads and measured overlaps (shared, not measured
+    /// again), only the tests of overlapping pairs differ — a pair some shrinking separates is
+    /// tested with one part shrunk, a gross pair ignores their collisions. The same as
+    /// [`World::new`] with that policy, at the cost of a copy (blocking rows are computed anew).
+    pub fn lenient(&self) -> World {
+        let notes = self
+            .notes
+            .iter()
+            .map(|n| OverlapNote { handling: if n.gross { OverlapHandling::Ignored } else { OverlapHandling::Shrunk }, ..n.clone() })
+            .collect();
+        World {
+            assembly: self.assembly.clone(),
+            geoms: self.geoms.iter().map(Geom::share).collect(),
+            ground: self.ground,
+            tolerance: self.tolerance,
+            contact_distance: self.contact_distance,
+            directions: self.directions.clone(),
+            contacts: self.contacts.clone(),
+            overlaps: self.overlaps.clone(),
+            // gross pairs ignore each other under both policies (strict tests them by its rule)
+            ignored: self.notes.iter().filter(|n| n.gross).flat_map(|n| [n.parts, (n.parts.1, n.parts.0)]).collect(),
+            strict: BTreeSet::new(),
+            notes,
+            policy: OverlapPolicy::Lenient,
+            threads: self.threads.clone(),
+            fixed: self.fixed.clone(),
+            rows: (0..self.num_parts()).map(|_| OnceLock::new()).collect(),
+            warnings: self.warnings.clone(),
+            config: WorldConfig { overlaps: OverlapPolicy::Lenient, ..self.config.clone() },
+        }
+    }
+
     /// Finds contacts (parts within the contact distance) and input overlaps between parts.
     fn measure_contacts(&mut self, max_overlap_fraction: f32, policy: OverlapPolicy) -> Result<()> {
         let count = self.geoms.len();

@@ -98,3 +98,32 @@ fn coincident_parts_are_reported_and_separate() {
     // a copy moving out of its twin enters no material the pair did not already share
     assert_eq!(free_axes(&w, 1, &PartSet::full(2)).len(), 6);
 }
+
+/// Issue 28 item 2: a locked core's lenient rerun tests its pairs in [`World::lenient`], a copy
+/// of the strict world that measures nothing again; it must test exactly as a world built with
+/// the lenient policy (a small overlap shrunk, a gross one ignored, the rest unchanged).
+#[test]
+fn issue_28_the_lenient_copy_of_a_strict_world_tests_as_a_lenient_world() {
+    let bolt = fixtures::bolt_and_nut(0.0005);
+    for a in [fixtures::pressed_peg(), fixtures::dowel_in_two_boards(), bolt, fixtures::ring_on_locked_post()] {
+        let name = a.source.display().to_string();
+        let strict = world(a.clone(), OverlapPolicy::Strict).unwrap();
+        let built = world(a, OverlapPolicy::Lenient).unwrap();
+        let copy = strict.lenient();
+        assert_eq!(copy.overlap_policy(), OverlapPolicy::Lenient);
+        assert_eq!(copy.overlap_notes(), built.overlap_notes(), "{name}");
+        assert_eq!(copy.directions(), built.directions(), "{name}");
+        assert_eq!(copy.config(), built.config(), "{name}");
+        for p in 0..copy.num_parts() {
+            assert_eq!(copy.blocking_row(p), built.blocking_row(p), "{name}: part {p}");
+            for q in 0..copy.num_parts() {
+                assert_eq!((copy.ignores(p, q), copy.is_strict_pair(p, q)), (built.ignores(p, q), built.is_strict_pair(p, q)), "{name}");
+            }
+        }
+    }
+    // and the peg it frees is held by the strict world it was copied from
+    let strict = world(fixtures::pressed_peg(), OverlapPolicy::Strict).unwrap();
+    let all = PartSet::full(2);
+    assert_eq!(free_axes(&strict, 1, &all), vec!["+z"]);
+    assert!(free_axes(&strict.lenient(), 1, &all).len() > 1);
+}

@@ -115,6 +115,7 @@ fn steps(model: &VoxelModel, plan: &GridPlan, n: usize, margin: f32) -> Vec<Step
                         removals: steps(model, p, n, margin),
                         stats: Stats::default(),
                     }),
+                    unit: false,
                 })
             });
             let part = if group.is_some() { g.base } else { g.parts[0] };

@@ -1,7 +1,10 @@
 //! The plan as text: the table `asp plan` prints and the optimiser's summary under it
 //! ([`PlanReport::write_text`]; Python's `Plan.table()`).
 
-use super::{AssemblyStep, ExplanationReason, MotionEntry, OptimisationEntry, ParetoEntry, PlanReport, PlanStatus, SubassemblyStatus};
+use super::{
+    AssemblyStep, CoreGridReason, CoreWhy, ExplanationReason, LenientStatus, LockedCore, MotionEntry, OptimisationEntry, ParetoEntry,
+    PlanReport, PlanStatus, SubassemblyStatus,
+};
 use crate::problem::StopReason;
 use std::io::Write;
 
@@ -50,6 +53,11 @@ fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
             if n == 1 { "" } else { "s" },
             names.join("; ")
         )?;
+        for core in &r.locked_cores {
+            if let Some(why) = &core.why {
+                write_why(out, r, core, why)?;
+            }
+        }
     }
     let width = r.parts.iter().map(|p| p.name.len()).max().unwrap_or(4).max(4);
     let fixed: Vec<&str> = r.parts.iter().filter(|p| p.fixed).map(|p| p.name.as_str()).collect();
@@ -132,6 +140,7 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
     let name = |i: usize| r.parts.get(i).map_or("?", |p| p.name.as_str());
     let label = |step: &AssemblyStep| match &step.subassembly {
         None => step.name.clone(),
+        Some(g) if g.status == SubassemblyStatus::Unit => format!("{} + {} more (unit)", step.name, g.parts.len() - 1),
         Some(g) => format!("{} + {} more (subassembly)", step.name, g.parts.len() - 1),
     };
     let width = sequence.iter().map(|s| label(s).len()).fold(width, usize::max);
@@ -163,6 +172,7 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
                 SubassemblyStatus::Partial => "built on its base in this order, but not all of it part by part:".to_string(),
                 SubassemblyStatus::NoPlan => "cannot be taken apart (it goes in as one unit):".to_string(),
                 SubassemblyStatus::Unplanned => "not planned".to_string(),
+                SubassemblyStatus::Unit => "declared one unit (--unit-group), not taken apart".to_string(),
                 other => format!("{} before its own plan was found; the parts that come off:", other.as_str().replace('_', " ")),
             };
             writeln!(out, "{inner}subassembly {} on base {}: {how}", members.join(", "), step.name)?;
@@ -217,6 +227,85 @@ fn write_summary(out: &mut impl std::io::Write, summary: &OptimisationEntry, fro
                 writeln!(out, "best {names}: {}", v.join(", "))?;
             }
         }
+    }
+    Ok(())
+}
+
+/// The most parts of a core whose blockers the table lists (the JSON lists all).
+const WHY_PARTS: usize = 6;
+/// The most blockers the table lists per part, and overlapping pairs per core.
+const WHY_ITEMS: usize = 4;
+
+/// A few lines under the locked-core line: why `core` is locked.
+fn write_why(out: &mut impl Write, r: &PlanReport, core: &LockedCore, why: &CoreWhy) -> std::io::Result<()> {
+    let base = r.parts.get(core.base).map_or("?", |p| p.name.as_str());
+    writeln!(out, "  why the core on {base} ({} parts) is locked:", core.parts.len())?;
+    // the deepest first
+    let mut overlaps: Vec<_> = why.overlaps.iter().collect();
+    overlaps.sort_by(|a, b| b.gross.cmp(&a.gross).then(b.depth.total_cmp(&a.depth)));
+    for o in overlaps.into_iter().take(WHY_ITEMS) {
+        let bound = if o.gross { "more than " } else { "" };
+        let verdict = if o.artefact {
+            format!("deeper than {:.4}: a modelling artefact, not an interlock", why.artefact_depth)
+        } else {
+            format!("within {:.4}: a fit, not an artefact", why.artefact_depth)
+        };
+        writeln!(out, "    overlap {} / {}: {bound}{:.4} deep, {verdict}", o.names[0], o.names[1], o.depth)?;
+    }
+    if why.overlaps.len() > WHY_ITEMS {
+        writeln!(out, "    ... and {} more overlapping pairs", why.overlaps.len() - WHY_ITEMS)?;
+    }
+    let on_grid = |g: Option<bool>| match g {
+        Some(true) => "; the core's own parts are",
+        Some(false) => "; nor are the core's own parts",
+        None => "",
+    };
+    let grid = match why.grid.reason {
+        CoreGridReason::Stuck => "tried: no moves on the grid take it apart".to_string(),
+        CoreGridReason::Budget => "tried: its budget ran out first".to_string(),
+        CoreGridReason::Off => "not tried (--no-grid)".to_string(),
+        CoreGridReason::Robot => "not tried (planned with a robot)".to_string(),
+        CoreGridReason::UnitGroups => "not tried (units declared with --unit-group)".to_string(),
+        CoreGridReason::TooManyParts => format!("not tried (more than 64 parts){}", on_grid(why.grid.core_on_grid)),
+        CoreGridReason::NotOnGrid => format!("not tried (the model's parts are not all on one grid){}", on_grid(why.grid.core_on_grid)),
+    };
+    writeln!(out, "    grid planner: {grid}")?;
+    let others = core.parts.len().saturating_sub(1);
+    let l = &why.lenient;
+    let lenient = match l.status {
+        LenientStatus::Unchanged if why.overlaps.is_empty() => "changes nothing (no two of its parts overlap)".to_string(),
+        LenientStatus::Unchanged => "changes nothing (its overlaps are already tested that way)".to_string(),
+        LenientStatus::Found if others == 1 => "would free its other part".to_string(),
+        LenientStatus::Found => format!("would free all {others} of its other parts"),
+        LenientStatus::Partial | LenientStatus::NoPlan => format!("would free {} of its {others} other parts", l.frees),
+        LenientStatus::BudgetExhausted => {
+            format!("would free at least {} of its {others} other parts (the rerun ran out of budget)", l.frees)
+        }
+        LenientStatus::Unknown => "not known (the rerun could not be set up)".to_string(),
+    };
+    writeln!(out, "    --overlaps lenient: {lenient}")?;
+    writeln!(out, "    if it is one component (bought or pressed together), declare it one unit: --unit-group NAME,NAME,...")?;
+    let d = why.directions;
+    for b in why.blocks.iter().take(WHY_PARTS) {
+        let by: Vec<String> =
+            b.by.iter()
+                .take(WHY_ITEMS)
+                .map(|q| {
+                    let alone = if q.only > 0 { format!(" (alone along {})", q.only) } else { String::new() };
+                    format!("{} along {}{alone}", q.name, q.directions)
+                })
+                .collect();
+        let more = if b.by.len() > WHY_ITEMS { format!(" and {} more", b.by.len() - WHY_ITEMS) } else { String::new() };
+        let held =
+            if b.free == 0 { format!("blocked along all {d} directions") } else { format!("free along {} of {d} directions", b.free) };
+        if by.is_empty() {
+            writeln!(out, "    {}: {held}", b.name)?;
+        } else {
+            writeln!(out, "    {}: {held}; by {}{more}", b.name, by.join(", "))?;
+        }
+    }
+    if why.blocks.len() > WHY_PARTS {
+        writeln!(out, "    ... and {} more parts (the plan JSON lists them)", why.blocks.len() - WHY_PARTS)?;
     }
     Ok(())
 }
