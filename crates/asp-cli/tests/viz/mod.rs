@@ -322,3 +322,26 @@ fn plot_draws_traces_and_rejects_a_plan_without_a_front() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("pareto_front"), "{}", stderr(&o));
 }
+
+/// Issue 25: a part name built to hurt stays text in the viewer: no element it spells is made,
+/// no script it carries runs, and the step list shows it verbatim.
+#[test]
+fn a_hostile_part_name_stays_text_in_the_viewer() {
+    let Some(mut browser) = Browser::launch() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let hostile = r#"</script><img src=x onerror="window.__pwned=1"><b id="injected">x</b>"#;
+    let mut a = fixtures::stacked_boxes();
+    a.parts[1].name = hostile.into();
+    let model = dir.path().join("hostile.glb");
+    write_glb(&a, &model).unwrap();
+    let plan = dir.path().join("hostile.json");
+    let o = asp(&["plan", model.to_str().unwrap(), "--quiet", "--out", plan.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    browser.open(&view(&plan, "hostile.html"));
+    browser.wait_for("typeof aspViewer !== 'undefined'", 10.0);
+    assert_eq!(browser.eval("typeof window.__pwned").as_str(), Some("undefined"), "the name's script ran");
+    assert_eq!(browser.eval("document.querySelectorAll('img, #injected').length").as_u64(), Some(0), "the name made elements");
+    let steps = browser.eval("document.getElementById('asp-steps').textContent");
+    assert!(steps.as_str().is_some_and(|t| t.contains(hostile)), "the step list does not show the name as text: {steps}");
+    browser.assert_no_errors();
+}
