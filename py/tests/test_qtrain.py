@@ -403,7 +403,7 @@ def test_a_q_function_trained_for_seconds_ranks_the_optimal_first_action_first(t
 
 
 def test_ranking_quality_chains_transitions_into_returns(tmp_path):
-    # a stub "model" that prefers the part with the highest index; with one state and two
+    # a fixed scoring function in place of a trained model: it prefers the highest part index; with one state and two
     # observed actions whose returns are known, the score follows the returns
     torch = _torch()
     from asp.qdata import TransitionDataset
