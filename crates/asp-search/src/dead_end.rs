@@ -77,15 +77,10 @@ pub fn deepest_dead_end(problem: &Mdp, max_states: usize) -> Option<DeadEnd> {
         }
     }
     let (present, memory, path) = best?;
-    // the motions of the removals, as an answer's are replayed
+    // the motions of the removals, as an answer's are replayed (every step was feasible)
+    let (_, motions) = problem.replay(&path).expect("the dead-end search took feasible removals only");
+    let removals: Vec<(usize, Motion)> = path.iter().copied().zip(motions).collect();
     let mut state = MapState::new(maps);
-    let mut replay_memory = problem.initial_memory();
-    let mut removals = Vec::with_capacity(path.len());
-    for &p in &path {
-        let (d, travel) = state.clearance(p).expect("a feasible removal has a free direction");
-        removals.push((p, Motion::Linear { direction: maps.hemisphere().directions()[d], distance: travel }));
-        problem.step(&mut state, &mut replay_memory, p, StepKind::Replay, &mut rewards);
-    }
     state.reset(&present);
     let mut stuck = Vec::new();
     let mut rejected = Vec::new();

@@ -401,6 +401,22 @@ impl Mdp {
     /// every step's feasibility, and returns its objective vector and each removal's motion. The
     /// sequence must remove every non-fixed part.
     pub fn evaluate(&self, sequence: &[usize]) -> Result<(Vec<f64>, Vec<Motion>)> {
+        let (totals, motions, state) = self.replay_state(sequence)?;
+        if !state.is_complete() {
+            let maps = &*self.maps;
+            let left: Vec<usize> = state.present().iter().filter(|&i| !maps.is_fixed(i)).collect();
+            return Err(SearchError::Infeasible { reason: format!("the sequence leaves parts {left:?} in place") });
+        }
+        Ok((totals, motions))
+    }
+
+    /// [`Mdp::evaluate`] for the first removals of a sequence: each step checked and its motion
+    /// returned, without asking that every part be removed.
+    pub fn replay(&self, sequence: &[usize]) -> Result<(Vec<f64>, Vec<Motion>)> {
+        self.replay_state(sequence).map(|(totals, motions, _)| (totals, motions))
+    }
+
+    fn replay_state(&self, sequence: &[usize]) -> Result<(Vec<f64>, Vec<Motion>, MapState<'_>)> {
         let maps = &*self.maps;
         let m = self.objectives.len();
         let mut state = MapState::new(maps);
@@ -419,11 +435,7 @@ impl Mdp {
                 *a += r;
             }
         }
-        if !state.is_complete() {
-            let left: Vec<usize> = state.present().iter().filter(|&i| !maps.is_fixed(i)).collect();
-            return Err(SearchError::Infeasible { reason: format!("the sequence leaves parts {left:?} in place") });
-        }
-        Ok((totals, motions))
+        Ok((totals, motions, state))
     }
 
     /// The feasible removals of the state `present` with `memory` (for the assembled state:
