@@ -108,6 +108,27 @@ impl Assembly {
         self.parts.iter().position(|p| p.name == name)
     }
 
+    /// The fastened pairs `(i, j)`, `i < j`, sorted, from every part's
+    /// [`PartMeta::fastened_to`], and one warning per name that names no part (or the part
+    /// itself).
+    pub fn fastenings(&self) -> (Vec<(usize, usize)>, Vec<String>) {
+        let index: std::collections::HashMap<&str, usize> = self.parts.iter().enumerate().map(|(i, p)| (p.name.as_str(), i)).collect();
+        let mut pairs = std::collections::BTreeSet::new();
+        let mut warnings = Vec::new();
+        for (i, p) in self.parts.iter().enumerate() {
+            for name in &p.meta.fastened_to {
+                match index.get(name.as_str()) {
+                    Some(&j) if j != i => {
+                        pairs.insert((i.min(j), i.max(j)));
+                    }
+                    _ => warnings
+                        .push(format!("part '{}' says it is fastened to '{name}', which is no other part of the model; ignored", p.name)),
+                }
+            }
+        }
+        (pairs.into_iter().collect(), warnings)
+    }
+
     /// Marks the named parts as fixed; an unknown name is an error that lists the known ones.
     pub fn set_fixed<S: AsRef<str>>(&mut self, names: &[S]) -> Result<()> {
         for name in names {

@@ -2,7 +2,8 @@
 //!
 //! Generators (and users) describe parts beyond their meshes in the glTF node's `extras.asp`:
 //! what the part is (`kind`), its exact voxels (`cells`) or boxes (`boxes`), and where a gripper
-//! may hold it (`grasp_points`). [`PartMeta::from_extras`] reads those keys once; everything in
+//! may hold it (`grasp_points`), and what it is fastened to (`fastened_to`, or the profile
+//! generator's `holds` / `attached_to` / `connectors`). [`PartMeta::from_extras`] reads those keys once; everything in
 //! asp reads the typed fields instead of the JSON. Malformed metadata is not fatal: the key is
 //! ignored and the loader warns, naming the part and the key.
 
@@ -23,6 +24,13 @@ pub struct PartMeta {
     /// Where a parallel gripper may hold the part (`grasp_points`, in the node's frame like its
     /// mesh in the file); after loading in the world frame, metres.
     pub grasps: Vec<Grasp>,
+    /// Names of the parts this one is fastened to (screwed, clamped, bolted): a joint that holds
+    /// while both parts are present. Read from `fastened_to` (a list of part names) and from what
+    /// the profile generator writes: a connector part's `holds` and `attached_to`, a profile's
+    /// merged `connectors[].attached_to`. `--stability physics` bonds each such pair into one
+    /// rigid body ([`crate::physics`]); the removal test ignores it (a fastener is undone before
+    /// its part moves).
+    pub fastened_to: Vec<String>,
 }
 
 /// A grasp of a parallel two-finger gripper.
@@ -63,6 +71,12 @@ impl PartMeta {
                 None => problems.push("extras.asp.grasp_points is not a list of {position, orientation, width}; ignored".to_string()),
             }
         }
+        match fastened_to(extras) {
+            Some(names) => meta.fastened_to = names,
+            None => problems.push(
+                "extras.asp.fastened_to (or holds, attached_to, connectors[].attached_to) is not a list of part names; ignored".to_string(),
+            ),
+        }
         (meta, problems)
     }
 
@@ -83,6 +97,35 @@ impl PartMeta {
 /// The value under `key` in the metadata object, or one level down under `asp`.
 fn lookup<'a>(extras: &'a Value, key: &str) -> Option<&'a Value> {
     extras.get(key).or_else(|| extras.get("asp").and_then(|a| a.get(key)))
+}
+
+/// The part names under `fastened_to`, `holds`, `attached_to` and `connectors[].attached_to`, in
+/// that order, without repeats; `None` when one of those keys is present but malformed.
+fn fastened_to(extras: &Value) -> Option<Vec<String>> {
+    let mut names: Vec<String> = Vec::new();
+    let mut add = |v: &Value| -> Option<()> {
+        let name = v.as_str().filter(|s| !s.is_empty())?;
+        if !names.iter().any(|n| n == name) {
+            names.push(name.to_string());
+        }
+        Some(())
+    };
+    if let Some(v) = lookup(extras, "fastened_to") {
+        v.as_array()?.iter().try_for_each(&mut add)?;
+    }
+    for key in ["holds", "attached_to"] {
+        if let Some(v) = lookup(extras, key) {
+            add(v)?;
+        }
+    }
+    if let Some(v) = lookup(extras, "connectors") {
+        for c in v.as_array()? {
+            if let Some(to) = c.get("attached_to") {
+                add(to)?;
+            }
+        }
+    }
+    Some(names)
 }
 
 fn parse_cells(v: &Value) -> Option<Vec<[i32; 3]>> {
@@ -179,6 +222,20 @@ mod tests {
         assert_eq!(problems.len(), 3, "{problems:?}");
         assert!(problems[0].contains("cells") && problems[1].contains("boxes") && problems[2].contains("grasp_points"));
         assert_eq!(PartMeta::from_extras(&Value::Null), (PartMeta::default(), Vec::new()));
+        let (m, problems) = PartMeta::from_extras(&json!({"fastened_to": "plate"}));
+        assert!(m.fastened_to.is_empty() && problems.len() == 1 && problems[0].contains("fastened_to"), "{problems:?}");
+    }
+
+    #[test]
+    fn fastenings_are_read_from_every_key_the_generators_write() {
+        let (m, problems) = PartMeta::from_extras(&json!({"asp": {"kind": "connector", "holds": "p1", "attached_to": "p2"}}));
+        assert!(problems.is_empty(), "{problems:?}");
+        assert_eq!(m.fastened_to, ["p1", "p2"]);
+        let (m, _) = PartMeta::from_extras(&json!({
+            "fastened_to": ["plate", "p3"],
+            "connectors": [{"shape": "U", "attached_to": "p3"}, {"shape": "O", "attached_to": "p4"}],
+        }));
+        assert_eq!(m.fastened_to, ["plate", "p3", "p4"]);
     }
 
     #[test]

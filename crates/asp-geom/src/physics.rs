@@ -32,8 +32,16 @@
 //! One fact of parry shapes it too: a convex part touching a triangle's edge face-on-face may get
 //! a false contact metres deep; such contacts with fixed meshes are dropped (see `ContactHook`).
 //!
-//! Fasteners are not modelled: a shelf held only by side contacts with the panels (its dowels or
-//! pins missing from the model) falls, where the contact graph calls it supported.
+//! - **Parts are fastened.** A connector screwed to the profiles it joins, a bolt in its nut:
+//!   what the model says is fastened ([`crate::meta::PartMeta::fastened_to`], written by the
+//!   profile generator for every connector) and the threaded contacts the world detects
+//!   ([`World::threads`]) bond their two parts into one rigid body while both are present,
+//!   like interference fits. Without that, a profile frame held only by its connectors' side
+//!   contacts collapses in its assembled state and no removal is ever stable.
+//!
+//! Fasteners missing from the model are not guessed: a shelf held only by side contacts with
+//! the panels (its dowels or pins not modelled, nothing declared) falls, where the contact graph
+//! calls it supported.
 //!
 //! The rapier world is built per call (so [`PhysicsStability`] is `Send + Sync` and can be used
 //! from rayon); only the collider shapes are cached. Rapier is deterministic single-threaded, and
@@ -165,6 +173,9 @@ struct PartShape {
 pub struct PhysicsStability {
     config: PhysicsConfig,
     shapes: Vec<OnceLock<Option<PartShape>>>,
+    /// Pairs bonded into one rigid body while both are present: interference fits, declared
+    /// fastenings and threaded contacts, `(i, j)` with `i < j`, sorted.
+    bonds: Vec<(usize, usize)>,
     threshold: f32,
     length_unit: f32,
     gravity: Vec3,
@@ -188,7 +199,11 @@ impl PhysicsStability {
             .collect();
         sizes.sort_by(f32::total_cmp);
         let length_unit = sizes.get(sizes.len() / 2).copied().unwrap_or(diag);
+        let (fastened, _) = world.assembly().fastenings();
+        let threaded = world.threads().keys().map(|&(p, q)| (p.min(q), p.max(q)));
+        let bonds: BTreeSet<(usize, usize)> = world.overlaps().keys().copied().chain(fastened).chain(threaded).collect();
         PhysicsStability {
+            bonds: bonds.into_iter().collect(),
             threshold: config.displacement_fraction * diag,
             config,
             shapes: (0..count).map(|_| OnceLock::new()).collect(),
@@ -254,7 +269,7 @@ impl PhysicsStability {
         let present = world.with_fixed(state);
         let count = self.shapes.len();
         let parts: Vec<usize> = present.iter().filter(|&i| i < count).collect();
-        let group = bonded_groups(world, &parts);
+        let group = bonded_groups(&self.bonds, &parts);
         let static_groups: BTreeSet<usize> =
             parts.iter().filter(|&&i| world.fixed().contains(i) || held.contains(i)).map(|i| group[i]).collect();
         let is_static = |g: usize| static_groups.contains(&g);
@@ -331,9 +346,9 @@ impl PhysicsStability {
     }
 }
 
-/// Groups of present parts bonded by interference fits ([`World::overlaps`]): part → group id
-/// (the smallest part index of its group).
-fn bonded_groups(world: &World, parts: &[usize]) -> BTreeMap<usize, usize> {
+/// Groups of present parts joined by `bonds` (interference fits, fastenings, threads): part →
+/// group id (the smallest part index of its group).
+fn bonded_groups(bonds: &[(usize, usize)], parts: &[usize]) -> BTreeMap<usize, usize> {
     let mut root: BTreeMap<usize, usize> = parts.iter().map(|&i| (i, i)).collect();
     fn find(root: &BTreeMap<usize, usize>, mut i: usize) -> usize {
         while let Some(&r) = root.get(&i).filter(|&&r| r != i) {
@@ -341,7 +356,7 @@ fn bonded_groups(world: &World, parts: &[usize]) -> BTreeMap<usize, usize> {
         }
         i
     }
-    for &(a, b) in world.overlaps().keys() {
+    for &(a, b) in bonds {
         if root.contains_key(&a) && root.contains_key(&b) {
             let (ra, rb) = (find(&root, a), find(&root, b));
             root.insert(ra.max(rb), ra.min(rb));

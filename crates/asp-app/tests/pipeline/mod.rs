@@ -346,3 +346,30 @@ fn issue_28_the_pumps_core_declared_one_unit_is_found() {
     assert!(text.contains("\n    --overlaps lenient: would free 3 of its 5 other parts\n"), "{text}");
     assert!(text.contains("\n    grid planner: not tried (units declared with --unit-group)\n"), "{text}");
 }
+
+/// Issue 26 item 1: under `--stability physics` the generated profile assemblies plan, single
+/// and double layer, connectors attached or as parts: the simulation holds what the connectors
+/// fasten (without it the frame collapses in its assembled state and nothing can leave). The
+/// plans are `found`: every part gets its own motion (a subassembly's parts in its own plan).
+#[test]
+fn issue_26_generated_profile_assemblies_plan_under_physics() {
+    use asp_app::pipeline::StabilitySetting;
+    use asp_gen::profiles::{ConnectorMode, ProfileAssembly, ProfileParams};
+    use asp_search::report::PlanStatus;
+    let physics =
+        PlanSettings { stability: StabilitySetting::Physics { threshold: 0.01 }, timeout: Some(120.0), ..PlanSettings::default() };
+    for (params, connectors, seed) in [
+        (ProfileParams::single_layer(), ConnectorMode::Attached, 4242),
+        (ProfileParams::single_layer(), ConnectorMode::Separate, 4242),
+        (ProfileParams::double_layer(), ConnectorMode::Attached, 17),
+    ] {
+        let params = ProfileParams { connectors, ..params };
+        let a = ProfileAssembly::generate(&params, seed).unwrap().to_assembly("test:profiles");
+        let fastened = a.fastenings().0.len();
+        assert!(fastened > 0 && a.fastenings().1.is_empty(), "{connectors:?} {seed}: the generator says what is fastened");
+        let r = plan_assembly(a, &physics, None).unwrap();
+        let what = format!("{connectors:?} seed {seed}: {}", r.report.to_text());
+        assert_eq!(r.report.status, PlanStatus::Found, "{what}");
+        assert!(r.report.locked_cores.is_empty(), "{what}");
+    }
+}

@@ -129,6 +129,8 @@ fn finish(mut assembly: Assembly, options: &LoadOptions) -> Result<Assembly> {
     assembly.set_fixed(&options.fixed)?;
     assembly.validate()?;
     crate::validate::check_model(&assembly)?;
+    let (_, unknown) = assembly.fastenings();
+    assembly.warnings.extend(unknown);
     Ok(assembly)
 }
 

@@ -125,6 +125,39 @@ fn a_pressed_plug_holds_in_a_ring() {
     assert_eq!(p.stability(&w, &set(3, &[0, 2])), unstable(3, &[2]));
 }
 
+/// Issue 26 item 1: what the model says is fastened holds. A bracket touches a post's side only,
+/// in mid-air: it falls, unless its extras say it is screwed to the post (`fastened_to`), or the
+/// post says it holds the bracket (the connector's `holds`); with the post gone the fastening
+/// goes too. A name that is no part of the model is a load warning, not a bond.
+#[test]
+fn a_fastened_bracket_holds_on_the_side_of_a_post() {
+    let model = |bracket_extras: serde_json::Value, post_extras: serde_json::Value| {
+        assembly(vec![
+            part("base", cuboid([-2.0, -2.0, -0.5], [3.0, 3.0, 0.0]), true),
+            Part::new("post", cuboid([0.0, 0.0, 0.0], [0.2, 0.2, 2.0]), false, post_extras),
+            Part::new("bracket", cuboid([0.2, 0.0, 1.0], [0.6, 0.2, 1.2]), false, bracket_extras),
+        ])
+    };
+    let null = serde_json::Value::Null;
+    let w = world(model(null.clone(), null.clone()));
+    assert_eq!(physics(&w).stability(&w, &PartSet::full(3)), unstable(3, &[2]), "nothing holds the bracket");
+    for (bracket, post) in [
+        (serde_json::json!({"asp": {"fastened_to": ["post"]}}), null.clone()),
+        (null.clone(), serde_json::json!({"asp": {"kind": "connector", "holds": "bracket"}})),
+    ] {
+        let w = world(model(bracket.clone(), post.clone()));
+        assert_eq!(w.assembly().fastenings(), (vec![(1, 2)], Vec::new()));
+        let p = physics(&w);
+        assert_eq!(p.stability(&w, &PartSet::full(3)), Stability::Stable, "{bracket} {post}");
+        assert_eq!(p.stability(&w, &set(3, &[0, 2])), unstable(3, &[2]), "the post gone, the bracket falls");
+    }
+    let a = model(serde_json::json!({"asp": {"fastened_to": ["pillar", "bracket"]}}), null);
+    let (pairs, warnings) = a.fastenings();
+    assert!(pairs.is_empty());
+    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    assert!(warnings[0].contains("'bracket'") && warnings[0].contains("'pillar'") && warnings[0].contains("ignored"), "{warnings:?}");
+}
+
 /// A cradle (3 × 1 × 2) standing on a fixed base, with a 1 × 1 notch `depth` deep in the middle
 /// of its top, and a unit block resting on the notch's floor.
 fn cradle(depth: f32) -> Assembly {
