@@ -25,6 +25,7 @@ use crate::assembly::Assembly;
 use crate::boxes::{self, PartShape};
 use crate::feasibility::{CounterSnapshot, Counters, FeasibilityChecker, Motion, MotionKind, Outcome, Stability};
 use crate::math::{aabb_of, Aabb, Vec3};
+use crate::mesh::Mesh;
 use crate::partset::PartSet;
 use crate::world::{
     best_free_direction, candidate_directions, clearance_past, ground_box, WorldConfig, DEFAULT_RELATIVE_CONTACT,
@@ -69,6 +70,15 @@ impl VoxelChecker {
         if n == 0 || n > 63 || !config.exact_boxes || assembly.validate().is_err() {
             return None;
         }
+        // the classification first: a model with a mesh part (most CAD models) is declined at
+        // its first one, before any work in proportion to the model's size
+        let mut part_boxes: Vec<Vec<Aabb>> = Vec::with_capacity(n + 1);
+        for p in &assembly.parts {
+            match PartShape::classify(p, true) {
+                (shape, None) => part_boxes.push(shape.boxes()?),
+                (_, Some(_)) => return None,
+            }
+        }
         let diag = assembly.diagonal().max(f32::MIN_POSITIVE);
         let tolerance = config.tolerance.unwrap_or(DEFAULT_RELATIVE_TOLERANCE * diag);
         let contact_distance = config.contact_distance.unwrap_or(DEFAULT_RELATIVE_CONTACT * diag);
@@ -76,23 +86,11 @@ impl VoxelChecker {
             return None;
         }
         let mut aabbs = Vec::with_capacity(n + 1);
-        let mut part_boxes: Vec<Vec<Aabb>> = Vec::with_capacity(n + 1);
         for p in &assembly.parts {
             if crate::validate::collapsed(p).is_some() {
                 return None;
             }
-            // the world's preparation of the mesh (Geom::new) without the collision mesh
-            let mut m = p.mesh.clone();
-            m.weld();
-            m.orient_outward();
-            if !m.topology().is_closed_manifold() {
-                return None;
-            }
-            aabbs.push(m.aabb()?);
-            match PartShape::classify(p, true) {
-                (shape, None) => part_boxes.push(shape.boxes()?),
-                (_, Some(_)) => return None,
-            }
+            aabbs.push(closed_bounds(&p.mesh)?);
         }
         let mut fixed: u64 = assembly.parts.iter().enumerate().filter(|(_, p)| p.fixed).fold(0, |m, (i, _)| m | 1 << i);
         if fixed == 0 {
@@ -102,8 +100,17 @@ impl VoxelChecker {
             fixed = 1 << n;
         }
         let count = aabbs.len();
-        let directions = candidate_directions(assembly, config);
         let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+        // every face in an axis plane: each normal cluster is (within rounding) an axis, which
+        // the six axes already hold, so the candidates are the axes (without clustering them)
+        let axial = |m: &Mesh| {
+            m.triangles.iter().all(|t| (0..3).any(|k| t.iter().all(|&i| m.vertices[i as usize][k] == m.vertices[t[0] as usize][k])))
+        };
+        let directions = if config.sphere_directions == 0 && assembly.parts.iter().all(|p| axial(&p.mesh)) {
+            axes.to_vec()
+        } else {
+            candidate_directions(assembly, config)
+        };
         if directions != axes {
             return None;
         }
@@ -292,6 +299,46 @@ impl FeasibilityChecker for VoxelChecker {
         self.needs_world.store(true, Ordering::Relaxed);
         None
     }
+}
+
+/// The bounds of `mesh` as the world prepares it (`Geom::new`: weld, orient, topology) when its
+/// welded surface is closed and manifold, without hashing: vertices with bit-identical
+/// coordinates (±0 alike) are one (the first stands for all), triangles that collapse are
+/// dropped, and every edge must be used by exactly two triangles in opposite directions.
+fn closed_bounds(mesh: &Mesh) -> Option<Aabb> {
+    let mut order: Vec<([u32; 3], u32)> =
+        mesh.vertices.iter().enumerate().map(|(i, v)| ([v.x + 0.0, v.y + 0.0, v.z + 0.0].map(f32::to_bits), i as u32)).collect();
+    order.sort_unstable();
+    // each vertex's welded id: its group's first vertex (ids keep the order of first appearance)
+    let mut id = vec![0u32; mesh.vertices.len()];
+    let mut firsts = Vec::new();
+    for (k, &(key, i)) in order.iter().enumerate() {
+        if k > 0 && order[k - 1].0 == key {
+            id[i as usize] = id[order[k - 1].1 as usize];
+        } else {
+            id[i as usize] = i;
+            firsts.push(i);
+        }
+    }
+    firsts.sort_unstable();
+    let bounds = aabb_of(firsts.iter().map(|&i| mesh.vertices[i as usize]))?;
+    let mut edges: Vec<(u32, u32, bool)> = Vec::with_capacity(3 * mesh.triangles.len());
+    for t in &mesh.triangles {
+        let t = t.map(|i| id[i as usize]);
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            continue;
+        }
+        let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
+        if (b - a).cross(c - a).length_squared() > 0.0 {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                edges.push((a.min(b), a.max(b), a < b));
+            }
+        }
+    }
+    edges.sort_unstable();
+    let closed = edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)).all(|e| e.len() == 2 && e[0].2 != e[1].2);
+    closed.then_some(bounds)
 }
 
 /// The indices of the set bits of `m`, increasing.

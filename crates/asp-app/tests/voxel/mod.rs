@@ -108,6 +108,11 @@ fn the_fast_path_declines_what_it_cannot_answer() {
     turned.parts[6].meta.cells = None;
     assert!(VoxelChecker::new(&turned, &WorldConfig::default()).is_none());
     assert!(plan_on_voxels(&turned, &settings, &budget, None).unwrap().is_none());
+    // an open mesh (the world warns about it)
+    let mut open = cube.clone();
+    open.parts[0].mesh.triangles.pop();
+    assert!(VoxelChecker::new(&open, &WorldConfig::default()).is_none());
+    assert!(World::new(open, &WorldConfig::default()).unwrap().warnings().iter().any(|w| w.contains("not closed")));
     // extra sphere directions are off the lattice's axes
     assert!(VoxelChecker::new(&cube, &WorldConfig { sphere_directions: 8, ..WorldConfig::default() }).is_none());
     // physics stability is the world's
