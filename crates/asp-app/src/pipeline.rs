@@ -445,6 +445,10 @@ fn plan_with_world(
     Ok(PlanResult { report, status: outcome.status, search: None })
 }
 
+/// The fraction of the time budget the voxel fast path may spend before the world plans
+/// (`1 / VOXEL_TIME_SHARE`).
+const VOXEL_TIME_SHARE: u32 = 10;
+
 /// The voxel fast path (issue 27 item 1): when every part is a union of boxes on one lattice
 /// ([`VoxelChecker`]) and the settings ask for nothing it cannot answer (contact stability, no
 /// extension, an ordering that needs no world), the depth-first search runs on the voxel
@@ -469,9 +473,22 @@ pub fn plan_on_voxels(
     let started = Instant::now();
     let Some(checker) = VoxelChecker::new(assembly, &config) else { return Ok(None) };
     let world_seconds = started.elapsed().as_secs_f64();
+    // the search stops as soon as it asks for the world (its plan would be discarded), and
+    // gets a tenth of the time: a model it cannot answer in that is planned on the world with
+    // the whole budget, as before, at most a tenth later
+    let abort = StopToken::new();
+    let share = Budget { timeout: budget.timeout.map(|t| t / VOXEL_TIME_SHARE), cancel: Some(abort.clone()), ..budget.clone() };
+    let watch = |p: &Progress| {
+        if checker.needs_world() || budget.cancel.as_ref().is_some_and(StopToken::is_stopped) {
+            abort.stop();
+        }
+        if let Some(report) = progress {
+            report(p);
+        }
+    };
     let mut problem = Problem::full(&checker);
-    problem.progress = progress;
-    let outcome = dfs(settings, factory).solve(&problem, budget);
+    problem.progress = Some(&watch);
+    let outcome = dfs(settings, factory).solve(&problem, &share);
     if checker.needs_world() || outcome.status != Status::Found {
         return Ok(None);
     }

@@ -129,6 +129,13 @@ fn the_fast_path_declines_what_it_cannot_answer() {
     let layers = [["000", "011", "000"], ["110", "010", "000"], ["000", "000", "000"]];
     let labels: Vec<usize> = layers.iter().flat_map(|l| l.iter().flat_map(|r| r.bytes().map(|b| (b - b'0') as usize))).collect();
     let stuck = SomaCube::from_labels(3, labels).unwrap().to_assembly(0.05, "stuck");
-    let quick = PlanSettings { path_planner: false, ..settings };
+    let quick = PlanSettings { path_planner: false, ..settings.clone() };
     assert!(plan_on_voxels(&stuck, &quick, &budget, None).unwrap().is_none());
+    // with the default settings too (the pair leaves as a group it cannot take apart: the
+    // world's plan is partial)
+    let started = std::time::Instant::now();
+    assert!(plan_on_voxels(&stuck, &settings, &budget, None).unwrap().is_none());
+    assert!(started.elapsed().as_secs_f64() < 1.0);
+    let world = plan_on_world(stuck, &settings, None).unwrap();
+    assert!(!world.found(), "{}", world.report.to_json());
 }
