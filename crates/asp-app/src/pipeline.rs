@@ -15,6 +15,7 @@ use asp_geom::io::LoadOptions;
 use asp_geom::math::Axis;
 use asp_geom::physics::PhysicsConfig;
 use asp_geom::rrt::RrtConfig;
+use asp_geom::voxel::VoxelChecker;
 use asp_geom::{
     Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, OverlapPolicy, PartSet, StabilityMode, Units, World, WorldConfig,
 };
@@ -296,14 +297,18 @@ pub fn checker(assembly: Assembly, settings: &PlanSettings) -> Result<Checker> {
 /// The depth-first planner the settings ask for, its ordering prepared on `world` (a learned
 /// ordering computes the model's graph features here, once).
 pub fn planner(settings: &PlanSettings, world: &World) -> Result<Dfs> {
-    let factory = settings.order.prepare(world)?;
-    Ok(Dfs::builder()
+    Ok(dfs(settings, settings.order.prepare(world)?))
+}
+
+/// The depth-first planner the settings ask for, with its ordering factory.
+fn dfs(settings: &PlanSettings, factory: Arc<dyn asp_search::OrderingFactory>) -> Dfs {
+    Dfs::builder()
         .ordering_factory(factory)
         .bookkeeping(settings.bookkeeping)
         .path_planner(settings.path_planner)
         .subassemblies(settings.subassemblies)
         .seed(settings.seed)
-        .build())
+        .build()
 }
 
 /// The search budget.
@@ -336,8 +341,39 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
     }
     let budget = budget(settings)?;
     let units = unit_sets(&assembly, &settings.unit_groups)?;
-    // the grid planner does not keep declared units together
-    let voxels = (settings.grid && settings.checker_extension.is_none() && units.is_empty()).then(|| VoxelModel::of(&assembly)).flatten();
+    let voxels = voxel_model(&assembly, settings, &units);
+    if voxels.is_none() && units.is_empty() {
+        if let Some(result) = plan_on_voxels(&assembly, settings, &budget, progress)? {
+            return Ok(result);
+        }
+    }
+    plan_with_world(assembly, settings, progress, budget, units, voxels)
+}
+
+/// [`plan_assembly`]'s feasibility plan on the collision world, never by the voxel fast path
+/// ([`plan_on_voxels`]): what the fast path must equal (`tests/voxel`), and the one plan of
+/// every model the fast path declines.
+pub fn plan_on_world(assembly: Assembly, settings: &PlanSettings, progress: Option<&(dyn Fn(&Progress) + Sync)>) -> Result<PlanResult> {
+    let budget = budget(settings)?;
+    let units = unit_sets(&assembly, &settings.unit_groups)?;
+    let voxels = voxel_model(&assembly, settings, &units);
+    plan_with_world(assembly, settings, progress, budget, units, voxels)
+}
+
+/// The voxel view the grid planner takes apart, when it may run: it does not keep declared
+/// units together, and a robot checks what the grid cannot.
+fn voxel_model(assembly: &Assembly, settings: &PlanSettings, units: &[PartSet]) -> Option<VoxelModel> {
+    (settings.grid && settings.checker_extension.is_none() && units.is_empty()).then(|| VoxelModel::of(assembly)).flatten()
+}
+
+fn plan_with_world(
+    assembly: Assembly,
+    settings: &PlanSettings,
+    progress: Option<&(dyn Fn(&Progress) + Sync)>,
+    budget: Budget,
+    units: Vec<PartSet>,
+    voxels: Option<VoxelModel>,
+) -> Result<PlanResult> {
     let grid_started = Instant::now();
     let probe = voxels.clone().map(|m| GridRun::probe(m, &budget, grid_started));
     let started = Instant::now();
@@ -407,6 +443,62 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
     finish_report(&mut report, world, &outcome, world_seconds);
     explain_cores(&mut report, world, settings, grid_ran, &units);
     Ok(PlanResult { report, status: outcome.status, search: None })
+}
+
+/// The fraction of the time budget the voxel fast path may spend before the world plans
+/// (`1 / VOXEL_TIME_SHARE`).
+const VOXEL_TIME_SHARE: u32 = 10;
+
+/// The voxel fast path (issue 27 item 1): when every part is a union of boxes on one lattice
+/// ([`VoxelChecker`]) and the settings ask for nothing it cannot answer (contact stability, no
+/// extension, an ordering that needs no world), the depth-first search runs on the voxel
+/// checker, which answers every removal test as the collision world would, and no world is
+/// built. Its plan is the plan of the world's search, so it is kept only when it is complete
+/// and asked for nothing of the world (the path planner, a subassembly's own plan); otherwise
+/// `None`, and the caller plans on the world as before ([`plan_on_world`]; `tests/voxel` holds
+/// the two equal). `budget` is [`budget`]'s of the settings.
+pub fn plan_on_voxels(
+    assembly: &Assembly,
+    settings: &PlanSettings,
+    budget: &Budget,
+    progress: Option<&(dyn Fn(&Progress) + Sync)>,
+) -> Result<Option<PlanResult>> {
+    if settings.checker_extension.is_some() || !matches!(settings.stability, StabilitySetting::Contact) {
+        return Ok(None);
+    }
+    let Some(factory) = settings.order.prepare_without_world() else { return Ok(None) };
+    // the world's settings are checked as the world's path checks them
+    let config = world_config(assembly, settings)?;
+    checker_config(settings)?;
+    let started = Instant::now();
+    let Some(checker) = VoxelChecker::new(assembly, &config) else { return Ok(None) };
+    let world_seconds = started.elapsed().as_secs_f64();
+    // the search stops as soon as it asks for the world (its plan would be discarded), and
+    // gets a tenth of the time: a model it cannot answer in that is planned on the world with
+    // the whole budget, as before, at most a tenth later
+    let abort = StopToken::new();
+    let share = Budget { timeout: budget.timeout.map(|t| t / VOXEL_TIME_SHARE), cancel: Some(abort.clone()), ..budget.clone() };
+    let watch = |p: &Progress| {
+        if checker.needs_world() || budget.cancel.as_ref().is_some_and(StopToken::is_stopped) {
+            abort.stop();
+        }
+        if let Some(report) = progress {
+            report(p);
+        }
+    };
+    let mut problem = Problem::full(&checker);
+    problem.progress = Some(&watch);
+    let outcome = dfs(settings, factory).solve(&problem, &share);
+    if checker.needs_world() || outcome.status != Status::Found {
+        return Ok(None);
+    }
+    let mut report = PlanReport::new(assembly, &outcome, checker.tolerance(), checker.warnings());
+    if !report.locked_cores.is_empty() {
+        return Ok(None);
+    }
+    report.stats.timings =
+        Some(Timings { load: 0.0, world: world_seconds, search: outcome.stats.seconds, path_planner: outcome.stats.path_planner_seconds });
+    Ok(Some(PlanResult { report, status: outcome.status, search: None }))
 }
 
 /// The declared units ([`PlanSettings::unit_groups`]) as sets of part indices.

@@ -14,3 +14,4 @@ mod request;
 mod robot;
 mod stepped;
 mod transitions;
+mod voxel;

@@ -11,6 +11,9 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// How many solved arrangements the classic Soma cube has up to symmetry (`--classic --all`).
+const CLASSIC_SOLUTIONS: usize = 240;
+
 /// Flags of `asp gen`.
 #[derive(Args, Debug)]
 pub struct GenArgs {
@@ -54,6 +57,10 @@ pub struct SomaArgs {
     /// The classic 7-piece 3×3×3 Soma cube in one of its solved arrangements.
     #[arg(long, conflicts_with = "size")]
     pub classic: bool,
+    /// With --classic: all 240 solved arrangements of the classic cube, distinct up to the
+    /// cube's 48 symmetries (soma_classic_all_000.glb to _239.glb).
+    #[arg(long, requires = "classic")]
+    pub all: bool,
     /// Edge length of one cell in metres.
     #[arg(long, default_value_t = 0.05)]
     pub cell: f64,
@@ -127,7 +134,12 @@ pub struct ProfilesArgs {
 pub fn run(args: &GenArgs) -> anyhow::Result<ExitCode> {
     let (generator, preset, batch_args) = match &args.kind {
         GenKind::Soma(a) => {
-            let generator = if a.classic {
+            let generator = if a.all {
+                if a.batch.count != 1 {
+                    bail!("--classic --all makes the 240 solutions; leave out --count");
+                }
+                Generator::ClassicSomaAll { cell: a.cell }
+            } else if a.classic {
                 if a.batch.count != 1 {
                     bail!("--classic makes the one classic cube; leave out --count");
                 }
@@ -159,7 +171,8 @@ pub fn run(args: &GenArgs) -> anyhow::Result<ExitCode> {
             (Generator::Profiles(p), a.preset.and(Some(name)), &a.batch)
         }
     };
-    let batch = Batch { generator, preset, count: batch_args.count, seed: batch_args.seed };
+    let count = if matches!(generator, Generator::ClassicSomaAll { .. }) { CLASSIC_SOLUTIONS } else { batch_args.count };
+    let batch = Batch { generator, preset, count, seed: batch_args.seed };
     let bar = if batch_args.quiet || !std::io::stderr().is_terminal() {
         ProgressBar::hidden()
     } else {
@@ -201,6 +214,8 @@ mod tests {
         assert!(matches!(a.kind, GenKind::Soma(SomaArgs { size: 5, classic: false, .. })));
         assert!(parse(&["soma", "--classic", "--out", "data/"]).is_ok());
         assert!(parse(&["soma", "--classic", "--size", "4", "--out", "x"]).is_err(), "conflicting flags");
+        assert!(matches!(parse(&["soma", "--classic", "--all", "--out", "x"]).unwrap().kind, GenKind::Soma(SomaArgs { all: true, .. })));
+        assert!(parse(&["soma", "--all", "--out", "x"]).is_err(), "--all needs --classic");
         let a = parse(&["profiles", "--preset", "double-layer", "--count", "7", "--out", "d"]).unwrap();
         assert!(matches!(a.kind, GenKind::Profiles(ProfilesArgs { preset: Some(Preset::DoubleLayer), .. })));
         let custom = [
@@ -248,6 +263,7 @@ mod tests {
         for args in [
             vec!["soma", "--size", "1", "--out", out, "-q"],
             vec!["soma", "--classic", "--count", "2", "--out", out, "-q"],
+            vec!["soma", "--classic", "--all", "--count", "2", "--out", out, "-q"],
             vec!["soma", "--count", "0", "--out", out, "-q"],
             vec!["profiles", "--height", "0.05", "--out", out, "-q"],
             vec!["profiles", "--width", "nan", "--out", out, "-q"],

@@ -34,7 +34,7 @@ pub fn file_name(generator: &Generator, index: usize, count: usize) -> String {
 pub fn generate_item(generator: &Generator, index: usize, count: usize, seed: u64) -> Result<(Generated, ManifestEntry)> {
     let file = file_name(generator, index, count);
     let seed = assembly_seed(seed, index);
-    let generated = generator.generate(seed, &file)?;
+    let generated = generator.generate_item(index, seed, &file)?;
     let parts = &generated.assembly.parts;
     let entry = ManifestEntry {
         file,

@@ -21,6 +21,12 @@ pub enum Generator {
         /// Edge length of one cell in metres.
         cell: f64,
     },
+    /// Every solution of the classic Soma cube up to symmetry
+    /// ([`SomaCube::classic_solutions`]: assembly `index` of a batch is solution `index`, of 240).
+    ClassicSomaAll {
+        /// Edge length of one cell in metres.
+        cell: f64,
+    },
     /// Aluminium profile assemblies.
     Profiles(ProfileParams),
 }
@@ -41,7 +47,7 @@ impl Generator {
     pub fn validate(&self) -> Result<()> {
         match self {
             Generator::Soma(p) => p.validate(),
-            Generator::ClassicSoma { cell } => validate_cell(*cell),
+            Generator::ClassicSoma { cell } | Generator::ClassicSomaAll { cell } => validate_cell(*cell),
             Generator::Profiles(p) => p.validate(),
         }
     }
@@ -51,12 +57,21 @@ impl Generator {
         match self {
             Generator::Soma(p) => format!("soma{}", p.size),
             Generator::ClassicSoma { .. } => "soma_classic".into(),
+            Generator::ClassicSomaAll { .. } => "soma_classic_all".into(),
             Generator::Profiles(_) => "profiles".into(),
         }
     }
 
-    /// Generates the assembly of `seed`; `source` names it (e.g. its file name).
+    /// Generates the assembly of `seed`; `source` names it (e.g. its file name). The classic
+    /// cube's solutions are chosen by their index, not a seed: see [`Generator::generate_item`].
     pub fn generate(&self, seed: u64, source: &str) -> Result<Generated> {
+        self.generate_item(0, seed, source)
+    }
+
+    /// Generates assembly `index` of a batch, of `seed`; `source` names it (e.g. its file name).
+    /// Only [`Generator::ClassicSomaAll`] reads the index (solution `index`; an index beyond
+    /// the 240 solutions is an error).
+    pub fn generate_item(&self, index: usize, seed: u64, source: &str) -> Result<Generated> {
         match self {
             Generator::Soma(p) => {
                 p.validate()?;
@@ -66,6 +81,17 @@ impl Generator {
             Generator::ClassicSoma { cell } => {
                 validate_cell(*cell)?;
                 Ok(soma_generated(&SomaCube::classic(), *cell, source))
+            }
+            Generator::ClassicSomaAll { cell } => {
+                validate_cell(*cell)?;
+                let all = classic_solutions();
+                let cube = all.get(index).ok_or_else(|| {
+                    crate::error::GenError::parameter(
+                        "count",
+                        format!("the classic cube has {} solutions, asked for number {}", all.len(), index + 1),
+                    )
+                })?;
+                Ok(soma_generated(cube, *cell, source))
             }
             Generator::Profiles(p) => {
                 let profiles = ProfileAssembly::generate(p, seed)?;
@@ -83,6 +109,12 @@ impl Generator {
             }
         }
     }
+}
+
+/// The classic cube's solutions, enumerated once per process.
+fn classic_solutions() -> &'static [SomaCube] {
+    static ALL: std::sync::OnceLock<Vec<SomaCube>> = std::sync::OnceLock::new();
+    ALL.get_or_init(SomaCube::classic_solutions)
 }
 
 fn soma_generated(cube: &SomaCube, cell: f64, source: &str) -> Generated {

@@ -123,6 +123,27 @@ impl SomaCube {
         cube
     }
 
+    /// Every solved arrangement of the classic Soma cube up to the cube's 48 symmetries
+    /// (rotations and reflections; a reflection turns each screw piece into the other):
+    /// the 240 distinct solutions of Piet Hein's puzzle, found by exact cover of the 27 cells
+    /// (all 11,520 placements of the seven labelled pieces, each solution's class kept once).
+    /// Each is given by the representative whose labels (in [`SomaCube::classic`]'s piece
+    /// order, cell index `x + 3 (y + 3 z)`) come first lexicographically, in that order.
+    pub fn classic_solutions() -> Vec<SomaCube> {
+        let mut canonical: Vec<[u8; 27]> = classic_exact_covers().iter().map(canonical_labels).collect();
+        canonical.sort_unstable();
+        canonical.dedup();
+        let names: Vec<String> = CLASSIC_LETTERS.iter().map(|l| format!("piece_{l}")).collect();
+        canonical
+            .into_iter()
+            .map(|labels| {
+                let mut cube = Self::from_labels_unchecked(3, labels.iter().map(|&l| l as usize).collect());
+                cube.names = names.clone();
+                cube
+            })
+            .collect()
+    }
+
     /// A cube from the piece index of every cell (index `x + S (y + S z)`), e.g. a puzzle
     /// designed by hand. Piece indices must run over `0..n` and every piece must be
     /// face-connected; pieces may have any number of cells.
@@ -316,6 +337,124 @@ impl RemovalModel for VoxelModel<'_> {
     }
 }
 
+/// The 48 symmetries of the cube as signed axis permutations: `(perm, signs)` maps cell `c`
+/// to `c'[k] = signs[k] * (c[perm[k]] - 1) + 1` (3×3×3, centred on cell 1); `proper` is false
+/// for the reflections.
+fn cube_symmetries() -> Vec<([usize; 3], [i32; 3], bool)> {
+    const PERMS: [([usize; 3], bool); 6] =
+        [([0, 1, 2], true), ([1, 2, 0], true), ([2, 0, 1], true), ([0, 2, 1], false), ([2, 1, 0], false), ([1, 0, 2], false)];
+    let mut out = Vec::with_capacity(48);
+    for (perm, even) in PERMS {
+        for bits in 0..8u32 {
+            let signs = [0, 1, 2].map(|k| if bits >> k & 1 == 1 { -1 } else { 1 });
+            let negatives = bits.count_ones() % 2 == 1;
+            out.push((perm, signs, even != negatives));
+        }
+    }
+    out
+}
+
+/// Every solution of the classic cube as labels (piece index per cell, [`CLASSIC_LETTERS`]
+/// order): exact cover of the 27 cells by one placement of each piece.
+fn classic_exact_covers() -> Vec<[u8; 27]> {
+    let classic = SomaCube::classic();
+    let symmetries: Vec<_> = cube_symmetries().into_iter().filter(|s| s.2).collect();
+    // every placement of every piece as a 27-bit mask, listed under its lowest cell
+    let mut placements: Vec<Vec<Vec<u32>>> = vec![vec![Vec::new(); 27]; 7];
+    for (p, cells) in classic.pieces.iter().enumerate() {
+        let mut seen: Vec<u32> = Vec::new();
+        for (perm, signs, _) in &symmetries {
+            let turned: Vec<[i32; 3]> = cells.iter().map(|c| std::array::from_fn(|k| signs[k] * c[perm[k]])).collect();
+            let lo: [i32; 3] = std::array::from_fn(|k| turned.iter().map(|c| c[k]).min().unwrap_or(0));
+            for dz in 0..3 {
+                for dy in 0..3 {
+                    for dx in 0..3 {
+                        let shift = [dx, dy, dz];
+                        let moved: Vec<[i32; 3]> = turned.iter().map(|c| std::array::from_fn(|k| c[k] - lo[k] + shift[k])).collect();
+                        if moved.iter().all(|c| c.iter().all(|&x| (0..3).contains(&x))) {
+                            let mask = moved.iter().fold(0u32, |m, &c| m | 1 << index(c, 3));
+                            if !seen.contains(&mask) {
+                                seen.push(mask);
+                                placements[p][mask.trailing_zeros() as usize].push(mask);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    fn cover(filled: u32, used: u8, chosen: &mut Vec<(usize, u32)>, placements: &[Vec<Vec<u32>>], out: &mut Vec<[u8; 27]>) {
+        if filled == (1 << 27) - 1 {
+            let mut labels = [0u8; 27];
+            for &(p, mask) in chosen.iter() {
+                for (i, l) in labels.iter_mut().enumerate() {
+                    if mask >> i & 1 == 1 {
+                        *l = p as u8;
+                    }
+                }
+            }
+            out.push(labels);
+            return;
+        }
+        let cell = (!filled).trailing_zeros() as usize;
+        for (p, by_cell) in placements.iter().enumerate() {
+            if used >> p & 1 == 1 {
+                continue;
+            }
+            for &mask in &by_cell[cell] {
+                if mask & filled == 0 {
+                    chosen.push((p, mask));
+                    cover(filled | mask, used | 1 << p, chosen, placements, out);
+                    chosen.pop();
+                }
+            }
+        }
+    }
+    let mut out = Vec::new();
+    cover(0, 0, &mut Vec::new(), &placements, &mut out);
+    out
+}
+
+/// The least image of a solution's labels under the cube's 48 symmetries (a reflection turns
+/// each piece into its mirror image: [`mirror_pieces`]).
+fn canonical_labels(labels: &[u8; 27]) -> [u8; 27] {
+    let mirror = mirror_pieces();
+    cube_symmetries()
+        .into_iter()
+        .map(|(perm, signs, proper)| {
+            let mut image = [0u8; 27];
+            for (i, &l) in labels.iter().enumerate() {
+                let c = coords(i, 3);
+                let to: [i32; 3] = std::array::from_fn(|k| signs[k] * (c[perm[k]] - 1) + 1);
+                image[index(to, 3)] = if proper { l } else { mirror[l as usize] };
+            }
+            image
+        })
+        .min()
+        .unwrap_or(*labels)
+}
+
+/// For each classic piece, the piece its mirror image is (up to a rotation): itself for the
+/// five achiral pieces, the other for the two screws.
+fn mirror_pieces() -> [u8; 7] {
+    let pieces = SomaCube::classic().pieces;
+    let shape = |cells: &[[i32; 3]]| -> Vec<[i32; 3]> {
+        let lo: [i32; 3] = std::array::from_fn(|k| cells.iter().map(|c| c[k]).min().unwrap_or(0));
+        let mut v: Vec<[i32; 3]> = cells.iter().map(|c| std::array::from_fn(|k| c[k] - lo[k])).collect();
+        v.sort_unstable();
+        v
+    };
+    let turned = |cells: &[[i32; 3]], perm: [usize; 3], signs: [i32; 3]| -> Vec<[i32; 3]> {
+        shape(&cells.iter().map(|c| std::array::from_fn(|k| signs[k] * c[perm[k]])).collect::<Vec<_>>())
+    };
+    let rotations: Vec<_> = cube_symmetries().into_iter().filter(|s| s.2).collect();
+    std::array::from_fn(|p| {
+        let mirrored = turned(&pieces[p], [0, 1, 2], [-1, 1, 1]);
+        (0..pieces.len()).find(|&q| rotations.iter().any(|&(perm, signs, _)| turned(&pieces[q], perm, signs) == mirrored)).unwrap_or(p)
+            as u8
+    })
+}
+
 fn index(c: [i32; 3], size: usize) -> usize {
     c[0] as usize + size * (c[1] as usize + size * c[2] as usize)
 }
@@ -341,6 +480,50 @@ mod tests {
     use super::*;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn the_classic_cube_has_240_solutions_up_to_symmetry() {
+        // 11,520 labelled solutions = 240 classes of 48 (no solution is symmetric)
+        assert_eq!(classic_exact_covers().len(), 11_520);
+        let all = SomaCube::classic_solutions();
+        assert_eq!(all.len(), 240);
+        let classes: std::collections::HashSet<[u8; 27]> =
+            all.iter().map(|c| canonical_labels(&std::array::from_fn(|i| c.labels[i] as u8))).collect();
+        assert_eq!(classes.len(), 240, "pairwise non-equivalent");
+        let classic = SomaCube::classic();
+        assert!(classes.contains(&canonical_labels(&std::array::from_fn(|i| classic.labels[i] as u8))), "the classic arrangement is one");
+        for cube in &all {
+            assert_eq!(cube.piece_sizes(), [0, 0, 1, 6]);
+            assert!((0..7).all(|p| cube.is_face_connected(p)));
+            // each piece is the classic piece turned (its cells up to a proper rotation)
+            assert_eq!(cube.names, classic.names);
+        }
+    }
+
+    #[test]
+    fn a_reflection_swaps_the_mirror_pieces() {
+        // the two screws (B and P in this layout) are each other's mirror images
+        let letter = |l: char| CLASSIC_LETTERS.iter().position(|&x| x == l).unwrap() as u8;
+        let mirror = mirror_pieces();
+        for (p, &l) in CLASSIC_LETTERS.iter().enumerate() {
+            let expected = match l {
+                'B' => letter('P'),
+                'P' => letter('B'),
+                _ => p as u8,
+            };
+            assert_eq!(mirror[p], expected, "piece {l}");
+        }
+        let classic = SomaCube::classic();
+        let labels: [u8; 27] = std::array::from_fn(|i| classic.labels[i] as u8);
+        // mirrored along x (the screws swapped): the same class
+        let mut mirrored = [0u8; 27];
+        for (i, &l) in labels.iter().enumerate() {
+            let c = coords(i, 3);
+            mirrored[index([2 - c[0], c[1], c[2]], 3)] = mirror[l as usize];
+        }
+        assert_eq!(canonical_labels(&mirrored), canonical_labels(&labels));
+        assert_eq!(cube_symmetries().iter().filter(|s| s.2).count(), 24);
+    }
 
     #[test]
     fn neighbours_include_the_zero_boundary() {

@@ -26,6 +26,7 @@ pub mod rrt;
 pub mod sample;
 pub mod sweep;
 pub mod validate;
+pub mod voxel;
 pub mod world;
 
 pub use assembly::{Assembly, Part, Units};

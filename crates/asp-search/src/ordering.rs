@@ -53,6 +53,12 @@ pub trait OrderingSource: Send + Sync {
     fn name(&self) -> String;
     /// The ordering factory for the model of `world`.
     fn prepare(&self, world: &World) -> crate::Result<Arc<dyn OrderingFactory>>;
+    /// The ordering factory when it needs nothing of the model (the built-in orderings), for
+    /// planners that build no collision world (the voxel checker, `asp_geom::voxel`); `None`
+    /// (the default) when it needs the world.
+    fn prepare_without_world(&self) -> Option<Arc<dyn OrderingFactory>> {
+        None
+    }
 }
 
 impl OrderingSource for BuiltinOrder {
@@ -62,6 +68,10 @@ impl OrderingSource for BuiltinOrder {
 
     fn prepare(&self, _world: &World) -> crate::Result<Arc<dyn OrderingFactory>> {
         Ok(Arc::new(*self))
+    }
+
+    fn prepare_without_world(&self) -> Option<Arc<dyn OrderingFactory>> {
+        Some(Arc::new(*self))
     }
 }
 

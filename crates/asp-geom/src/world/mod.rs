@@ -17,6 +17,8 @@ mod directions;
 mod geom;
 mod removal;
 
+pub(crate) use removal::best_free_direction;
+
 pub use directions::candidate_directions;
 use geom::{contains_point, nests, Geom};
 
@@ -698,15 +700,22 @@ impl World {
     }
 
     fn clearance_of(&self, a: &Aabb, others: impl Iterator<Item = usize>, dir: Vec3) -> f32 {
-        let others = aabb_of(others.filter(|&q| q < self.num_parts()).flat_map(|q| [self.geoms[q].aabb.mins, self.geoms[q].aabb.maxs]))
-            .unwrap_or(*a);
-        let t = (0..3)
-            .filter(|&i| dir[i].abs() > 1e-6)
-            .map(|i| if dir[i] > 0.0 { (others.maxs[i] - a.mins[i]) / dir[i] } else { (a.maxs[i] - others.mins[i]) / -dir[i] })
-            .fold(f32::INFINITY, f32::min)
-            .max(0.0);
-        t + self.contact_distance
+        let others = aabb_of(others.filter(|&q| q < self.num_parts()).flat_map(|q| [self.geoms[q].aabb.mins, self.geoms[q].aabb.maxs]));
+        clearance_past(a, others, dir, self.contact_distance)
     }
+}
+
+/// How far box `a` travels along unit `dir` until it clears the bounds `others` (its own
+/// starting bounds when `None`), plus `contact_distance`: the travel of a straight removal,
+/// which the collision world and the voxel checker ([`crate::voxel`]) share.
+pub(crate) fn clearance_past(a: &Aabb, others: Option<Aabb>, dir: Vec3, contact_distance: f32) -> f32 {
+    let others = others.unwrap_or(*a);
+    let t = (0..3)
+        .filter(|&i| dir[i].abs() > 1e-6)
+        .map(|i| if dir[i] > 0.0 { (others.maxs[i] - a.mins[i]) / dir[i] } else { (a.maxs[i] - others.mins[i]) / -dir[i] })
+        .fold(f32::INFINITY, f32::min)
+        .max(0.0);
+    t + contact_distance
 }
 
 /// Default contact tolerance ([`WorldConfig::tolerance`], [`crate::distmap::MapConfig`]),
@@ -731,7 +740,7 @@ fn significant(x: f64, digits: i32) -> String {
 }
 
 /// A slab under the model whose top face lies at the model's lowest point along `up`.
-fn ground_box(bb: &Aabb, up: Vec3, diag: f32) -> Mesh {
+pub(crate) fn ground_box(bb: &Aabb, up: Vec3, diag: f32) -> Mesh {
     let centre = (bb.mins + bb.maxs) * 0.5;
     let half = Vec3::splat(1.5 * diag);
     let (mut mins, mut maxs) = (centre - half, centre + half);

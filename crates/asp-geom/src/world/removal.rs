@@ -75,28 +75,7 @@ impl World {
         blockers_along: impl Fn(usize) -> PartSet,
         travel: impl Fn(Vec3) -> f32,
     ) -> std::result::Result<Motion, PartSet> {
-        let up = self.assembly.up.vector();
-        let mut best: Option<(f32, Vec3)> = None;
-        let mut blockers = PartSet::empty(self.geoms.len());
-        for (k, dir) in self.directions.iter().enumerate() {
-            let b = blockers_along(k);
-            if b.is_empty() {
-                let d = travel(*dir);
-                let better = match best {
-                    None => true,
-                    Some((bd, bdir)) => d < bd - 1e-6 * bd.max(1e-9) || (d <= bd + 1e-6 * bd && dir.dot(up) > bdir.dot(up) + 1e-6),
-                };
-                if better {
-                    best = Some((d, *dir));
-                }
-            } else {
-                blockers.union_with(&b);
-            }
-        }
-        match best {
-            Some((distance, direction)) => Ok(Motion::Linear { direction, distance }),
-            None => Err(blockers),
-        }
+        best_free_direction(&self.directions, self.assembly.up.vector(), self.geoms.len(), blockers_along, travel)
     }
 
     /// A removal of `p` from `state` by two straight moves in turn when no single straight line
@@ -266,5 +245,38 @@ impl World {
                     && contains_point(&shrunk, shrunk_pose.inverse_transform_point(raw_pose.transform_point(raw.vertices()[0]))))
         });
         hit
+    }
+}
+
+/// The free direction of `directions` (no blockers) with the shortest travel, ties to the one
+/// closest to `up`; or the union of every direction's blockers (a set with room for `parts`).
+/// The one choice the collision world and the voxel checker ([`crate::voxel`]) share.
+pub(crate) fn best_free_direction(
+    directions: &[Vec3],
+    up: Vec3,
+    parts: usize,
+    blockers_along: impl Fn(usize) -> PartSet,
+    travel: impl Fn(Vec3) -> f32,
+) -> std::result::Result<Motion, PartSet> {
+    let mut best: Option<(f32, Vec3)> = None;
+    let mut blockers = PartSet::empty(parts);
+    for (k, dir) in directions.iter().enumerate() {
+        let b = blockers_along(k);
+        if b.is_empty() {
+            let d = travel(*dir);
+            let better = match best {
+                None => true,
+                Some((bd, bdir)) => d < bd - 1e-6 * bd.max(1e-9) || (d <= bd + 1e-6 * bd && dir.dot(up) > bdir.dot(up) + 1e-6),
+            };
+            if better {
+                best = Some((d, *dir));
+            }
+        } else {
+            blockers.union_with(&b);
+        }
+    }
+    match best {
+        Some((distance, direction)) => Ok(Motion::Linear { direction, distance }),
+        None => Err(blockers),
     }
 }
