@@ -126,15 +126,24 @@ impl World {
         }
         let mut warnings = assembly.warnings.clone();
         let mut geoms = Vec::with_capacity(assembly.len() + 1);
-        for p in &assembly.parts {
-            // a part whose welded surface keeps no triangle (models built in memory; the loader
-            // refuses them in the same words)
-            if let Some(reason) = crate::validate::collapsed(p) {
-                return Err(GeomError::Assembly { path: assembly.source.clone(), reason });
-            }
-            let (mut g, t) = Geom::new(&p.mesh)
-                .map_err(|e| GeomError::Assembly { path: assembly.source.clone(), reason: format!("part '{}': {e}", p.name) })?;
-            let (shape, warning) = PartShape::classify(p, config.exact_boxes);
+        // each part's welding, orientation and BVH in parallel (independent), then in part order
+        // the first error and the warnings, as a loop over the parts would give them
+        let prepared: Vec<_> = assembly
+            .parts
+            .par_iter()
+            .map(|p| {
+                // a part whose welded surface keeps no triangle (models built in memory; the
+                // loader refuses them in the same words)
+                if let Some(reason) = crate::validate::collapsed(p) {
+                    return Err(GeomError::Assembly { path: assembly.source.clone(), reason });
+                }
+                let made = Geom::new(&p.mesh)
+                    .map_err(|e| GeomError::Assembly { path: assembly.source.clone(), reason: format!("part '{}': {e}", p.name) })?;
+                Ok((made, PartShape::classify(p, config.exact_boxes)))
+            })
+            .collect();
+        for (p, made) in assembly.parts.iter().zip(prepared) {
+            let ((mut g, t), (shape, warning)) = made?;
             warnings.extend(warning);
             g.boxes = shape.boxes();
             if !t.is_closed_manifold() {
@@ -231,6 +240,18 @@ impl World {
                 (0..3).all(|k| a.mins[k] <= b.maxs[k] + m && b.mins[k] <= a.maxs[k] + m)
             })
             .collect();
+        // every part a mesh pair measures is shrunk by the tolerance first (each pair's test
+        // starts there, and the removal tests use it): once per part, in parallel, instead of
+        // inside the pairs, where pairs sharing a part would wait on its cache
+        let meshed: BTreeSet<usize> = pairs
+            .iter()
+            .filter(|&&(i, j)| self.geoms[i].boxes.is_none() || self.geoms[j].boxes.is_none())
+            .flat_map(|&(i, j)| [i, j])
+            .filter(|&k| !self.geoms[k].eroded_cached(self.tolerance))
+            .collect();
+        meshed.into_iter().collect::<Vec<_>>().par_iter().for_each(|&k| {
+            self.geoms[k].eroded(self.tolerance);
+        });
         let limit_of = |k: usize| max_overlap_fraction * (self.geoms[k].aabb.maxs - self.geoms[k].aabb.mins).min_element();
         type Found = (usize, usize, bool, Option<f32>, Option<f32>);
         let found: Vec<Found> = pairs
@@ -516,6 +537,12 @@ impl World {
         let n = self.num_parts();
         let pairs: Vec<(usize, usize)> =
             (0..n).flat_map(|p| self.contacts[p].iter().filter(move |&q| q < n && q != p).map(move |q| (p, q))).collect();
+        // each candidate fastener's axis once, in parallel (pairs sharing a part would wait on
+        // its cache one after the other)
+        let movers: BTreeSet<usize> = pairs.iter().map(|&(p, _)| p).filter(|&p| self.geoms[p].boxes.is_none()).collect();
+        movers.into_iter().collect::<Vec<_>>().par_iter().for_each(|&p| {
+            self.symmetry_axis(p);
+        });
         let found: Vec<((usize, usize), Thread)> = pairs
             .par_iter()
             .filter_map(|&(p, q)| {
