@@ -50,8 +50,9 @@ fn main() {
         (load_s, world_s, tests_s) = (load_s + l, world_s + w, tests_s + r);
         if !many {
             println!(
-                "{}: {parts} parts, {triangles} triangles: load {l:.3} s, world {w:.3} s, cold tests of all parts {r:.3} s ({free} free)",
-                model.display()
+                "{}: {parts} parts, {triangles} triangles: load {l:.4} s, world {w:.4} s, cold tests of all parts {r:.4} s ({:.2} ms per part, {free} free)",
+                model.display(),
+                1e3 * r / parts.max(1) as f64
             );
         }
     }

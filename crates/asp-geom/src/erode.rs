@@ -5,7 +5,7 @@
 //! tolerance: sliding along a face or a zero-clearance shaft leaving its hole is free (see
 //! `research/parry-removal-test.md`: this was the only strategy right on every fixture).
 
-use crate::math::Vec3;
+use crate::math::{Aabb, Vec3};
 use parry3d::math::Mat3;
 use std::collections::HashMap;
 
@@ -97,6 +97,40 @@ pub fn eroded_mesh(vertices: &[Vec3], triangles: &[[u32; 3]], amount: f32) -> (V
             tris[k][c] = index;
         }
     }
+    (out, tris)
+}
+
+/// The triangles of [`eroded_mesh`]`(vertices, triangles, amount)` that may reach `region`,
+/// eroded exactly as there, at the cost of the triangles near the region (issue 27 item 3: an
+/// overlapping pair's trial erosions shrink only the part of a mesh near the other part).
+///
+/// A vertex moves by at most `3 × amount`, so a triangle whose box, grown by twice that, misses
+/// `region` cannot reach it and is left out. A vertex's offset depends only on the faces around
+/// it, taken in triangle order: the triangles kept are eroded together with every triangle
+/// sharing a vertex with them (in their original order), which gives them the same vertices,
+/// bit for bit, as the erosion of the whole mesh. Returns the vertices (indexed as
+/// [`eroded_mesh`] indexes them for the sub-mesh) and the kept triangles only.
+pub fn eroded_near(vertices: &[Vec3], triangles: &[[u32; 3]], amount: f32, region: &Aabb) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let margin = Vec3::splat(6.0 * amount.abs());
+    let (lo, hi) = (region.mins - margin, region.maxs + margin);
+    let near = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        let (tmin, tmax) = (a.min(b).min(c), a.max(b).max(c));
+        // a NaN vertex keeps its triangle (as the whole mesh's erosion would)
+        !(tmin.cmpgt(hi).any() || tmax.cmplt(lo).any())
+    };
+    let keep: Vec<bool> = triangles.iter().map(near).collect();
+    let mut marked = vec![false; vertices.len()];
+    for (t, _) in triangles.iter().zip(&keep).filter(|(_, &k)| k) {
+        for &i in t {
+            marked[i as usize] = true;
+        }
+    }
+    // the kept triangles and their neighbours, in order; which of them are kept
+    let (ring, kept): (Vec<[u32; 3]>, Vec<bool>) =
+        triangles.iter().zip(&keep).filter(|(t, _)| t.iter().any(|&i| marked[i as usize])).map(|(t, &k)| (*t, k)).unzip();
+    let (out, tris) = eroded_mesh(vertices, &ring, amount);
+    let tris = tris.into_iter().zip(kept).filter(|&(_, k)| k).map(|(t, _)| t).collect();
     (out, tris)
 }
 
@@ -273,6 +307,58 @@ mod tests {
                 if ok {
                     let unclamped = fast.length() < 0.0299;
                     assert!(!unclamped || ns.iter().all(|n| (n.dot(fast) + 0.01).abs() < 1e-5), "{ns:?}: {fast:?}");
+                }
+            }
+        }
+    }
+
+    /// Issue 27 item 3: the trial erosions of an overlapping pair shrink only the triangles
+    /// near the other part; those triangles are the whole erosion's, bit for bit (saddle splits
+    /// included), and every triangle of the whole erosion that reaches the region is among them.
+    #[test]
+    fn erosion_near_a_region_is_the_whole_erosion_there() {
+        let cells: Vec<[i32; 3]> = (0..4).flat_map(|x| (0..3).map(move |y| [x, y, (x * y) % 2])).collect();
+        let voxels = Mesh::from_voxels(&cells, Vec3::ONE, Vec3::ZERO);
+        let mut prism = crate::fixtures::prism(0.5, 0.5, 0.6, -0.3, 1.4, 24);
+        prism.weld();
+        prism.orient_outward();
+        for (m, amounts) in [(&voxels, [0.01f32, 0.2]), (&prism, [0.001, 0.1])] {
+            for amount in amounts {
+                let (whole_v, whole_t) = eroded_mesh(&m.vertices, &m.triangles, amount);
+                let regions = [
+                    ([0.8, 0.8, -1.0], [1.6, 1.2, 3.0]),
+                    ([-1.0, -1.0, -1.0], [0.2, 5.0, 0.1]),
+                    // thin slabs just inside the bottom faces, which the shrunk faces move into
+                    ([-1.0, -1.0, 0.009], [5.0, 5.0, 0.011]),
+                    ([-1.0, -1.0, -0.2995], [5.0, 5.0, -0.2985]),
+                    ([9.0, 9.0, 9.0], [10.0, 10.0, 10.0]),
+                ];
+                for (lo, hi) in regions {
+                    let region = Aabb::new(Vec3::from(lo), Vec3::from(hi));
+                    let (near_v, near_t) = eroded_near(&m.vertices, &m.triangles, amount, &region);
+                    let corners = |v: &[Vec3], t: &[u32; 3]| t.map(|i| v[i as usize].to_array().map(f32::to_bits));
+                    let whole: Vec<_> = whole_t.iter().map(|t| corners(&whole_v, t)).collect();
+                    let near: Vec<_> = near_t.iter().map(|t| corners(&near_v, t)).collect();
+                    // the kept triangles are the whole erosion's, in order
+                    let mut rest = whole.iter();
+                    for t in &near {
+                        assert!(
+                            rest.any(|w| w == t),
+                            "amount {amount}, region {region:?}: a kept triangle differs from the whole erosion's"
+                        );
+                    }
+                    // none that reaches the region is left out
+                    for (t, w) in whole_t.iter().zip(&whole) {
+                        let b = crate::math::aabb_of(t.map(|i| whole_v[i as usize])).unwrap();
+                        let meets = (0..3).all(|k| b.mins[k] <= region.maxs[k] && b.maxs[k] >= region.mins[k]);
+                        assert!(
+                            !meets || near.contains(w),
+                            "amount {amount}, region {region:?}: a triangle reaching the region was left out"
+                        );
+                    }
+                    if hi[0] > 5.0 {
+                        assert!(near.is_empty(), "a region away from the mesh keeps no triangle");
+                    }
                 }
             }
         }

@@ -82,11 +82,22 @@ impl SymmetryAxis {
     }
 }
 
+/// Whether `y` lies within `distance` of `mesh`'s surface, as `project_local_point` would say
+/// (the distance to the closest point on a triangle), asking only whether some triangle is that
+/// near (issue 27 item 3): the closest-point search visits the BVH down to the closest triangle
+/// even for points far off the surface (most turned samples of a part that is not a fastener),
+/// and among many near triangles (a modelled thread) keeps looking for the closest.
+fn within(mesh: &TriMesh, y: Vec3, distance: f32) -> bool {
+    mesh.bvh()
+        .leaves(|n| n.aabb().distance_to_local_point(y, true) <= distance)
+        .any(|j| (mesh.triangle(j).project_local_point(y, false).point - y).length() <= distance)
+}
+
 /// Whether `x`, turned by `angle` about `axis` (and shifted along it by up to [`SHIFTS`] times
 /// `slack` either way, in steps of `slack`: a helical thread turned by θ is itself shifted by
 /// `pitch·θ/2π`), lies within `slack` of `mesh`'s surface.
 fn lands(x: Vec3, angle: f32, axis: &SymmetryAxis, mesh: &TriMesh, slack: f32) -> bool {
-    let near_surface = |y: Vec3| (mesh.project_local_point(y, false).point - y).length() <= slack;
+    let near_surface = |y: Vec3| within(mesh, y, slack);
     let y = axis.turn(x, angle);
     near_surface(y)
         || (1..=SHIFTS).any(|k| {
@@ -345,7 +356,7 @@ fn contact_zone(axis: &SymmetryAxis, pm: &TriMesh, qm: &TriMesh, contact: f32, m
         if n.dot(axis.direction).abs() >= FLANK.end || x.cmplt(lo_q).any() || x.cmpgt(hi_q).any() {
             continue;
         }
-        let touching = (qm.project_local_point(*x, false).point - *x).length() <= contact || qm.contains_local_point(*x);
+        let touching = within(qm, *x, contact) || qm.contains_local_point(*x);
         if touching {
             radius = radius.max(axis.radial(*x));
             lo_e = lo_e.min(along(*x));
@@ -453,4 +464,48 @@ pub fn threaded_contact(axis: &SymmetryAxis, pm: &TriMesh, qm: &TriMesh, contact
         return None;
     }
     invariant(&local, axis, qm, SLACK * axis.radius).then_some(Thread { axis: *axis, radius })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixtures::bolt_and_nut;
+    use parry3d::shape::TriMeshFlags;
+
+    /// Issue 27 item 3: whether a point lies within a distance of a surface, asked of the
+    /// triangles that near (the symmetry and thread checks' query), says what the closest
+    /// point's distance says, for points on, near and far from a threaded bolt's surface.
+    #[test]
+    fn a_near_triangle_answers_as_the_closest_point_does() {
+        let bolt = &bolt_and_nut(0.0).parts[1].mesh;
+        let mesh = TriMesh::with_flags(bolt.vertices.clone(), bolt.triangles.clone(), TriMeshFlags::ORIENTED).unwrap();
+        let bb = mesh.local_aabb();
+        let mut seed = 11u32;
+        let mut r = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32
+        };
+        let (mut near, mut far) = (0, 0);
+        for k in 0..3000 {
+            let y = if k % 3 == 0 {
+                // on the surface, then pushed off it a little
+                let v = mesh.vertices()[(r() * mesh.vertices().len() as f32) as usize % mesh.vertices().len()];
+                v + (Vec3::new(r(), r(), r()) - 0.5) * 0.0006
+            } else {
+                bb.mins + (bb.maxs - bb.mins) * (Vec3::new(r(), r(), r()) * 1.4 - 0.2)
+            };
+            let closest = (mesh.project_local_point(y, false).point - y).length();
+            for d in [0.00005, 0.0003, 0.001] {
+                assert_eq!(within(&mesh, y, d), closest <= d, "point {y:?}, distance {d}: closest point {closest}");
+                if closest <= d {
+                    near += 1;
+                } else {
+                    far += 1;
+                }
+            }
+            // exactly at the closest point's distance: within
+            assert!(within(&mesh, y, closest), "point {y:?} at its own distance {closest}");
+        }
+        assert!(near > 1000 && far > 1000, "the points test both answers ({near} near, {far} far)");
+    }
 }

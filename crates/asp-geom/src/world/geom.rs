@@ -2,7 +2,7 @@
 //! strict-overlap samples and symmetry axis.
 
 use super::*;
-use crate::erode::eroded_mesh;
+use crate::erode::{eroded_mesh, eroded_near};
 
 /// One part's collision geometry.
 pub(super) struct Geom {
@@ -85,17 +85,30 @@ impl Geom {
         // the tolerance's erosion is cached (every later test of the part uses it); the deeper
         // trial erosions of overlapping pairs are tested as triangle soups (no BVH to build)
         let shrunk = self.eroded_cached(amount).then(|| self.eroded(amount));
+        let (inside, around) = (other.closed && nests(&self.aabb, &other.aabb), self.closed && nests(&other.aabb, &self.aabb));
         let soup;
         let (vertices, triangles): (&[Vec3], &[[u32; 3]]) = match &shrunk {
             Some(m) => (m.vertices(), m.indices()),
-            None => {
+            None if inside => {
+                // the containment test below asks for the shrunk mesh's first vertex
                 soup = eroded_mesh(self.mesh.vertices(), self.mesh.indices(), amount);
                 (&soup.0, &soup.1)
             }
+            None => {
+                // only the triangles that may reach the other part: a trial erosion costs the
+                // overlap's neighbourhood, not the whole mesh
+                soup = eroded_near(self.mesh.vertices(), self.mesh.indices(), amount, &other.aabb);
+                (&soup.0, &soup.1)
+            }
         };
-        sweep::soup_crosses(vertices, triangles, &other.mesh)
-            || (other.closed && nests(&self.aabb, &other.aabb) && contains_point(&other.mesh, vertices[0]))
-            || (self.closed && nests(&other.aabb, &self.aabb) && {
+        let crosses = match &shrunk {
+            // the cached erosion has its BVH: descend both trees together
+            Some(m) => sweep::meshes_cross(m, &other.mesh),
+            None => sweep::soup_crosses(vertices, triangles, &other.mesh),
+        };
+        crosses
+            || (inside && contains_point(&other.mesh, vertices[0]))
+            || (around && {
                 let shrunk = shrunk.unwrap_or_else(|| Arc::new(self.erode(amount)));
                 contains_point(&shrunk, other.mesh.vertices()[0])
             })

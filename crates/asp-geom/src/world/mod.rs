@@ -128,15 +128,24 @@ impl World {
         }
         let mut warnings = assembly.warnings.clone();
         let mut geoms = Vec::with_capacity(assembly.len() + 1);
-        for p in &assembly.parts {
-            // a part whose welded surface keeps no triangle (models built in memory; the loader
-            // refuses them in the same words)
-            if let Some(reason) = crate::validate::collapsed(p) {
-                return Err(GeomError::Assembly { path: assembly.source.clone(), reason });
-            }
-            let (mut g, t) = Geom::new(&p.mesh)
-                .map_err(|e| GeomError::Assembly { path: assembly.source.clone(), reason: format!("part '{}': {e}", p.name) })?;
-            let (shape, warning) = PartShape::classify(p, config.exact_boxes);
+        // each part's welding, orientation and BVH in parallel (independent), then in part order
+        // the first error and the warnings, as a loop over the parts would give them
+        let prepared: Vec<_> = assembly
+            .parts
+            .par_iter()
+            .map(|p| {
+                // a part whose welded surface keeps no triangle (models built in memory; the
+                // loader refuses them in the same words)
+                if let Some(reason) = crate::validate::collapsed(p) {
+                    return Err(GeomError::Assembly { path: assembly.source.clone(), reason });
+                }
+                let made = Geom::new(&p.mesh)
+                    .map_err(|e| GeomError::Assembly { path: assembly.source.clone(), reason: format!("part '{}': {e}", p.name) })?;
+                Ok((made, PartShape::classify(p, config.exact_boxes)))
+            })
+            .collect();
+        for (p, made) in assembly.parts.iter().zip(prepared) {
+            let ((mut g, t), (shape, warning)) = made?;
             warnings.extend(warning);
             g.boxes = shape.boxes();
             if !t.is_closed_manifold() {
@@ -233,6 +242,18 @@ impl World {
                 (0..3).all(|k| a.mins[k] <= b.maxs[k] + m && b.mins[k] <= a.maxs[k] + m)
             })
             .collect();
+        // every part a mesh pair measures is shrunk by the tolerance first (each pair's test
+        // starts there, and the removal tests use it): once per part, in parallel, instead of
+        // inside the pairs, where pairs sharing a part would wait on its cache
+        let meshed: BTreeSet<usize> = pairs
+            .iter()
+            .filter(|&&(i, j)| self.geoms[i].boxes.is_none() || self.geoms[j].boxes.is_none())
+            .flat_map(|&(i, j)| [i, j])
+            .filter(|&k| !self.geoms[k].eroded_cached(self.tolerance))
+            .collect();
+        meshed.into_iter().collect::<Vec<_>>().par_iter().for_each(|&k| {
+            self.geoms[k].eroded(self.tolerance);
+        });
         let limit_of = |k: usize| max_overlap_fraction * (self.geoms[k].aabb.maxs - self.geoms[k].aabb.mins).min_element();
         type Found = (usize, usize, bool, Option<f32>, Option<f32>);
         let found: Vec<Found> = pairs
@@ -518,6 +539,12 @@ impl World {
         let n = self.num_parts();
         let pairs: Vec<(usize, usize)> =
             (0..n).flat_map(|p| self.contacts[p].iter().filter(move |&q| q < n && q != p).map(move |q| (p, q))).collect();
+        // each candidate fastener's axis once, in parallel (pairs sharing a part would wait on
+        // its cache one after the other)
+        let movers: BTreeSet<usize> = pairs.iter().map(|&(p, _)| p).filter(|&p| self.geoms[p].boxes.is_none()).collect();
+        movers.into_iter().collect::<Vec<_>>().par_iter().for_each(|&p| {
+            self.symmetry_axis(p);
+        });
         let found: Vec<((usize, usize), Thread)> = pairs
             .par_iter()
             .filter_map(|&(p, q)| {
@@ -757,12 +784,91 @@ pub(crate) fn ground_box(bb: &Aabb, up: Vec3, diag: f32) -> Mesh {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use crate::erode::eroded_mesh;
+    use crate::fixtures::{assemble, bolt_and_nut, dowel_in_two_boards, part, pressed_peg};
+    use crate::math::{Axis, Rot};
+
+    /// Whether `a` shrunk by `amount` still overlaps `b`, as `Geom::eroded_hits` decided it
+    /// before issue 27 item 3: the whole mesh eroded, as a triangle soup.
+    fn hits_by_whole_erosion(a: &Geom, amount: f32, b: &Geom) -> bool {
+        let (v, t) = eroded_mesh(a.mesh.vertices(), a.mesh.indices(), amount);
+        sweep::soup_crosses(&v, &t, &b.mesh)
+            || (b.closed && nests(&a.aabb, &b.aabb) && contains_point(&b.mesh, v[0]))
+            || (a.closed && nests(&b.aabb, &a.aabb) && contains_point(&a.erode(amount), b.mesh.vertices()[0]))
+    }
+
+    /// `World::extra_erosion`'s doubling and bisection over `hits_by_whole_erosion`.
+    fn depth_by_whole_erosion(w: &World, p: usize, q: usize, limit: f32) -> Option<f32> {
+        let (a, b, tol) = (&w.geoms[p], &w.geoms[q], w.tolerance);
+        let clear = |extra: f32| !hits_by_whole_erosion(a, tol + extra, b);
+        if clear(0.0) {
+            return Some(0.0);
+        }
+        let mut hi = tol;
+        while !clear(hi) {
+            if hi >= limit {
+                return None;
+            }
+            hi = (hi * 2.0).min(limit);
+        }
+        let mut lo = hi / 2.0;
+        for _ in 0..4 {
+            let mid = 0.5 * (lo + hi);
+            if clear(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Some(hi)
+    }
+
+    /// Issue 27 item 3: the trial erosions of an overlapping pair shrink only the triangles near
+    /// the other part; every pair's measured depth (shallow, deep, gross, nested, threaded) is
+    /// the one the whole erosions give, so the warnings and explanations print the same.
+    #[test]
+    fn overlap_depths_measured_near_the_other_part_are_the_whole_erosions() {
+        // a stool's seat and two legs, tessellated (2-unit cells), turned off the axes (no exact
+        // boxes), the legs pushed `depth` and a fifth of it into the seat; and a tessellated cube
+        // nested in a larger one
+        let slab = |n: [i32; 3], origin: [f32; 3]| {
+            let cells: Vec<[i32; 3]> = (0..n[0]).flat_map(|x| (0..n[1]).flat_map(move |y| (0..n[2]).map(move |z| [x, y, z]))).collect();
+            let mut m = Mesh::from_voxels(&cells, Vec3::splat(2.0), Vec3::from(origin));
+            m.vertices.iter_mut().for_each(|v| *v = Rot::from_rotation_z(0.35) * *v);
+            part("panel", m, false)
+        };
+        let stool = |depth: f32| {
+            let parts = vec![
+                slab([20, 20, 1], [0.0, 0.0, 40.0]),
+                slab([1, 20, 20], [0.0, 0.0, depth]),
+                slab([1, 20, 20], [38.0, 0.0, 0.2 * depth]),
+            ];
+            assemble("stool", parts, Axis::Z)
+        };
+        let nested = assemble("nested", vec![slab([6, 6, 6], [0.0, 0.0, 0.0]), slab([2, 2, 2], [4.0, 4.0, 4.0])], Axis::Z);
+        let mut pairs = 0;
+        for assembly in [stool(0.3), stool(1.5), nested, pressed_peg(), dowel_in_two_boards(), bolt_and_nut(0.0001)] {
+            let w = World::new(assembly, &WorldConfig { exact_boxes: false, ..WorldConfig::default() }).unwrap();
+            assert!(!w.overlap_notes().is_empty(), "{}: the fixture overlaps", w.assembly().source.display());
+            for i in 0..w.num_parts() {
+                for j in w.contacts(i).iter().filter(|&j| j < w.num_parts() && j != i) {
+                    let limit = 0.4 * (w.geoms[i].aabb.maxs - w.geoms[i].aabb.mins).min_element();
+                    let expected = depth_by_whole_erosion(&w, i, j, limit);
+                    assert_eq!(w.extra_erosion(i, j, limit), expected, "{}: {} in {}", w.assembly().source.display(), w.name(i), w.name(j));
+                    pairs += usize::from(expected != Some(0.0));
+                }
+            }
+        }
+        assert!(pairs >= 8, "{pairs} overlapping ordered pairs measured");
+    }
+
     #[test]
     fn lengths_in_messages_keep_three_significant_digits() {
-        assert_eq!(super::significant(0.000123456, 3), "0.000123");
-        assert_eq!(super::significant(0.0021, 3), "0.00210");
-        assert_eq!(super::significant(12.345, 3), "12.3");
-        assert_eq!(super::significant(1234.5, 3), "1234");
-        assert_eq!(super::significant(0.0, 3), "0");
+        assert_eq!(significant(0.000123456, 3), "0.000123");
+        assert_eq!(significant(0.0021, 3), "0.00210");
+        assert_eq!(significant(12.345, 3), "12.3");
+        assert_eq!(significant(1234.5, 3), "1234");
+        assert_eq!(significant(0.0, 3), "0");
     }
 }
