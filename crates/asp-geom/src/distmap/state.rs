@@ -59,7 +59,11 @@ fn min_block<const W: usize>(values: &[f32], rows: &[usize], init: &[f32], out: 
 /// A minimum map depends only on which of the part's blockers are present, so each computed
 /// row is kept with that set as its key and reused — after later removals and across
 /// [`MapState::reset`]s — while the part's present blockers are the same.
-#[derive(Clone, Debug)]
+///
+/// [`Clone::clone_from`] reuses the target's buffers and copies only the kept minimum maps
+/// whose keys differ (a row is a function of its key), so copying a state each step of a local
+/// search allocates nothing.
+#[derive(Debug)]
 pub struct MapState<'m> {
     maps: &'m DistanceMaps,
     all: DirMask,
@@ -95,6 +99,60 @@ pub struct MapState<'m> {
 }
 
 const UNCOUNTED: u16 = u16::MAX;
+
+impl Clone for MapState<'_> {
+    fn clone(&self) -> Self {
+        MapState {
+            maps: self.maps,
+            all: self.all,
+            present: self.present,
+            free: self.free,
+            unchecked: self.unchecked,
+            rows: self.rows.clone(),
+            row_keys: self.row_keys.clone(),
+            row_free: self.row_free.clone(),
+            row_sums: self.row_sums.clone(),
+            covers: self.covers.clone(),
+            watchers: self.watchers.clone(),
+            supports: self.supports.clone(),
+            critical: self.critical.clone(),
+            holding: self.holding,
+            fixed: self.fixed,
+            counters: self.counters,
+            kept: self.kept.clone(),
+        }
+    }
+
+    /// Copies `source` into `self` without allocating when both are over the same maps: a kept
+    /// minimum map is copied only when its key differs (equal keys mean equal rows, sums and
+    /// free directions), the scratch is not copied.
+    fn clone_from(&mut self, source: &Self) {
+        if !std::ptr::eq(self.maps, source.maps) {
+            *self = source.clone();
+            return;
+        }
+        self.all = source.all;
+        self.present = source.present;
+        self.free = source.free;
+        self.unchecked = source.unchecked;
+        let stride = self.maps.stride;
+        for (i, (mine, theirs)) in self.row_keys.iter_mut().zip(&source.row_keys).enumerate() {
+            if *mine != *theirs {
+                *mine = *theirs;
+                self.rows[i * stride..(i + 1) * stride].copy_from_slice(&source.rows[i * stride..(i + 1) * stride]);
+                self.row_free[i] = source.row_free[i];
+                self.row_sums[i] = source.row_sums[i];
+            }
+        }
+        self.covers.copy_from_slice(&source.covers);
+        self.watchers.copy_from_slice(&source.watchers);
+        self.supports.copy_from_slice(&source.supports);
+        self.critical.copy_from_slice(&source.critical);
+        self.holding = source.holding;
+        self.fixed = source.fixed;
+        self.counters = source.counters;
+    }
+}
 
 /// The removability tests a [`MapState`] ran. Its answers are incremental: a part found free
 /// stays free as parts leave and is not tested again, a stuck part is tested again only when a
