@@ -231,3 +231,50 @@ fn map_state_clone_from_copies_the_kept_rows_that_differ() {
     assert_eq!(again, acts);
     assert_eq!(b.min_map(1), a.min_map(1));
 }
+
+#[test]
+fn map_state_kept_sums_answer_like_a_fresh_state() {
+    // A 2×2×2 block of unit boxes; one state jumps between subsets (the search's resets), so
+    // that rows are recomputed, evicted and found again among the kept sums.
+    let mut parts = Vec::new();
+    for z in 0..2 {
+        for y in 0..2 {
+            for x in 0..2 {
+                let lo = Vec3::new(x as f32, y as f32, z as f32);
+                parts.push(part(&format!("c{x}{y}{z}"), Mesh::cuboid(lo, lo + Vec3::ONE)));
+            }
+        }
+    }
+    let maps = DistanceMaps::build(&assembly(parts), &MapConfig::builder().resolution(5).build().unwrap()).unwrap();
+    let n = 8;
+    let subsets: Vec<PartSet> = [
+        vec![0, 1, 2, 3, 4, 5, 6, 7],
+        vec![0, 1, 2, 3, 4, 5, 6],
+        vec![0, 1, 2, 3, 4, 5],
+        vec![0, 1, 2, 3, 5, 6, 7],
+        vec![0, 1, 2, 3, 7],
+        vec![0, 1, 2, 3, 4],
+        vec![0, 1, 2, 3],
+        vec![0, 2, 3],
+    ]
+    .into_iter()
+    .map(|v| PartSet::from_indices(n, v))
+    .collect();
+    let mut s = MapState::new(&maps);
+    for round in 0..3 {
+        for (k, present) in subsets.iter().enumerate().chain(subsets.iter().enumerate().rev()) {
+            s.reset(present);
+            let mut fresh = MapState::new(&maps);
+            fresh.reset(present);
+            for i in present.iter() {
+                // free directions first (before any row of this state), then the sum, then again
+                assert_eq!(s.free_mask(i), fresh.free_mask(i), "round {round} subset {k} part {i}");
+                let want = fresh.min_map_sum(i);
+                assert_eq!(s.min_map_sum(i), want, "round {round} subset {k} part {i}");
+                assert_eq!(s.free_mask(i), fresh.free_mask(i), "round {round} subset {k} part {i}");
+                let direct: f64 = maps.min_map(i, present).iter().map(|&v| v as f64).sum();
+                assert!((want - direct).abs() < 1e-3 * direct.abs().max(1.0), "round {round} subset {k} part {i}");
+            }
+        }
+    }
+}
