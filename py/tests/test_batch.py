@@ -18,14 +18,13 @@ from conftest import LACK, ROOT, need, without_seconds
 ray = need("ray", "asp.batch on Ray needs ray (pip install 'ray>=2.9')")
 
 from asp.batch import BatchError, BenchJob, CollectJob, GenJob, PlanJob, run  # noqa: E402
-from asp.batch.runner import JOURNAL_DIR, WORKER_ENV, chunk_size  # noqa: E402
+from asp.batch.runner import JOURNAL_DIR, _init_local, chunk_size  # noqa: E402
 
 
 @pytest.fixture(scope="module")
 def local_ray():
     """One local Ray with 2 CPUs for the module (asp.batch.run uses a Ray that is already up)."""
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, configure_logging=False,
-             runtime_env={"env_vars": dict(WORKER_ENV)})
+    _init_local(ray, 2)
     yield
     ray.shutdown()
 

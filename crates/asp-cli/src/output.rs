@@ -122,13 +122,42 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
     if args.json && many {
         writeln!(stdout, "[")?;
     }
-    for (k, model) in models.iter().enumerate() {
-        let out = match &out_dir {
+    // The output file of each model, named in model order (as the serial loop named them).
+    let outs: Vec<Option<PathBuf>> = models
+        .iter()
+        .map(|model| match &out_dir {
             Some(dir) => Some(dir.join(format!("{}.json", unique_stem(model, &mut names)))),
             None => args.out.clone(),
-        };
-        let verdict = match plan_one(args, &settings, model, out.as_deref(), &mut stdout, printed > 0) {
+        })
+        .collect();
+    // Several models are planned in parallel (rayon over the models, the world's own parallel
+    // loops nested inside), each into its own buffers; the buffers are printed in model order,
+    // so the output's order and bytes are the serial loop's.
+    let plan_buffered = |model: &PathBuf, out: &Option<PathBuf>| {
+        let mut text = Vec::new();
+        let mut warnings = Vec::new();
+        let verdict = plan_one(args, &settings, model, out.as_deref(), &mut text, &mut warnings, many);
+        (verdict, text, warnings)
+    };
+    let results: Vec<_> = if many {
+        use rayon::prelude::*;
+        models.par_iter().zip(outs.par_iter()).map(|(m, o)| plan_buffered(m, o)).collect()
+    } else {
+        models.iter().zip(&outs).map(|(m, o)| plan_buffered(m, o)).collect()
+    };
+    for (k, (verdict, text, warnings)) in results.into_iter().enumerate() {
+        std::io::stderr().write_all(&warnings)?;
+        let verdict = match verdict {
             Ok(v) => {
+                if printed > 0 {
+                    if args.json {
+                        write!(stdout, ",")?;
+                    } else {
+                        writeln!(stdout)?;
+                    }
+                }
+                stdout.write_all(&text)?;
+                stdout.flush()?;
                 printed += 1;
                 v
             }
@@ -176,20 +205,22 @@ fn unique_stem(model: &Path, taken: &mut BTreeSet<String>) -> String {
     name
 }
 
-/// Plans one model: prints its table (or JSON) and writes its files.
+/// Plans one model: prints its table (or JSON) to `stdout` and its warnings to `warnings`, and
+/// writes its files. One of `many` models plans without a progress bar (they run in parallel).
 fn plan_one(
     args: &PlanArgs,
     settings: &PlanSettings,
     model: &Path,
     out: Option<&Path>,
     stdout: &mut impl Write,
-    separate: bool,
+    warnings: &mut impl Write,
+    many: bool,
 ) -> anyhow::Result<Verdict> {
     let load_started = Instant::now();
     let assembly = pipeline::load(model, settings)?;
     let load_seconds = load_started.elapsed().as_secs_f64();
     let for_mcap = args.mcap.as_ref().map(|_| assembly.clone());
-    let bar = progress_bar(args.quiet || settings.optimise.is_some());
+    let bar = progress_bar(args.quiet || many || settings.optimise.is_some());
     let report_progress = |p: &Progress| {
         if let Some(bar) = &bar {
             bar.set_length(p.total as u64);
@@ -208,7 +239,7 @@ fn plan_one(
     let report = &result.report;
     if !args.quiet {
         for w in &report.warnings {
-            eprintln!("warning: {}: {w}", model.display());
+            writeln!(warnings, "warning: {}: {w}", model.display())?;
         }
     }
     if let (Some(path), Some(search)) = (&args.optimise.trace, &result.search) {
@@ -223,17 +254,10 @@ fn plan_one(
         asp_geom::io::write_atomic(path, json.as_bytes()).with_context(|| format!("{}: cannot write the plan", path.display()))?;
     }
     if args.json {
-        if separate {
-            write!(stdout, ",")?;
-        }
         write!(stdout, "{json}")?;
     } else {
-        if separate {
-            writeln!(stdout)?;
-        }
         report.write_text(stdout)?;
     }
-    stdout.flush()?;
     // Ctrl-C during any search (the optimiser's too) ends with 130 after its result is written
     let interrupted =
         report.stats.stopped_by == Some(StopReason::Interrupted) || settings.cancel.as_ref().is_some_and(StopToken::is_stopped);

@@ -120,7 +120,25 @@ fn show_defaults(mut command: clap::Command, keys: fn(&str) -> bool) -> clap::Co
 
 /// Parses the process arguments (exits with usage on error).
 pub fn parse() -> Cli {
-    let mut matches = show_defaults(Cli::command(), |_| false).get_matches();
+    parse_from(std::env::args_os())
+}
+
+/// Parses `args` (the program name first). The defaults shown in `--help` cost a resolved
+/// request per flag, so they are put into the command only when clap has something to print
+/// (help, version, an error): a run that parses pays for none of them.
+pub fn parse_from<I, T>(args: I) -> Cli
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let args: Vec<std::ffi::OsString> = args.into_iter().map(Into::into).collect();
+    if let Ok(mut matches) = Cli::command().try_get_matches_from(&args) {
+        if let Ok(cli) = Cli::from_arg_matches_mut(&mut matches) {
+            return cli;
+        }
+    }
+    // help, version or a usage error: the command with the defaults prints it
+    let mut matches = show_defaults(Cli::command(), |_| false).get_matches_from(&args);
     Cli::from_arg_matches_mut(&mut matches).unwrap_or_else(|e| e.exit())
 }
 
@@ -137,5 +155,17 @@ mod tests {
         }
         assert_eq!(flag("max_tests"), "--max-tests");
         assert_eq!(flag("path_planner"), "--no-path-planner");
+    }
+
+    #[test]
+    fn a_run_parses_without_the_help_defaults_and_help_still_shows_them() {
+        let cli = parse_from(["asp", "plan", "model.glb", "--max-tests", "7"]);
+        let Command::Plan(args) = cli.command else { panic!("plan") };
+        assert_eq!(args.models, vec![std::path::PathBuf::from("model.glb")]);
+        let plain = Cli::command().find_subcommand_mut("plan").unwrap().render_long_help().to_string();
+        assert!(!plain.contains("[default: 1000]"));
+        // what an error or --help prints comes from the command with the defaults
+        let err = show_defaults(Cli::command(), |_| false).try_get_matches_from(["asp", "plan", "--help"]).unwrap_err();
+        assert!(err.to_string().contains("[default: 1000]"), "{err}");
     }
 }

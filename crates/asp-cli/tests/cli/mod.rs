@@ -504,3 +504,38 @@ fn issue_28_unit_group_plans_named_parts_as_one_unit() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("--unit-group: a unit needs at least two parts"), "{}", stderr(&o));
 }
+
+/// `--each` plans its models in parallel; what it prints and writes is the serial loop's, in
+/// model order: each model's plan as planning it alone gives it.
+#[test]
+fn plan_each_in_parallel_prints_in_model_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let models = dir.path().join("s4");
+    let o = asp(&["gen", "soma", "--size", "4", "--count", "6", "--seed", "3", "--out", models.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut files: Vec<PathBuf> =
+        std::fs::read_dir(&models).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "glb")).collect();
+    files.sort();
+    assert_eq!(files.len(), 6);
+    let without_timings = |mut v: serde_json::Value| {
+        v["stats"].as_object_mut().unwrap().remove("timings");
+        v["stats"].as_object_mut().unwrap().remove("seconds");
+        v
+    };
+    let o = asp(&["plan", "--each", models.to_str().unwrap(), "--json", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let all: serde_json::Value = serde_json::from_slice(&o.stdout).expect("a JSON array of plans");
+    let all = all.as_array().unwrap();
+    assert_eq!(all.len(), files.len());
+    let o = asp(&["plan", "--each", models.to_str().unwrap(), "-q"]);
+    let table = String::from_utf8(o.stdout).unwrap();
+    let mut tables = Vec::new();
+    for (plan, file) in all.iter().zip(&files) {
+        let one = asp(&["plan", file.to_str().unwrap(), "--json"]);
+        let alone: serde_json::Value = serde_json::from_slice(&one.stdout).unwrap();
+        assert_eq!(without_timings(plan.clone()), without_timings(alone), "{}", file.display());
+        tables.push(String::from_utf8(asp(&["plan", file.to_str().unwrap()]).stdout).unwrap());
+    }
+    let strip = |t: &str| t.lines().filter(|l| !l.contains("found in")).collect::<Vec<_>>().join("\n");
+    assert_eq!(strip(&table), strip(&tables.join("\n")));
+}

@@ -59,7 +59,11 @@ fn min_block<const W: usize>(values: &[f32], rows: &[usize], init: &[f32], out: 
 /// A minimum map depends only on which of the part's blockers are present, so each computed
 /// row is kept with that set as its key and reused — after later removals and across
 /// [`MapState::reset`]s — while the part's present blockers are the same.
-#[derive(Clone, Debug)]
+///
+/// [`Clone::clone_from`] reuses the target's buffers and copies only the kept minimum maps
+/// whose keys differ (a row is a function of its key), so copying a state each step of a local
+/// search allocates nothing.
+#[derive(Debug)]
 pub struct MapState<'m> {
     maps: &'m DistanceMaps,
     all: DirMask,
@@ -92,9 +96,77 @@ pub struct MapState<'m> {
     /// Scratch (one slot per part): the rows (`i * (n + 1) + j`) of the blockers `j` that shape
     /// part `i`'s minimum map.
     kept: Vec<usize>,
+    /// Beside the one kept row per part: the sums and free directions of its last
+    /// [`SUM_WAYS`] computed rows, keyed like the rows (`SUM_WAYS` slots per part, the next to
+    /// replace in `sum_next`). A rollout revisits a part's few blocker sets far more often than
+    /// it needs a whole row.
+    sum_keys: Vec<Bits>,
+    sum_values: Vec<(f64, DirMask)>,
+    sum_next: Vec<u8>,
 }
 
+/// Sums kept per part beside its row ([`MapState::min_map_sum`]).
+const SUM_WAYS: usize = 4;
+
 const UNCOUNTED: u16 = u16::MAX;
+
+impl Clone for MapState<'_> {
+    fn clone(&self) -> Self {
+        MapState {
+            maps: self.maps,
+            all: self.all,
+            present: self.present,
+            free: self.free,
+            unchecked: self.unchecked,
+            rows: self.rows.clone(),
+            row_keys: self.row_keys.clone(),
+            row_free: self.row_free.clone(),
+            row_sums: self.row_sums.clone(),
+            covers: self.covers.clone(),
+            watchers: self.watchers.clone(),
+            supports: self.supports.clone(),
+            critical: self.critical.clone(),
+            holding: self.holding,
+            fixed: self.fixed,
+            counters: self.counters,
+            kept: self.kept.clone(),
+            sum_keys: self.sum_keys.clone(),
+            sum_values: self.sum_values.clone(),
+            sum_next: self.sum_next.clone(),
+        }
+    }
+
+    /// Copies `source` into `self` without allocating when both are over the same maps: a kept
+    /// minimum map is copied only when its key differs (equal keys mean equal rows, sums and
+    /// free directions), the scratch and the kept sums (a cache valid in any state) are not
+    /// copied.
+    fn clone_from(&mut self, source: &Self) {
+        if !std::ptr::eq(self.maps, source.maps) {
+            *self = source.clone();
+            return;
+        }
+        self.all = source.all;
+        self.present = source.present;
+        self.free = source.free;
+        self.unchecked = source.unchecked;
+        let stride = self.maps.stride;
+        for (i, (mine, theirs)) in self.row_keys.iter_mut().zip(&source.row_keys).enumerate() {
+            if *mine != *theirs {
+                *mine = *theirs;
+                self.rows[i * stride..(i + 1) * stride].copy_from_slice(&source.rows[i * stride..(i + 1) * stride]);
+                self.row_free[i] = source.row_free[i];
+                self.row_sums[i] = source.row_sums[i];
+            }
+        }
+        self.covers.copy_from_slice(&source.covers);
+        self.watchers.copy_from_slice(&source.watchers);
+        self.supports.copy_from_slice(&source.supports);
+        self.critical.copy_from_slice(&source.critical);
+        self.holding = source.holding;
+        self.fixed = source.fixed;
+        self.counters = source.counters;
+    }
+}
 
 /// The removability tests a [`MapState`] ran. Its answers are incremental: a part found free
 /// stays free as parts leave and is not tested again, a stuck part is tested again only when a
@@ -134,6 +206,9 @@ impl<'m> MapState<'m> {
             fixed: Bits::from_set(&PartSet::from_indices(n, (0..n).filter(|&i| maps.fixed[i]))),
             kept: vec![0; n],
             counters: MapCounters::default(),
+            sum_keys: vec![Bits::NO_KEY; n * SUM_WAYS],
+            sum_values: vec![(0.0, DirMask::EMPTY); n * SUM_WAYS],
+            sum_next: vec![0; n],
         };
         s.reset(&PartSet::full(n));
         s
@@ -272,8 +347,17 @@ impl<'m> MapState<'m> {
         // Start from the last cover's present members (they block where they blocked), then
         // take any direction still open: without a present blocker along it the part is free,
         // else the first such blocker joins the cover.
+        let mut cover = self.covers[i];
+        if !cover.is_empty() && cover.and_not(&self.present).is_empty() {
+            // the whole last cover is present: it still blocks every direction
+            for k in cover.iter() {
+                self.watchers[k].insert(i);
+            }
+            self.counters.blocked += 1;
+            return false;
+        }
         let mut blocked = DirMask::EMPTY;
-        let mut cover = self.covers[i].and(&self.present);
+        cover = cover.and(&self.present);
         for j in cover.iter() {
             blocked = blocked.or(maps.blocked[first + j]);
         }
@@ -314,11 +398,21 @@ impl<'m> MapState<'m> {
 
     /// `B^M̄(p_i, s)`: the free directions of present part `i`.
     pub fn free_mask(&self, i: usize) -> DirMask {
-        if self.row_is_current(i) {
+        let key = self.maps.blocker_set[i].and(&self.present);
+        if key == self.row_keys[i] {
             self.row_free[i]
+        } else if let Some(slot) = self.kept_sum(i, &key) {
+            self.sum_values[slot].1
         } else {
             self.all.and_not(self.blocked_now(i))
         }
+    }
+
+    /// The slot of part `i`'s kept sum for present blockers `key`, if one is kept.
+    #[inline]
+    fn kept_sum(&self, i: usize, key: &Bits) -> Option<usize> {
+        let first = i * SUM_WAYS;
+        self.sum_keys[first..first + SUM_WAYS].iter().position(|k| k == key).map(|w| first + w)
     }
 
     /// Whether the kept minimum map of part `i` was computed for its present blockers.
@@ -392,12 +486,23 @@ impl<'m> MapState<'m> {
         self.row_sums[i] = min_rows(&maps.values, kept, &maps.init_row, row);
         self.row_free[i] = self.all.and_not(blocked);
         self.row_keys[i] = key;
+        let slot = i * SUM_WAYS + self.sum_next[i] as usize;
+        self.sum_keys[slot] = key;
+        self.sum_values[slot] = (self.row_sums[i], self.row_free[i]);
+        self.sum_next[i] = ((self.sum_next[i] as usize + 1) % SUM_WAYS) as u8;
     }
 
     /// `Σ_{k,l} M̄_{k,l}(p_i, s)` of present part `i` (the accessibility reward, eq. 6.15),
     /// summed in eight interleaved lanes.
     pub fn min_map_sum(&mut self, i: usize) -> f64 {
-        self.min_map(i);
+        let key = self.maps.blocker_set[i].and(&self.present);
+        if key == self.row_keys[i] {
+            return self.row_sums[i];
+        }
+        if let Some(slot) = self.kept_sum(i, &key) {
+            return self.sum_values[slot].0;
+        }
+        self.refresh_row(i);
         self.row_sums[i]
     }
 

@@ -188,3 +188,93 @@ fn the_world_and_the_maps_classify_parts_alike_under_one_flag() {
     assert!((0..3).all(|i| maps.geometry(i) == PartGeometry::Mesh && world.boxes(i).is_none()));
     assert!(DistanceMaps::build_on(world, &config).is_err(), "a world with the other setting is refused");
 }
+
+#[test]
+fn map_state_clone_from_copies_the_kept_rows_that_differ() {
+    // A column of four boxes; two states part ways, then one is copied onto the other.
+    let parts = (0..4)
+        .map(|k| {
+            let z = k as f32;
+            part(&format!("b{k}"), Mesh::cuboid(Vec3::new(0.0, 0.0, z), Vec3::new(1.0, 1.0, z + 1.0)))
+        })
+        .collect();
+    let maps = DistanceMaps::build(&assembly(parts), &MapConfig::default()).unwrap();
+    let mut a = MapState::new(&maps);
+    let mut b = MapState::new(&maps);
+    // b keeps rows for the full state, a for the state without the top box
+    for i in 0..4 {
+        b.min_map(i);
+    }
+    a.remove(3);
+    for i in 0..3 {
+        a.min_map(i);
+    }
+    let mut acts = Vec::new();
+    a.feasible_actions(&mut acts);
+    b.clone_from(&a);
+    assert_eq!(b.present(), a.present());
+    assert_eq!(b.counters(), a.counters());
+    for i in 0..3 {
+        let direct = maps.min_map(i, &a.present());
+        assert_eq!(b.min_map(i), direct.as_slice(), "part {i}");
+        assert_eq!(b.min_map_sum(i), a.min_map_sum(i), "part {i}");
+        assert_eq!(b.free_mask(i), a.free_mask(i), "part {i}");
+    }
+    let mut again = Vec::new();
+    b.feasible_actions(&mut again);
+    assert_eq!(again, acts);
+    // both go on alike
+    a.remove(2);
+    b.remove(2);
+    a.feasible_actions(&mut acts);
+    b.feasible_actions(&mut again);
+    assert_eq!(again, acts);
+    assert_eq!(b.min_map(1), a.min_map(1));
+}
+
+#[test]
+fn map_state_kept_sums_answer_like_a_fresh_state() {
+    // A 2×2×2 block of unit boxes; one state jumps between subsets (the search's resets), so
+    // that rows are recomputed, evicted and found again among the kept sums.
+    let mut parts = Vec::new();
+    for z in 0..2 {
+        for y in 0..2 {
+            for x in 0..2 {
+                let lo = Vec3::new(x as f32, y as f32, z as f32);
+                parts.push(part(&format!("c{x}{y}{z}"), Mesh::cuboid(lo, lo + Vec3::ONE)));
+            }
+        }
+    }
+    let maps = DistanceMaps::build(&assembly(parts), &MapConfig::builder().resolution(5).build().unwrap()).unwrap();
+    let n = 8;
+    let subsets: Vec<PartSet> = [
+        vec![0, 1, 2, 3, 4, 5, 6, 7],
+        vec![0, 1, 2, 3, 4, 5, 6],
+        vec![0, 1, 2, 3, 4, 5],
+        vec![0, 1, 2, 3, 5, 6, 7],
+        vec![0, 1, 2, 3, 7],
+        vec![0, 1, 2, 3, 4],
+        vec![0, 1, 2, 3],
+        vec![0, 2, 3],
+    ]
+    .into_iter()
+    .map(|v| PartSet::from_indices(n, v))
+    .collect();
+    let mut s = MapState::new(&maps);
+    for round in 0..3 {
+        for (k, present) in subsets.iter().enumerate().chain(subsets.iter().enumerate().rev()) {
+            s.reset(present);
+            let mut fresh = MapState::new(&maps);
+            fresh.reset(present);
+            for i in present.iter() {
+                // free directions first (before any row of this state), then the sum, then again
+                assert_eq!(s.free_mask(i), fresh.free_mask(i), "round {round} subset {k} part {i}");
+                let want = fresh.min_map_sum(i);
+                assert_eq!(s.min_map_sum(i), want, "round {round} subset {k} part {i}");
+                assert_eq!(s.free_mask(i), fresh.free_mask(i), "round {round} subset {k} part {i}");
+                let direct: f64 = maps.min_map(i, present).iter().map(|&v| v as f64).sum();
+                assert!((want - direct).abs() < 1e-3 * direct.abs().max(1.0), "round {round} subset {k} part {i}");
+            }
+        }
+    }
+}

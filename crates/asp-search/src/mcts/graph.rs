@@ -5,7 +5,7 @@
 use crate::mdp::{Mdp, MAX_OBJECTIVES};
 use asp_geom::PartSet;
 use std::collections::HashMap;
-use std::hash::{Hash, Hasher};
+use std::hash::{BuildHasherDefault, Hash, Hasher};
 
 pub(crate) const NONE: u32 = u32::MAX;
 
@@ -59,7 +59,7 @@ pub(crate) struct Tree<V> {
     /// `w` memory words per node.
     pub memory: Vec<u64>,
     pub w: usize,
-    pub index: HashMap<u64, u32>,
+    pub index: HashMap<u64, u32, BuildHasherDefault<KeyHasher>>,
     pub m: usize,
     /// With a policy that gives priors: per node, its feasible actions' priors (a range of
     /// `node_priors`), and per edge its action's prior.
@@ -119,10 +119,54 @@ impl<V> Iterator for EdgeIter<'_, V> {
 
 /// A hash of a state (present parts and the memories' key words), for the transposition index.
 pub(super) fn state_hash(present: &PartSet, memory: &[u64], problem: &Mdp) -> u64 {
-    let mut h = std::collections::hash_map::DefaultHasher::new();
+    let mut h = KeyHasher::default();
     present.hash(&mut h);
     problem.hash_key(memory, &mut h);
     h.finish()
+}
+
+/// The transposition index's hasher: a multiply-xor mix of the state's words (they are
+/// hashed once by [`state_hash`]), which the index then uses as they are. Only speed depends
+/// on it: the index's chains are compared state by state ([`Tree::is`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct KeyHasher(u64);
+
+impl KeyHasher {
+    #[inline]
+    fn mix(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+impl Hasher for KeyHasher {
+    #[inline]
+    fn finish(&self) -> u64 {
+        // a final avalanche, so that the index's table (which reads the high and the low bits)
+        // sees every word
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.mix(u64::from_le_bytes(word));
+        }
+    }
+
+    #[inline]
+    fn write_u64(&mut self, x: u64) {
+        self.mix(x);
+    }
+
+    #[inline]
+    fn write_usize(&mut self, x: usize) {
+        self.mix(x as u64);
+    }
 }
 
 /// Global bounds of the returns seen so far (per objective).

@@ -130,7 +130,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             rewards: Vec::new(),
             memory: memory.clone(),
             w,
-            index: HashMap::new(),
+            index: HashMap::default(),
             m,
             prior_spans: Vec::new(),
             node_priors: Vec::new(),
