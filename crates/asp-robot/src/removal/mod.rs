@@ -541,7 +541,8 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         let tool = Pose::from_parts(g.position, g.orientation);
         let lifted = Pose::from_translation(direction * self.config.lift) * tool;
         let seed = self.config.ik.seed ^ (p as u64).wrapping_mul(0x2545_f491_4f6c_dd1d) ^ (gi as u64).wrapping_mul(0x9e37_79b9);
-        let ik = IkConfig { seed, ..self.config.ik.clone() };
+        // computed once per grasp, so it can afford more restarts than a per-state test did
+        let ik = IkConfig { seed, restarts: self.config.ik.restarts.max(12), ..self.config.ik.clone() };
         let arm = robot.ik(&tool, None, &ik).solution().map(|s| s.joints.clone()).and_then(|qg| {
             let ql = robot.ik(&lifted, Some(&qg), &IkConfig { restarts: 0, ..ik.clone() }).solution().map(|s| s.joints.clone())?;
             Some((qg, ql))
