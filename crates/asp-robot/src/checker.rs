@@ -38,6 +38,19 @@ fn mix(x: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// The unit direction of a removal's first move (a straight line's direction, a path's first
+/// segment), `None` when it does not start with a translation.
+fn first_direction(motion: &Motion) -> Option<asp_geom::math::Vec3> {
+    match motion {
+        Motion::Linear { direction, .. } | Motion::Screw { direction, .. } => Some(*direction),
+        Motion::Path { poses, pivot } => poses
+            .windows(2)
+            .map(|w| w[1].transform_point(*pivot) - w[0].transform_point(*pivot))
+            .find(|d| d.length() > 1e-6)
+            .map(|d| d.normalize()),
+    }
+}
+
 /// Robot removability on top of a collision-world checker.
 pub struct RobotChecker<'c> {
     inner: &'c dyn FeasibilityChecker,
@@ -124,12 +137,18 @@ impl FeasibilityChecker for RobotChecker<'_> {
     fn test_removal(&self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome {
         let outcome = self.inner.test_removal(part, state, kind);
         match &outcome {
-            Outcome::Removed(Motion::Linear { direction, .. }) => {
+            // a screw turns out as its thread requires: not the arm's lift (as before)
+            Outcome::Removed(Motion::Screw { .. }) => outcome,
+            Outcome::Removed(motion) => {
                 let key = (state.words().to_vec(), part);
                 if self.plans.lock().expect("not poisoned").contains_key(&key) {
                     return outcome;
                 }
-                match self.planner.plan(part, state, *direction, step_seed(self.seed, state, part), self.replans) {
+                // the arm lifts up when it can (thesis 5.3), else along the motion's first move
+                let Some(direction) = first_direction(motion) else {
+                    return self.refuse(part, state, RobotFailure::Blocked { by: None });
+                };
+                match self.planner.plan(part, state, direction, step_seed(self.seed, state, part), self.replans) {
                     Ok(r) => {
                         self.plans.lock().expect("not poisoned").insert(key, r);
                         outcome
@@ -137,7 +156,6 @@ impl FeasibilityChecker for RobotChecker<'_> {
                     Err(f) => self.refuse(part, state, f),
                 }
             }
-            Outcome::Removed(Motion::Path { .. }) => self.refuse(part, state, RobotFailure::Blocked { by: None }),
             _ => outcome,
         }
     }

@@ -31,6 +31,7 @@ use asp_search::{Mdp, PathLength, PlanOutcome, SearchError, Status, StuckReason}
 
 use crate::checker::{HoldingChecker, RobotChecker};
 use crate::removal::{RemovalConfig, RemovalPlanner, RobotCell, RobotFailure, RobotRemoval};
+use crate::reuse::PathStore;
 use crate::robot::Robot;
 
 /// The objective name of the robot's path length.
@@ -215,6 +216,15 @@ type PlanKey = (Vec<u64>, usize, usize, bool);
 /// grasp` do not depend on `k` at all. A simulation (one plan) therefore reuses what an
 /// expansion (`k` plans) learnt and the other way round, and a full plan's verdict is the first
 /// path's ([`RemovalPlanner::removable`]).
+///
+/// Across states (issue 24): each search thread keeps a [`PathStore`] of the paths and monotone
+/// failures it found, each with its state. A rollout step takes a kept path whose state holds
+/// every present part (collision-free there; its length an upper bound) or a kept failure from
+/// a subset of the state before it plans; an expansion plans only for a path shorter than a
+/// kept one ([`RemovalPlanner::plan_below`]) and keeps the kept one when none is. Replays plan
+/// each state on its own, the same in every search. The stores are per thread (and emptied
+/// when a search is built, [`RobotModel::new_search`]), so a search's answer depends on its
+/// seed and thread count only.
 #[derive(Debug)]
 pub struct RobotModel {
     planner: RemovalPlanner<Arc<World>>,
@@ -224,6 +234,8 @@ pub struct RobotModel {
     cache: Mutex<HashMap<PlanKey, Result<RobotRemoval, RobotFailure>>>,
     /// Per (state, part): what is known of its feasibility.
     verdicts: Mutex<HashMap<(Vec<u64>, usize), Known>>,
+    /// Per search thread: what it learnt, reused in its later states ([`PathStore`]).
+    threads: Mutex<HashMap<std::thread::ThreadId, Arc<Mutex<ThreadStore>>>>,
 }
 
 /// What is known of one step's feasibility.
@@ -260,6 +272,17 @@ impl Known {
     }
 }
 
+/// A state (bitset words) and a part.
+type StepKey = (Vec<u64>, usize);
+
+/// One search thread's store, and the step its filter checked last in a rollout (the
+/// rollout's reward plans the same step next).
+#[derive(Debug, Default)]
+struct ThreadStore {
+    store: PathStore,
+    last: Option<(StepKey, Result<RobotRemoval, RobotFailure>)>,
+}
+
 impl RobotModel {
     fn replans(&self, step: &StepContext<'_, '_>) -> usize {
         if step.kind() == StepKind::Simulation {
@@ -279,13 +302,30 @@ impl RobotModel {
         self.verdicts.lock().expect("not poisoned").entry((present.to_vec(), part)).or_default().learn(replans, r);
     }
 
-    /// The robot's plan for `step`: for expansion and replay the shortest path of `k` plans per
-    /// grasp ([`RemovalPlanner::plan`]); for simulation (a rollout's estimate) the first path
-    /// found with one plan per grasp ([`RemovalPlanner::removable`], the path the `robot`
-    /// filter found when it admitted the step, so a rollout step costs no second search).
-    pub fn plan(&self, step: &mut StepContext<'_, '_>) -> Result<RobotRemoval, RobotFailure> {
-        let replans = self.replans(step);
-        let first = step.kind() == StepKind::Simulation;
+    /// Forgets what the search threads learnt ([`PathStore`]): a new search starts from
+    /// nothing, so its answer depends on its seed alone. The plans and verdicts of single
+    /// states (the same in every search) are kept.
+    pub fn new_search(&self) {
+        self.threads.lock().expect("not poisoned").clear();
+    }
+
+    /// This thread's store.
+    fn thread_store(&self) -> Arc<Mutex<ThreadStore>> {
+        self.threads.lock().expect("not poisoned").entry(std::thread::current().id()).or_default().clone()
+    }
+
+    /// Paths reused and failures reused so far (all threads of the current search).
+    pub fn reuse_hits(&self) -> (u64, u64) {
+        self.threads.lock().expect("not poisoned").values().fold((0, 0), |(a, b), t| {
+            let (x, y) = t.lock().expect("not poisoned").store.hits();
+            (a + x, b + y)
+        })
+    }
+
+    /// The plan of `step` as a function of its state alone, for `replans` plans per grasp
+    /// (`first`: the first path found, [`RemovalPlanner::removable`]; else the shortest,
+    /// [`RemovalPlanner::plan`]), shared by all threads.
+    fn state_plan(&self, step: &mut StepContext<'_, '_>, replans: usize, first: bool) -> Result<RobotRemoval, RobotFailure> {
         let present = step.present();
         let key = (present.words().to_vec(), step.part(), replans, first);
         if let Some(r) = self.cache.lock().expect("not poisoned").get(&key) {
@@ -305,12 +345,122 @@ impl RobotModel {
         r
     }
 
-    /// Whether the robot can do `step`: the verdict of [`RobotModel::plan`] from the first
-    /// path found ([`RemovalPlanner::removable`]: the same grasps and seeds, so the same
-    /// verdict and the same failure), without searching for the shortest; known verdicts (of
-    /// this or another number of replans, see [`RobotModel`]) are not planned again.
+    /// The lift of `step` (up when free, else the removal direction; see
+    /// [`RemovalPlanner::lift_direction`]).
+    fn lift(&self, step: &mut StepContext<'_, '_>) -> Result<Vec3, RobotFailure> {
+        match step.motion() {
+            Some(Motion::Linear { direction, .. }) => self.planner.lift_direction(step.part(), &step.present(), Some(direction)),
+            _ => Err(RobotFailure::Blocked { by: None }),
+        }
+    }
+
+    /// A rollout step with this thread's store: a kept path valid in the state, else a kept
+    /// failure that holds in it, else the state's own first path (kept in the store).
+    fn simulation(&self, step: &mut StepContext<'_, '_>) -> Result<RobotRemoval, RobotFailure> {
+        let present = step.present();
+        let key = (present.words().to_vec(), step.part());
+        let store = self.thread_store();
+        let mut t = store.lock().expect("not poisoned");
+        if let Some((k, r)) = &t.last {
+            if *k == key {
+                return r.clone();
+            }
+        }
+        if let Some(r) = t.store.path(step.part(), &present) {
+            let r = Ok(r.clone());
+            t.last = Some((key, r.clone()));
+            return r;
+        }
+        let r = match self.lift(step) {
+            Err(f) => Err(f),
+            Ok(lift) => match t.store.failure(step.part(), &present, lift, 1) {
+                Some(f) => Err(f),
+                None => {
+                    let r = self.state_plan(step, 1, true);
+                    t.store.learn(step.part(), &present, lift, 1, &r);
+                    r
+                }
+            },
+        };
+        t.last = Some((key, r.clone()));
+        r
+    }
+
+    /// An expansion with this thread's store: with a kept path valid in the state, only a
+    /// shorter one is planned (`k` plans per grasp, [`RemovalPlanner::plan_below`]) and the
+    /// kept one serves when none is; without one, the state's own shortest plan.
+    fn expansion(&self, step: &mut StepContext<'_, '_>) -> Result<RobotRemoval, RobotFailure> {
+        let replans = self.replans(step);
+        let present = step.present();
+        let store = self.thread_store();
+        let mut t = store.lock().expect("not poisoned");
+        let kept = t.store.path(step.part(), &present).cloned();
+        let lift = self.lift(step);
+        let r = match (kept, &lift) {
+            (Some(kept), Ok(lift)) => self.planner.plan_below(step.part(), &present, *lift, step.seed(), replans, kept.length).or(Ok(kept)),
+            (Some(kept), Err(_)) => Ok(kept),
+            (None, Err(f)) => Err(f.clone()),
+            (None, Ok(lift)) => match t.store.failure(step.part(), &present, *lift, replans) {
+                Some(f) => Err(f),
+                None => self.state_plan(step, replans, false),
+            },
+        };
+        if let Ok(lift) = lift {
+            t.store.learn(step.part(), &present, lift, replans, &r);
+        }
+        r
+    }
+
+    /// The robot's plan for `step`: for a rollout step (simulation) the first path found with
+    /// one plan per grasp, or a path kept from a state with more parts (this thread's
+    /// [`PathStore`]); for an expansion the shortest of `k` plans per grasp, or a kept path
+    /// when none is shorter; for a replay the state's own shortest plan, the same in every
+    /// search.
+    pub fn plan(&self, step: &mut StepContext<'_, '_>) -> Result<RobotRemoval, RobotFailure> {
+        match step.kind() {
+            StepKind::Simulation => self.simulation(step),
+            StepKind::Expansion => self.expansion(step),
+            StepKind::Replay => {
+                let replans = self.replans(step);
+                self.state_plan(step, replans, false)
+            }
+        }
+    }
+
+    /// Whether the robot can do `step`: in a rollout the verdict of the plan it will take
+    /// ([`RobotModel::plan`]); at an expansion, yes when this thread keeps a path valid in the
+    /// state, else the verdict of the first path found with `k` plans per grasp (a kept failure
+    /// that holds in the state, or [`RemovalPlanner::removable`], the same grasps and seeds as
+    /// the full plan, so the same verdict); in a replay the latter, without the store.
     pub fn feasible(&self, step: &mut StepContext<'_, '_>) -> Result<(), RobotFailure> {
         let replans = self.replans(step);
+        match step.kind() {
+            StepKind::Simulation => return self.simulation(step).map(|_| ()),
+            StepKind::Replay => {}
+            StepKind::Expansion => {
+                let present = step.present();
+                let store = self.thread_store();
+                let mut t = store.lock().expect("not poisoned");
+                if t.store.path(step.part(), &present).is_some() {
+                    return Ok(());
+                }
+                let lift = self.lift(step)?;
+                if let Some(f) = t.store.failure(step.part(), &present, lift, replans) {
+                    return Err(f);
+                }
+                let r = self.state_verdict(step, replans);
+                if let Err(f) = &r {
+                    t.store.learn(step.part(), &present, lift, replans, &Err(f.clone()));
+                }
+                return r;
+            }
+        }
+        self.state_verdict(step, replans)
+    }
+
+    /// The verdict of the first path found in `step`'s state with `replans` plans per grasp
+    /// (shared by all threads).
+    fn state_verdict(&self, step: &mut StepContext<'_, '_>, replans: usize) -> Result<(), RobotFailure> {
         let present = step.present();
         let key = (present.words().to_vec(), step.part());
         if let Some(v) = self.known(&key.0, key.1, replans) {
@@ -321,10 +471,6 @@ impl RobotModel {
             _ => Err(RobotFailure::Blocked { by: None }),
         };
         self.learn(&key.0, key.1, replans, r.as_ref().map(|_| ()));
-        if step.kind() == StepKind::Simulation {
-            // the simulation's plan of this step ([`RobotModel::plan`])
-            self.cache.lock().expect("not poisoned").insert((key.0, key.1, replans, true), r.clone());
-        }
         r.map(|_| ())
     }
 
@@ -418,6 +564,7 @@ impl RobotExtension {
             assembly: model.assembly.clone(),
             cache: Mutex::new(HashMap::new()),
             verdicts: Mutex::new(HashMap::new()),
+            threads: Mutex::new(HashMap::new()),
         });
         *slot = Some((id, m.clone()));
         Ok(m)
@@ -433,11 +580,15 @@ impl MdpExtension for RobotExtension {
         if name.trim() != ROBOT_PATH {
             return Ok(None);
         }
-        Ok(Some(Arc::new(RobotPath(self.model(model)?))))
+        let m = self.model(model)?;
+        m.new_search();
+        Ok(Some(Arc::new(RobotPath(m))))
     }
 
     fn filters(&self, model: &ModelContext<'_>) -> asp_search::Result<Vec<Arc<dyn ActionFilter>>> {
-        Ok(vec![Arc::new(RobotFilter(self.model(model)?))])
+        let m = self.model(model)?;
+        m.new_search();
+        Ok(vec![Arc::new(RobotFilter(m))])
     }
 
     fn describe(&self, model: &ModelContext<'_>, sequence: &[usize]) -> asp_search::Result<Option<RobotReport>> {

@@ -51,8 +51,10 @@ pub use stats::PlanStats;
 use stats::{Counters, C};
 
 use std::borrow::Borrow;
+use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::OnceLock;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use asp_geom::math::{Pose, Rot, Vec3};
@@ -88,6 +90,17 @@ struct Obstacles {
     bounds: Option<Aabb>,
 }
 
+/// The arm's configurations for one grasp and lift direction ([`RemovalPlanner::grasp_ik`]).
+struct GraspIk {
+    /// At the grasp and at the lifted pose (`None`: out of the arm's reach).
+    arm: Option<(Vec<f64>, Vec<f64>)>,
+    /// At the drop-off, in the order they are tried.
+    drop: Vec<Vec<f64>>,
+}
+
+/// A part, a grasp and a lift direction (its bits).
+type IkKey = (usize, usize, [u32; 3]);
+
 /// Plans robot removals of the parts of one collision world (`W`: a `&World`, an
 /// `Arc<World>`, or anything else that borrows one).
 pub struct RemovalPlanner<W: Borrow<World>> {
@@ -114,6 +127,8 @@ pub struct RemovalPlanner<W: Borrow<World>> {
     cuboids: Vec<Option<Vec<Placed>>>,
     /// The same shrunk by the held part's margin, for the part in hand.
     held_cuboids: Vec<Option<Vec<Placed>>>,
+    /// Inverse kinematics per part, grasp and lift direction (state-independent).
+    ik_cache: Mutex<HashMap<IkKey, Arc<GraspIk>>>,
     counters: Counters,
 }
 
@@ -211,6 +226,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
             self_pairs,
             cuboids,
             held_cuboids,
+            ik_cache: Mutex::new(HashMap::new()),
             counters: Counters::default(),
         }
     }
@@ -445,7 +461,23 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
     /// ([`RemovalPlanner::plan_exhaustive`]) — or after [`RemovalConfig::path_grasps`] planned
     /// grasps (a cap: then a later grasp might have been shorter).
     pub fn plan(&self, p: usize, present: &PartSet, direction: Vec3, seed: u64, replans: usize) -> Result<RobotRemoval, RobotFailure> {
-        self.plan_grasps(p, present, direction, seed, replans, Mode::Bounded)
+        self.plan_grasps(p, present, direction, seed, replans, Mode::Bounded, f64::INFINITY)
+    }
+
+    /// [`RemovalPlanner::plan`] for a path shorter than `below` (metres; the length of a path
+    /// known to work, e.g. one found among more parts): grasps whose lower bound is not below
+    /// it are not examined and paths not shorter are dropped unchecked. `Err` when none is
+    /// shorter (the failure then says nothing about the known path).
+    pub fn plan_below(
+        &self,
+        p: usize,
+        present: &PartSet,
+        direction: Vec3,
+        seed: u64,
+        replans: usize,
+        below: f64,
+    ) -> Result<RobotRemoval, RobotFailure> {
+        self.plan_grasps(p, present, direction, seed, replans, Mode::Bounded, below)
     }
 
     /// Whether the robot can take the part out, with the first path found: the same grasps in
@@ -454,7 +486,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
     /// the same failure), at a fraction of the cost; its path is not the shortest. For
     /// feasibility tests (the optimiser's `robot` filter).
     pub fn removable(&self, p: usize, present: &PartSet, direction: Vec3, seed: u64, replans: usize) -> Result<RobotRemoval, RobotFailure> {
-        self.plan_grasps(p, present, direction, seed, replans, Mode::FirstPath)
+        self.plan_grasps(p, present, direction, seed, replans, Mode::FirstPath, f64::INFINITY)
     }
 
     /// [`RemovalPlanner::plan`] without its shortcuts: every grasp is examined and every
@@ -469,9 +501,69 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         seed: u64,
         replans: usize,
     ) -> Result<RobotRemoval, RobotFailure> {
-        self.plan_grasps(p, present, direction, seed, replans, Mode::Exhaustive)
+        self.plan_grasps(p, present, direction, seed, replans, Mode::Exhaustive, f64::INFINITY)
     }
 
+    /// The direction the arm lifts part `p` out of `present` along (thesis 5.3: 5 cm up): up
+    /// when that lift is collision-free (the world's exact sweep), else `direction` (the
+    /// removal direction the geometry found, when there is one). A part taken out sideways
+    /// would be pulled along its neighbours' faces, and a part pulled down would drag the
+    /// gripper into the structure below it; the generated assemblies are built to be lifted.
+    /// Fails with [`RobotFailure::Blocked`] naming the part the last lift tried hits.
+    pub fn lift_direction(&self, p: usize, present: &PartSet, direction: Option<Vec3>) -> Result<Vec3, RobotFailure> {
+        let world = self.world();
+        let bb = world.aabb(p);
+        let pivot = (bb.mins + bb.maxs) * 0.5;
+        let up = self.cell.up;
+        let mut hit = None;
+        for d in [Some(up), direction.filter(|d| d.dot(up) < 1.0 - 1e-6)].into_iter().flatten() {
+            let lift = Pose::from_translation(d * self.config.lift);
+            match world.collision_between(p, &Pose::IDENTITY, &lift, pivot, present) {
+                None => return Ok(d),
+                Some(by) => hit = Some(by),
+            }
+        }
+        Err(RobotFailure::Blocked { by: hit })
+    }
+
+    /// The arm's configurations for grasp `gi` of part `p` lifted along `direction`, computed
+    /// once: inverse kinematics of the grasp and lifted poses (seeded by the part and grasp
+    /// only, so the same in every state and thread) and of the drop-off poses (the lifted
+    /// orientation, then the gripper pointing down, turned twice), each started from the
+    /// lifted configuration.
+    fn grasp_ik(&self, p: usize, gi: usize, direction: Vec3) -> Arc<GraspIk> {
+        let key = (p, gi, direction.to_array().map(f32::to_bits));
+        if let Some(k) = self.ik_cache.lock().expect("not poisoned").get(&key) {
+            return k.clone();
+        }
+        let robot = &self.cell.robot;
+        let g = &self.grasps(p)[gi];
+        let tool = Pose::from_parts(g.position, g.orientation);
+        let lifted = Pose::from_translation(direction * self.config.lift) * tool;
+        let seed = self.config.ik.seed ^ (p as u64).wrapping_mul(0x2545_f491_4f6c_dd1d) ^ (gi as u64).wrapping_mul(0x9e37_79b9);
+        // computed once per grasp, so it can afford more restarts than a per-state test did
+        let ik = IkConfig { seed, restarts: self.config.ik.restarts.max(12), ..self.config.ik.clone() };
+        let arm = robot.ik(&tool, None, &ik).solution().map(|s| s.joints.clone()).and_then(|qg| {
+            let ql = robot.ik(&lifted, Some(&qg), &IkConfig { restarts: 0, ..ik.clone() }).solution().map(|s| s.joints.clone())?;
+            Some((qg, ql))
+        });
+        let mut drop = Vec::new();
+        if let Some((_, ql)) = &arm {
+            let down = Rot::from_rotation_arc(Vec3::Z, -self.cell.up);
+            for (k, rot) in [lifted.rotation, down, down * Rot::from_rotation_z(std::f32::consts::FRAC_PI_2)].into_iter().enumerate() {
+                let target = Pose::from_parts(self.cell.drop_off, rot);
+                let cfg = IkConfig { seed: ik.seed ^ (k as u64 + 1), ..ik.clone() };
+                if let Some(s) = robot.ik(&target, Some(ql), &cfg).solution() {
+                    drop.push(s.joints.clone());
+                }
+            }
+        }
+        let k = Arc::new(GraspIk { arm, drop });
+        self.ik_cache.lock().expect("not poisoned").insert(key, k.clone());
+        k
+    }
+
+    #[allow(clippy::too_many_arguments)] // the plan's inputs, the search mode and its bound
     fn plan_grasps(
         &self,
         p: usize,
@@ -480,18 +572,15 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         seed: u64,
         replans: usize,
         mode: Mode,
+        below: f64,
     ) -> Result<RobotRemoval, RobotFailure> {
         let exhaustive = mode == Mode::Exhaustive;
         let counters = &self.counters;
         counters.add(C::Plans, 1);
         let world = self.world();
         let robot = &self.cell.robot;
-        let bb = world.aabb(p);
-        let pivot = (bb.mins + bb.maxs) * 0.5;
+        let direction = counters.timed(C::Lift, || self.lift_direction(p, present, Some(direction)))?;
         let lift = Pose::from_translation(direction * self.config.lift);
-        if let Some(by) = counters.timed(C::Lift, || world.collision_between(p, &Pose::IDENTITY, &lift, pivot, present)) {
-            return Err(RobotFailure::Blocked { by: Some(by) });
-        }
         let obstacles = self.obstacles(present, p);
         let grasps = self.grasps(p);
         let shrunk = world.eroded(p, self.config.margin.max(world.tolerance()));
@@ -510,13 +599,11 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let cap = if exhaustive { usize::MAX } else { self.config.path_grasps.max(1) };
         let (mut unreachable, mut colliding, mut no_drop, mut reached, mut tried) = (0, 0, 0, 0, 0);
-        // grasps solved so far with their arm configurations: the nearest one seeds the next
-        // grasp's inverse kinematics
-        let mut solved: Vec<(Pose, Vec<f64>)> = Vec::new();
         let mut best: Option<RobotRemoval> = None;
         for (n, &(bound, gi)) in order.iter().enumerate() {
             let found = mode == Mode::FirstPath && best.is_some();
-            if found || !exhaustive && (tried >= cap || best.as_ref().is_some_and(|b| b.length <= bound)) {
+            let shortest = best.as_ref().map_or(below, |b| b.length);
+            if found || !exhaustive && (tried >= cap || shortest <= bound) {
                 counters.add(C::Pruned, (order.len() - n) as u64);
                 break;
             }
@@ -534,24 +621,15 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
                 colliding += 1;
                 continue;
             }
-            // 2. inverse kinematics of both poses
-            let ik = IkConfig { seed: seed ^ (gi as u64).wrapping_mul(0x9e37_79b9), ..self.config.ik.clone() };
-            let start = solved
-                .iter()
-                .map(|(pose, q)| ((pose.translation - tool.translation).length() + 0.3 * pose.rotation.angle_between(tool.rotation), q))
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .map(|(_, q)| q.as_slice());
-            let reached_ik = counters.timed(C::Ik, || {
-                let qg = robot.ik(&tool, start, &ik).solution().map(|s| s.joints.clone())?;
-                let ql = robot.ik(&lifted, Some(&qg), &IkConfig { restarts: 0, ..ik.clone() }).solution().map(|s| s.joints.clone())?;
-                Some((qg, ql))
-            });
-            let Some((qg, ql)) = reached_ik else {
+            // 2. inverse kinematics of both poses (per grasp and lift, once: it does not depend
+            // on the state, so an arm out of reach stays out of reach)
+            let ik = counters.timed(C::Ik, || self.grasp_ik(p, gi, direction));
+            let Some((qg, ql)) = ik.arm.as_ref() else {
                 counters.add(C::Unreachable, 1);
                 unreachable += 1;
                 continue;
             };
-            solved.push((tool, qg.clone()));
+            let (qg, ql) = (qg.clone(), ql.clone());
             // 3. the whole arm and the held part at both poses and between them
             let grasp_pose = robot.tool_pose(&qg);
             let space = ArmSpace::new(self, p, &shrunk, grasp_pose, g.width, &obstacles, self.config.edge_resolution);
@@ -560,20 +638,9 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
                 continue;
             }
             reached += 1;
-            // 4. drop-off: the lifted orientation first, then the gripper pointing down
-            let qd = counters.timed(C::DropOff, || {
-                let down = Rot::from_rotation_arc(Vec3::Z, -self.cell.up);
-                for (k, rot) in [lifted.rotation, down, down * Rot::from_rotation_z(std::f32::consts::FRAC_PI_2)].into_iter().enumerate() {
-                    let target = Pose::from_parts(self.cell.drop_off, rot);
-                    let cfg = IkConfig { seed: ik.seed ^ (k as u64 + 1), ..ik.clone() };
-                    if let Some(s) = robot.ik(&target, Some(&ql), &cfg).solution() {
-                        if space.valid(&s.joints) {
-                            return Some(s.joints.clone());
-                        }
-                    }
-                }
-                None
-            });
+            // 4. drop-off: the first of its configurations (lifted orientation, then the
+            // gripper pointing down) where the arm and the part in hand are collision-free
+            let qd = counters.timed(C::DropOff, || ik.drop.iter().find(|q| space.valid(q)).cloned());
             let Some(qd) = qd else {
                 no_drop += 1;
                 continue;
@@ -594,7 +661,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
                 // needs no re-check
                 let kept = counters.timed(C::Recheck, || {
                     let length = fine.tool_travel(&joints);
-                    let better = best.as_ref().is_none_or(|b| length < b.length);
+                    let better = length < best.as_ref().map_or(below, |b| b.length);
                     (better && joints.windows(2).all(|w| fine.edge_valid(&w[0], &w[1]))).then_some(length)
                 });
                 if let Some(length) = kept {

@@ -4,6 +4,7 @@ mod ik;
 mod load;
 mod recheck;
 mod removal;
+mod reuse;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

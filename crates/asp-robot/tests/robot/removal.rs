@@ -101,8 +101,29 @@ fn a_walled_in_block_has_no_reachable_grasp() {
         }
         other => panic!("expected no reachable grasp, got {other:?}"),
     }
-    // sideways the lift hits a wall
-    assert!(matches!(planner.plan(1, &state, Vec3::X, 3, 1), Err(RobotFailure::Blocked { by: Some(3) })));
+    // the arm lifts up when it can (thesis 5.3), whatever the removal direction: sideways the
+    // lift would hit a wall, up it is free (and the grasps still collide)
+    assert_eq!(planner.lift_direction(1, &state, Some(Vec3::X)), Ok(Vec3::Z));
+    assert!(matches!(planner.plan(1, &state, Vec3::X, 3, 1), Err(RobotFailure::NoReachableGrasp { .. })));
+    // with only the walls and the plate but a lid over the block, the lift up hits the lid and
+    // sideways a wall: blocked, naming the last lift's part
+    let mut parts = vec![
+        box_part("plate", [-0.2, -0.2, -0.02], [0.3, 0.2, 0.0]),
+        box_part("block", [0.08, -0.02, 0.0], [0.12, 0.02, 0.04]),
+        box_part("wall_xm", [0.06, -0.05, 0.0], [0.075, 0.05, 0.04]),
+        box_part("wall_xp", [0.125, -0.05, 0.0], [0.14, 0.05, 0.04]),
+        box_part("lid", [0.06, -0.05, 0.04], [0.14, 0.05, 0.05]),
+    ];
+    for (i, p) in parts.iter_mut().enumerate() {
+        p.fixed = i != 1;
+    }
+    let lidded = World::new(assemble("lidded", parts, Axis::Z), &WorldConfig::default()).unwrap();
+    let cell = RobotCell::for_assembly(lidded.assembly(), Robot::panda(), Some(Vec3::new(-0.35, 0.0, -0.02)), None);
+    let covered = RemovalPlanner::new(&lidded, cell, RemovalConfig::default());
+    let all = PartSet::full(lidded.num_parts());
+    assert_eq!(covered.lift_direction(1, &all, Some(Vec3::X)), Err(RobotFailure::Blocked { by: Some(3) }));
+    assert_eq!(covered.lift_direction(1, &all, None), Err(RobotFailure::Blocked { by: Some(4) }));
+    assert_eq!(covered.lift_direction(1, &all, Some(Vec3::Y)), Ok(Vec3::Y));
     // without the walls the same block comes out
     let parts = vec![box_part("plate", [-0.2, -0.2, -0.02], [0.3, 0.2, 0.0]), box_part("block", [0.08, -0.02, 0.0], [0.12, 0.02, 0.04])];
     let mut free = assemble("free", parts, Axis::Z);
