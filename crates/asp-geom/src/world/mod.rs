@@ -412,27 +412,7 @@ impl World {
         let tol = self.tolerance;
         // the plain tolerance first, from the cache (most pairs merely touch)
         a.eroded(tol);
-        let clear = |extra: f32| !a.eroded_hits(tol + extra, b);
-        if clear(0.0) {
-            return Some(0.0);
-        }
-        let mut hi = tol;
-        while !clear(hi) {
-            if hi >= limit {
-                return None;
-            }
-            hi = (hi * 2.0).min(limit);
-        }
-        let mut lo = hi / 2.0;
-        for _ in 0..4 {
-            let mid = 0.5 * (lo + hi);
-            if clear(mid) {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        Some(hi)
+        depth_search(tol, limit, |extra| !a.eroded_hits(tol + extra, b))
     }
 
     /// The assembly this world was built from.
@@ -782,6 +762,32 @@ pub(crate) fn ground_box(bb: &Aabb, up: Vec3, diag: f32) -> Mesh {
     Mesh::cuboid(mins, maxs)
 }
 
+/// The least extra erosion (within a factor 2^-4 of the first doubling step) at which `clear`
+/// holds: 0 when it holds at once, else doubling from `tol` up to `limit` (`None` past it), then
+/// four bisections. `clear` must be monotone in the extra erosion.
+fn depth_search(tol: f32, limit: f32, clear: impl Fn(f32) -> bool) -> Option<f32> {
+    if clear(0.0) {
+        return Some(0.0);
+    }
+    let mut hi = tol;
+    while !clear(hi) {
+        if hi >= limit {
+            return None;
+        }
+        hi = (hi * 2.0).min(limit);
+    }
+    let mut lo = hi / 2.0;
+    for _ in 0..4 {
+        let mid = 0.5 * (lo + hi);
+        if clear(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -798,30 +804,10 @@ mod tests {
             || (a.closed && nests(&b.aabb, &a.aabb) && contains_point(&a.erode(amount), b.mesh.vertices()[0]))
     }
 
-    /// `World::extra_erosion`'s doubling and bisection over `hits_by_whole_erosion`.
+    /// `World::extra_erosion`'s search over `hits_by_whole_erosion` (the erosion of the whole part).
     fn depth_by_whole_erosion(w: &World, p: usize, q: usize, limit: f32) -> Option<f32> {
         let (a, b, tol) = (&w.geoms[p], &w.geoms[q], w.tolerance);
-        let clear = |extra: f32| !hits_by_whole_erosion(a, tol + extra, b);
-        if clear(0.0) {
-            return Some(0.0);
-        }
-        let mut hi = tol;
-        while !clear(hi) {
-            if hi >= limit {
-                return None;
-            }
-            hi = (hi * 2.0).min(limit);
-        }
-        let mut lo = hi / 2.0;
-        for _ in 0..4 {
-            let mid = 0.5 * (lo + hi);
-            if clear(mid) {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        Some(hi)
+        depth_search(tol, limit, |extra| !hits_by_whole_erosion(a, tol + extra, b))
     }
 
     /// Issue 27 item 3: the trial erosions of an overlapping pair shrink only the triangles near
