@@ -101,7 +101,8 @@ fn no_plan_exits_1_and_explains() {
 /// Issue 25 item 4, issue 24 item 4: with `--robot`, a part the geometry lets out but the arm
 /// cannot take out is explained by the arm's reason, not "blocked by" parts that do not block
 /// it: a block out of reach of the base `--robot-base` puts (no reachable grasp), and the L's
-/// block, which leaves its housing only along a path (the arm lifts along a straight line).
+/// block, which leaves its housing only along a path: the arm now lifts path motions too (up
+/// when free), so what stops it is the grasp: the block is wider than the gripper opens.
 #[test]
 fn issue_25_a_robot_refusal_is_explained_by_the_arms_reason() {
     let dir = tempfile::tempdir().unwrap();
@@ -129,7 +130,11 @@ fn issue_25_a_robot_refusal_is_explained_by_the_arms_reason() {
     let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let why = &plan["explanation"][0];
     assert_eq!((&why["name"], &why["parts"]), (&"block".into(), &serde_json::json!([])), "{why}");
-    assert_eq!(why["robot"]["reason"], "no_straight_lift", "{why}");
+    assert_eq!(
+        (&why["robot"]["reason"], &why["robot"]["detail"]),
+        (&"no_reachable_grasp".into(), &"no grasp fits the gripper".into()),
+        "{why}"
+    );
 }
 
 /// Asserts a one-line error naming `needle`, exit code 2, no panic.
