@@ -153,6 +153,79 @@ pub fn inward_samples(mesh: &TriMesh, target: usize, depth: f32) -> Vec<Vec3> {
     out
 }
 
+/// Most local samples per part and pair ([`local_inward_samples`]).
+const LOCAL_SAMPLES_CAP: usize = 20_000;
+
+/// Samples of `mesh` (a part whose box is `own`) near another part (box `other`), moved inward
+/// by `depth`: the mesh's surface clipped to the two boxes' intersection grown by a quarter of
+/// its largest extent (at least four `depth`s), sampled about a tenth of the intersection's
+/// smallest extent apart (at least two `depth`s; at most [`LOCAL_SAMPLES_CAP`] points). Where a
+/// small part is drawn into a large one (a dowel in a solid panel), the whole-surface samples
+/// are too sparse to see the small part cut sideways through the large one's surface next to
+/// it; these see it at the scale of the overlap. Empty when the boxes do not meet.
+pub fn local_inward_samples(mesh: &TriMesh, own: &Aabb, other: &Aabb, depth: f32) -> Vec<Vec3> {
+    let (lo, hi) = (own.mins.max(other.mins), own.maxs.min(other.maxs));
+    let extent = hi - lo;
+    if extent.min_element() < 0.0 {
+        return Vec::new();
+    }
+    let grow = (0.25 * extent.max_element()).max(4.0 * depth);
+    let region = Aabb::new(lo - Vec3::splat(grow), hi + Vec3::splat(grow));
+    let spacing = (0.1 * extent.min_element()).max(2.0 * depth);
+    if !(spacing > 0.0 && spacing.is_finite()) {
+        return Vec::new();
+    }
+    let (vertices, triangles) = (mesh.vertices(), mesh.indices());
+    let mut clipped: Vec<Vec3> = Vec::new();
+    let mut tris: Vec<[u32; 3]> = Vec::new();
+    let mut area = 0.0f64;
+    for t in triangles {
+        let poly = clip_to_box(t.map(|i| vertices[i as usize]), &region);
+        if poly.len() < 3 {
+            continue;
+        }
+        let base = clipped.len() as u32;
+        clipped.extend_from_slice(&poly);
+        for k in 1..poly.len() as u32 - 1 {
+            area += 0.5 * f64::from((poly[k as usize] - poly[0]).cross(poly[k as usize + 1] - poly[0]).length());
+            tris.push([base, base + k, base + k + 1]);
+        }
+    }
+    let target = ((area / f64::from(spacing * spacing)).ceil() as usize).min(LOCAL_SAMPLES_CAP);
+    if target == 0 {
+        return Vec::new();
+    }
+    let sample = sample_triangles(&clipped, &tris, target);
+    sample.points.iter().zip(&sample.normals).map(|(p, n)| *p - *n * depth).collect()
+}
+
+/// Triangle `t` clipped to box `b` (Sutherland–Hodgman against its six planes): the corners
+/// of the convex polygon left, in the triangle's winding; empty when nothing is left.
+fn clip_to_box(t: [Vec3; 3], b: &Aabb) -> Vec<Vec3> {
+    let mut poly: Vec<Vec3> = t.to_vec();
+    for axis in 0..3 {
+        for (bound, keep_below) in [(b.maxs[axis], true), (b.mins[axis], false)] {
+            if poly.is_empty() {
+                return poly;
+            }
+            let inside = |v: Vec3| if keep_below { v[axis] <= bound } else { v[axis] >= bound };
+            let mut out = Vec::with_capacity(poly.len() + 2);
+            for i in 0..poly.len() {
+                let (a, c) = (poly[i], poly[(i + 1) % poly.len()]);
+                if inside(a) {
+                    out.push(a);
+                }
+                if inside(a) != inside(c) {
+                    let f = (bound - a[axis]) / (c[axis] - a[axis]);
+                    out.push(a + (c - a) * f);
+                }
+            }
+            poly = out;
+        }
+    }
+    poly
+}
+
 /// Whether point `s`, moved along unit `dir` for `t` in `[0, t_max]`, can meet box `b` widened
 /// by `pad` (a cull: true when unsure).
 fn path_meets(s: Vec3, dir: Vec3, t_max: f32, b: &Aabb, pad: f32) -> bool {

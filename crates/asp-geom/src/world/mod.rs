@@ -102,6 +102,10 @@ pub struct World {
     ignored: BTreeSet<(usize, usize)>,
     /// Ordered pairs (both orders) tested by the strict overlap rule.
     strict: BTreeSet<(usize, usize)>,
+    /// Per ordered strict pair `(p, q)` that no shrinking separates (tested by the strict rule
+    /// alone): `p`'s samples for their strict test, its whole-surface samples and dense ones near
+    /// `q` (made the first time the pair is tested).
+    strict_samples: BTreeMap<(usize, usize), OnceLock<Vec<Vec3>>>,
     notes: Vec<OverlapNote>,
     policy: OverlapPolicy,
     /// Threaded contacts (ordered pairs), found with the world.
@@ -181,6 +185,7 @@ impl World {
             overlaps: BTreeMap::new(),
             ignored: BTreeSet::new(),
             strict: BTreeSet::new(),
+            strict_samples: BTreeMap::new(),
             notes: Vec::new(),
             policy: config.overlaps,
             threads: BTreeMap::new(),
@@ -220,6 +225,7 @@ impl World {
             // gross pairs ignore each other under both policies (strict tests them by its rule)
             ignored: self.notes.iter().filter(|n| n.gross).flat_map(|n| [n.parts, (n.parts.1, n.parts.0)]).collect(),
             strict: BTreeSet::new(),
+            strict_samples: BTreeMap::new(),
             notes,
             policy: OverlapPolicy::Lenient,
             threads: self.threads.clone(),
@@ -338,6 +344,10 @@ impl World {
                     self.strict.insert((i, j));
                     self.strict.insert((j, i));
                     if gross {
+                        // no shrunk sweep guards this pair: its samples alone must see a part
+                        // cut sideways through the other
+                        self.strict_samples.insert((i, j), OnceLock::new());
+                        self.strict_samples.insert((j, i), OnceLock::new());
                         self.ignored.insert((i, j));
                         self.ignored.insert((j, i));
                     }
@@ -502,8 +512,23 @@ impl World {
         if !self.is_strict_pair(p, q) {
             return None;
         }
-        let (sp, sq) = (self.strict_samples(p), self.strict_samples(q));
+        let (sp, sq) = (self.strict_pair_samples(p, q), self.strict_pair_samples(q, p));
         overlap::strict_entry(sp, &self.geoms[p].mesh, sq, &self.geoms[q].mesh, from, dir, t_max, first_only)
+    }
+
+    /// Part `p`'s samples for its strict test with `q`: its whole-surface samples (about
+    /// [`STRICT_SAMPLES`], spread over the whole part: centimetres apart on a large panel, where
+    /// a dowel drawn into it could slide sideways between them), and, when no shrinking
+    /// separates the pair (so no shrunk sweep guards it), its surface near `q` sampled densely
+    /// ([`overlap::local_inward_samples`] in the pair's common box).
+    fn strict_pair_samples(&self, p: usize, q: usize) -> &[Vec3] {
+        let Some(cell) = self.strict_samples.get(&(p, q)) else { return self.strict_samples(p) };
+        cell.get_or_init(|| {
+            let mut all = self.strict_samples(p).to_vec();
+            let (a, b) = (self.geoms[p].mesh.local_aabb(), self.geoms[q].mesh.local_aabb());
+            all.extend(overlap::local_inward_samples(&self.geoms[p].mesh, &a, &b, self.tolerance));
+            all
+        })
     }
 
     /// Part `p`'s axis of near rotational symmetry (a bolt, screw, nut, washer), if any.

@@ -72,6 +72,24 @@ fn a_dowel_in_two_boards_comes_out_after_the_upper_board_both_upward() {
     }
 }
 
+/// A dowel drawn into a large solid panel (no hole modelled) may not slide sideways through it:
+/// the panel's whole-surface samples are about 2 cm apart on its 2 m² of surface, and the
+/// 8 mm dowel slid between them until the pair's own samples near the dowel came in (issue 28
+/// item 3, the carcasses of `asp gen stress`: the independent replay saw the dowels cut
+/// through their side panels).
+#[test]
+fn a_dowel_drawn_into_a_large_panel_leaves_along_its_axis_only() {
+    let mut panel = fixtures::box_part("panel", [0.0, 0.0, 0.0], [1.0, 1.0, 0.018]);
+    panel.fixed = true;
+    let dowel = fixtures::part("dowel", fixtures::prism(0.37, 0.61, 0.004, 0.003, 0.033, 16), false);
+    let w = world(fixtures::assemble("dowel_in_panel", vec![panel, dowel], asp_geom::math::Axis::Z), OverlapPolicy::Strict).unwrap();
+    assert!(w.overlap_notes()[0].gross, "{:?}", w.overlap_notes());
+    let all = PartSet::full(2);
+    assert_eq!(free_axes(&w, 1, &all), vec!["+z"]);
+    let free = free_directions(&w, 1, &all);
+    assert!(!free.is_empty() && free.iter().all(|d| d.dot(Vec3::Z) > 0.9999), "{free:?}");
+}
+
 #[test]
 fn a_nested_part_is_reported_and_held() {
     // a small box wholly inside a bigger one (a duplicated inner body)
