@@ -13,5 +13,6 @@ mod pipeline;
 mod request;
 mod robot;
 mod stepped;
+mod stress;
 mod transitions;
 mod voxel;

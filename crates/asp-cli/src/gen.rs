@@ -4,7 +4,7 @@
 
 use anyhow::bail;
 use asp_gen::batch::{write_batch, Batch, Generator};
-use asp_gen::{ConnectorMode, ProfileParams, SomaParams};
+use asp_gen::{ConnectorMode, ProfileParams, SomaParams, StressKind, StressParams};
 use clap::{Args, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -29,6 +29,32 @@ pub enum GenKind {
     Soma(SomaArgs),
     /// 3D assemblies of 20 mm aluminium profiles with U and O connectors and grasp points.
     Profiles(ProfilesArgs),
+    /// Stress cases for the planner: chairs with rungs in pockets of two legs, carcasses of
+    /// panels joined by dowels, plates clamped by threaded bolts and nuts (sizes, counts and fits
+    /// drawn from the seed).
+    Stress(StressArgs),
+}
+
+/// Which stress case (`asp gen stress --kind`).
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum StressKindArg {
+    /// Four legs, a seat on tenons, rungs on two or four sides whose ends sit in the legs.
+    Chair,
+    /// Two side panels and two or three shelves joined by round dowels (holes modelled or not).
+    Carcass,
+    /// Two plates clamped by one to four threaded bolts with nuts.
+    Bolted,
+}
+
+/// Flags of `asp gen stress`.
+#[derive(Args, Debug)]
+pub struct StressArgs {
+    /// Which stress case.
+    #[arg(long, value_enum)]
+    pub kind: StressKindArg,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub batch: BatchArgs,
 }
 
 /// Flags every generator has.
@@ -169,6 +195,14 @@ pub fn run(args: &GenArgs) -> anyhow::Result<ExitCode> {
                 Connectors::Attached => ConnectorMode::Attached,
             };
             (Generator::Profiles(p), a.preset.and(Some(name)), &a.batch)
+        }
+        GenKind::Stress(a) => {
+            let stress = match a.kind {
+                StressKindArg::Chair => StressKind::Chair,
+                StressKindArg::Carcass => StressKind::Carcass,
+                StressKindArg::Bolted => StressKind::Bolted,
+            };
+            (Generator::Stress(StressParams { stress }), None, &a.batch)
         }
     };
     let count = if matches!(generator, Generator::ClassicSomaAll { .. }) { CLASSIC_SOLUTIONS } else { batch_args.count };

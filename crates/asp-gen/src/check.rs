@@ -157,10 +157,17 @@ impl BoxModel {
     /// The model of `parts` (boxes per part) with their fixed flags; boxes of two parts that
     /// share a face patch (within `tol`) are in contact.
     pub fn new(parts: Vec<Vec<Cuboid>>, fixed: Vec<bool>, tol: f64) -> Self {
+        Self::with_contacts(parts, fixed, tol, false)
+    }
+
+    /// As [`BoxModel::new`], and when `overlaps` also boxes of two parts that overlap deeper
+    /// than `tol` are in contact (parts fitted or drawn into each other: a press fit, a thread,
+    /// a dowel drawn into a solid panel).
+    pub fn with_contacts(parts: Vec<Vec<Cuboid>>, fixed: Vec<bool>, tol: f64, overlaps: bool) -> Self {
         let mut contacts = vec![Vec::new(); parts.len()];
         for i in 0..parts.len() {
             for j in i + 1..parts.len() {
-                if parts[i].iter().any(|a| parts[j].iter().any(|b| a.touches(b, tol))) {
+                if parts[i].iter().any(|a| parts[j].iter().any(|b| a.touches(b, tol) || (overlaps && a.overlaps(b, tol)))) {
                     contacts[i].push(j);
                     contacts[j].push(i);
                 }

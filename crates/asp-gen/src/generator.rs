@@ -5,6 +5,7 @@ use crate::check::DisassemblyCheck;
 use crate::error::Result;
 use crate::profiles::{ConnectorShape, ProfileAssembly, ProfileParams};
 use crate::soma::{validate_cell, SomaCube, SomaParams};
+use crate::stress::{StressCase, StressParams};
 use asp_geom::Assembly;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -29,6 +30,9 @@ pub enum Generator {
     },
     /// Aluminium profile assemblies.
     Profiles(ProfileParams),
+    /// Stress cases for the planner: chairs, dowelled carcasses, bolted plates
+    /// ([`crate::stress`]).
+    Stress(StressParams),
 }
 
 /// One generated assembly with what its checks found.
@@ -49,6 +53,7 @@ impl Generator {
             Generator::Soma(p) => p.validate(),
             Generator::ClassicSoma { cell } | Generator::ClassicSomaAll { cell } => validate_cell(*cell),
             Generator::Profiles(p) => p.validate(),
+            Generator::Stress(_) => Ok(()),
         }
     }
 
@@ -59,6 +64,7 @@ impl Generator {
             Generator::ClassicSoma { .. } => "soma_classic".into(),
             Generator::ClassicSomaAll { .. } => "soma_classic_all".into(),
             Generator::Profiles(_) => "profiles".into(),
+            Generator::Stress(p) => p.stress.name().into(),
         }
     }
 
@@ -107,6 +113,19 @@ impl Generator {
                 let checks = checks(&assembly, &profiles.check_disassembly(), profiles.max_penetration().max(0.0));
                 Ok(Generated { assembly, counts, checks })
             }
+            Generator::Stress(p) => {
+                let case = StressCase::generate(p.stress, &mut ChaCha8Rng::seed_from_u64(seed));
+                let assembly = case.to_assembly(source);
+                let counts = PartCounts::Stress {
+                    legs: case.count("leg"),
+                    rungs: case.count("rung"),
+                    panels: case.count("side") + case.count("shelf") + case.count("plate"),
+                    dowels: case.count("dowel"),
+                    bolts: case.count("bolt"),
+                };
+                let checks = Checks { straight_line_required: false, ..checks(&assembly, &case.check(), case.max_penetration) };
+                Ok(Generated { assembly, counts, checks })
+            }
         }
     }
 }
@@ -131,6 +150,7 @@ fn checks(assembly: &Assembly, check: &DisassemblyCheck, max_penetration: f64) -
         stuck_parts: check.stuck.iter().map(|&i| assembly.parts[i].name.clone()).collect(),
         stable_order_found: check.stable_order,
         max_penetration,
+        straight_line_required: true,
     }
 }
 
@@ -158,6 +178,19 @@ pub enum PartCounts {
         /// Grasp points over all profiles.
         grasp_points: usize,
     },
+    /// A stress case.
+    Stress {
+        /// Chair legs.
+        legs: usize,
+        /// Chair rungs.
+        rungs: usize,
+        /// Panels, shelves and plates.
+        panels: usize,
+        /// Dowels.
+        dowels: usize,
+        /// Bolts (each with its nut).
+        bolts: usize,
+    },
 }
 
 /// What the generator verified on its own geometry (voxels or boxes), before any planner.
@@ -174,11 +207,20 @@ pub struct Checks {
     /// Deepest interpenetration of two parts in metres (boxes of profile assemblies; 0 for
     /// Soma cubes, whose cells cannot overlap).
     pub max_penetration: f64,
+    /// Whether the generator promises that single parts along ±axes take the assembly apart
+    /// (Soma cubes, profiles); stress cases need groups, screw motions or fits on purpose, so
+    /// only their contact linkage must pass. Absent in older manifests: true.
+    #[serde(default = "yes")]
+    pub straight_line_required: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Checks {
     /// Whether every check passed.
     pub fn passed(&self) -> bool {
-        self.contact_linked && self.straight_line_disassemblable && self.stable_order_found
+        self.contact_linked && (!self.straight_line_required || (self.straight_line_disassemblable && self.stable_order_found))
     }
 }

@@ -8,6 +8,7 @@ pub mod generator;
 pub mod manifest;
 pub mod profiles;
 pub mod soma;
+pub mod stress;
 
 pub use batch::{assembly_seed, generate_batch, write_batch, Batch, Generated, Generator};
 pub use check::DisassemblyCheck;
@@ -15,3 +16,4 @@ pub use error::{GenError, Result};
 pub use manifest::{Manifest, ManifestEntry};
 pub use profiles::{ConnectorMode, ProfileAssembly, ProfileParams};
 pub use soma::{SomaCube, SomaParams};
+pub use stress::{StressCase, StressKind, StressParams};

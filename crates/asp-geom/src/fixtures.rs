@@ -282,18 +282,13 @@ fn hexagon_ring(vertices: &mut Vec<Vec3>, centre: (f32, f32), r: f32, z: f32) ->
     helical_rows(vertices, centre, z, 0.0, 0..=0, |i, _| hexagon_radius(r, angle(i))).remove(0)
 }
 
-/// Issue 9's bolt and nut, in metres: a fixed plate (33 × 33 × 4 mm, a square clearance hole of
-/// 11 mm around the Z axis), a hexagon-head bolt (major radius 5 mm, pitch 1.5 mm, a real helical
-/// V-thread of depth 0.8 mm meshed with 12 facets per turn and rows a facet's rise
-/// apart) whose head bears on the plate's top and whose shank reaches 3 mm below the nut, and a
-/// hexagon nut (6 mm) under the plate with the matching internal thread, its bore drawn
-/// `interference` inside the bolt's thread (0: the thread surfaces coincide, as they touch in
-/// CAD; more: they overlap). Physically the bolt leaves only by unscrewing upward (+Z: its head
-/// stops it downward, its thread sideways) and the nut only by unscrewing downward.
-/// Parts: 0 plate (fixed), 1 bolt, 2 nut.
-pub fn bolt_and_nut(interference: f32) -> Assembly {
+/// The bolt and nut of [`bolt_and_nut`] for a clamped stack `grip` thick (metres), about the Z
+/// axis: the head's bearing face at the top of the stack (`grip`, rounded to the thread's rows),
+/// the nut's top face at z = 0, the shank 3 mm below the nut; `interference` as there. Returns
+/// (bolt, nut), outward wound.
+pub fn threaded_bolt_and_nut(grip: f32, interference: f32) -> (Mesh, Mesh) {
     let (major, depth, pitch) = (0.005f32, 0.0008f32, 0.0015f32);
-    let (head_r, head_h, plate_t, nut_h, below) = (0.009f32, 0.006f32, 0.004f32, 0.006f32, 0.003f32);
+    let (head_r, head_h, nut_h, below) = (0.009f32, 0.006f32, 0.006f32, 0.003f32);
     let dz = pitch / THREAD_FACETS as f32;
     let z0 = -(nut_h + below);
     let rows = |h: f32| (h / dz).round() as u32;
@@ -301,11 +296,11 @@ pub fn bolt_and_nut(interference: f32) -> Assembly {
     // bolt: shank rows from z0 to the plate's top, head above
     let mut v = Vec::new();
     let mut t = Vec::new();
-    let shank = helical_rows(&mut v, centre, z0, dz, 0..=rows(plate_t - z0), |i, z| thread_radius(major, depth, pitch, i, z));
+    let shank = helical_rows(&mut v, centre, z0, dz, 0..=rows(grip - z0), |i, z| thread_radius(major, depth, pitch, i, z));
     for w in shank.windows(2) {
         ring_strip(&w[0], &w[1], &mut t);
     }
-    let top_z = z0 + rows(plate_t - z0) as f32 * dz;
+    let top_z = z0 + rows(grip - z0) as f32 * dz;
     let head_lo = hexagon_ring(&mut v, centre, head_r, top_z);
     let head_hi = hexagon_ring(&mut v, centre, head_r, top_z + head_h);
     ring_strip(&shank[shank.len() - 1], &head_lo, &mut t); // the bearing face, facing -Z
@@ -339,6 +334,21 @@ pub fn bolt_and_nut(interference: f32) -> Assembly {
     ring_strip(&out_hi, &bore[bore.len() - 1], &mut t);
     let mut nut = Mesh::new(v, t);
     nut.orient_outward();
+    (bolt, nut)
+}
+
+/// Issue 9's bolt and nut, in metres: a fixed plate (33 × 33 × 4 mm, a square clearance hole of
+/// 11 mm around the Z axis), a hexagon-head bolt (major radius 5 mm, pitch 1.5 mm, a real helical
+/// V-thread of depth 0.8 mm meshed with 12 facets per turn and rows a facet's rise
+/// apart) whose head bears on the plate's top and whose shank reaches 3 mm below the nut, and a
+/// hexagon nut (6 mm) under the plate with the matching internal thread, its bore drawn
+/// `interference` inside the bolt's thread (0: the thread surfaces coincide, as they touch in
+/// CAD; more: they overlap). Physically the bolt leaves only by unscrewing upward (+Z: its head
+/// stops it downward, its thread sideways) and the nut only by unscrewing downward.
+/// Parts: 0 plate (fixed), 1 bolt, 2 nut.
+pub fn bolt_and_nut(interference: f32) -> Assembly {
+    let plate_t = 0.004f32;
+    let (bolt, nut) = threaded_bolt_and_nut(plate_t, interference);
     // the plate: 3 × 3 cells of 11 mm, the middle one open
     let cells: Vec<[i32; 3]> = (0..3).flat_map(|x| (0..3).map(move |y| [x, y, 0])).filter(|c| *c != [1, 1, 0]).collect();
     let cell = 0.011f32;

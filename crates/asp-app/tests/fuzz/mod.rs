@@ -471,7 +471,7 @@ fn request(rng: &mut ChaCha8Rng, diagonal: f64) -> (PlanRequest, String) {
 
 /// The report's plan as removals (disassembly order, world frame, metres): the insertions
 /// reversed. Only for models in metres.
-fn removals(steps: &[AssemblyStep], n: usize) -> Vec<Step> {
+pub(crate) fn removals(steps: &[AssemblyStep], n: usize) -> Vec<Step> {
     let f = |v: [f64; 3]| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32);
     steps
         .iter()
