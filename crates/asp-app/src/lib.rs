@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod bench_mcts;
 pub mod catalogue;
+pub mod cell;
 pub mod collect;
 pub mod collect_q;
 pub mod error;

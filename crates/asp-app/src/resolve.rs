@@ -216,7 +216,7 @@ fn limits(r: &PlanRequest) -> Result<asp_geom::io::Limits> {
 
 /// The robot of the request, if any: its URDF's meshes found under the rules of
 /// `package_path` and `allow_outside_files`, and refused when it has no gripper to take a part.
-fn robot(r: &PlanRequest) -> Result<Option<asp_robot::RobotSetup>> {
+pub fn robot(r: &PlanRequest) -> Result<Option<asp_robot::RobotSetup>> {
     let Some(name) = &r.robot else { return Ok(None) };
     let package_paths = r
         .package_path

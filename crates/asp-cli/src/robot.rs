@@ -21,6 +21,29 @@ pub struct RobotArgs {
 pub enum RobotAction {
     /// Joints, limits, reach and an FK/IK round-trip check of a URDF robot (exit 1 if the check fails).
     Check(CheckArgs),
+    /// Which parts of a model the robot cell can take out on their own (the only part left
+    /// besides the fixed ones): a reachable grasp, the lift and a path to the drop-off. A part
+    /// that fails here fails in every state of a search. Exit 1 when some part fails.
+    Cell(Box<CellArgs>),
+}
+
+/// Flags of `asp robot cell`.
+#[derive(Args, Debug)]
+pub struct CellArgs {
+    /// The model (a glTF/GLB, OBJ or STL file, or a folder of part files).
+    pub model: PathBuf,
+    /// Write the check as JSON to this file (`-` for standard output) besides the table.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Seed of the path planner (as `asp plan --seed`).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub load: crate::flags::ModelArgs,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub robot: crate::flags::PlanRobotArgs,
 }
 
 /// Flags of `asp robot check`.
@@ -64,7 +87,51 @@ fn robot_files(package_paths: &[String], allow_outside_files: bool) -> anyhow::R
 pub fn run(args: &RobotArgs) -> anyhow::Result<ExitCode> {
     match &args.action {
         RobotAction::Check(a) => check(a),
+        RobotAction::Cell(a) => cell(a),
     }
+}
+
+fn cell(args: &CellArgs) -> anyhow::Result<ExitCode> {
+    let mut map = crate::flags::Map::new();
+    args.load.put(&mut map);
+    args.robot.put(&mut map);
+    if let Some(seed) = args.seed {
+        map.insert("seed".into(), seed.into());
+    }
+    let request = crate::request::request(map, None)?;
+    let check = asp_app::cell::check_cell(&args.model, &request).map_err(crate::request::cli_error)?;
+    let p3 = |v: [f64; 3]| format!("({:.4}, {:.4}, {:.4})", v[0], v[1], v[2]);
+    println!("{}: robot {}, base at {}, drop-off at {} (model units)", check.model, check.robot, p3(check.base), p3(check.drop_off));
+    let width = check.parts.iter().map(|p| p.name.chars().count()).max().unwrap_or(4).max(4);
+    println!("{:<width$}  {:>6}  alone", "part", "grasps");
+    for p in &check.parts {
+        let what = match (&p.path_length, &p.lift, &p.detail) {
+            (Some(l), Some(d), _) => format!("taken out, path {l:.4} (lift along {})", p3(*d)),
+            (_, _, Some(detail)) => detail.clone(),
+            _ => p.outcome.to_string(),
+        };
+        println!("{:<width$}  {:>6}  {what}", p.name, p.grasps);
+    }
+    let failed: Vec<&str> = check.unreachable().map(|p| p.name.as_str()).collect();
+    let total = check.parts.len();
+    if failed.is_empty() {
+        println!("the cell takes all {total} movable parts out on their own");
+    } else {
+        println!(
+            "the cell cannot take {} of {total} movable parts out even on their own: {} (no plan can; move the base with --robot-base or the drop-off with --drop-off)",
+            failed.len(),
+            failed.join(", ")
+        );
+    }
+    if let Some(path) = &args.json {
+        let json = serde_json::to_string_pretty(&check)? + "\n";
+        if path.as_os_str() == "-" {
+            print!("{json}");
+        } else {
+            std::fs::write(path, json).map_err(|e| anyhow::anyhow!("{}: cannot write the check: {e}", path.display()))?;
+        }
+    }
+    Ok(if failed.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
 fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {

@@ -327,3 +327,29 @@ fn the_explanation_names_the_robot_reason_not_parts_that_do_not_block() {
     assert!(near.parts.is_empty(), "{near:?}");
     assert_eq!(near.robot.as_ref().map(|r| r.reason), Some(RobotReason::NoDropOff), "{near:?}");
 }
+
+/// Issue 24 item 4: `asp robot cell` says which parts the cell can take out on their own before
+/// any search: the near block, not the two far ones (out of reach); with the drop-off out of
+/// reach, none (no path). The same request gives the same answer.
+#[test]
+fn the_cell_check_names_the_parts_the_arm_cannot_take_out_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("near_and_far.glb");
+    asp_geom::io::write_glb(&near_and_far(), &path).unwrap();
+    let request = asp_app::PlanRequest { robot_base: Some([-0.4, 0.0, 0.0]), seed: Some(3), ..Default::default() };
+    let check = asp_app::cell::check_cell(&path, &request).unwrap();
+    assert_eq!(check.robot, "panda", "the shipped arm by default");
+    assert_eq!(check.base, [-0.4, 0.0, 0.0]);
+    let outcome = |c: &asp_app::cell::CellCheck| c.parts.iter().map(|p| (p.name.clone(), p.outcome)).collect::<Vec<_>>();
+    assert_eq!(
+        outcome(&check),
+        [("near".to_string(), "taken_out"), ("far_low".to_string(), "no_reachable_grasp"), ("far_top".to_string(), "no_reachable_grasp")]
+    );
+    let near = &check.parts[0];
+    assert!(near.path_length.is_some_and(|l| l > 0.05) && near.lift == Some([0.0, 0.0, 1.0]), "{near:?}");
+    assert!(check.parts[1].detail.as_deref().is_some_and(|d| d.contains("out of reach")), "{:?}", check.parts[1]);
+    assert_eq!(asp_app::cell::check_cell(&path, &request).unwrap(), check, "the same request, the same answer");
+    let far_drop = asp_app::PlanRequest { drop_off: Some([-3.0, 0.0, 0.4]), ..request };
+    let check = asp_app::cell::check_cell(&path, &far_drop).unwrap();
+    assert_eq!(check.parts[0].outcome, "no_path", "{:?}", check.parts[0]);
+}

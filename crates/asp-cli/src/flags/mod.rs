@@ -23,7 +23,7 @@ mod plan;
 
 pub use learn::{BenchArgs, BenchKind, CollectArgs, CollectKind, FeasibleArgs, MctsArgs, TransitionsArgs};
 pub use model::ModelArgs;
-pub use plan::PlanArgs;
+pub use plan::{PlanArgs, PlanRobotArgs};
 
 use asp_app::request::Choice;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};

@@ -137,6 +137,35 @@ fn issue_25_a_robot_refusal_is_explained_by_the_arms_reason() {
     );
 }
 
+/// Issue 24 item 4: `asp robot cell` names, before any search, the parts the cell cannot take
+/// out even on their own (exit 1), with the arm's reason; `--json -` prints the check; a bad
+/// robot base is a one-line error naming its flag (exit 2).
+#[test]
+fn issue_24_the_robot_cell_check_names_what_the_arm_cannot_reach() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut plate = fixtures::box_part("plate", [-0.1, -0.25, -0.02], [1.5, 0.25, 0.0]);
+    plate.fixed = true;
+    let near = fixtures::box_part("near", [0.1, -0.02, 0.0], [0.14, 0.02, 0.04]);
+    let far = fixtures::box_part("far", [1.28, -0.02, 0.0], [1.32, 0.02, 0.04]);
+    let model = fixture_file(dir.path(), &fixtures::assemble("reach", vec![plate, near, far], asp_geom::math::Axis::Z), "reach.glb");
+    let m = model.to_str().unwrap();
+    let o = asp(&["robot", "cell", m, "--robot-base=-0.4,0,0"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let table = String::from_utf8(o.stdout).unwrap();
+    let line = |name: &str| table.lines().find(|l| l.starts_with(name)).unwrap_or_else(|| panic!("{table}")).to_string();
+    assert!(line("near ").contains("taken out, path"), "{table}");
+    assert!(line("far ").contains("no reachable grasp") && line("far ").contains("out of reach"), "{table}");
+    assert!(table.contains("cannot take 1 of 2 movable parts out even on their own: far"), "{table}");
+    let o = asp(&["robot", "cell", m, "--robot-base=-0.4,0,0", "--json", "-"]);
+    let text = String::from_utf8(o.stdout).unwrap();
+    let check: serde_json::Value = serde_json::from_str(&text[text.find("\n{").unwrap() + 1..]).unwrap();
+    assert_eq!(check["parts"][1]["outcome"], "no_reachable_grasp", "{check}");
+    let o = asp(&["robot", "cell", m, "--robot-base=1,2"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert!(err.contains("--robot-base") && err.trim().lines().count() == 1, "{err}");
+}
+
 /// Asserts a one-line error naming `needle`, exit code 2, no panic.
 fn assert_error(o: &Output, needle: &str) {
     let err = stderr(o);
