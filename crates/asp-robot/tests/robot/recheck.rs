@@ -1,9 +1,10 @@
 //! The independent re-check of a robot removal, shared by asp-robot's tests and asp-app's (which
 //! include this file by path): no robot code is trusted by it.
 
-use asp_geom::math::{Pose, Vec3};
+use asp_geom::math::{Aabb, Pose, Vec3};
 use asp_geom::{PartSet, World};
 use asp_robot::{RobotCell, RobotRemoval};
+use parry3d::bounding_volume::BoundingVolume;
 use parry3d::query::{self, PointQuery};
 use parry3d::shape::TriMesh;
 
@@ -38,6 +39,10 @@ fn depth_inside(mesh: &TriMesh, x: Vec3) -> f32 {
 /// finger shape (unshrunk) must not penetrate a part still present (nor the floor) by more
 /// than `allowed` metres (parry `contact`), and the held part's edge points must not lie more
 /// than `allowed` inside another part, nor theirs inside it. Returns the first violation.
+///
+/// Pairs whose bounding boxes (grown by `allowed`) do not meet are skipped: neither a
+/// penetration deeper than `allowed` nor a point inside a part can happen outside its box, so
+/// the verdict is the one of testing every pair (and the test runs in seconds, not minutes).
 pub fn recheck(world: &World, cell: &RobotCell, part: usize, present: &PartSet, r: &RobotRemoval, allowed: f32) -> Result<(), String> {
     let robot = &cell.robot;
     let obstacles: Vec<usize> = world.with_fixed(present).iter().filter(|&q| q != part).collect();
@@ -47,6 +52,10 @@ pub fn recheck(world: &World, cell: &RobotCell, part: usize, present: &PartSet, 
     let floor = parry3d::shape::HalfSpace::new(cell.up);
     let floor_pose = Pose::from_translation(cell.up * cell.floor);
     let held = world.mesh(part);
+    let boxes: Vec<Aabb> = obstacles.iter().map(|&o| world.aabb(o).loosened(allowed)).collect();
+    // edge points in each part's own frame, made once
+    let held_points = edge_points(held, &Pose::IDENTITY, 0.004);
+    let obstacle_points: Vec<Vec<Vec3>> = obstacles.iter().map(|&o| edge_points(world.mesh(o), &Pose::IDENTITY, 0.004)).collect();
     for (w, pair) in r.joints.windows(2).enumerate() {
         let (a, b) = (&pair[0], &pair[1]);
         let max_step = a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
@@ -66,16 +75,20 @@ pub fn recheck(world: &World, cell: &RobotCell, part: usize, present: &PartSet, 
                         }
                     }
                 }
-                for &o in &obstacles {
+                let shape_box = s.compute_aabb(&pose);
+                for (j, &o) in obstacles.iter().enumerate() {
                     if k < base_shapes && world.ground() == Some(o) {
                         continue;
                     }
-                    if let Ok(Some(c)) = query::contact(&pose, &*s, &Pose::IDENTITY, world.mesh(o), 0.0) {
-                        if c.dist < -allowed {
-                            return Err(format!("segment {w} sample {i}: robot shape {k} penetrates part {o} by {}", -c.dist));
+                    if boxes[j].intersects(&shape_box) {
+                        if let Ok(Some(c)) = query::contact(&pose, &*s, &Pose::IDENTITY, world.mesh(o), 0.0) {
+                            if c.dist < -allowed {
+                                return Err(format!("segment {w} sample {i}: robot shape {k} penetrates part {o} by {}", -c.dist));
+                            }
                         }
                     }
-                    if depth_inside(world.mesh(o), pose.translation) > allowed {
+                    // (the shape's origin need not lie in its box: a mesh link's frame)
+                    if boxes[j].contains_local_point(pose.translation) && depth_inside(world.mesh(o), pose.translation) > allowed {
                         return Err(format!("segment {w} sample {i}: robot shape {k} inside part {o}"));
                     }
                 }
@@ -83,12 +96,16 @@ pub fn recheck(world: &World, cell: &RobotCell, part: usize, present: &PartSet, 
             let displacement = robot.tool_pose(&q) * grasp.inverse();
             if i % 4 == 0 || i == n {
                 let inv = displacement.inverse();
-                for &o in &obstacles {
+                let held_box = world.aabb(part).transform_by(&displacement).loosened(allowed);
+                for (j, &o) in obstacles.iter().enumerate() {
+                    if !boxes[j].intersects(&held_box) {
+                        continue;
+                    }
                     let om = world.mesh(o);
-                    if edge_points(held, &displacement, 0.004).iter().any(|&x| depth_inside(om, x) > allowed) {
+                    if held_points.iter().any(|&x| depth_inside(om, displacement.transform_point(x)) > allowed) {
                         return Err(format!("segment {w} sample {i}: the held part enters part {o}"));
                     }
-                    if edge_points(om, &Pose::IDENTITY, 0.004).iter().any(|&x| depth_inside(held, inv.transform_point(x)) > allowed) {
+                    if obstacle_points[j].iter().any(|&x| depth_inside(held, inv.transform_point(x)) > allowed) {
                         return Err(format!("segment {w} sample {i}: part {o} enters the held part"));
                     }
                 }

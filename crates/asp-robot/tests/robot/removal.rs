@@ -444,3 +444,32 @@ fn robot_cell_reach() {
         }
     }
 }
+
+/// The re-check the other tests trust catches what it is for: a path that passes among the
+/// parts it was planned with fails once a box stands across the gripper's way (the held part
+/// or the arm would pass through it), and a box beside the way changes nothing.
+#[test]
+fn the_recheck_refuses_a_path_through_a_part() {
+    let mut plate = box_part("plate", [-0.2, -0.2, -0.02], [0.3, 0.2, 0.0]);
+    plate.fixed = true;
+    let block = box_part("block", [0.08, -0.02, 0.0], [0.12, 0.02, 0.04]);
+    let world = World::new(assemble("one", vec![plate.clone(), block.clone()], Axis::Z), &WorldConfig::default()).unwrap();
+    let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), Some(Vec3::new(-0.35, 0.0, -0.02)), None);
+    let planner = RemovalPlanner::new(&world, cell.clone(), RemovalConfig::default());
+    let r = planner.plan(1, &PartSet::full(2), Vec3::Z, 3, 1).expect("a free block on a plate comes out");
+    recheck(&world, &cell, 1, &PartSet::full(2), &r, 0.003).expect("its own path re-checks");
+    let with = |name: &str, centre: Vec3, half: f32| {
+        let (lo, hi) = (centre - Vec3::splat(half), centre + Vec3::splat(half));
+        let mut wall = box_part(name, lo.to_array(), hi.to_array());
+        wall.fixed = true;
+        World::new(assemble("two", vec![plate.clone(), block.clone(), wall], Axis::Z), &WorldConfig::default()).unwrap()
+    };
+    // a 4 cm cube on the gripper's way, half-way to the drop-off
+    let mid = r.gripper_path[r.gripper_path.len() / 2];
+    let across = with("across", mid, 0.02);
+    let err = recheck(&across, &cell, 1, &PartSet::full(3), &r, 0.003).expect_err("a path through a box");
+    assert!(err.contains("part 2"), "{err}");
+    // the same cube far off the way
+    let beside = with("beside", Vec3::new(0.25, 0.15, 0.5), 0.02);
+    recheck(&beside, &cell, 1, &PartSet::full(3), &r, 0.003).expect("a box off the way is no obstacle");
+}
