@@ -137,7 +137,12 @@ pub fn bench_model(path: &Path, name: &str, settings: &PlanSettings, methods: &[
             let checker = Checker::new(world, checker_config.clone());
             let dfs = pipeline::planner(&m, checker.world())?;
             let started = Instant::now();
-            let outcome = dfs.solve(&Problem::full(&checker), &budget);
+            // with a robot (or held parts) the search runs on the extension's checker, whose
+            // refusals count as failed tests, as in `asp plan`
+            let outcome = match &settings.checker_extension {
+                Some(ext) => ext.solve(&checker, m.seed, &mut |c| dfs.solve(&Problem::full(c), &budget))?.0,
+                None => dfs.solve(&Problem::full(&checker), &budget),
+            };
             secs.push(started.elapsed().as_secs_f64());
             let c = outcome.stats.counters;
             tests.push(c.removal_tests as f64);

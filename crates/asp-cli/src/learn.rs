@@ -118,7 +118,9 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<std::process::ExitCode> {
     if a.orderings == 0 {
         bail!("--orderings must be at least 1");
     }
-    let mut settings = model_settings(&a.load, crate::flags::Map::new())?;
+    let mut robot = crate::flags::Map::new();
+    a.robot.put(&mut robot);
+    let mut settings = model_settings(&a.load, robot)?;
     settings.max_tests = a.max_tests;
     settings.timeout = a.timeout.map(|t| positive("timeout", t)).transpose()?;
     let models = collect::model_paths(&a.models)?;

@@ -353,3 +353,21 @@ fn the_cell_check_names_the_parts_the_arm_cannot_take_out_alone() {
     let check = asp_app::cell::check_cell(&path, &far_drop).unwrap();
     assert_eq!(check.parts[0].outcome, "no_path", "{:?}", check.parts[0]);
 }
+
+/// Issue 26 item 6: `asp bench feasible` runs under the robot checker too: with the arm, the
+/// blocks out of its reach make every run fail and its refusals count as failed tests; without
+/// it every run finds a plan.
+#[test]
+fn the_feasibility_bench_runs_under_the_robot_checker() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("near_and_far.glb");
+    asp_geom::io::write_glb(&near_and_far(), &path).unwrap();
+    let methods = asp_app::bench::parse_methods("vanilla,bk", None).unwrap();
+    let plain = asp_app::bench::bench_model(&path, "nf", &PlanSettings::default(), &methods, 2).unwrap();
+    assert!(plain.iter().all(|r| r.found == 2), "{plain:?}");
+    let setup = RobotSetup { base: Some(Vec3::new(-0.4, 0.0, 0.0)), ..RobotSetup::panda() };
+    let robot =
+        PlanSettings { checker_extension: Some(Arc::new(CellSetup { robot: Some(setup), grippers: 1 })), ..PlanSettings::default() };
+    let rows = asp_app::bench::bench_model(&path, "nf", &robot, &methods, 2).unwrap();
+    assert!(rows.iter().all(|r| r.found == 0 && r.failed_collision.mean > 0.0), "{rows:?}");
+}

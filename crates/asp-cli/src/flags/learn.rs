@@ -140,6 +140,9 @@ pub struct FeasibleArgs {
     /// Loading and testing.
     #[command(flatten)]
     pub load: ModelArgs,
+    /// A robot that must carry every removal out (Table 3.1 under the robot checker).
+    #[command(flatten)]
+    pub robot: super::PlanRobotArgs,
 }
 
 /// Flags of `asp bench mcts`.
