@@ -20,10 +20,12 @@ pub(crate) use put;
 mod learn;
 mod model;
 mod plan;
+mod robot;
 
 pub use learn::{BenchArgs, BenchKind, CollectArgs, CollectKind, FeasibleArgs, MctsArgs, TransitionsArgs};
 pub use model::ModelArgs;
 pub use plan::{PlanArgs, PlanRobotArgs};
+pub use robot::{CellArgs, CheckArgs, RobotAction, RobotArgs};
 
 use asp_app::request::Choice;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
@@ -57,7 +59,7 @@ pub enum Command {
     /// Plot the Pareto front of a plan JSON, or the search's progress from --trace CSVs.
     Plot(crate::plot::PlotArgs),
     /// Robots (`check`: joints, limits, reach and an FK/IK sanity check of a URDF).
-    Robot(crate::robot::RobotArgs),
+    Robot(RobotArgs),
 }
 
 /// The flag of a request key: `max_tests` is `--max-tests`, the switches are `--no-...`.

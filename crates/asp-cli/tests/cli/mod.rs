@@ -98,6 +98,16 @@ fn no_plan_exits_1_and_explains() {
     }
 }
 
+/// A block near the robot and one 1.7 m from its base at `--robot-base=-0.4,0,0`, on a fixed
+/// plate, written to `dir/reach.glb`.
+fn reach_model(dir: &Path) -> PathBuf {
+    let mut plate = fixtures::box_part("plate", [-0.1, -0.25, -0.02], [1.5, 0.25, 0.0]);
+    plate.fixed = true;
+    let near = fixtures::box_part("near", [0.1, -0.02, 0.0], [0.14, 0.02, 0.04]);
+    let far = fixtures::box_part("far", [1.28, -0.02, 0.0], [1.32, 0.02, 0.04]);
+    fixture_file(dir, &fixtures::assemble("reach", vec![plate, near, far], asp_geom::math::Axis::Z), "reach.glb")
+}
+
 /// Issue 25 item 4, issue 24 item 4: with `--robot`, a part the geometry lets out but the arm
 /// cannot take out is explained by the arm's reason, not "blocked by" parts that do not block
 /// it: a block out of reach of the base `--robot-base` puts (no reachable grasp), and the L's
@@ -106,11 +116,7 @@ fn no_plan_exits_1_and_explains() {
 #[test]
 fn issue_25_a_robot_refusal_is_explained_by_the_arms_reason() {
     let dir = tempfile::tempdir().unwrap();
-    let mut plate = fixtures::box_part("plate", [-0.1, -0.25, -0.02], [1.5, 0.25, 0.0]);
-    plate.fixed = true;
-    let near = fixtures::box_part("near", [0.1, -0.02, 0.0], [0.14, 0.02, 0.04]);
-    let far = fixtures::box_part("far", [1.28, -0.02, 0.0], [1.32, 0.02, 0.04]);
-    let model = fixture_file(dir.path(), &fixtures::assemble("reach", vec![plate, near, far], asp_geom::math::Axis::Z), "reach.glb");
+    let model = reach_model(dir.path());
     let out = dir.path().join("reach.json");
     let o = asp(&["plan", model.to_str().unwrap(), "--robot", "panda", "--robot-base=-0.4,0,0", "--out", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
@@ -143,11 +149,7 @@ fn issue_25_a_robot_refusal_is_explained_by_the_arms_reason() {
 #[test]
 fn issue_24_the_robot_cell_check_names_what_the_arm_cannot_reach() {
     let dir = tempfile::tempdir().unwrap();
-    let mut plate = fixtures::box_part("plate", [-0.1, -0.25, -0.02], [1.5, 0.25, 0.0]);
-    plate.fixed = true;
-    let near = fixtures::box_part("near", [0.1, -0.02, 0.0], [0.14, 0.02, 0.04]);
-    let far = fixtures::box_part("far", [1.28, -0.02, 0.0], [1.32, 0.02, 0.04]);
-    let model = fixture_file(dir.path(), &fixtures::assemble("reach", vec![plate, near, far], asp_geom::math::Axis::Z), "reach.glb");
+    let model = reach_model(dir.path());
     let m = model.to_str().unwrap();
     let o = asp(&["robot", "cell", m, "--robot-base=-0.4,0,0"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
