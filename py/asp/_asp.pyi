@@ -22,6 +22,7 @@ __all__ = [
     "gen_manifest",
     "model_items",
     "collect_item",
+    "plan_items",
     "collect_index",
     "bench_item",
     "bench_table",

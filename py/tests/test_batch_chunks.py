@@ -7,11 +7,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from conftest import without_seconds
-
 from asp import _asp
 from asp.batch import GenJob, PlanJob, run
 from asp.batch.runner import ChunkSizer, chunk_size
+from conftest import without_seconds
 
 
 def soma_models(tmp_path: Path, count: int) -> Path:

@@ -132,9 +132,20 @@ fn plan_row(item: PlanItem) -> PlanRow {
     }
 }
 
+/// Writes `bytes` to `.<name>.tmp` beside `path`, then renames it to `path`, as the batch's
+/// Python side writes its files: a kill never leaves half a file under the real name. Without
+/// the fsync of `asp_geom::io::write_atomic` (a batch's journal, not the disk, says what is
+/// done; an fsync per small plan cost more than planning it).
+fn write_replacing(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.tmp"));
+    std::fs::write(&tmp, bytes)?;
+    std::fs::rename(&tmp, path)
+}
+
 /// Loads and plans one model as `asp plan` does for each model of `--each` (the load's seconds
-/// into the plan's timings) and writes its plan JSON to `file` (through a temporary file and a
-/// rename): the bytes `asp plan MODEL --json` prints, timings apart.
+/// into the plan's timings) and writes its plan JSON to `file` ([`write_replacing`]): the bytes
+/// `asp plan MODEL --json` prints, timings apart.
 fn plan_item(model: &Path, file: &Path, settings: &PlanSettings) -> PlanItem {
     let started = std::time::Instant::now();
     let run = || -> Result<_, Error> {
@@ -146,12 +157,12 @@ fn plan_item(model: &Path, file: &Path, settings: &PlanSettings) -> PlanItem {
             t.load = load_seconds;
         }
         let report = &result.report;
-        asp_geom::io::write_atomic(file, report.to_json().as_bytes()).map_err(|e| Error {
+        write_replacing(file, report.to_json().as_bytes()).map_err(|e| Error {
             kind: crate::errors::Kind::Other,
             message: format!("{}: cannot write the plan ({e})", file.display()),
             path: None,
         })?;
-        let status = match serde_json::to_value(&report.status) {
+        let status = match serde_json::to_value(report.status) {
             Ok(serde_json::Value::String(s)) => s,
             _ => format!("{:?}", report.status),
         };
