@@ -5,10 +5,11 @@ tasks are sized by measured cost (:class:`ChunkSizer`)."""
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 
 from asp import _asp
-from asp.batch import GenJob, PlanJob, run
+from asp.batch import GenJob, PlanJob, run, runner
 from asp.batch.runner import ChunkSizer, chunk_size
 from conftest import without_seconds
 
@@ -80,3 +81,66 @@ def test_chunks_grow_to_the_measured_cost_and_spread_the_tail():
     fast = ChunkSizer(100_000, 2)
     fast.learn(0.0001, 64)
     assert fast.size(90_000) == ChunkSizer.MOST
+
+
+class Ref:
+    """A finished task's reference (hashable by identity, as Ray's)."""
+
+    def __init__(self, value) -> None:
+        self.value = value
+
+
+class FakeRay:
+    """Ray's calls that a local batch makes, run in this process; ``shutdown`` takes 0.3 s."""
+
+    def __init__(self) -> None:
+        self.up = False
+        self.sizes: list[int] = []
+
+    def is_initialized(self) -> bool:
+        return self.up
+
+    def init(self, **kw) -> None:
+        self.up = True
+
+    def cluster_resources(self) -> dict:
+        return {"CPU": 2}
+
+    def put(self, value):
+        return value
+
+    def remote(self, **kw):
+        fake = self
+
+        class Task:
+            def __init__(self, fn) -> None:
+                self.fn = fn
+
+            def remote(self, *args):
+                fake.sizes.append(len(args[2]))
+                return Ref(self.fn(*args))
+
+        return Task
+
+    def wait(self, refs, num_returns=1):
+        return refs[:num_returns], refs[num_returns:]
+
+    def get(self, ref):
+        return ref.value
+
+    def shutdown(self) -> None:
+        time.sleep(0.3)
+        self.up = False
+
+
+def test_stopping_ray_is_reported_apart_from_the_items(tmp_path, monkeypatch):
+    models = soma_models(tmp_path, 40)
+    fake = FakeRay()
+    monkeypatch.setattr(runner, "_ray_module", lambda: fake)
+    outcome = run(PlanJob([models]), tmp_path / "plans", ray="local", workers=2, quiet=True)
+    assert outcome.ok and outcome.ran == 40 and not fake.up
+    assert outcome.shutdown_seconds >= 0.3
+    assert outcome.seconds >= outcome.startup_seconds + outcome.shutdown_seconds
+    assert "s stopping it)" in outcome.summary.splitlines()[-1]
+    # the first tasks take chunk_size's items, the next ones the measured cost's, the tail spreads
+    assert fake.sizes[0] == chunk_size(40, 2) == 1 and sum(fake.sizes) == 40 and max(fake.sizes) > 1
