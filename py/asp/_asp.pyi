@@ -22,6 +22,7 @@ __all__ = [
     "gen_manifest",
     "model_items",
     "collect_item",
+    "plan_items",
     "collect_index",
     "bench_item",
     "bench_table",
@@ -159,6 +160,14 @@ def gen_manifest(
 ) -> str: ...
 def model_items(paths: Sequence[str | PathLike[str]]) -> list[tuple[str, int, str, str]]:
     """``(path, index, name, dir)`` of each model, as a data set names them."""
+def plan_items(
+    models: Sequence[tuple[str | PathLike[str], str]],
+    out: str | PathLike[str],
+    settings: dict[str, Any],
+    load: dict[str, Any] | None = None,
+) -> list[tuple[str | None, str, bool, int, int, int, float]]:
+    """Plans ``(model, plan file)`` pairs into ``out`` in parallel: ``(error, status, found, parts,
+    steps, removal_tests, seconds)`` per model, ``error`` one line or ``None``."""
 def collect_item(
     path: str | PathLike[str],
     index: int,

@@ -116,6 +116,92 @@ fn model_settings(dict: &Bound<'_, PyDict>, load: Option<&Bound<'_, PyDict>>) ->
     Ok(asp_app::resolve(&request)?)
 }
 
+/// What one model of a plan batch gave: `Ok((status, found, parts, steps, removal_tests,
+/// seconds))` (the plan's status as the plan JSON spells it, its assembly steps, the seconds of
+/// loading and planning) or `Err(message)`, one line naming the file, as `asp.AspError`'s text.
+pub type PlanItem = Result<(String, bool, usize, usize, u64, f64), String>;
+
+/// A [`PlanItem`] as Python gets it: `(error, status, found, parts, steps, removal_tests,
+/// seconds)`, the error `None` or the other fields empty.
+pub type PlanRow = (Option<String>, String, bool, usize, usize, u64, f64);
+
+fn plan_row(item: PlanItem) -> PlanRow {
+    match item {
+        Ok((status, found, parts, steps, tests, seconds)) => (None, status, found, parts, steps, tests, seconds),
+        Err(message) => (Some(message), String::new(), false, 0, 0, 0, 0.0),
+    }
+}
+
+/// Writes `bytes` to `.<name>.tmp` beside `path`, then renames it to `path`, as the batch's
+/// Python side writes its files: a kill never leaves half a file under the real name. Without
+/// the fsync of `asp_geom::io::write_atomic` (a batch's journal, not the disk, says what is
+/// done; an fsync per small plan cost more than planning it).
+fn write_replacing(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.tmp"));
+    std::fs::write(&tmp, bytes)?;
+    std::fs::rename(&tmp, path)
+}
+
+/// Loads and plans one model as `asp plan` does for each model of `--each` (the load's seconds
+/// into the plan's timings) and writes its plan JSON to `file` ([`write_replacing`]): the bytes
+/// `asp plan MODEL --json` prints, timings apart.
+fn plan_item(model: &Path, file: &Path, settings: &PlanSettings) -> PlanItem {
+    let started = std::time::Instant::now();
+    let run = || -> Result<_, Error> {
+        let assembly = asp_app::pipeline::load(model, settings)?;
+        let parts = assembly.len();
+        let load_seconds = started.elapsed().as_secs_f64();
+        let mut result = asp_app::pipeline::plan_assembly(assembly, settings, None)?;
+        if let Some(t) = result.report.stats.timings.as_mut() {
+            t.load = load_seconds;
+        }
+        let report = &result.report;
+        write_replacing(file, report.to_json().as_bytes()).map_err(|e| Error {
+            kind: crate::errors::Kind::Other,
+            message: format!("{}: cannot write the plan ({e})", file.display()),
+            path: None,
+        })?;
+        let status = match serde_json::to_value(report.status) {
+            Ok(serde_json::Value::String(s)) => s,
+            _ => format!("{:?}", report.status),
+        };
+        Ok((status, result.found(), parts, report.assembly_sequence.len(), report.stats.removal_tests))
+    };
+    match run() {
+        Ok((status, found, parts, steps, tests)) => Ok((status, found, parts, steps, tests, started.elapsed().as_secs_f64())),
+        Err(e) => Err(e.message),
+    }
+}
+
+/// Plans a chunk of models of a plan batch with the same settings: `models` are
+/// `(model path, plan file name)` pairs, each plan written to `out/<file>`. The settings (the
+/// keywords of `asp.Assembly.plan`, and `asp.load`'s in `load`) are resolved once for the chunk,
+/// and the models planned in parallel on rayon's pool (one thread in a Ray task), the GIL
+/// released and Ctrl-C watched as in `Assembly.plan`. One result per model, in order
+/// ([`PlanRow`]): a model that cannot be loaded or planned, or settings that are wrong, give
+/// their error for that model (for every model, for the settings); only an interrupt raises.
+#[pyfunction]
+#[pyo3(signature = (models, out, settings, load=None))]
+pub fn plan_items(
+    py: Python<'_>,
+    models: Vec<(PathBuf, String)>,
+    out: PathBuf,
+    settings: &Bound<'_, PyDict>,
+    load: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Vec<PlanRow>> {
+    let settings = match model_settings(settings, load) {
+        Ok(s) => s,
+        Err(e) => return Ok(models.iter().map(|_| plan_row(Err(e.message.clone()))).collect()),
+    };
+    let token = asp_search::StopToken::new();
+    let settings = PlanSettings { cancel: Some(token.clone()), ..settings };
+    crate::run::interruptible(py, &token, || {
+        use rayon::prelude::*;
+        models.par_iter().map(|(model, file)| plan_row(plan_item(model, &out.join(file), &settings))).collect()
+    })
+}
+
 fn collect_settings(runs: usize, seed: u64, max_tests: Option<u64>, timeout: Option<f64>, plan: PlanSettings) -> CollectSettings {
     CollectSettings { runs, seed, plan, max_tests, timeout, ..CollectSettings::default() }
 }

@@ -9,7 +9,7 @@
 //! - [`qgraphs`]: the `asp-q/1` graphs of optimiser states (`Assembly.q_graphs`);
 //! - [`run`]: the pipeline with the GIL released, interruptible by Ctrl-C;
 //! - [`search`]: the stepped optimiser run of `Assembly.search` (online Q-learning);
-//! - [`batch`]: the items of `asp.batch` (generation, collection, benchmarks), JSON in and out;
+//! - [`batch`]: the items of `asp.batch` (generation, plans in chunks, collection, benchmarks);
 //! - [`errors`]: asp's errors as `asp.errors` exceptions.
 
 pub mod arrays;
@@ -86,6 +86,7 @@ fn asp_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(batch::gen_item, m)?)?;
     m.add_function(wrap_pyfunction!(batch::gen_manifest, m)?)?;
     m.add_function(wrap_pyfunction!(batch::model_items, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::plan_items, m)?)?;
     m.add_function(wrap_pyfunction!(batch::collect_item, m)?)?;
     m.add_function(wrap_pyfunction!(batch::collect_index, m)?)?;
     m.add_function(wrap_pyfunction!(batch::bench_item, m)?)?;

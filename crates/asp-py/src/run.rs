@@ -33,6 +33,16 @@ const WORKER_STACK: usize = 8 << 20;
 pub fn plan(py: Python<'_>, assembly: Assembly, settings: &PlanSettings) -> PyResult<PlanResult> {
     let token = StopToken::new();
     let settings = PlanSettings { cancel: Some(token.clone()), ..settings.clone() };
+    let result = interruptible(py, &token, move || pipeline::plan_assembly(assembly, &settings, None))?;
+    result.map_err(|e| Error::from(e).into_py(py))
+}
+
+/// Runs `work` on a worker thread with the GIL released while this thread waits, asking Python
+/// for pending signals every [`SIGNAL_INTERVAL`]; a raised signal stops `token` (which `work`
+/// must watch), and once `work` has ended its result is dropped and the signal's exception is
+/// raised. One thread per call: callers with many small jobs hand it a batch of them
+/// (`asp._asp.plan_items`).
+pub fn interruptible<T: Send>(py: Python<'_>, token: &StopToken, work: impl FnOnce() -> T + Send) -> PyResult<T> {
     let (done, finished) = mpsc::channel::<()>();
     // a Receiver is Send but not Sync: the closures that wait without the GIL borrow it
     let finished = Mutex::new(finished);
@@ -43,7 +53,7 @@ pub fn plan(py: Python<'_>, assembly: Assembly, settings: &PlanSettings) -> PyRe
             .spawn_scoped(scope, move || {
                 // the channel closes when this closure ends, normally or by a panic
                 let _done = done;
-                pipeline::plan_assembly(assembly, &settings, None)
+                work()
             })
             .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("cannot start the planning thread: {e}")))?;
         let mut raised: Option<PyErr> = None;
@@ -61,7 +71,7 @@ pub fn plan(py: Python<'_>, assembly: Assembly, settings: &PlanSettings) -> PyRe
             // a bug, not bad input: pyo3 turns the panic into a PanicException
             (Err(payload), _) => panic::resume_unwind(payload),
             (Ok(_), Some(e)) => Err(e),
-            (Ok(result), None) => result.map_err(|e| Error::from(e).into_py(py)),
+            (Ok(result), None) => Ok(result),
         }
     })
 }

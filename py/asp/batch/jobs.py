@@ -13,7 +13,6 @@ from __future__ import annotations
 import abc
 import json
 import os
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -204,30 +203,26 @@ class PlanJob(Job):
         return f"{found} of {len(rows)} models planned{locked}{errors}; plans and summary.json in {out}"
 
 
-def _plan(spec: dict[str, Any], payload: dict[str, Any], out: str) -> dict[str, Any]:
-    import asp
+def _plan_chunk(spec: dict[str, Any], payloads: list[dict[str, Any]], out: str) -> list[dict[str, Any]]:
+    """Plans a chunk of models in one native call (``_asp.plan_items``): the settings resolved
+    once, the models in parallel on asp's thread pool (one thread in a Ray task), each plan
+    written to ``OUT/<dir>.json`` with the bytes ``asp plan --each`` writes (timings apart), and
+    a small row per model, or ``{"error": message}`` for one that could not be planned."""
+    settings = {k: v for k, v in spec["settings"].items() if v is not None}
+    files = [f"{p['dir']}.json" for p in payloads]
+    rows = _asp.plan_items([(p["path"], f) for p, f in zip(payloads, files)], out, settings, load=spec["load"])
+    results: list[dict[str, Any]] = []
+    for file, (error, status, found, parts, steps, tests, seconds) in zip(files, rows):
+        if error is not None:
+            results.append({"error": error})
+        else:
+            results.append({"file": file, "files": [file], "status": status, "found": found, "parts": parts,
+                            "steps": steps, "removal_tests": tests, "seconds": seconds})
+    return results
 
-    load = spec["load"]
-    started = time.perf_counter()
-    assembly = asp.load(payload["path"], unit=load["unit"], up=load["up"], fixed=load["fixed"],
-                        max_triangles=load.get("max_triangles"), max_parts=load.get("max_parts"))
-    plan = assembly.plan(**spec["settings"])
-    seconds = time.perf_counter() - started
-    file = f"{payload['dir']}.json"
-    _write_atomic(Path(out) / file, plan.json)  # the bytes Plan.write and `asp plan --out` write
-    stats = plan.stats
-    return {
-        "file": file,
-        "files": [file],
-        "status": plan.status,
-        "found": plan.found,
-        "parts": len(assembly),
-        # counted on the parsed plan: `plan.assembly_sequence` deep-copies every step (a tenth
-        # of a small model's item)
-        "steps": len(plan._dict.get("assembly_sequence", [])),
-        "removal_tests": stats.get("removal_tests", 0),
-        "seconds": seconds,
-    }
+
+def _plan(spec: dict[str, Any], payload: dict[str, Any], out: str) -> dict[str, Any]:
+    return _plan_chunk(spec, [payload], out)[0]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -359,6 +354,16 @@ def run_item(kind: str, spec: dict[str, Any], payload: dict[str, Any], out: str)
         return {"error": str(e)}
 
 
+# kinds whose chunks run in one native call (the per-item call costs more than a small item)
+_CHUNK_RUNNERS = {"plan": _plan_chunk}
+#: The kinds of job whose chunks are one native call (see :func:`run_chunk`).
+CHUNKED = frozenset(_CHUNK_RUNNERS)
+
+
 def run_chunk(kind: str, spec: dict[str, Any], payloads: list[dict[str, Any]], out: str) -> list[dict[str, Any]]:
-    """:func:`run_item` of several items in turn (one Ray task)."""
+    """:func:`run_item` of several items (one Ray task, or one step of the serial loop): a plan
+    chunk in one native call, in parallel; other kinds one item after the other."""
+    chunk = _CHUNK_RUNNERS.get(kind)
+    if chunk is not None:
+        return chunk(spec, payloads, out)
     return [run_item(kind, spec, p, out) for p in payloads]

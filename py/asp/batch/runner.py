@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any, Callable, TextIO
 
 from ..errors import AspError
-from .jobs import Item, Job, run_chunk, run_item
+from .jobs import CHUNKED, Item, Job, run_chunk
 
 JOURNAL_DIR = ".asp-batch"
 
@@ -33,7 +33,8 @@ class BatchError(AspError):
 @dataclass
 class Outcome:
     """What a batch did: items run now, skipped as done before, and failed (with the error);
-    ``seconds`` of the whole run, of which ``startup_seconds`` starting or joining Ray."""
+    ``seconds`` of the whole run, of which ``startup_seconds`` starting or joining Ray and
+    ``shutdown_seconds`` stopping the Ray it started."""
 
     total: int
     ran: int = 0
@@ -41,6 +42,7 @@ class Outcome:
     failed: dict[str, str] = field(default_factory=dict)
     seconds: float = 0.0
     startup_seconds: float = 0.0
+    shutdown_seconds: float = 0.0
     summary: str = ""
 
     @property
@@ -194,10 +196,16 @@ def run(job: Job, out: os.PathLike | str, ray: str | None = "local", workers: in
 
     try:
         if ray in (None, "none") or not todo:  # nothing to run: no Ray to start
-            for item in todo:
-                finished(item, run_item(job.kind, job.spec, item.payload, str(out)))
+            # plans in chunks as on Ray (one native call each, its models in parallel); other
+            # kinds one item at a time (each journaled as soon as it ends)
+            size = chunk_size(len(todo), 1) if job.kind in CHUNKED else 1
+            for start in range(0, len(todo), size):
+                chunk = todo[start:start + size]
+                for item, result in zip(chunk, run_chunk(job.kind, job.spec, [i.payload for i in chunk], str(out))):
+                    finished(item, result)
         else:
-            outcome.startup_seconds = _run_ray(job, todo, str(out), ray, workers, finished, progress.restart)
+            outcome.startup_seconds, outcome.shutdown_seconds = _run_ray(
+                job, todo, str(out), ray, workers, finished, progress.restart)
     except KeyboardInterrupt:
         journal.close()
         progress.message(
@@ -218,9 +226,11 @@ def run(job: Job, out: os.PathLike | str, ray: str | None = "local", workers: in
                 "command again (finished items are kept)")
         outcome.summary = f"{outcome.summary}\n{note}" if outcome.summary else note
     if outcome.ran:
-        work = outcome.seconds - outcome.startup_seconds
+        work = outcome.seconds - outcome.startup_seconds - outcome.shutdown_seconds
         rate = outcome.ran / work if work > 0 else float("inf")
         startup = f", after {outcome.startup_seconds:.1f} s starting Ray" if outcome.startup_seconds else ""
+        if outcome.shutdown_seconds:
+            startup += f", {outcome.shutdown_seconds:.1f} s stopping it"
         outcome.summary += f"\n{outcome.ran} items in {work:.1f} s ({rate:.2f} items/s{startup})"
     return outcome
 
@@ -234,9 +244,10 @@ def _ray_module():
 
 
 def chunk_size(items: int, slots: int) -> int:
-    """Items per Ray task: one while there are few (the slowest item bounds the batch, so spread
-    them), up to 64 when there are many, so that a task's overhead (a few milliseconds) does not
-    swamp items that take one (generating a Soma cube). A kill loses at most the chunks in flight."""
+    """Items of the first Ray tasks, before any cost is measured (:class:`ChunkSizer`): one while
+    there are few (the slowest item bounds the batch, so spread them), up to 64 when there are
+    many, so that a task's overhead (a few milliseconds) does not swamp items that take one
+    (generating a Soma cube). A kill loses at most the chunks in flight."""
     return max(1, min(64, items // (16 * slots)))
 
 
@@ -263,9 +274,49 @@ def _init_local(ray: Any, cpus: int) -> None:
                 os.environ[k] = v
 
 
+def timed_chunk(kind: str, spec: dict[str, Any], payloads: list[dict[str, Any]], out: str) -> tuple[float, list[dict[str, Any]]]:
+    """:func:`run_chunk` and the seconds it took where it ran (what :class:`ChunkSizer` learns from)."""
+    started = time.perf_counter()
+    results = run_chunk(kind, spec, payloads, out)
+    return time.perf_counter() - started, results
+
+
+class ChunkSizer:
+    """Items per Ray task by measured cost: the first tasks take :func:`chunk_size` items; once
+    tasks have come back, as many items as take about :attr:`TARGET` seconds at the mean cost
+    per item measured so far (up to :attr:`MOST`), and never more than an even share of what is
+    left among twice the slots, so the last tasks still spread over the workers. Ray's overhead
+    per task (a few milliseconds, and the driver's round trip through ``ray.wait``) then stays a
+    small part of each task, whatever an item costs."""
+
+    TARGET = 0.1
+    MOST = 256
+
+    def __init__(self, items: int, slots: int) -> None:
+        self.slots = slots
+        self.first = chunk_size(items, slots)
+        self.seconds = 0.0
+        self.items = 0
+
+    def learn(self, seconds: float, items: int) -> None:
+        """A task of ``items`` items took ``seconds`` where it ran."""
+        self.seconds += seconds
+        self.items += items
+
+    def size(self, left: int) -> int:
+        """Items for the next task, with ``left`` items not yet sent."""
+        if self.items == 0:
+            return self.first
+        per_item = self.seconds / self.items
+        wanted = self.MOST if per_item <= 0 else int(self.TARGET / per_item)
+        share = -(-left // (2 * self.slots))  # ceiling: the tail spreads over the workers
+        return max(1, min(self.MOST, wanted, share))
+
+
 def _run_ray(job: Job, todo: list[Item], out: str, address: str, workers: int | None,
-             finished: Callable[[Item, dict[str, Any]], None], ready: Callable[[], None]) -> float:
-    """Runs the items as Ray tasks; returns the seconds spent starting or joining Ray."""
+             finished: Callable[[Item, dict[str, Any]], None], ready: Callable[[], None]) -> tuple[float, float]:
+    """Runs the items as Ray tasks; returns the seconds spent starting or joining Ray and the
+    seconds spent stopping the Ray it started."""
     started = time.perf_counter()
     ray = _ray_module()
     started_here = not ray.is_initialized()
@@ -283,34 +334,40 @@ def _run_ray(job: Job, todo: list[Item], out: str, address: str, workers: int | 
     startup = time.perf_counter() - started
     ready()
     try:
-        if not todo:
-            return startup
-        cpus = int(ray.cluster_resources().get("CPU", 1))
-        slots = max(1, min(workers, cpus) if workers else cpus)
-        task = ray.remote(num_cpus=1, max_retries=1)(run_chunk)
-        spec = ray.put(job.spec)
-        size = chunk_size(len(todo), slots)
-        chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
-        chunks.reverse()
-        pending: dict[Any, list[Item]] = {}
-        # a bounded number of tasks in flight (twice the CPUs that run them): a batch of 100,000
-        # assemblies does not become 100,000 tasks at once, and results are journaled as they come
-        while chunks or pending:
-            while chunks and len(pending) < 2 * slots:
-                chunk = chunks.pop()
-                pending[task.remote(job.kind, spec, [i.payload for i in chunk], out)] = chunk
-            # (not `ready`: that is the callback of this function's arguments)
-            finished_refs, _ = ray.wait(list(pending), num_returns=1)
-            for ref in finished_refs:
-                chunk = pending.pop(ref)
-                try:
-                    results = ray.get(ref)
-                except Exception as e:  # a worker that died (out of memory, a crash)
-                    first = str(e).splitlines()[0] if str(e) else ""
-                    results = [{"error": f"the task failed: {type(e).__name__}: {first}"}] * len(chunk)
-                for item, result in zip(chunk, results):
-                    finished(item, result)
-        return startup
+        if todo:
+            _run_tasks(ray, job, todo, out, workers, finished)
     finally:
+        stopping = time.perf_counter()
         if started_here:
             ray.shutdown()
+    return startup, time.perf_counter() - stopping
+
+
+def _run_tasks(ray: Any, job: Job, todo: list[Item], out: str, workers: int | None,
+               finished: Callable[[Item, dict[str, Any]], None]) -> None:
+    """The items as Ray tasks of :class:`ChunkSizer`'s sizes, a bounded number in flight."""
+    cpus = int(ray.cluster_resources().get("CPU", 1))
+    slots = max(1, min(workers, cpus) if workers else cpus)
+    task = ray.remote(num_cpus=1, max_retries=1)(timed_chunk)
+    spec = ray.put(job.spec)
+    sizer = ChunkSizer(len(todo), slots)
+    sent = 0
+    pending: dict[Any, list[Item]] = {}
+    # a bounded number of tasks in flight (twice the CPUs that run them): a batch of 100,000
+    # assemblies does not become 100,000 tasks at once, and results are journaled as they come
+    while sent < len(todo) or pending:
+        while sent < len(todo) and len(pending) < 2 * slots:
+            chunk = todo[sent:sent + sizer.size(len(todo) - sent)]
+            sent += len(chunk)
+            pending[task.remote(job.kind, spec, [i.payload for i in chunk], out)] = chunk
+        finished_refs, _ = ray.wait(list(pending), num_returns=1)
+        for ref in finished_refs:
+            chunk = pending.pop(ref)
+            try:
+                seconds, results = ray.get(ref)
+                sizer.learn(seconds, len(chunk))
+            except Exception as e:  # a worker that died (out of memory, a crash)
+                first = str(e).splitlines()[0] if str(e) else ""
+                results = [{"error": f"the task failed: {type(e).__name__}: {first}"}] * len(chunk)
+            for item, result in zip(chunk, results):
+                finished(item, result)
