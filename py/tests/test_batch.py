@@ -51,6 +51,7 @@ def test_gen_on_ray_writes_the_files_of_asp_gen(tmp_path, asp_cli, local_ray):
         (["soma", "--size", "2", "--count", "70", "--seed", "4"], GenJob.soma(size=2, count=70, seed=4)),
         (["profiles", "--preset", "double-layer", "--count", "2", "--seed", "3"],
          GenJob.profiles("double-layer", count=2, seed=3)),
+        (["stress", "--kind", "bolted", "--count", "3", "--seed", "5"], GenJob.stress("bolted", count=3, seed=5)),
     ]:
         cli, batch = tmp_path / f"cli-{args[0]}-{args[2]}", tmp_path / f"batch-{args[0]}-{args[2]}"
         code, _, err = asp_cli("gen", *args, "--out", str(cli), "--quiet")

@@ -77,7 +77,9 @@ def _parser() -> argparse.ArgumentParser:
     prof.add_argument("--preset", choices=["single-layer", "double-layer"], help="a thesis data set (default single-layer)")
     prof.add_argument("--param", action="append", metavar="KEY=VALUE",
                       help="override a parameter (width, length, height, layers, supports, front, back, min_length, ...)")
-    for q in (soma, prof):
+    stress = gsub.add_parser("stress", help="the planner's stress cases: chairs, dowelled carcasses, bolted plates")
+    stress.add_argument("--kind", required=True, choices=["chair", "carcass", "bolted"], help="which stress case")
+    for q in (soma, prof, stress):
         q.add_argument("--count", type=int, default=1, help="how many assemblies (default 1)")
         q.add_argument("--seed", type=int, default=0, help="batch seed: the same seed gives the same files (default 0)")
         _common(q)
@@ -122,6 +124,8 @@ def job_of(args: argparse.Namespace) -> Job:
     if args.command == "gen":
         if args.generator == "soma":
             return GenJob.soma(size=args.size, cell=args.cell, count=args.count, seed=args.seed)
+        if args.generator == "stress":
+            return GenJob.stress(args.kind, count=args.count, seed=args.seed)
         return GenJob.profiles(args.preset, _pairs(args.param, "param"), count=args.count, seed=args.seed)
     load = LoadSettings(unit=args.unit, up=args.up, fixed=list(args.fixed), max_triangles=args.max_triangles, max_parts=args.max_parts)
     settings = _pairs(args.set, "set")

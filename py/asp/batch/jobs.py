@@ -101,6 +101,14 @@ class GenJob(Job):
         return GenJob({"kind": "soma", "size": size, "cell": cell}, **kw)
 
     @staticmethod
+    def stress(kind: str, **kw: Any) -> GenJob:
+        """The planner's stress cases (``asp gen stress --kind KIND``): ``chair``, ``carcass`` or
+        ``bolted``."""
+        if kind not in ("chair", "carcass", "bolted"):
+            raise ValueError(f"unknown stress kind '{kind}' (one of bolted, carcass, chair)")
+        return GenJob({"kind": "stress", "stress": kind}, **kw)
+
+    @staticmethod
     def profiles(preset: str | None = None, overrides: dict[str, Any] | None = None, **kw: Any) -> GenJob:
         params = json.loads(_asp.profile_preset(preset or "single-layer"))
         for key, value in (overrides or {}).items():
