@@ -127,6 +127,8 @@ pub struct GnnOrdering {
     by_part: Vec<f32>,
     failures: u64,
     first_failure: Option<String>,
+    /// States with at most one candidate part, ordered without an inference.
+    skipped: u64,
 }
 
 impl std::fmt::Debug for GnnOrdering {
@@ -153,6 +155,7 @@ impl GnnOrdering {
             by_part: vec![f32::NEG_INFINITY; parts],
             failures: 0,
             first_failure: None,
+            skipped: 0,
         })
     }
 
@@ -219,6 +222,11 @@ impl GnnOrdering {
         self.encoded.is_some()
     }
 
+    /// How many states had at most one candidate part and were ordered without an inference.
+    pub fn skipped(&self) -> u64 {
+        self.skipped
+    }
+
     /// How many states could not be scored (their parts kept the incoming order).
     pub fn failures(&self) -> u64 {
         self.failures
@@ -237,6 +245,11 @@ impl PartOrdering for GnnOrdering {
     fn order(&mut self, state: &PartSet, parts: &mut Vec<usize>) {
         if let Some(tie) = &mut self.tie {
             tie.order(state, parts);
+        }
+        if parts.len() <= 1 {
+            // one candidate: no ranking to pay an inference for
+            self.skipped += 1;
+            return;
         }
         match self.scores(state) {
             Ok(_) => {
@@ -298,6 +311,7 @@ impl OrderingFactory for GnnFactory {
             by_part: vec![f32::NEG_INFINITY; parts],
             failures: 0,
             first_failure: None,
+            skipped: 0,
         })
     }
 }

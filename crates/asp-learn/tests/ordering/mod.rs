@@ -40,6 +40,20 @@ fn parts_are_tested_by_descending_score() {
 }
 
 #[test]
+fn a_single_candidate_costs_no_inference() {
+    let world = World::new(fixtures::figure_6_2(1.0), &WorldConfig::default()).unwrap();
+    let graph = Arc::new(AssemblyGraph::build(&world, &GraphConfig::default()).unwrap());
+    let mut ordering = GnnOrdering::new(graph.clone(), model()).unwrap();
+    let state = PartSet::full(graph.num_parts());
+    let mut one = vec![1];
+    ordering.order(&state, &mut one);
+    assert_eq!((one, ordering.skipped()), (vec![1], 1));
+    let mut two = vec![0, 1];
+    ordering.order(&state, &mut two);
+    assert_eq!(ordering.skipped(), 1, "two candidates are ranked");
+}
+
+#[test]
 fn equal_scores_keep_the_incoming_order() {
     // four isolated parts with identical attributes score the same
     let config = GraphConfig::default();
@@ -103,7 +117,8 @@ fn cached_encodings_score_every_state_as_tract_does() {
         (s >> 40) as f32 / (1u64 << 24) as f32
     };
     let parts = 100;
-    let mut edges: Vec<(usize, usize)> = (0..parts).flat_map(|i| (1..=3).flat_map(move |d| [(i, (i + d) % parts), ((i + d) % parts, i)])).collect();
+    let mut edges: Vec<(usize, usize)> =
+        (0..parts).flat_map(|i| (1..=3).flat_map(move |d| [(i, (i + d) % parts), ((i + d) % parts, i)])).collect();
     edges.sort();
     edges.dedup();
     let nodes: Vec<f32> = (0..parts * nd).map(|_| 3.0 * next()).collect();
