@@ -21,7 +21,7 @@ use crate::qnet::QNet;
 
 impl RemovabilityModel {
     /// Score every node of a state graph ([`AssemblyGraph::state`]); outputs follow
-    /// `graph.nodes`. Runs the Rust forward pass ([`GraphModel::fast_net`]) when the model has
+    /// `graph.nodes`. Runs the Rust forward pass ([`RemovabilityModel::fast_net`]) when the model has
     /// one, tract otherwise ([`score_graph_tract`](Self::score_graph_tract)).
     pub fn score_graph(&self, graph: &StateGraph) -> Result<Vec<f32>> {
         let mut out = Vec::new();
