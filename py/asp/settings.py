@@ -15,7 +15,7 @@ from typing import Literal, TypedDict
 __all__ = ["Order", "Overlaps", "PlanSettings", "QUse", "Stability", "Support", "given"]
 
 #: Part orderings of the depth-first search (``order=``).
-Order = Literal["given", "shuffled", "random", "bookkeeping", "gnn"]
+Order = Literal["auto", "given", "shuffled", "random", "bookkeeping", "gnn"]
 #: What to do with parts that overlap in the input (``overlaps=``).
 Overlaps = Literal["strict", "lenient", "error"]
 #: The feasibility search's stability criterion (``stability=``).

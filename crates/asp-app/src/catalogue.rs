@@ -36,6 +36,14 @@ pub struct OrderingEntry {
 /// The part orderings, in the order the docs list them; the first is the default.
 pub const ORDERINGS: &[OrderingEntry] = &[
     OrderingEntry {
+        name: "auto",
+        help: "by what a removal test costs: `given` where tests are cheap (the default checker), `gnn` with bookkeeping where they are expensive (`stability` physics)",
+        bookkeeping: false,
+        takes_model: true,
+        // the cheap case; `resolve` puts the learned ordering in for an expensive checker
+        build: |_| Ok(Arc::new(BuiltinOrder::Given)),
+    },
+    OrderingEntry {
         name: "given",
         help: "the model's part order",
         bookkeeping: false,
@@ -68,14 +76,17 @@ pub const ORDERINGS: &[OrderingEntry] = &[
         help: "parts in order of the removability a graph neural network predicts (`model`), predicted again after each removal (thesis 3.5.3)",
         bookkeeping: false,
         takes_model: true,
-        build: |model| {
-            Ok(Arc::new(match model {
-                Some(p) => asp_learn::GnnSource::load(p, asp_geom::graph::GraphConfig::default())?,
-                None => asp_learn::GnnSource::shipped()?,
-            }))
-        },
+        build: gnn,
     },
 ];
+
+/// The `gnn` ordering of `model`, or of the shipped model.
+pub fn gnn(model: Option<&Path>) -> Result<Arc<dyn OrderingSource>> {
+    Ok(Arc::new(match model {
+        Some(p) => asp_learn::GnnSource::load(p, asp_geom::graph::GraphConfig::default())?,
+        None => asp_learn::GnnSource::shipped()?,
+    }))
+}
 
 /// The ordering called `name`, or an error listing the names.
 pub fn ordering(name: &str) -> Result<&'static OrderingEntry> {
@@ -262,7 +273,7 @@ mod tests {
         let gnn = ordering("gnn").unwrap();
         assert_eq!((gnn.build)(None).unwrap().name(), "gnn");
         let e = ordering("sideways").unwrap_err().to_string();
-        assert_eq!(e, "order: unknown order 'sideways' (use given, shuffled, random, bookkeeping, gnn)");
+        assert_eq!(e, "order: unknown order 'sideways' (use auto, given, shuffled, random, bookkeeping, gnn)");
         let files = asp_robot::RobotFiles::default();
         assert!(robot("panda", &files).is_ok());
         assert!(robot("/no/such/robot.urdf", &files).unwrap_err().to_string().contains("/no/such/robot.urdf"));

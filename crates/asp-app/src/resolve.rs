@@ -140,16 +140,31 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
             format!("the removability model of `order` gnn; it has no effect with `order` {order_name}"),
         ));
     }
-    let order = (entry.build)(r.model.as_deref()).map_err(|e| match (&r.model, e) {
-        (Some(_), e) => AppError::setting("model", e.to_string()),
-        (None, e) => e,
-    })?;
     let stability = match r.stability.unwrap_or(Stability::Contact) {
         Stability::Contact => StabilitySetting::Contact,
         Stability::Physics => StabilitySetting::Physics {
             threshold: positive("physics_threshold", r.physics_threshold)?.unwrap_or_else(default_physics_threshold),
         },
     };
+    // `auto`: decided once per request from the checker, never from a clock, so one seed gives
+    // one plan (ARCHITECTURE.md, "Cost-aware default ordering")
+    let expensive_tests = matches!(stability, StabilitySetting::Physics { .. });
+    let build = match (entry.name, expensive_tests) {
+        ("auto", true) => catalogue::gnn,
+        _ => entry.build,
+    };
+    let auto_bookkeeping = entry.name == "auto" && expensive_tests;
+    let model_error = |e: AppError| match &r.model {
+        Some(_) => AppError::setting("model", e.to_string()),
+        None => e,
+    };
+    let order = build(r.model.as_deref()).map_err(model_error)?;
+    if entry.name == "auto" && !expensive_tests && r.model.is_some() {
+        return Err(AppError::setting(
+            "model",
+            "the removability model of `order` gnn; `order` auto uses it only with `stability` physics (give `order` gnn to use it here)",
+        ));
+    }
     let timeout = match r.timeout {
         None => Some(DEFAULT_TIMEOUT),
         Some(0.0) => None,
@@ -172,7 +187,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         },
         stability,
         order,
-        bookkeeping: r.bookkeeping.unwrap_or(false) || entry.bookkeeping,
+        bookkeeping: r.bookkeeping.unwrap_or(false) || entry.bookkeeping || auto_bookkeeping,
         seed: r.seed.unwrap_or(0),
         path_planner: r.path_planner.unwrap_or(d.path_planner),
         subassemblies: r.subassemblies.unwrap_or(d.subassemblies),
@@ -371,6 +386,11 @@ mod tests {
         assert_eq!((s.normals, s.seed, s.timeout, s.bookkeeping, s.grid), (d.normals, d.seed, d.timeout, d.bookkeeping, d.grid));
         assert_eq!(s.order.name(), "given");
         assert!(s.optimise.is_none() && s.checker_extension.is_none());
+        // the default `auto`: the learned ordering with bookkeeping only where tests are expensive
+        let s = resolve(&PlanRequest::from_json(r#"{"stability": "physics"}"#).unwrap()).unwrap();
+        assert!(s.bookkeeping && s.order.name() == "gnn");
+        let s = resolve(&PlanRequest::from_json(r#"{"stability": "physics", "order": "given"}"#).unwrap()).unwrap();
+        assert!(!s.bookkeeping && s.order.name() == "given");
         let o = resolve(&PlanRequest::from_json(r#"{"objective": "access"}"#).unwrap()).unwrap().optimise.unwrap();
         let od = OptimiseSettings::default();
         assert_eq!(
@@ -424,8 +444,17 @@ mod tests {
     fn values_are_checked_with_the_key() {
         assert_eq!(err(r#"{"timeout": -1}"#), "timeout: must be a positive number, got -1");
         assert!(resolve(&PlanRequest::from_json(r#"{"timeout": 0}"#).unwrap()).unwrap().timeout.is_none());
-        assert_eq!(err(r#"{"order": "sideways"}"#), "order: unknown order 'sideways' (use given, shuffled, random, bookkeeping, gnn)");
-        assert_eq!(err(r#"{"model": "m.onnx"}"#), "model: the removability model of `order` gnn; it has no effect with `order` given");
+        assert_eq!(
+            err(r#"{"order": "sideways"}"#),
+            "order: unknown order 'sideways' (use auto, given, shuffled, random, bookkeeping, gnn)"
+        );
+        assert_eq!(
+            err(r#"{"order": "given", "model": "m.onnx"}"#),
+            "model: the removability model of `order` gnn; it has no effect with `order` given"
+        );
+        assert!(err(r#"{"model": "m.onnx"}"#)
+            .starts_with("model: the removability model of `order` gnn; `order` auto uses it only with `stability` physics"));
+        assert!(err(r#"{"stability": "physics", "model": "/no/such.onnx"}"#).starts_with("model: "));
         assert!(err(r#"{"order": "gnn", "model": "/no/such.onnx"}"#).starts_with("model: "));
         assert_eq!(
             err(r#"{"objective": "access,dirchange"}"#),

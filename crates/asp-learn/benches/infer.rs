@@ -101,5 +101,29 @@ fn q_forward(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, infer, q_forward);
+/// The shipped removability model as `--order gnn` runs it (issue 26 item 4): the Rust forward
+/// pass from node and edge encodings cached per graph, per state of 40 and 100 parts with 4 and 5
+/// edges per part (the sizes of `shipped/...` above).
+fn gnn_state(c: &mut Criterion) {
+    use asp_geom::graph::{AssemblyGraph, GraphConfig};
+    use std::sync::Arc;
+    let shipped = Arc::new(RemovabilityModel::from_bytes(asp_learn::SHIPPED_MODEL, "shipped").unwrap());
+    let config = GraphConfig::default();
+    let mut group = c.benchmark_group("gnn_state");
+    for (n, e) in [(40usize, 160usize), (100, 500)] {
+        let (x, ei, _) = graph(n, e, 1);
+        let mut edges: Vec<(usize, usize)> = (0..e).map(|k| (ei[k] as usize, ei[e + k] as usize)).collect();
+        edges.sort();
+        edges.dedup();
+        let attr = (0..edges.len() * config.edge_dim()).map(|k| ((k * 37) % 1000) as f32 / 500.0).collect();
+        let graph = Arc::new(AssemblyGraph::from_parts(&config, x, edges, attr).unwrap());
+        let mut ordering = asp_learn::GnnOrdering::new(graph, shipped.clone()).unwrap();
+        assert!(ordering.is_fast());
+        let state = asp_geom::PartSet::full(n);
+        group.bench_function(format!("shipped/n{n}_e{e}"), |b| b.iter(|| black_box(ordering.scores(black_box(&state)).unwrap()[0])));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, infer, q_forward, gnn_state);
 criterion_main!(benches);

@@ -117,6 +117,12 @@ pub struct GraphModel {
     /// The file's float32 initialisers in file order: name, shape, values (the Rust forward
     /// pass of Q models reads its weights here, `qnet.rs`).
     initializers: Vec<(String, Vec<usize>, Vec<f32>)>,
+    /// The file's boolean initialisers: name and values (the `log1p` column masks of the
+    /// encoder, read by the Rust forward pass).
+    bool_initializers: Vec<(String, Vec<bool>)>,
+    /// The Rust forward pass of a removability model (`qnet.rs`), built on first use; `None`
+    /// when the file is not the trainer's architecture (tract then runs every state).
+    fast: std::sync::OnceLock<Option<Arc<crate::qnet::QNet>>>,
 }
 
 /// A removability model (the graph model of `--order gnn`).
@@ -227,6 +233,8 @@ impl GraphModel {
             symbolic: Mutex::new(None),
             buckets: Mutex::new(HashMap::new()),
             initializers: graph.initializer.iter().filter_map(float_initializer).collect(),
+            bool_initializers: graph.initializer.iter().filter_map(bool_initializer).collect(),
+            fast: std::sync::OnceLock::new(),
         };
         // run once, so a model tract cannot execute fails here and not in the middle of a search
         let x = vec![0.0; 2 * node_dim];
@@ -392,6 +400,23 @@ impl GraphModel {
         self.initializers.iter().find(|(n, _, _)| n == name).map(|(_, s, v)| (s.as_slice(), v.as_slice()))
     }
 
+    /// The boolean initialiser `name`, flattened.
+    pub(crate) fn bool_initializer(&self, name: &str) -> Option<&[bool]> {
+        self.bool_initializers.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_slice())
+    }
+
+    /// The Rust forward pass of this removability model ([`QNet::removability`](crate::qnet::QNet::removability)),
+    /// built and checked against tract on first use; `None` when the file is not the trainer's
+    /// architecture or is a Q model.
+    pub fn fast_net(&self) -> Option<&Arc<crate::qnet::QNet>> {
+        self.fast
+            .get_or_init(|| match self.kind {
+                ModelKind::Removability => crate::qnet::QNet::removability(self).ok().map(Arc::new),
+                ModelKind::Q => None,
+            })
+            .as_ref()
+    }
+
     /// The values of the float32 initialisers of rank 0, in file order.
     pub(crate) fn scalar_initializers(&self) -> Vec<f32> {
         self.initializers.iter().filter(|(_, s, _)| s.is_empty()).map(|(_, _, v)| v[0]).collect()
@@ -401,6 +426,17 @@ impl GraphModel {
     pub fn cached_plans(&self) -> usize {
         self.buckets.lock().map(|p| p.len()).unwrap_or(0)
     }
+}
+
+/// A boolean initialiser stored in the file (raw bytes or `int32_data`).
+fn bool_initializer(t: &pb::TensorProto) -> Option<(String, Vec<bool>)> {
+    if t.data_type != BOOL {
+        return None;
+    }
+    let len: usize = t.dims.iter().map(|&d| usize::try_from(d).ok()).product::<Option<usize>>()?;
+    let values: Vec<bool> =
+        if !t.raw_data.is_empty() { t.raw_data.iter().map(|&b| b != 0).collect() } else { t.int32_data.iter().map(|&b| b != 0).collect() };
+    (values.len() == len).then(|| (t.name.clone(), values))
 }
 
 /// A float32 initialiser stored in the file (raw little-endian bytes or `float_data`).
@@ -505,6 +541,8 @@ fn check_signature(graph: &pb::GraphProto, node_dim: usize, edge_dim: usize, out
 }
 
 const FLOAT: i32 = 1;
+/// ONNX `TensorProto.DataType.BOOL`.
+const BOOL: i32 = 9;
 const INT64: i32 = 7;
 
 #[derive(Clone, Debug)]

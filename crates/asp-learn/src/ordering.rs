@@ -17,11 +17,42 @@ use asp_search::{OrderingFactory, OrderingSource, PartOrdering, SearchError};
 
 use crate::error::Result;
 use crate::model::RemovabilityModel;
+use crate::qnet::QNet;
 
 impl RemovabilityModel {
     /// Score every node of a state graph ([`AssemblyGraph::state`]); outputs follow
-    /// `graph.nodes`.
+    /// `graph.nodes`. Runs the Rust forward pass ([`RemovabilityModel::fast_net`]) when the model has
+    /// one, tract otherwise ([`score_graph_tract`](Self::score_graph_tract)).
     pub fn score_graph(&self, graph: &StateGraph) -> Result<Vec<f32>> {
+        let mut out = Vec::new();
+        self.score_graph_into(graph, &mut out, &mut Scratch::default())?;
+        Ok(out)
+    }
+
+    /// [`score_graph`](Self::score_graph) into `out`, with reusable buffers.
+    pub fn score_graph_into(&self, graph: &StateGraph, out: &mut Vec<f32>, scratch: &mut Scratch) -> Result<()> {
+        match self.fast_net() {
+            Some(net) => {
+                let n = graph.num_nodes();
+                out.clear();
+                out.resize(n, 0.0);
+                if n > 0 {
+                    scratch.wanted.clear();
+                    scratch.wanted.extend(0..n);
+                    net.forward_graph(&graph.x, n, &graph.edge_index, &graph.edge_attr, &scratch.wanted, out, &mut scratch.net);
+                }
+                Ok(())
+            }
+            None => {
+                *out = self.score_graph_tract(graph)?;
+                Ok(())
+            }
+        }
+    }
+
+    /// Score every node of a state graph with tract (the reference the Rust forward pass is
+    /// checked against).
+    pub fn score_graph_tract(&self, graph: &StateGraph) -> Result<Vec<f32>> {
         self.score(&graph.x, graph.num_nodes(), &graph.edge_index, graph.num_edges(), &graph.edge_attr)
     }
 
@@ -31,6 +62,55 @@ impl RemovabilityModel {
     }
 }
 
+/// Reusable buffers of [`RemovabilityModel::score_graph_into`].
+#[derive(Debug, Default)]
+pub struct Scratch {
+    net: crate::qnet::Scratch,
+    wanted: Vec<usize>,
+}
+
+/// What the Rust forward pass reads of one model graph that no state changes: every part's
+/// node encoding and every edge's encoding (node and edge attributes are functions of the part
+/// and the pair alone), computed once per graph and shared by its orderings.
+struct Encoded {
+    net: Arc<QNet>,
+    /// `[num_parts, width]`.
+    nodes: Vec<f32>,
+    /// `[graph edges, width]`, in the graph's edge order.
+    edges: Vec<f32>,
+}
+
+impl Encoded {
+    /// The encodings of `graph` when `model` has a Rust forward pass.
+    fn of(graph: &AssemblyGraph, model: &RemovabilityModel) -> Option<Arc<Self>> {
+        let net = model.fast_net()?.clone();
+        let w = net.width();
+        let mut scratch = Vec::new();
+        let mut nodes = vec![0.0; graph.num_parts() * w];
+        net.encode_nodes(graph.nodes_flat(), graph.num_parts(), &mut nodes, &mut scratch);
+        let mut edges = vec![0.0; graph.num_edges() * w];
+        for (k, out) in edges.chunks_exact_mut(w).enumerate() {
+            net.encode_edge(graph.edge_attr(k), out, &mut scratch);
+        }
+        Some(Arc::new(Encoded { net, nodes, edges }))
+    }
+}
+
+/// The per-state buffers of the cached forward pass.
+#[derive(Default)]
+struct StateBuffers {
+    /// Position of each present part among the state's nodes.
+    rank: Vec<u32>,
+    nodes: Vec<usize>,
+    h0: Vec<f32>,
+    sources: Vec<u32>,
+    targets: Vec<u32>,
+    edges: Vec<f32>,
+    wanted: Vec<usize>,
+    out: Vec<f32>,
+    net: crate::qnet::Scratch,
+}
+
 /// Orders the candidate parts of a state by descending predicted removability.
 pub struct GnnOrdering {
     /// The initial ordering that breaks ties (`None`: the incoming order).
@@ -38,10 +118,17 @@ pub struct GnnOrdering {
     graph: Arc<AssemblyGraph>,
     model: Arc<RemovabilityModel>,
     scratch: StateGraph,
+    buffers: Scratch,
+    out: Vec<f32>,
+    /// The cached encodings of the Rust forward pass (`None`: tract on every state).
+    encoded: Option<Arc<Encoded>>,
+    state: StateBuffers,
     /// Score of each part of the last scored state (`-inf` for parts not in it).
     by_part: Vec<f32>,
     failures: u64,
     first_failure: Option<String>,
+    /// States with at most one candidate part, ordered without an inference.
+    skipped: u64,
 }
 
 impl std::fmt::Debug for GnnOrdering {
@@ -58,25 +145,86 @@ impl GnnOrdering {
         let parts = graph.num_parts();
         Ok(GnnOrdering {
             tie: None,
+            encoded: Encoded::of(&graph, &model),
+            state: StateBuffers::default(),
             graph,
             model,
             scratch: StateGraph::default(),
+            buffers: Scratch::default(),
+            out: Vec::new(),
             by_part: vec![f32::NEG_INFINITY; parts],
             failures: 0,
             first_failure: None,
+            skipped: 0,
         })
     }
 
     /// The predicted removability of every part of the model in `state` (`-inf` for parts
     /// that are not present).
     pub fn scores(&mut self, state: &PartSet) -> Result<&[f32]> {
+        if let Some(encoded) = &self.encoded {
+            self.score_cached(&encoded.clone(), state);
+            return Ok(&self.by_part);
+        }
         self.graph.state_into(state, &mut self.scratch);
-        let scores = self.model.score_graph(&self.scratch)?;
+        self.model.score_graph_into(&self.scratch, &mut self.out, &mut self.buffers)?;
         self.by_part.fill(f32::NEG_INFINITY);
-        for (&part, &p) in self.scratch.nodes.iter().zip(&scores) {
+        for (&part, &p) in self.scratch.nodes.iter().zip(&self.out) {
             self.by_part[part] = if p.is_nan() { f32::NEG_INFINITY } else { p };
         }
         Ok(&self.by_part)
+    }
+
+    /// [`scores`](Self::scores) by the Rust forward pass from the cached encodings: the state's
+    /// nodes and edges are gathered in the order of [`AssemblyGraph::state_into`] (so the sums
+    /// run in the same order as on a built state graph and give the same bits).
+    fn score_cached(&mut self, encoded: &Encoded, state: &PartSet) {
+        let (graph, b, w) = (&self.graph, &mut self.state, encoded.net.width());
+        let parts = graph.num_parts();
+        b.rank.resize(parts, 0);
+        b.nodes.clear();
+        b.nodes.extend(state.iter().take_while(|&i| i < parts));
+        b.h0.clear();
+        for (r, &i) in b.nodes.iter().enumerate() {
+            b.rank[i] = r as u32;
+            b.h0.extend_from_slice(&encoded.nodes[i * w..(i + 1) * w]);
+        }
+        b.sources.clear();
+        b.targets.clear();
+        b.edges.clear();
+        let edges = graph.edges();
+        for &s in &b.nodes {
+            for k in graph.edges_from(s) {
+                let t = edges[k].1;
+                if state.contains(t) {
+                    b.sources.push(b.rank[s]);
+                    b.targets.push(b.rank[t]);
+                    b.edges.extend_from_slice(&encoded.edges[k * w..(k + 1) * w]);
+                }
+            }
+        }
+        let n = b.nodes.len();
+        b.wanted.clear();
+        b.wanted.extend(0..n);
+        b.out.clear();
+        b.out.resize(n, 0.0);
+        if n > 0 {
+            encoded.net.forward_encoded(&b.h0, &[], n, &b.sources, &b.targets, &b.edges, &b.wanted, &mut b.out, &mut b.net);
+        }
+        self.by_part.fill(f32::NEG_INFINITY);
+        for (&part, &p) in b.nodes.iter().zip(&b.out) {
+            self.by_part[part] = if p.is_nan() { f32::NEG_INFINITY } else { p };
+        }
+    }
+
+    /// Whether states are scored by the Rust forward pass from cached encodings (`false`: tract).
+    pub fn is_fast(&self) -> bool {
+        self.encoded.is_some()
+    }
+
+    /// How many states had at most one candidate part and were ordered without an inference.
+    pub fn skipped(&self) -> u64 {
+        self.skipped
     }
 
     /// How many states could not be scored (their parts kept the incoming order).
@@ -98,6 +246,11 @@ impl PartOrdering for GnnOrdering {
         if let Some(tie) = &mut self.tie {
             tie.order(state, parts);
         }
+        if parts.len() <= 1 {
+            // one candidate: no ranking to pay an inference for
+            self.skipped += 1;
+            return;
+        }
         match self.scores(state) {
             Ok(_) => {
                 let by_part = &self.by_part;
@@ -116,6 +269,7 @@ impl PartOrdering for GnnOrdering {
 pub struct GnnFactory {
     graph: Arc<AssemblyGraph>,
     model: Arc<RemovabilityModel>,
+    encoded: Option<Arc<Encoded>>,
 }
 
 impl std::fmt::Debug for GnnFactory {
@@ -128,7 +282,8 @@ impl GnnFactory {
     /// A factory for `graph`; fails when the model was trained on other features.
     pub fn new(graph: Arc<AssemblyGraph>, model: Arc<RemovabilityModel>) -> Result<Self> {
         model.check_graph(&graph)?;
-        Ok(GnnFactory { graph, model })
+        let encoded = Encoded::of(&graph, &model);
+        Ok(GnnFactory { graph, model, encoded })
     }
 
     /// The model graph the orderings score.
@@ -146,12 +301,17 @@ impl OrderingFactory for GnnFactory {
         let parts = self.graph.num_parts();
         Box::new(GnnOrdering {
             tie: Some(Shuffled::new(num_parts, seed)),
+            encoded: self.encoded.clone(),
+            state: StateBuffers::default(),
             graph: self.graph.clone(),
             model: self.model.clone(),
             scratch: StateGraph::default(),
+            buffers: Scratch::default(),
+            out: Vec::new(),
             by_part: vec![f32::NEG_INFINITY; parts],
             failures: 0,
             first_failure: None,
+            skipped: 0,
         })
     }
 }

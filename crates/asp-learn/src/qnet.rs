@@ -1,5 +1,7 @@
 //! The forward pass of the trainer's Q network (`py/asp/train/q.py`, `QNetwork`) written out in
-//! Rust, for the Q-function's inner loop (issue 12: one inference per guided rollout step).
+//! Rust, for the Q-function's inner loop (issue 12: one inference per guided rollout step), and
+//! of the removability GNN (`py/asp/train/gnn.py`, the same encoder with `log1p` input columns
+//! and a sigmoid head; [`QNet::removability`]) for `--order gnn` (issue 26 item 4).
 //!
 //! Why not tract: the exported graph (docs/learning.md, "Q models") costs about 22 M
 //! multiply-adds per state at 40 parts (81 directions, width 64), and tract runs it near the
@@ -189,11 +191,26 @@ pub struct QNet {
     n1: Dense,
     n2: Dense,
     temperature: Vec<f32>,
-    /// `phi_q.0`'s columns reading `h_i`.
-    q1_node: Dense,
-    /// `phi_q.0`'s columns reading the pooled embedding (with the bias).
-    q1_pool: Dense,
-    q2: Dense,
+    /// Which node and edge attribute columns get `log(1 + max(v, 0))` before standardising
+    /// (the encoder's `node_log_mask`/`edge_log_mask`; all `false` for Q models).
+    node_log: Vec<bool>,
+    edge_log: Vec<bool>,
+    head: Head,
+}
+
+/// What the network puts on the node embeddings.
+#[derive(Clone, Debug)]
+enum Head {
+    /// The Q network's `phi_q` over `[h_i, hbar]`.
+    Q {
+        /// `phi_q.0`'s columns reading `h_i`.
+        q1_node: Dense,
+        /// `phi_q.0`'s columns reading the pooled embedding (with the bias).
+        q1_pool: Dense,
+        q2: Dense,
+    },
+    /// The removability GNN's `sigmoid(head(h_i))`.
+    Removability(Dense),
 }
 
 /// Per-thread buffers of [`QNet::forward`] (reused; no allocation once warm).
@@ -226,12 +243,22 @@ impl QNet {
     /// forward pass agrees with tract on a generated graph; `Err` says why not (the caller then
     /// keeps tract).
     pub fn from_model(model: &GraphModel) -> std::result::Result<Self, String> {
-        let net = Self::read(model)?;
+        let net = Self::read(model, false)?;
         net.self_check(model)?;
         Ok(net)
     }
 
-    fn read(model: &GraphModel) -> std::result::Result<Self, String> {
+    /// The network of a loaded removability model (`py/asp/train/gnn.py`, `RemovabilityGNN`:
+    /// the same encoder with `log1p` input columns and a linear head with a sigmoid), if its
+    /// file holds that architecture and agrees with tract on a generated graph (see
+    /// [`from_model`](Self::from_model)). [`forward`](Self::forward) then gives removabilities.
+    pub fn removability(model: &GraphModel) -> std::result::Result<Self, String> {
+        let net = Self::read(model, true)?;
+        net.self_check(model)?;
+        Ok(net)
+    }
+
+    fn read(model: &GraphModel, removability: bool) -> std::result::Result<Self, String> {
         let (node_dim, edge_dim) = (model.node_dim(), model.edge_dim());
         let meta = |key: &str| -> std::result::Result<usize, String> {
             model.metadata().get(key).and_then(|v| v.parse().ok()).ok_or_else(|| format!("no integer metadata '{key}'"))
@@ -259,8 +286,24 @@ impl QNet {
         let e2 = linear("phi_e.2", width, width)?;
         let n1 = linear("phi_n.0", width, width)?;
         let n2 = linear("phi_n.2", width, width)?;
-        let q1 = linear("phi_q.0", 2 * width, width)?;
-        let q2 = linear("phi_q.2", width, 1)?;
+        let head = if removability {
+            Head::Removability(linear("head", width, 1)?)
+        } else {
+            let q1 = linear("phi_q.0", 2 * width, width)?;
+            let q2 = linear("phi_q.2", width, 1)?;
+            let q1_node = Dense { input: width, output: width, w: q1.w[..width * width].to_vec(), b: vec![0.0; width] };
+            let q1_pool = Dense { input: width, output: width, w: q1.w[width * width..].to_vec(), b: q1.b.clone() };
+            Head::Q { q1_node, q1_pool, q2 }
+        };
+        // a missing mask is no log1p column (the exporter keeps the buffers; a file without
+        // them and with Log ops fails the self-check)
+        let mask = |name: &str, dim: usize| -> std::result::Result<Vec<bool>, String> {
+            match model.bool_initializer(name) {
+                None => Ok(vec![false; dim]),
+                Some(m) if m.len() == dim => Ok(m.to_vec()),
+                Some(m) => Err(format!("mask '{name}' has {} entries, expected {dim}", m.len())),
+            }
+        };
         let temperature = model.scalar_initializers();
         if temperature.len() != layers {
             return Err(format!("{} scalar tensors, expected one temperature per layer ({layers})", temperature.len()));
@@ -275,8 +318,6 @@ impl QNet {
             w[r * 2 * width + width..(r + 1) * 2 * width].copy_from_slice(&e2e1.w[r * width..(r + 1) * width]);
         }
         let e2_fused = Dense { input: width, output: 2 * width, w, b: [e2.b.clone(), e2e1.b].concat() };
-        let q1_node = Dense { input: width, output: width, w: q1.w[..width * width].to_vec(), b: vec![0.0; width] };
-        let q1_pool = Dense { input: width, output: width, w: q1.w[width * width..].to_vec(), b: q1.b.clone() };
         Ok(QNet {
             width,
             layers,
@@ -294,9 +335,9 @@ impl QNet {
             n1,
             n2,
             temperature,
-            q1_node,
-            q1_pool,
-            q2,
+            node_log: mask("node_log_mask", node_dim)?,
+            edge_log: mask("edge_log_mask", edge_dim)?,
+            head,
         })
     }
 
@@ -360,7 +401,8 @@ impl QNet {
         let d = self.edge_dim;
         let xs = grow(scratch, rows * d);
         for (o, row) in xs.chunks_exact_mut(d).zip(attr.chunks_exact(d)) {
-            for (k, (o, v)) in o.iter_mut().zip(row).enumerate() {
+            for (k, (o, &v)) in o.iter_mut().zip(row).enumerate() {
+                let v = if self.edge_log[k] { (1.0 + v.max(0.0)).ln() } else { v };
                 *o = (v - self.edge_mean[k]) / self.edge_std[k];
             }
         }
@@ -409,7 +451,57 @@ impl QNet {
         out: &mut [f32],
         s: &mut Scratch,
     ) {
-        pulp::Arch::new().dispatch(Forward { net: self, x, n, sources, targets, edges, wanted, out, s });
+        pulp::Arch::new().dispatch(Forward { net: self, x, h0: None, n, sources, targets, edges, wanted, out, s });
+    }
+
+    /// Node attribute rows (`x [rows, node_dim]`) to what [`forward_encoded`](Self::forward_encoded)
+    /// reads of each node (`width` floats: the node encoder's output). Depends only on the row,
+    /// so callers cache it per part.
+    pub fn encode_nodes(&self, x: &[f32], rows: usize, out: &mut [f32], scratch: &mut Vec<f32>) {
+        let nd = self.node_dim;
+        let xs = grow(scratch, rows * nd);
+        self.normalise_nodes(x, xs);
+        // the instruction set of forward's own node encoding, so both give the same bits
+        struct Encode<'a>(&'a Dense, &'a [f32], usize, &'a mut [f32]);
+        impl pulp::WithSimd for Encode<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn with_simd<S: Simd>(self, simd: S) {
+                let Encode(dense, xs, rows, out) = self;
+                dense.apply(simd, xs, rows, true, out);
+            }
+        }
+        pulp::Arch::new().dispatch(Encode(&self.node_encoder, xs, rows, &mut out[..rows * self.width]));
+    }
+
+    /// [`forward`](Self::forward) from encoded nodes: `h0 [n, width]` the rows of
+    /// [`encode_nodes`](Self::encode_nodes) (cached per part) instead of `x`. `x` is read only by a
+    /// Q head's pooling (its first column weighs each node; an empty `x` weighs every node 1) and
+    /// may be empty for a removability model.
+    #[allow(clippy::too_many_arguments)]
+    pub fn forward_encoded(
+        &self,
+        h0: &[f32],
+        x: &[f32],
+        n: usize,
+        sources: &[u32],
+        targets: &[u32],
+        edges: &[f32],
+        wanted: &[usize],
+        out: &mut [f32],
+        s: &mut Scratch,
+    ) {
+        pulp::Arch::new().dispatch(Forward { net: self, x, h0: Some(h0), n, sources, targets, edges, wanted, out, s });
+    }
+
+    fn normalise_nodes(&self, x: &[f32], xs: &mut [f32]) {
+        let nd = self.node_dim;
+        for (o, row) in xs.chunks_exact_mut(nd).zip(x.chunks_exact(nd)) {
+            for (k, (o, &v)) in o.iter_mut().zip(row).enumerate() {
+                let v = if self.node_log[k] { (1.0 + v.max(0.0)).ln() } else { v };
+                *o = (v - self.node_mean[k]) / self.node_std[k];
+            }
+        }
     }
 
     /// The forward pass, row-major throughout (node `t`'s or edge `k`'s `width` features are
@@ -420,6 +512,7 @@ impl QNet {
         &self,
         simd: S,
         x: &[f32],
+        h0: Option<&[f32]>,
         n: usize,
         sources: &[u32],
         targets: &[u32],
@@ -431,16 +524,17 @@ impl QNet {
         let w = self.width;
         let e = sources.len();
         let nd = self.node_dim;
-        // standardised node attributes, encoded
-        let xs = grow(&mut s.xs, n * nd);
-        for (o, row) in xs.chunks_exact_mut(nd).zip(x.chunks_exact(nd)) {
-            for (k, (o, v)) in o.iter_mut().zip(row).enumerate() {
-                *o = (v - self.node_mean[k]) / self.node_std[k];
-            }
-        }
+        // standardised node attributes, encoded (or their cached encodings)
         let mut h = std::mem::take(&mut s.h);
         grow(&mut h, n * w);
-        self.node_encoder.apply(simd, &s.xs, n, true, &mut h);
+        match h0 {
+            Some(h0) => h[..n * w].copy_from_slice(&h0[..n * w]),
+            None => {
+                let xs = grow(&mut s.xs, n * nd);
+                self.normalise_nodes(x, xs);
+                self.node_encoder.apply(simd, &s.xs, n, true, &mut h);
+            }
+        }
         let inv_count = grow(&mut s.inv_count, n);
         inv_count.fill(0.0);
         for &t in targets {
@@ -526,12 +620,27 @@ impl QNet {
             }
             self.n2.apply(simd, &s.p, n, true, &mut h);
         }
+        let (q1_node, q1_pool, q2) = match &self.head {
+            Head::Q { q1_node, q1_pool, q2 } => (q1_node, q1_pool, q2),
+            Head::Removability(head) => {
+                // p_i = sigmoid(head(h_i))
+                for (o, &k) in out.iter_mut().zip(wanted) {
+                    let mut v = head.b[0];
+                    for (&a, &b) in h[k * w..(k + 1) * w].iter().zip(&head.w) {
+                        v += a * b;
+                    }
+                    *o = 1.0 / (1.0 + (-v).exp());
+                }
+                s.h = h;
+                return;
+            }
+        };
         // q_i = phi_Q([h_i, hbar]), hbar the mean of the real nodes (x[:, 0] = 1)
         let mut weight = 0.0f32;
         let pooled = grow(&mut s.u, w);
         pooled.fill(0.0);
         for t in 0..n {
-            let r = x[t * nd];
+            let r = x.get(t * nd).copied().unwrap_or(1.0);
             weight += r;
             for j in 0..w {
                 pooled[j] += r * h[t * w + j];
@@ -542,16 +651,16 @@ impl QNet {
             *v /= norm;
         }
         let pool = grow(&mut s.mean, w);
-        self.q1_pool.apply(simd, &s.u[..w], 1, true, pool);
+        q1_pool.apply(simd, &s.u[..w], 1, true, pool);
         let rows = grow(&mut s.z, wanted.len() * w);
         for (r, &k) in rows.chunks_exact_mut(w).zip(wanted) {
             r.copy_from_slice(&h[k * w..(k + 1) * w]);
         }
         let hidden = grow(&mut s.q_hidden, wanted.len() * w);
-        self.q1_node.apply(simd, &s.z, wanted.len(), false, hidden);
+        q1_node.apply(simd, &s.z, wanted.len(), false, hidden);
         for (o, row) in out.iter_mut().zip(hidden.chunks_exact(w)) {
-            let mut q = self.q2.b[0];
-            for ((r, p), v) in row.iter().zip(&s.mean[..w]).zip(&self.q2.w) {
+            let mut q = q2.b[0];
+            for ((r, p), v) in row.iter().zip(&s.mean[..w]).zip(&q2.w) {
                 q += (r + p).max(0.0) * v;
             }
             *o = q;
@@ -565,6 +674,7 @@ impl QNet {
 struct Forward<'a> {
     net: &'a QNet,
     x: &'a [f32],
+    h0: Option<&'a [f32]>,
     n: usize,
     sources: &'a [u32],
     targets: &'a [u32],
@@ -579,8 +689,8 @@ impl pulp::WithSimd for Forward<'_> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
-        let Forward { net, x, n, sources, targets, edges, wanted, out, s } = self;
-        net.forward_any(simd, x, n, sources, targets, edges, wanted, out, s);
+        let Forward { net, x, h0, n, sources, targets, edges, wanted, out, s } = self;
+        net.forward_any(simd, x, h0, n, sources, targets, edges, wanted, out, s);
     }
 }
 

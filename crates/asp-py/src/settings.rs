@@ -221,10 +221,10 @@ mod tests {
         let e = |json: &str| -> Error { PlanRequest::from_json(json).and_then(|r| asp_app::resolve(&r)).map(|_| ()).unwrap_err().into() };
         let err = e(r#"{"order": "sideways"}"#);
         assert_eq!(err.kind, Kind::Config);
-        assert_eq!(err.message, "order: unknown order 'sideways' (use given, shuffled, random, bookkeeping, gnn)");
+        assert_eq!(err.message, "order: unknown order 'sideways' (use auto, given, shuffled, random, bookkeeping, gnn)");
         let err = e(r#"{"objective": "access", "timeout": 5}"#);
         assert_eq!(err.message, "timeout: applies to the feasibility search only (without objective); the optimiser's limit is time_limit");
         assert_eq!(kind_of::<()>(Err(e(r#"{"order": "gnn", "model": "/no/such/model.onnx"}"#))), Some(Kind::Config));
-        assert_eq!(order_names(), ["given", "shuffled", "random", "bookkeeping", "gnn"]);
+        assert_eq!(order_names(), ["auto", "given", "shuffled", "random", "bookkeeping", "gnn"]);
     }
 }

@@ -86,7 +86,7 @@ def _parser() -> argparse.ArgumentParser:
 
     pl = sub.add_parser("plan", help="plan every model (asp plan --json)")
     _models(pl)
-    pl.add_argument("--order", help="part ordering: given, shuffled, random, bookkeeping, gnn (default given)")
+    pl.add_argument("--order", help="part ordering: auto, given, shuffled, random, bookkeeping, gnn (default auto)")
     pl.add_argument("--model", help="removability model of --order gnn (default: the shipped one)")
     pl.add_argument("--bookkeeping", action="store_true", help="bookkeeping of blocked parts")
     pl.add_argument("--seed", type=int, help="seed of every random choice (default 0)")

@@ -152,7 +152,7 @@ mod tests {
     fn the_flags_parse_and_show_the_requests_defaults() {
         Cli::command().debug_assert();
         let help = show_defaults(Cli::command(), |_| false).find_subcommand_mut("plan").unwrap().render_long_help().to_string();
-        for shown in ["[default: 10]", "[default: 60", "[default: 1000]", "[default: 0.2]", "[default: strict]", "[default: given]"] {
+        for shown in ["[default: 10]", "[default: 60", "[default: 1000]", "[default: 0.2]", "[default: strict]", "[default: auto]"] {
             assert!(help.contains(shown), "{shown} missing from:\n{help}");
         }
         assert_eq!(flag("max_tests"), "--max-tests");

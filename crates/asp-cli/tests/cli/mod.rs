@@ -267,7 +267,30 @@ fn physics_stability_takes_the_keystone_before_a_pillar() {
     // contact graph: a pillar may go first (the keystone still touches the other one)
     assert_eq!(order(&[]), vec![1, 3, 2]);
     // physics: a keystone on one pillar tips over, so it must leave first
-    assert_eq!(order(&["--stability", "physics"]), vec![3, 1, 2]);
+    assert_eq!(order(&["--stability", "physics", "--order", "given"]), vec![3, 1, 2]);
+    // the default under physics (`auto`: gnn with bookkeeping) ranks the pillars its own way
+    assert_eq!(order(&["--stability", "physics"])[0], 3);
+}
+
+/// Issue 26 item 3: the default ordering (`auto`) is the learned ordering with bookkeeping under
+/// `--stability physics`, decided from the checker and not from a clock: the same seed gives
+/// the same plan and the same tests, twice, as `--order gnn --bookkeeping` does.
+#[test]
+fn issue_26_the_default_ordering_under_physics_is_gnn_with_bookkeeping_and_repeats() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = fixture_file(dir.path(), &fixtures::figure_6_2(1.0), "fig.glb");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["plan", model.to_str().unwrap(), "--json", "--stability", "physics", "--seed", "5"];
+        args.extend_from_slice(extra);
+        let o = asp(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (plan["disassembly_sequence"].clone(), plan["stats"]["removal_tests"].clone())
+    };
+    let auto = run(&[]);
+    assert_eq!(run(&["--order", "auto"]), auto);
+    assert_eq!(run(&[]), auto, "the same seed gives the same plan");
+    assert_eq!(run(&["--order", "gnn", "--bookkeeping"]), auto);
 }
 
 #[test]

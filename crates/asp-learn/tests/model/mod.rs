@@ -192,3 +192,62 @@ fn inconsistent_inputs_are_errors_not_panics() {
     bad[4] = -1;
     assert!(msg(model.score(&x, 4, &bad, 3, &ea)).contains("edge_index[1][1] = -1 is not a node"));
 }
+
+/// The Rust forward pass of a removability model on one graph, every node.
+fn fast_score(model: &RemovabilityModel, x: &[f32], n: usize, edge_index: &[i64], edge_attr: &[f32]) -> Vec<f32> {
+    let net = model.fast_net().expect("the trainer's architecture has a Rust forward pass");
+    let wanted: Vec<usize> = (0..n).collect();
+    let mut out = vec![0.0; n];
+    net.forward_graph(x, n, edge_index, edge_attr, &wanted, &mut out, &mut asp_learn::qnet::Scratch::default());
+    out
+}
+
+#[test]
+fn the_rust_forward_pass_matches_pytorch_and_tract() {
+    let shipped = RemovabilityModel::from_bytes(asp_learn::SHIPPED_MODEL, "shipped").unwrap();
+    let random = RemovabilityModel::load(fixture("random_gnn.onnx"), FEATURES, 74, 152).unwrap();
+    let dense = RemovabilityModel::load(fixture("random_gnn_dense.onnx"), FEATURES, 74, 152).unwrap();
+    // PyTorch's outputs
+    for (model, file) in [(&shipped, "shipped_cases.json"), (&random, "random_gnn_cases.json"), (&dense, "random_gnn_cases.json")] {
+        let mut worst = 0.0f32;
+        for case in &cases_of(file).cases {
+            let got = fast_score(model, &case.x, case.n, &case.edge_index, &case.edge_attr);
+            worst = worst.max(max_diff(&got, &case.removability));
+        }
+        assert!(worst <= 1e-4, "{file}: max abs diff to PyTorch {worst}");
+    }
+    // tract, on graphs of the sizes the search meets
+    for model in [&shipped, &random, &dense] {
+        for (k, (n, e)) in [(1, 0), (2, 1), (13, 40), (40, 160), (100, 500)].into_iter().enumerate() {
+            let (x, ei, ea) = graph(n, e, k as u64 + 11);
+            let want = model.score(&x, n, &ei, e, &ea).unwrap();
+            let got = fast_score(model, &x, n, &ei, &ea);
+            assert!(max_diff(&got, &want) <= 1e-4, "{model:?} n={n} e={e}: {}", max_diff(&got, &want));
+        }
+    }
+}
+
+#[test]
+fn the_rust_forward_pass_matches_tract_on_the_tiny_model() {
+    // other dimensions (6 node and 5 edge attributes) than the random fixtures
+    let tiny = RemovabilityModel::load(fixture("tiny_gnn.onnx"), "tiny/1", 6, 5).unwrap();
+    for (n, e, seed) in [(3usize, 4usize, 1u64), (12, 30, 2), (40, 160, 3)] {
+        let mut s = seed;
+        let mut next = move || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let x: Vec<f32> = (0..n * 6).map(|_| 2.0 * next()).collect();
+        let attr: Vec<f32> = (0..e * 5).map(|_| 2.0 * next() - 0.3).collect();
+        let ei: Vec<i64> = (0..2 * e).map(|_| (next() * n as f32) as i64 % n as i64).collect();
+        let want = tiny.score(&x, n, &ei, e, &attr).unwrap();
+        let got = fast_score(&tiny, &x, n, &ei, &attr);
+        assert!(max_diff(&got, &want) <= 1e-4, "n={n} e={e}: {}", max_diff(&got, &want));
+    }
+}
+
+#[test]
+fn a_q_model_has_no_removability_forward_pass() {
+    let q = asp_learn::GraphModel::open_kind(fixture("random_q_access.onnx"), asp_learn::ModelKind::Q).unwrap();
+    assert!(q.fast_net().is_none(), "a Q model is not a removability model");
+}

@@ -40,6 +40,20 @@ fn parts_are_tested_by_descending_score() {
 }
 
 #[test]
+fn a_single_candidate_costs_no_inference() {
+    let world = World::new(fixtures::figure_6_2(1.0), &WorldConfig::default()).unwrap();
+    let graph = Arc::new(AssemblyGraph::build(&world, &GraphConfig::default()).unwrap());
+    let mut ordering = GnnOrdering::new(graph.clone(), model()).unwrap();
+    let state = PartSet::full(graph.num_parts());
+    let mut one = vec![1];
+    ordering.order(&state, &mut one);
+    assert_eq!((one, ordering.skipped()), (vec![1], 1));
+    let mut two = vec![0, 1];
+    ordering.order(&state, &mut two);
+    assert_eq!(ordering.skipped(), 1, "two candidates are ranked");
+}
+
+#[test]
 fn equal_scores_keep_the_incoming_order() {
     // four isolated parts with identical attributes score the same
     let config = GraphConfig::default();
@@ -82,4 +96,59 @@ fn other_features_are_refused() {
     let world = World::new(fixtures::stacked_boxes(), &WorldConfig::default()).unwrap();
     let graph = Arc::new(AssemblyGraph::build(&world, &config).unwrap());
     assert!(GnnFactory::new(graph, model()).is_err());
+}
+
+#[test]
+fn cached_encodings_score_every_state_as_tract_does() {
+    let shipped = Arc::new(RemovabilityModel::from_bytes(asp_learn::SHIPPED_MODEL, "shipped").unwrap());
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let config = GraphConfig::default();
+    let (f, nd, ed) = (config.features(), config.node_dim(), config.edge_dim());
+    let random = Arc::new(RemovabilityModel::load(dir.join("random_gnn.onnx"), &f, nd, ed).unwrap());
+    let dense = Arc::new(RemovabilityModel::load(dir.join("random_gnn_dense.onnx"), &f, nd, ed).unwrap());
+    let mut graphs: Vec<Arc<AssemblyGraph>> = [fixtures::figure_6_2(1.0), fixtures::hooked_bracket(), fixtures::dowel_in_two_boards()]
+        .into_iter()
+        .map(|a| Arc::new(AssemblyGraph::build(&World::new(a, &WorldConfig::default()).unwrap(), &config).unwrap()))
+        .collect();
+    // a synthetic 100-part graph: each part touches its next three (both directions)
+    let mut s = 7u64;
+    let mut next = move || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let parts = 100;
+    let mut edges: Vec<(usize, usize)> =
+        (0..parts).flat_map(|i| (1..=3).flat_map(move |d| [(i, (i + d) % parts), ((i + d) % parts, i)])).collect();
+    edges.sort();
+    edges.dedup();
+    let nodes: Vec<f32> = (0..parts * nd).map(|_| 3.0 * next()).collect();
+    let attr: Vec<f32> = (0..edges.len() * ed).map(|_| 2.0 * next()).collect();
+    graphs.push(Arc::new(AssemblyGraph::from_parts(&config, nodes, edges, attr).unwrap()));
+    for model in [&shipped, &random, &dense] {
+        for graph in &graphs {
+            let mut ordering = GnnOrdering::new(graph.clone(), model.clone()).unwrap();
+            assert!(ordering.is_fast());
+            let n = graph.num_parts();
+            let mut state = PartSet::full(n);
+            // the full state, then removals one by one (a part drawn from the present ones)
+            for _ in 0..n.min(12) {
+                let want = model.score_graph_tract(&graph.state(&state)).unwrap();
+                let got = ordering.scores(&state).unwrap().to_vec();
+                let present: Vec<usize> = state.iter().filter(|&i| i < n).collect();
+                for (&part, &w) in present.iter().zip(&want) {
+                    assert!((got[part] - w).abs() <= 1e-4, "{model:?} part {part} of {present:?}: {} vs tract {w}", got[part]);
+                }
+                // the cached path gives the bits of the uncached Rust pass on a built state graph
+                let built = model.score_graph(&graph.state(&state)).unwrap();
+                for (&part, &b) in present.iter().zip(&built) {
+                    assert_eq!(got[part].to_bits(), b.to_bits());
+                }
+                assert_eq!(got.iter().filter(|v| v.is_finite()).count(), present.len());
+                if present.len() <= 1 {
+                    break;
+                }
+                state = state.without(present[(next() * present.len() as f32) as usize % present.len()]);
+            }
+        }
+    }
 }
