@@ -159,7 +159,7 @@ const LOCAL_SAMPLES_CAP: usize = 20_000;
 /// Samples of `mesh` (a part whose box is `own`) near another part (box `other`), moved inward
 /// by `depth`: the mesh's surface clipped to the two boxes' intersection grown by a quarter of
 /// its largest extent (at least four `depth`s), sampled about a tenth of the intersection's
-/// smallest extent apart (at least two `depth`s; at most [`LOCAL_SAMPLES_CAP`] points). Where a
+/// smallest extent apart (at least two `depth`s; at most 20,000 points). Where a
 /// small part is drawn into a large one (a dowel in a solid panel), the whole-surface samples
 /// are too sparse to see the small part cut sideways through the large one's surface next to
 /// it; these see it at the scale of the overlap. Empty when the boxes do not meet.
