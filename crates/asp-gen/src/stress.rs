@@ -123,7 +123,7 @@ fn b(mins: [f64; 3], maxs: [f64; 3]) -> Cuboid {
 }
 
 impl StressCase {
-    /// Generates the case of `kind` for `seed`.
+    /// Generates the case of `kind`, its sizes, counts and fits drawn from `rng`.
     pub fn generate(kind: StressKind, rng: &mut impl Rng) -> StressCase {
         match kind {
             StressKind::Chair => chair(rng),
