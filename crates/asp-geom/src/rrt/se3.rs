@@ -210,7 +210,7 @@ fn search(world: &World, part: usize, state: &PartSet, config: &RrtConfig, seed:
     };
     match connect_trees(&space, &[identity], &goals, &growth, &mut rng) {
         Some(path) => {
-            let path = shortcut(&space, path, 0, &mut rng);
+            let path = shortcut(&space, path);
             let poses = path.iter().map(|q| space.pose(q)).collect();
             Ok(Motion::Path { poses, pivot: space.centre })
         }

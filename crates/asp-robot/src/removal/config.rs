@@ -46,7 +46,7 @@ impl Default for RemovalConfig {
             path_grasps: 6,
             ik: IkConfig { max_iterations: 60, restarts: 3, position_tolerance: 1e-4, rotation_tolerance: 1e-3, ..IkConfig::default() },
             grasp: GraspConfig::default(),
-            rrt: RrtConnectConfig { step: 0.4, max_iterations: 1500, shortcut_attempts: 40, seed: 0 },
+            rrt: RrtConnectConfig { step: 0.4, max_iterations: 1500, seed: 0 },
             edge_resolution: 0.01,
             check_resolution: 0.002,
             margin: 0.001,
