@@ -649,23 +649,36 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
             tried += 1;
             counters.add(C::Planned, 1);
             let fine = ArmSpace::new(self, p, &shrunk, grasp_pose, g.width, &obstacles, self.config.check_resolution);
+            let repair = ArmSpace::new(self, p, &shrunk, grasp_pose, g.width, &obstacles, self.config.repair_resolution);
             for r in 0..replans.max(1) {
                 let cfg = RrtConnectConfig {
                     seed: seed ^ ((gi as u64) << 20) ^ (r as u64).wrapping_mul(0x5851_f42d_4c95_7f2d),
                     ..self.config.rrt.clone()
                 };
-                let Ok(path) = counters.timed(C::Rrt, || rrt_connect(&space, &ql, &qd, &cfg)) else { continue };
-                let mut joints = vec![qg.clone()];
-                joints.extend(path);
-                // the length first (forward kinematics only): a path that cannot be the best
-                // needs no re-check
-                let kept = counters.timed(C::Recheck, || {
-                    let length = fine.tool_travel(&joints);
-                    let better = length < best.as_ref().map_or(below, |b| b.length);
-                    (better && joints.windows(2).all(|w| fine.edge_valid(&w[0], &w[1]))).then_some(length)
-                });
-                if let Some(length) = kept {
-                    let gripper_path = space.tool_samples(&joints);
+                // the tree on coarse edges; when the fine re-check refuses its path, once more
+                // on the repair resolution's edges (same seed)
+                let mut kept = None;
+                for (attempt, tree) in [&space, &repair].into_iter().enumerate() {
+                    let Ok(path) = counters.timed(C::Rrt, || rrt_connect(tree, &ql, &qd, &cfg)) else { break };
+                    let mut joints = vec![qg.clone()];
+                    joints.extend(path);
+                    // the length first (forward kinematics only): a path that cannot be the
+                    // best needs no re-check
+                    let (length, better, valid) = counters.timed(C::Recheck, || {
+                        let length = fine.tool_travel(&joints);
+                        let better = length < best.as_ref().map_or(below, |b| b.length);
+                        (length, better, better && joints.windows(2).all(|w| fine.edge_valid(&w[0], &w[1])))
+                    });
+                    if valid {
+                        kept = Some((joints, length));
+                    } else if better && attempt == 0 {
+                        counters.add(C::Refused, 1);
+                        continue;
+                    }
+                    break;
+                }
+                if let Some((joints, length)) = kept {
+                    let gripper_path = repair.tool_samples(&joints);
                     best = Some(RobotRemoval {
                         grasp: g.clone(),
                         grasp_index: gi,

@@ -40,9 +40,12 @@ pub struct PlanStats {
     pub held_checks: u64,
     /// Edge samples not tested because the clearance at an earlier sample proved them free.
     pub skipped_samples: u64,
+    /// Paths of the coarse tree the fine re-check refused (each planned again on the repair
+    /// resolution's edges).
+    pub rechecks_refused: u64,
 }
 
-pub(super) const N_COUNTERS: usize = 16;
+pub(super) const N_COUNTERS: usize = 17;
 
 #[derive(Default)]
 pub(super) struct Counters([AtomicU64; N_COUNTERS]);
@@ -65,6 +68,7 @@ pub(super) enum C {
     RobotChecks,
     HeldChecks,
     Skipped,
+    Refused,
 }
 
 impl Counters {
@@ -105,6 +109,7 @@ impl Counters {
             robot_checks: v(C::RobotChecks),
             held_checks: v(C::HeldChecks),
             skipped_samples: v(C::Skipped),
+            rechecks_refused: v(C::Refused),
         }
     }
 }

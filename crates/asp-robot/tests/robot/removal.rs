@@ -473,3 +473,33 @@ fn the_recheck_refuses_a_path_through_a_part() {
     let beside = with("beside", Vec3::new(0.25, 0.15, 0.5), 0.02);
     recheck(&beside, &cell, 1, &PartSet::full(3), &r, 0.003).expect("a box off the way is no obstacle");
 }
+
+/// Coarse tree edges cost no removal: a path the fine re-check refuses is planned again on the
+/// repair resolution's edges. With tree edges so coarse (0.3 m) that their paths are often
+/// refused, every top profile of the frame the default planner takes out is still taken out,
+/// by a path the independent re-check accepts, and the repair did happen.
+#[test]
+fn a_path_the_fine_recheck_refuses_is_planned_again_on_finer_edges() {
+    let world = World::new(profiles(), &WorldConfig::default()).unwrap();
+    let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
+    // one planned grasp, one plan: a refused path is not made up for by another grasp
+    let one = RemovalConfig { path_grasps: 1, ..RemovalConfig::default() };
+    let default = RemovalPlanner::new(&world, cell.clone(), one.clone());
+    let coarse = RemovalPlanner::new(&world, cell.clone(), RemovalConfig { edge_resolution: 0.3, ..one });
+    let state = PartSet::full(world.num_parts());
+    let mut planned = 0;
+    for p in 0..world.num_parts() {
+        if world.fixed().contains(p) {
+            continue;
+        }
+        let Some(d) = lift_direction(&world, p, &state).filter(|d| d.z > 0.9) else { continue };
+        if default.plan(p, &state, d, 5, 1).is_err() {
+            continue;
+        }
+        let r = coarse.plan(p, &state, d, 5, 1).unwrap_or_else(|f| panic!("part {p}: the coarse planner failed: {f:?}"));
+        recheck(&world, &cell, p, &state, &r, 0.003).unwrap_or_else(|e| panic!("part {p}: {e}"));
+        planned += 1;
+    }
+    assert!(planned >= 3, "only {planned} parts planned");
+    assert!(coarse.stats().rechecks_refused > 0, "no coarse path was refused: the test shows nothing ({:?})", coarse.stats());
+}
