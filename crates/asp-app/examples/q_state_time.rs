@@ -55,11 +55,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     println!(
-        "{}: {} parts, {} directions, Rust forward pass: {}; {timed} states (mean {:.1} parts present, {:.1} actions): {:.3} ms per state",
+        "{}: {} parts, {} directions, Rust forward pass: {:?}; {timed} states (mean {:.1} parts present, {:.1} actions): {:.3} ms per state",
         model,
         maps.num_parts(),
         maps.num_directions(),
-        q.rust_forward().is_ok(),
+        q.rust_forward(),
         parts_total as f64 / timed as f64,
         actions_total as f64 / timed as f64,
         seconds / timed as f64 * 1e3
