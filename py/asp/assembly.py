@@ -345,6 +345,12 @@ class Assembly:
         contact_distance: float | None = None,
         overlaps: str = "strict",
         neighbours: int = 8,
+        robot: str | None = None,
+        robot_base: str | Sequence[float] | None = None,
+        drop_off: str | Sequence[float] | None = None,
+        replans: int | None = None,
+        package_path: Sequence[str] | None = None,
+        allow_outside_files: bool | None = None,
     ) -> QGraphs:
         """The distance maps and optimisation problem of this model (as :meth:`plan` with
         ``objective`` builds them), as a :class:`QGraphs` that gives the graph of any optimiser
@@ -358,6 +364,10 @@ class Assembly:
         :param contact_distance: as in :meth:`plan`.
         :param overlaps: as in :meth:`plan`.
         :param neighbours: nearest parts each part node gets an edge from (``K``).
+        :param robot: the robot of :meth:`plan` (with ``robot_base``, ``drop_off``, ``replans``,
+            ``package_path``, ``allow_outside_files``): needed for the objective ``robot-path``;
+            the graphs do not depend on it (a data set of ``asp collect transitions --robot``
+            records these keywords).
         :raises ConfigError: an unknown objective or a bad value.
         """
         settings = {
@@ -369,6 +379,12 @@ class Assembly:
             "contact_distance": contact_distance,
             "overlaps": overlaps,
             "neighbours": neighbours,
+            "robot": robot,
+            "robot_base": None if robot_base is None or isinstance(robot_base, str) else list(robot_base),
+            "drop_off": None if drop_off is None or isinstance(drop_off, str) else list(drop_off),
+            "replans": replans,
+            "package_path": None if package_path is None else list(package_path),
+            "allow_outside_files": allow_outside_files,
         }
         return QGraphs(self._native.q_graphs(settings))
 

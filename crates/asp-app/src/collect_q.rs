@@ -91,6 +91,12 @@ pub struct MapsArgs {
     pub contact_distance: Option<f64>,
     /// The overlap policy: `strict`, `lenient` or `error`.
     pub overlaps: String,
+    /// The robot's keys (`robot`, `robot_base`, `drop_off`, `replans`, `package_path`,
+    /// `allow_outside_files`) when the search had one (`--robot`): its filter shaped the
+    /// recorded actions and `robot-path` needs it. Absent without a robot; a URDF file is named
+    /// by its absolute path.
+    #[serde(flatten)]
+    pub robot: serde_json::Map<String, serde_json::Value>,
 }
 
 /// One model's entry in `index.json`.
@@ -314,6 +320,7 @@ fn model_entry(
             tolerance: plan.tolerance,
             contact_distance: plan.contact_distance,
             overlaps: plan.overlaps.name().into(),
+            robot: robot_keys(o),
         },
         parts: maps.num_parts(),
         removable: problem.removals(),
@@ -322,6 +329,19 @@ fn model_entry(
         capped: false,
         episodes_run: 0,
     })
+}
+
+/// The robot's request keys of `o`, a URDF file's path made absolute (the data set is read
+/// from another folder).
+fn robot_keys(o: &OptimiseSettings) -> serde_json::Map<String, serde_json::Value> {
+    let mut keys = o.robot_keys.clone();
+    if let Some(serde_json::Value::String(name)) = keys.get("robot") {
+        let is_catalogued = crate::catalogue::ROBOTS.iter().any(|r| r.name == name);
+        if let (false, Ok(path)) = (is_catalogued, std::fs::canonicalize(name)) {
+            keys.insert("robot".into(), path.display().to_string().into());
+        }
+    }
+    keys
 }
 
 /// The `index.json` of a data set holding the transitions of one model searched on `problem`

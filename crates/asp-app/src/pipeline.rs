@@ -191,6 +191,11 @@ pub struct OptimiseSettings {
     /// The rollout and expansion policy, made for the problem (default: uniformly random; e.g.
     /// ε-greedy over learned Q-functions, [`crate::catalogue::QPolicy`]).
     pub policy: Option<Arc<dyn PolicySource>>,
+    /// The request keys of the robot that `extensions` were built from (`robot`, `robot_base`,
+    /// `drop_off`, `replans`, `package_path`, `allow_outside_files`, as given; empty without a
+    /// robot): a transitions data set records them, so that `Assembly.q_graphs` rebuilds the
+    /// same problem ([`crate::collect_q::MapsArgs`]).
+    pub robot_keys: serde_json::Map<String, serde_json::Value>,
 }
 
 impl Default for OptimiseSettings {
@@ -209,6 +214,7 @@ impl Default for OptimiseSettings {
             support: Support::Below,
             extensions: Vec::new(),
             policy: None,
+            robot_keys: serde_json::Map::new(),
         }
     }
 }

@@ -306,7 +306,28 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
         },
         extensions,
         policy,
+        robot_keys: robot_keys(r),
     }))
+}
+
+/// The robot's keys of `r` as given (none without `robot`), for [`OptimiseSettings::robot_keys`].
+fn robot_keys(r: &PlanRequest) -> serde_json::Map<String, Value> {
+    let mut keys = serde_json::Map::new();
+    if r.robot.is_none() {
+        return keys;
+    }
+    if let Ok(Value::Object(all)) = serde_json::to_value(r) {
+        for key in ["robot", "robot_base", "drop_off", "replans", "package_path", "allow_outside_files"] {
+            match all.get(key) {
+                None | Some(Value::Null) => {}
+                Some(Value::Array(v)) if v.is_empty() => {}
+                Some(v) => {
+                    keys.insert(key.into(), v.clone());
+                }
+            }
+        }
+    }
+    keys
 }
 
 /// Every setting's default, by key, as the searches use them (`null`: none, or derived from the

@@ -63,6 +63,7 @@ fn transitions(a: &TransitionsArgs) -> anyhow::Result<std::process::ExitCode> {
         extra.insert("pareto".into(), true.into());
     }
     crate::flags::put!(extra, a, budget, resolution, d_max, support);
+    a.robot.put(&mut extra);
     let mut plan = model_settings(&a.load, extra)?;
     let optimise = plan.optimise.take().context("--objective")?;
     let settings = TransitionSettings { seed: a.seed, plan, optimise, limit: a.max_transitions };

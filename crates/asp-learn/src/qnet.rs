@@ -259,6 +259,7 @@ impl QNet {
     }
 
     fn read(model: &GraphModel, removability: bool) -> std::result::Result<Self, String> {
+        const ENCODER_PREFIX: &str = "encoder.";
         let (node_dim, edge_dim) = (model.node_dim(), model.edge_dim());
         let meta = |key: &str| -> std::result::Result<usize, String> {
             model.metadata().get(key).and_then(|v| v.parse().ok()).ok_or_else(|| format!("no integer metadata '{key}'"))
@@ -267,8 +268,13 @@ impl QNet {
         if width == 0 || layers == 0 {
             return Err("asp.width and asp.layers must be positive".into());
         }
+        // the trainer's names: the encoder's parameters at the top (the first trainers) or under
+        // `encoder.` (`QNetwork` and `RemovabilityGNN` compose a `GraphEncoder`)
         let tensor = |name: &str, dims: &[usize]| -> std::result::Result<Vec<f32>, String> {
-            let (shape, data) = model.initializer(name).ok_or_else(|| format!("no float tensor '{name}'"))?;
+            let (shape, data) = model
+                .initializer(name)
+                .or_else(|| model.initializer(&format!("{ENCODER_PREFIX}{name}")))
+                .ok_or_else(|| format!("no float tensor '{name}'"))?;
             if shape != dims {
                 return Err(format!("tensor '{name}' has shape {shape:?}, expected {dims:?}"));
             }
@@ -298,7 +304,7 @@ impl QNet {
         // a missing mask is no log1p column (the exporter keeps the buffers; a file without
         // them and with Log ops fails the self-check)
         let mask = |name: &str, dim: usize| -> std::result::Result<Vec<bool>, String> {
-            match model.bool_initializer(name) {
+            match model.bool_initializer(name).or_else(|| model.bool_initializer(&format!("{ENCODER_PREFIX}{name}"))) {
                 None => Ok(vec![false; dim]),
                 Some(m) if m.len() == dim => Ok(m.to_vec()),
                 Some(m) => Err(format!("mask '{name}' has {} entries, expected {dim}", m.len())),

@@ -165,12 +165,26 @@ pub fn graph_settings(dict: &Bound<'_, PyDict>) -> Result<GraphSettings, Error> 
 }
 
 /// The request keys of [`q_graph_settings`]: the world's and the optimiser's that shape the
-/// maps and the MDP.
-const Q_GRAPH_REQUEST_KEYS: [&str; 7] = ["objective", "resolution", "d_max", "support", "tolerance", "contact_distance", "overlaps"];
+/// maps and the MDP, and the robot's (the objective `robot-path` needs one).
+const Q_GRAPH_REQUEST_KEYS: [&str; 13] = [
+    "objective",
+    "resolution",
+    "d_max",
+    "support",
+    "tolerance",
+    "contact_distance",
+    "overlaps",
+    "robot",
+    "robot_base",
+    "drop_off",
+    "replans",
+    "package_path",
+    "allow_outside_files",
+];
 
 /// The settings of `asp.Assembly.q_graphs`' keywords: the world's (tolerance, contact distance,
 /// overlaps), the optimiser's that shape the maps and the MDP (objective, resolution, `d_max`,
-/// support), and the neighbours per part node (default 8).
+/// support), the robot's, and the neighbours per part node (default 8).
 pub fn q_graph_settings(dict: &Bound<'_, PyDict>) -> Result<(PlanSettings, asp_app::OptimiseSettings, usize), Error> {
     let [mut request, own] = split(dict, &Q_GRAPH_REQUEST_KEYS, &["neighbours"])?;
     let neighbours = count(&own, "neighbours")?.unwrap_or(asp_search::qgraph::DEFAULT_NEIGHBOURS);

@@ -522,6 +522,11 @@ impl Objective for RobotPath {
     fn worst_total(&self, _maps: &DistanceMaps, removals: usize) -> f64 {
         -LENGTH_BOUND * removals as f64
     }
+
+    fn reward_range(&self, _maps: &DistanceMaps) -> Option<(f64, f64)> {
+        // a step's reward is minus a path length, never below the bound a failing step costs
+        Some((-LENGTH_BOUND, 0.0))
+    }
 }
 
 /// The optimiser's extension: one [`RobotModel`] per model, shared by the filter and the

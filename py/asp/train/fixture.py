@@ -16,10 +16,11 @@ Writes into the folder:
   edges) with PyTorch's outputs, inputs written as shortest float32 decimals;
 * ``tiny_gnn.onnx``: a 1-layer, 8-wide model with ``node_dim`` 6, ``edge_dim`` 5 and features
   ``tiny/1``, for the tests that a model of other dimensions is refused;
-* ``random_q_access.onnx``, ``random_q_dirchange.onnx``: :class:`~asp.train.q.QNetwork` Q models
-  (3 layers, 32 wide, features ``asp-q/1 directions=25 neighbours=8``, for maps of resolution 5)
-  briefly fitted to a random target on synthetic state graphs, so their values differ between
-  parts; ``--only q`` writes just these two.
+* ``random_q_access.onnx``, ``random_q_dirchange.onnx``, ``random_q_robot-path.onnx``:
+  :class:`~asp.train.q.QNetwork` Q models (3 layers, 32 wide, features ``asp-q/1 directions=25
+  neighbours=8``, for maps of resolution 5) briefly fitted to a random target on synthetic state
+  graphs, so their values differ between parts; ``--only q`` writes just these three,
+  ``--only q --objective NAME`` just one of them.
 """
 
 from __future__ import annotations
@@ -115,15 +116,21 @@ def write_fixtures(out: Path) -> None:
 Q_FEATURES = "asp-q/1 directions=25 neighbours=8"
 
 
-def write_q_fixtures(out: Path) -> None:
-    """Write the two Q-model fixtures into ``out``."""
+#: The objectives of the Q-model fixtures (each seeded by its position, so adding one changes no other).
+Q_OBJECTIVES = ("access", "dirchange", "robot-path")
+
+
+def write_q_fixtures(out: Path, only: str | None = None) -> None:
+    """Write the Q-model fixtures into ``out`` (all of :data:`Q_OBJECTIVES`, or ``only`` that one)."""
     from .q import QNetwork, export_q, synthetic_q_graph
 
     out.mkdir(parents=True, exist_ok=True)
     torch.set_num_threads(1)
     directions, neighbours = 25, 8
     node_dim, edge_dim = 28 + 2 * directions, 5 + 2 * directions
-    for k, objective in enumerate(("access", "dirchange")):
+    for k, objective in enumerate(Q_OBJECTIVES):
+        if only is not None and objective != only:
+            continue
         torch.manual_seed(SEED + 10 + k)
         rng = np.random.default_rng(SEED + 10 + k)
         graphs = []
@@ -159,10 +166,13 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m asp.train.fixture", description=__doc__.split("\n\n")[0])
     parser.add_argument("out", type=Path, help="folder to write the fixtures into")
     parser.add_argument("--only", choices=["q"], help="write only the Q-model fixtures")
+    parser.add_argument("--objective", choices=Q_OBJECTIVES, help="with --only q: write only this objective's Q model")
     args = parser.parse_args(argv)
+    if args.objective is not None and args.only != "q":
+        parser.error("--objective needs --only q")
     if args.only != "q":
         write_fixtures(args.out)
-    write_q_fixtures(args.out)
+    write_q_fixtures(args.out, args.objective)
     return 0
 
 

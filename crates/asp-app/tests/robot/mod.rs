@@ -371,3 +371,93 @@ fn the_feasibility_bench_runs_under_the_robot_checker() {
     let rows = asp_app::bench::bench_model(&path, "nf", &robot, &methods, 2).unwrap();
     assert!(rows.iter().all(|r| r.found == 0 && r.failed_collision.mean > 0.0), "{rows:?}");
 }
+
+/// The `robot-path` Q model fixture (`python -m asp.train.fixture --only q`: features `asp-q/1
+/// directions=25 neighbours=8`, for maps of resolution 5).
+fn robot_q_fixture() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../asp-learn/tests/data/random_q_robot-path.onnx")
+}
+
+/// The settings of a plan request given as JSON (the CLI's and Python's way in).
+fn resolved(json: &str) -> PlanSettings {
+    asp_app::resolve(&asp_app::PlanRequest::from_json(json).unwrap()).unwrap()
+}
+
+/// Issue 24 item 2: `asp collect transitions --robot panda --objective robot-path` records robot
+/// MCTS with the robot-path rewards, and its index rebuilds the same problem (robot included),
+/// as Python's `Assembly.q_graphs(**maps)` does.
+#[test]
+fn transitions_are_collected_under_the_robot_with_robot_path_rewards() {
+    use asp_app::collect_q::{collect_transitions, TransitionSettings};
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("blocks.glb");
+    asp_geom::io::write_glb(&blocks(), &model).unwrap();
+    let mut plan = resolved(
+        r#"{"objective": "robot-path", "robot": "panda", "drop_off": [0.1, 0.45, 0.3], "episodes": 2, "budget": 2, "resolution": 5}"#,
+    );
+    let optimise = plan.optimise.take().unwrap();
+    let settings = TransitionSettings { seed: 1, plan, optimise, ..TransitionSettings::default() };
+    let out = dir.path().join("q");
+    let index = collect_transitions(std::slice::from_ref(&model), &out, &settings, &|_| {}).unwrap();
+    assert_eq!(index.objectives, ["robot-path"]);
+    let entry = &index.assemblies[0];
+    assert_eq!(entry.reward_ranges, [[-20.0, 0.0]]);
+    assert_eq!((entry.removable, entry.episodes_run), (4, 2));
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("index.json")).unwrap()).unwrap();
+    let maps = &json["assemblies"][0]["maps"];
+    assert_eq!(
+        *maps,
+        serde_json::json!({"objective": "robot-path", "resolution": 5, "d_max": null, "support": "below", "tolerance": null,
+                           "contact_distance": null, "overlaps": "strict", "robot": "panda", "drop_off": [0.1, 0.45, 0.3]})
+    );
+    // every step is one the robot did: minus its path length, within the range
+    let text = std::fs::read_to_string(out.join(&entry.dir).join("transitions.jsonl")).unwrap();
+    let lines: Vec<serde_json::Value> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), entry.transitions);
+    assert!(lines.iter().any(|l| l["kind"] == "expansion") && lines.iter().any(|l| l["complete"] == true));
+    for l in &lines {
+        let r = l["rewards"][0].as_f64().unwrap();
+        assert!(r < 0.0 && r > -20.0, "{l}");
+    }
+    // the maps' keywords (plus what `q_graphs` adds) resolve to the same problem, robot included
+    let mut request = maps.as_object().unwrap().clone();
+    request.insert("pareto".into(), true.into());
+    let mut again = asp_app::resolve(&asp_app::PlanRequest::from_value(serde_json::Value::Object(request)).unwrap()).unwrap();
+    let o = again.optimise.take().unwrap();
+    assert_eq!(o.extensions.len(), 1);
+    let assembly = Arc::new(asp_app::pipeline::load(&model, &again).unwrap());
+    let p = asp_app::pipeline::optimiser_problem(&assembly, &again, &o).unwrap().mdp;
+    assert_eq!(p.objective_names(), ["robot-path"]);
+    assert_eq!(asp_search::qgraph::QGraphConfig::for_maps(p.maps()).features(), index.features);
+}
+
+/// Issue 24 item 2: the optimiser under the robot guided by a `robot-path` Q model (ε-greedy
+/// rollouts, Q-ordered expansions): a plan whose paths re-check, the same for the same seed, and
+/// not the vanilla search's (greedy rollouts and expansions take other removals).
+#[test]
+fn the_optimiser_under_the_robot_is_guided_by_a_robot_path_q_model() {
+    let q = robot_q_fixture();
+    let base = r#""objective": "robot-path", "robot": "panda", "episodes": 2, "budget": 2, "resolution": 5, "threads": 1, "seed": 4"#;
+    let vanilla = plan_assembly(blocks(), &resolved(&format!("{{{base}}}")), None).unwrap();
+    let guided = resolved(&format!(r#"{{{base}, "q": {q:?}, "q_use": "both", "epsilon": 0}}"#));
+    assert_eq!(guided.optimise.as_ref().unwrap().policy.as_ref().unwrap().name(), "q");
+    let a = plan_assembly(blocks(), &guided, None).unwrap();
+    assert!(a.found(), "{:?}", a.report.explanation);
+    recheck_report(&blocks(), &a.report, &RobotSetup::panda());
+    let b = plan_assembly(blocks(), &guided, None).unwrap();
+    assert_eq!(without_times(&a.report), without_times(&b.report));
+    assert_ne!(without_times(&a.report), without_times(&vanilla.report));
+}
+
+/// Issue 24 item 2: a Q model of another objective is refused before the search, naming the file
+/// and both objectives; so is the robot-path model for another objective.
+#[test]
+fn a_q_model_of_another_objective_is_refused_under_the_robot() {
+    let access = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../asp-learn/tests/data/random_q_access.onnx");
+    for (objective, q, estimates) in [("robot-path", access, "access"), ("access", robot_q_fixture(), "robot-path")] {
+        let json = format!(r#"{{"objective": "{objective}", "robot": "panda", "episodes": 1, "resolution": 5, "q": {q:?}}}"#);
+        let e = plan_assembly(blocks(), &resolved(&json), None).unwrap_err().to_string();
+        assert!(e.starts_with("q: ") && e.contains(q.file_name().unwrap().to_str().unwrap()), "{e}");
+        assert!(e.contains(&format!("estimates objective '{estimates}'")) && e.contains(&format!("that of '{objective}'")), "{e}");
+    }
+}

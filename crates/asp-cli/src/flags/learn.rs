@@ -33,7 +33,8 @@ pub struct TransitionsArgs {
     /// The data set folder to write.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// The objectives (comma-separated: access, dirchange, pathlen); several run Pareto-MCTS.
+    /// The objectives (comma-separated: access, dirchange, pathlen, robot-path with --robot);
+    /// several run Pareto-MCTS.
     #[arg(long, value_name = "LIST")]
     pub objective: String,
     /// MCTS episodes per model (one search per model, one thread).
@@ -60,6 +61,10 @@ pub struct TransitionsArgs {
     /// Loading and testing.
     #[command(flatten)]
     pub load: ModelArgs,
+    /// A robot arm that must carry every removal out, as on `asp plan` (`--objective robot-path`
+    /// needs one).
+    #[command(flatten)]
+    pub robot: super::PlanRobotArgs,
 }
 
 /// Flags of `asp collect removability`.

@@ -291,6 +291,22 @@ fn collect_transitions_writes_the_documented_data_set() {
     let o = asp(&["collect", "transitions", models.to_str().unwrap(), "--objective", "access,speed", "--out", bad.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("--objective") && stderr(&o).contains("speed"), "{}", stderr(&o));
+    // the robot flags of `asp plan` (issue 24 item 2): robot-path needs --robot, a robot setting
+    // needs the robot, and the feasibility search's --grippers is refused; nothing is written
+    let m = models.to_str().unwrap();
+    for (flags, words) in [
+        (&["--objective", "robot-path"][..], "robot-path needs a robot (--robot panda or a URDF file)"),
+        (&["--objective", "access", "--drop-off", "0,0,1"][..], "--drop-off: needs a robot (--robot)"),
+        (&["--objective", "robot-path", "--robot", "panda", "--grippers", "2"][..], "--grippers: applies to the feasibility search only"),
+        (&["--objective", "robot-path", "--robot", "/no/such/arm.urdf"][..], "/no/such/arm.urdf"),
+    ] {
+        let mut args = vec!["collect", "transitions", m, "--out", bad.to_str().unwrap()];
+        args.extend_from_slice(flags);
+        let o = asp(&args);
+        assert_eq!(o.status.code(), Some(2), "{flags:?}");
+        assert!(stderr(&o).contains(words) && stderr(&o).trim().lines().count() == 1, "{flags:?}: {}", stderr(&o));
+        assert!(!bad.exists(), "{flags:?}");
+    }
 }
 
 #[test]

@@ -150,14 +150,16 @@ fn walk_states(p: &Mdp, walks: u64, mut visit: impl FnMut(&mut MapState<'_>, &[u
 
 #[test]
 fn the_rust_forward_pass_gives_tracts_values() {
-    // both fixtures (width 32, 3 layers), on a generated 4×4×4 Soma cube and a double-layer
+    // the fixtures (width 32, 3 layers), on a generated 4×4×4 Soma cube and a double-layer
     // profile assembly, in every state of random removal walks: the Rust forward pass with its
     // per-pair edge cache (one worker for all states, so cached pairs are reused across states)
     // against tract on the graph with its edge attributes
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
     let cube = asp_gen::SomaCube::random(4, &mut rng).unwrap().to_assembly(0.05, "soma4");
     let profiles = asp_gen::ProfileAssembly::generate(&asp_gen::ProfileParams::double_layer(), 901).unwrap().to_assembly("profiles");
-    for name in ["random_q_access.onnx", "random_q_dirchange.onnx"] {
+    // (`random_q_robot-path.onnx` comes from the trainer whose `QNetwork` composes a
+    // `GraphEncoder`: its encoder's parameters are named `encoder.*`, the others' at the top)
+    for name in ["random_q_access.onnx", "random_q_dirchange.onnx", "random_q_robot-path.onnx"] {
         let fast = OnnxQ::load(fixture(name), 25).unwrap();
         assert_eq!(fast.rust_forward(), Ok(()), "{name}");
         let tract = fast.clone().tract_only();
