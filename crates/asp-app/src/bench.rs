@@ -201,19 +201,21 @@ pub fn write_table(out: &mut impl std::io::Write, rows: &[BenchRow]) -> std::io:
 mod tests {
     use super::*;
 
+    const D: asp_learn::Checker = asp_learn::Checker::Default;
+
     #[test]
     fn method_lists_parse_and_bad_names_are_errors() {
-        let methods = parse_methods(default_methods(false), None).unwrap();
+        let methods = parse_methods(default_methods(false), None, D).unwrap();
         let names: Vec<(&str, bool)> = methods.iter().map(|m| (m.name.as_str(), m.bookkeeping)).collect();
         assert_eq!(names, [("vanilla", false), ("bk", true), ("random", false), ("random+bk", true)]);
         assert_eq!(methods[0].order.name(), "shuffled");
-        let err = parse_methods("vanilla,gnn+bk", Some(Path::new("/no/such/model.onnx"))).err().unwrap();
+        let err = parse_methods("vanilla,gnn+bk", Some(Path::new("/no/such/model.onnx")), D).err().unwrap();
         assert!(err.to_string().contains("/no/such/model.onnx"), "{err}");
-        let gnn = parse_methods("gnn+bk", None).unwrap();
+        let gnn = parse_methods("gnn+bk", None, D).unwrap();
         assert_eq!((gnn[0].order.name().as_str(), gnn[0].bookkeeping), ("gnn", true));
-        let err = parse_methods("vanilla,fastest", None).err().unwrap();
+        let err = parse_methods("vanilla,fastest", None, D).err().unwrap();
         assert!(err.to_string().contains("unknown method 'fastest'"), "{err}");
-        assert!(parse_methods(" , ", None).is_err());
+        assert!(parse_methods(" , ", None, D).is_err());
     }
 
     #[test]

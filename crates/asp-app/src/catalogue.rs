@@ -18,6 +18,10 @@ use asp_search::{BuiltinOrder, Mdp, OrderingSource, Policy};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// Builds an ordering from the model file (when it takes one and one is given) for a run whose
+/// removals `checker` decides.
+pub type BuildOrdering = fn(model: Option<&Path>, checker: asp_learn::Checker) -> Result<Arc<dyn OrderingSource>>;
+
 /// A named part ordering of the depth-first search (`order`).
 #[derive(Clone, Copy, Debug)]
 pub struct OrderingEntry {
@@ -31,7 +35,7 @@ pub struct OrderingEntry {
     pub takes_model: bool,
     /// Builds the ordering (with the model file, when it takes one and one is given) for a run
     /// whose removals the `checker` decides (a learned ordering needs a model of that checker).
-    pub build: fn(model: Option<&Path>, checker: asp_learn::Checker) -> Result<Arc<dyn OrderingSource>>,
+    pub build: BuildOrdering,
 }
 
 /// The part orderings, in the order the docs list them; the first is the default.
