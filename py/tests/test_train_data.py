@@ -246,3 +246,24 @@ def test_stacks_dataset_labels_follow_the_rule(tmp_path):
         covered[g.edge_index[1][above]] = True
         expected = (~covered) & g.mask
         np.testing.assert_array_equal(g.labels.astype(bool), expected)
+
+
+def test_checker_and_failure_reasons_are_read(tmp_path):
+    root = _small(tmp_path / "ds")
+    assert RemovabilityDataset.open(root).checker == "default"  # written without the key
+    index = json.loads((root / "index.json").read_text())
+    index["checker"] = "physics"
+    (root / "index.json").write_text(json.dumps(index))
+    lines = (root / "small" / "states.jsonl").read_text().splitlines()
+    first = json.loads(lines[0])
+    first.update(collision=[2], gravity=[3])
+    (root / "small" / "states.jsonl").write_text("\n".join([json.dumps(first), *lines[1:]]) + "\n")
+    ds = RemovabilityDataset.open(root)
+    assert ds.checker == "physics"
+    states = list(ds.states())
+    assert list(states[0].collision) == [2] and list(states[0].gravity) == [3]
+    assert len(states[1].collision) == 0 and len(states[1].gravity) == 0
+    index["checker"] = "magic"
+    (root / "index.json").write_text(json.dumps(index))
+    with pytest.raises(DataError, match="checker 'magic'"):
+        RemovabilityDataset.open(root)

@@ -130,3 +130,43 @@ def test_module_runs_as_a_program(stacks, tmp_path):
     rng = np.random.default_rng(0)
     y = run_onnx(out, rng.random((4, 10), dtype=np.float32), np.array([[0, 1], [1, 0]]), rng.random((2, 6), dtype=np.float32))
     assert y.shape == (4,)
+
+
+def _with_checker(src: Path, dst: Path, checker: str | None) -> Path:
+    """A copy of the data set ``src`` whose ``index.json`` names ``checker`` (none: the key removed)."""
+    import shutil
+
+    shutil.copytree(src, dst)
+    index = json.loads((dst / "index.json").read_text())
+    index.pop("checker", None)
+    if checker is not None:
+        index["checker"] = checker
+    (dst / "index.json").write_text(json.dumps(index))
+    return dst
+
+
+@pytest.mark.parametrize("checker", ["physics", None])
+def test_the_model_records_the_checker_of_its_labels(stacks, tmp_path, checker):
+    import onnx
+
+    data = _with_checker(stacks, tmp_path / "ds", checker)
+    out = tmp_path / "m.onnx"
+    assert main(["removability", str(data), "--out", str(out), "--epochs", "1", "--holdout", "d"]) == 0
+    meta = {p.key: p.value for p in onnx.load(str(out)).metadata_props}
+    # a data set from before the index named its checker was labelled by the default checker
+    expected = checker or "default"
+    assert meta["asp.checker"] == expected
+    assert json.loads(Path(str(out) + ".json").read_text())["checker"] == expected
+
+
+def test_data_sets_of_two_checkers_do_not_train_one_model(stacks, tmp_path, capsys):
+    a = _with_checker(stacks, tmp_path / "a", "physics")
+    b = _with_checker(stacks, tmp_path / "b", None)
+    # rename b's assemblies so only the checker differs
+    index = json.loads((b / "index.json").read_text())
+    for entry in index["assemblies"]:
+        entry["name"] = "b_" + entry["name"]
+    (b / "index.json").write_text(json.dumps(index))
+    assert main(["removability", str(a), str(b), "--out", str(tmp_path / "m.onnx"), "--epochs", "1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "labelled by the default checker" in err and "physics checker" in err, err

@@ -41,8 +41,10 @@ pub fn default_methods(learned: bool) -> &'static str {
 /// The methods of a comma-separated list: `vanilla` (the catalogue's `shuffled`), `bk` (vanilla
 /// with bookkeeping), or any ordering of the catalogue ([`crate::catalogue::ORDERINGS`]: `random`,
 /// `given`, `gnn`, ...), each optionally `+bk`. An ordering that reads a model (`gnn`) gets
-/// `model` (the shipped one when `None`), loaded only when the list names it.
-pub fn parse_methods(list: &str, model: Option<&Path>) -> Result<Vec<Method>> {
+/// `model` (the shipped one of `checker` when `None`), loaded only when the list names it; a
+/// model trained on another checker's labels than `checker` (the benchmark's
+/// [`PlanSettings::checker`]) is an error.
+pub fn parse_methods(list: &str, model: Option<&Path>, checker: asp_learn::Checker) -> Result<Vec<Method>> {
     let mut out = Vec::new();
     for name in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let (base, bookkeeping) = match name.strip_suffix("+bk") {
@@ -54,7 +56,7 @@ pub fn parse_methods(list: &str, model: Option<&Path>) -> Result<Vec<Method>> {
             let names: Vec<&str> = crate::catalogue::ORDERINGS.iter().map(|o| o.name).collect();
             AppError::config(format!("unknown method '{base}' (vanilla, bk, {}, each optionally +bk)", names.join(", ")))
         })?;
-        let order = (entry.build)(if entry.takes_model { model } else { None })?;
+        let order = (entry.build)(if entry.takes_model { model } else { None }, checker)?;
         out.push(Method { name: name.to_string(), order, bookkeeping: bookkeeping || entry.bookkeeping });
     }
     if out.is_empty() {
@@ -199,19 +201,21 @@ pub fn write_table(out: &mut impl std::io::Write, rows: &[BenchRow]) -> std::io:
 mod tests {
     use super::*;
 
+    const D: asp_learn::Checker = asp_learn::Checker::Default;
+
     #[test]
     fn method_lists_parse_and_bad_names_are_errors() {
-        let methods = parse_methods(default_methods(false), None).unwrap();
+        let methods = parse_methods(default_methods(false), None, D).unwrap();
         let names: Vec<(&str, bool)> = methods.iter().map(|m| (m.name.as_str(), m.bookkeeping)).collect();
         assert_eq!(names, [("vanilla", false), ("bk", true), ("random", false), ("random+bk", true)]);
         assert_eq!(methods[0].order.name(), "shuffled");
-        let err = parse_methods("vanilla,gnn+bk", Some(Path::new("/no/such/model.onnx"))).err().unwrap();
+        let err = parse_methods("vanilla,gnn+bk", Some(Path::new("/no/such/model.onnx")), D).err().unwrap();
         assert!(err.to_string().contains("/no/such/model.onnx"), "{err}");
-        let gnn = parse_methods("gnn+bk", None).unwrap();
+        let gnn = parse_methods("gnn+bk", None, D).unwrap();
         assert_eq!((gnn[0].order.name().as_str(), gnn[0].bookkeeping), ("gnn", true));
-        let err = parse_methods("vanilla,fastest", None).err().unwrap();
+        let err = parse_methods("vanilla,fastest", None, D).err().unwrap();
         assert!(err.to_string().contains("unknown method 'fastest'"), "{err}");
-        assert!(parse_methods(" , ", None).is_err());
+        assert!(parse_methods(" , ", None, D).is_err());
     }
 
     #[test]

@@ -9,7 +9,7 @@
 //!     help: "parts by decreasing width",
 //!     bookkeeping: false,
 //!     takes_model: false,
-//!     build: |_model| Ok(Arc::new(my_crate::WidestFirst)),
+//!     build: |_model, _checker| Ok(Arc::new(my_crate::WidestFirst)),
 //! },
 //! ```
 
@@ -17,6 +17,10 @@ use crate::error::{AppError, Result};
 use asp_search::{BuiltinOrder, Mdp, OrderingSource, Policy};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+/// Builds an ordering from the model file (when it takes one and one is given) for a run whose
+/// removals `checker` decides.
+pub type BuildOrdering = fn(model: Option<&Path>, checker: asp_learn::Checker) -> Result<Arc<dyn OrderingSource>>;
 
 /// A named part ordering of the depth-first search (`order`).
 #[derive(Clone, Copy, Debug)]
@@ -29,8 +33,9 @@ pub struct OrderingEntry {
     pub bookkeeping: bool,
     /// Whether it reads a model file (`model`).
     pub takes_model: bool,
-    /// Builds the ordering (with the model file, when it takes one and one is given).
-    pub build: fn(model: Option<&Path>) -> Result<Arc<dyn OrderingSource>>,
+    /// Builds the ordering (with the model file, when it takes one and one is given) for a run
+    /// whose removals the `checker` decides (a learned ordering needs a model of that checker).
+    pub build: BuildOrdering,
 }
 
 /// The part orderings, in the order the docs list them; the first is the default.
@@ -41,35 +46,35 @@ pub const ORDERINGS: &[OrderingEntry] = &[
         bookkeeping: false,
         takes_model: true,
         // the cheap case; `resolve` puts the learned ordering in for an expensive checker
-        build: |_| Ok(Arc::new(BuiltinOrder::Given)),
+        build: |_, _| Ok(Arc::new(BuiltinOrder::Given)),
     },
     OrderingEntry {
         name: "given",
         help: "the model's part order",
         bookkeeping: false,
         takes_model: false,
-        build: |_| Ok(Arc::new(BuiltinOrder::Given)),
+        build: |_, _| Ok(Arc::new(BuiltinOrder::Given)),
     },
     OrderingEntry {
         name: "shuffled",
         help: "one random order drawn from the seed at the start and kept (the thesis' vanilla AbD)",
         bookkeeping: false,
         takes_model: false,
-        build: |_| Ok(Arc::new(BuiltinOrder::Shuffled)),
+        build: |_, _| Ok(Arc::new(BuiltinOrder::Shuffled)),
     },
     OrderingEntry {
         name: "random",
         help: "a fresh random order in every state (from the seed and the state)",
         bookkeeping: false,
         takes_model: false,
-        build: |_| Ok(Arc::new(BuiltinOrder::Random)),
+        build: |_, _| Ok(Arc::new(BuiltinOrder::Random)),
     },
     OrderingEntry {
         name: "bookkeeping",
         help: "the given order with bookkeeping: a blocked part is retested only after a blocker is gone",
         bookkeeping: true,
         takes_model: false,
-        build: |_| Ok(Arc::new(BuiltinOrder::Given)),
+        build: |_, _| Ok(Arc::new(BuiltinOrder::Given)),
     },
     OrderingEntry {
         name: "gnn",
@@ -80,12 +85,20 @@ pub const ORDERINGS: &[OrderingEntry] = &[
     },
 ];
 
-/// The `gnn` ordering of `model`, or of the shipped model.
-pub fn gnn(model: Option<&Path>) -> Result<Arc<dyn OrderingSource>> {
-    Ok(Arc::new(match model {
-        Some(p) => asp_learn::GnnSource::load(p, asp_geom::graph::GraphConfig::default())?,
-        None => asp_learn::GnnSource::shipped()?,
-    }))
+/// The `gnn` ordering of `model`, or of the shipped model, for a run under `checker`: without a
+/// file, the shipped model trained on that checker's labels (the default checker's where none is
+/// shipped, [`asp_learn::shipped_model`]); a file trained on another checker's labels (its
+/// `asp.checker`; a file without it counts as `default`) is an error naming it and both checkers.
+pub fn gnn(model: Option<&Path>, checker: asp_learn::Checker) -> Result<Arc<dyn OrderingSource>> {
+    Ok(Arc::new(gnn_source(model, checker)?))
+}
+
+/// The source [`gnn`] orders with: `model`, or the shipped model of `checker`.
+pub fn gnn_source(model: Option<&Path>, checker: asp_learn::Checker) -> Result<asp_learn::GnnSource> {
+    Ok(match model {
+        Some(p) => asp_learn::GnnSource::load_for(p, asp_geom::graph::GraphConfig::default(), checker)?,
+        None => asp_learn::GnnSource::shipped_for(checker)?,
+    })
 }
 
 /// The ordering called `name`, or an error listing the names.
@@ -267,11 +280,11 @@ mod tests {
     #[test]
     fn orderings_build_by_name_and_unknown_names_list_the_known() {
         for o in ORDERINGS.iter().filter(|o| !o.takes_model) {
-            let source = (o.build)(None).unwrap();
+            let source = (o.build)(None, asp_learn::Checker::Default).unwrap();
             assert_eq!(source.name(), if o.name == "bookkeeping" { "given" } else { o.name });
         }
         let gnn = ordering("gnn").unwrap();
-        assert_eq!((gnn.build)(None).unwrap().name(), "gnn");
+        assert_eq!((gnn.build)(None, asp_learn::Checker::Default).unwrap().name(), "gnn");
         let e = ordering("sideways").unwrap_err().to_string();
         assert_eq!(e, "order: unknown order 'sideways' (use auto, given, shuffled, random, bookkeeping, gnn)");
         let files = asp_robot::RobotFiles::default();

@@ -93,6 +93,9 @@ pub struct Collected {
     pub seed: u64,
     /// Runs per model.
     pub runs: usize,
+    /// The checker whose tests labelled the states (`default`, `physics`; see
+    /// [`PlanSettings::checker`]). A data set written before this key labels for `default`.
+    pub checker: String,
     /// The models.
     pub assemblies: Vec<CollectedModel>,
 }
@@ -117,6 +120,38 @@ struct StateLine {
     step: usize,
     present: Vec<usize>,
     removable: Vec<usize>,
+    /// The labelled parts that are not removable because every straight candidate motion collides.
+    collision: Vec<usize>,
+    /// The labelled parts that could leave but leave the rest unstable (the stability check of
+    /// the data set's checker: contact graph or physics simulation).
+    gravity: Vec<usize>,
+}
+
+/// The checker whose labels a collection under `plan` records: the physics simulation under the
+/// physics stability check, else the default checker. Labels of the robot's checker are not
+/// collected (the arm's tests run inside the search only): a robot is an error.
+pub fn label_checker(plan: &PlanSettings) -> Result<asp_learn::Checker> {
+    if plan.checker == asp_learn::Checker::Robot {
+        return Err(AppError::setting("robot", "removability labels are collected without a robot (the default or physics checker)"));
+    }
+    Ok(match plan.stability {
+        pipeline::StabilitySetting::Physics { .. } => asp_learn::Checker::Physics,
+        pipeline::StabilitySetting::Contact => asp_learn::Checker::Default,
+    })
+}
+
+/// The label of every present, non-fixed part of `state` with the reason of each failure, as
+/// `(removable, collision, gravity)`.
+fn label_state(checker: &impl FeasibilityChecker, state: &PartSet) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let (mut removable, mut collision, mut gravity) = (Vec::new(), Vec::new(), Vec::new());
+    for p in state.iter().filter(|&p| !checker.is_fixed(p)) {
+        match checker.test_removal(p, state, MotionKind::Linear) {
+            Outcome::Removed(_) => removable.push(p),
+            Outcome::Collision { .. } => collision.push(p),
+            Outcome::Unstable { .. } => gravity.push(p),
+        }
+    }
+    (removable, collision, gravity)
 }
 
 /// The models named by `paths`: each `.glb`/`.gltf` file; a folder holding glTF files gives each
@@ -243,6 +278,7 @@ pub fn write_index(out: &Path, settings: &CollectSettings, assemblies: Vec<Colle
         edge_dim: settings.graph.edge_dim(),
         seed: settings.seed,
         runs: settings.runs,
+        checker: label_checker(&settings.plan)?.name().into(),
         assemblies,
     };
     write_json(&out.join("index.json"), &index)?;
@@ -264,6 +300,7 @@ pub fn collect_model(item: &ModelItem, out: &Path, settings: &CollectSettings) -
         return Err(AppError::config("the number of runs must be at least 1"));
     }
     settings.graph.validate()?;
+    label_checker(&settings.plan)?;
     let (path, m, name, dir) = (item.path.as_path(), item.index, item.name.as_str(), item.dir.as_str());
     let assembly = pipeline::load(path, &settings.plan)?;
     let checker = pipeline::checker(assembly, &settings.plan)?;
@@ -294,15 +331,9 @@ pub fn collect_model(item: &ModelItem, out: &Path, settings: &CollectSettings) -
             states
                 .iter()
                 .enumerate()
-                .map(|(step, state)| StateLine {
-                    run,
-                    step,
-                    present: state.iter().collect(),
-                    removable: state
-                        .iter()
-                        .filter(|&p| !checker.is_fixed(p))
-                        .filter(|&p| matches!(checker.test_removal(p, state, MotionKind::Linear), Outcome::Removed(_)))
-                        .collect(),
+                .map(|(step, state)| {
+                    let (removable, collision, gravity) = label_state(&checker, state);
+                    StateLine { run, step, present: state.iter().collect(), removable, collision, gravity }
                 })
                 .collect()
         })

@@ -154,11 +154,17 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         _ => entry.build,
     };
     let auto_bookkeeping = entry.name == "auto" && expensive_tests;
+    // which checker decides removals: a learned ordering needs a model trained on its labels
+    let checker = match (&robot, &stability) {
+        (Some(_), _) => asp_learn::Checker::Robot,
+        (None, StabilitySetting::Physics { .. }) => asp_learn::Checker::Physics,
+        (None, StabilitySetting::Contact) => asp_learn::Checker::Default,
+    };
     let model_error = |e: AppError| match &r.model {
         Some(_) => AppError::setting("model", e.to_string()),
         None => e,
     };
-    let order = build(r.model.as_deref()).map_err(model_error)?;
+    let order = build(r.model.as_deref(), checker).map_err(model_error)?;
     if entry.name == "auto" && !expensive_tests && r.model.is_some() {
         return Err(AppError::setting(
             "model",
@@ -200,6 +206,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         optimise,
         cancel: None,
         checker_extension,
+        checker,
     })
 }
 

@@ -100,14 +100,14 @@ fn transitions(a: &TransitionsArgs) -> anyhow::Result<std::process::ExitCode> {
 }
 
 /// The methods of `asp bench feasible` for the model called `name`.
-fn methods(args: &FeasibleArgs, name: &str) -> anyhow::Result<Vec<Method>> {
+fn methods(args: &FeasibleArgs, name: &str, checker: asp_learn::Checker) -> anyhow::Result<Vec<Method>> {
     let model = match (&args.model, &args.models_dir) {
         (Some(m), _) => Some(m.clone()),
         (None, Some(dir)) => Some(dir.join(format!("{name}.onnx"))),
         (None, None) => None,
     };
     let list = args.methods.clone().unwrap_or_else(|| bench::default_methods(model.is_some()).to_string());
-    bench::parse_methods(&list, model.as_deref()).map_err(crate::request::cli_error).context("--methods")
+    bench::parse_methods(&list, model.as_deref(), checker).map_err(crate::request::cli_error).context("--methods")
 }
 
 /// Runs `asp bench`.
@@ -131,7 +131,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<std::process::ExitCode> {
         if tty {
             eprintln!("[{}/{}] {}", k + 1, models.len(), path.display());
         }
-        let methods = methods(a, &name)?;
+        let methods = methods(a, &name, settings.checker)?;
         rows.extend(bench::bench_model(path, &name, &settings, &methods, a.orderings)?);
     }
     let mut stdout = std::io::stdout().lock();

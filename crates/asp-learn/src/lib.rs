@@ -7,6 +7,6 @@ pub mod qfunction;
 pub mod qnet;
 
 pub use error::{LearnError, Result};
-pub use model::{GraphModel, ModelKind, RemovabilityModel, ShapePolicy};
-pub use ordering::{GnnFactory, GnnOrdering, GnnSource, SHIPPED_MODEL};
+pub use model::{Checker, GraphModel, ModelKind, RemovabilityModel, ShapePolicy};
+pub use ordering::{shipped_model, GnnFactory, GnnOrdering, GnnSource, ShippedModel, SHIPPED_MODEL, SHIPPED_MODELS, SHIPPED_PHYSICS_MODEL};
 pub use qfunction::{epsilon_greedy, epsilon_greedy_models, open_q_models, OnnxQ};

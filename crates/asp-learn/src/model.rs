@@ -30,6 +30,50 @@ pub const INPUTS: [&str; 3] = ["x", "edge_index", "edge_attr"];
 /// The output name of a removability model.
 pub const OUTPUT: &str = "removability";
 
+/// The metadata property naming the removal checker whose labels a removability model was
+/// trained on.
+pub const CHECKER_KEY: &str = "asp.checker";
+
+/// The removal checker whose labels a removability model ranks for (`asp.checker`): the same
+/// part can be removable under one and not under another (a part that slides out without
+/// collision may leave the rest toppling in the simulation, or have no grasp for the arm).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+pub enum Checker {
+    /// Straight-line removal tests with the contact-graph stability check (`--stability
+    /// contact`, no robot). A model without `asp.checker` is one of these.
+    #[default]
+    Default,
+    /// The same removal tests with the physics stability check (`--stability physics`).
+    Physics,
+    /// Removals the robot arm performs (`--robot`).
+    Robot,
+}
+
+impl Checker {
+    /// Every checker, in the order the docs list them.
+    pub const ALL: [Checker; 3] = [Checker::Default, Checker::Physics, Checker::Robot];
+
+    /// The `asp.checker` value (and the data set's `checker`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Checker::Default => "default",
+            Checker::Physics => "physics",
+            Checker::Robot => "robot",
+        }
+    }
+
+    /// The checker called `name`.
+    pub fn parse(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|c| c.name() == name)
+    }
+}
+
+impl std::fmt::Display for Checker {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// What a graph model computes per node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ModelKind {
@@ -103,6 +147,8 @@ pub struct GraphModel {
     kind: ModelKind,
     metadata: BTreeMap<String, String>,
     features: String,
+    /// The checker of its labels (`asp.checker`; [`Checker::Default`] when the file has none).
+    checker: Checker,
     node_dim: usize,
     edge_dim: usize,
     /// The decluttered model with symbolic `n` and `e`.
@@ -194,6 +240,13 @@ impl GraphModel {
         };
         let node_dim = meta_dim("asp.node_dim")?;
         let edge_dim = meta_dim("asp.edge_dim")?;
+        let checker = match metadata.get(CHECKER_KEY) {
+            None => Checker::Default,
+            Some(v) => Checker::parse(v).ok_or_else(|| {
+                let names: Vec<&str> = Checker::ALL.iter().map(|c| c.name()).collect();
+                mismatch(format!("{CHECKER_KEY} is '{v}', expected one of {}", names.join(", ")))
+            })?,
+        };
         let graph = proto.graph.as_ref().ok_or_else(|| mismatch("has no graph".into()))?;
         check_signature(graph, node_dim, edge_dim, expected.output()).map_err(mismatch)?;
 
@@ -224,6 +277,7 @@ impl GraphModel {
             kind: expected,
             metadata,
             features,
+            checker,
             node_dim,
             edge_dim,
             typed,
@@ -265,6 +319,24 @@ impl GraphModel {
             return mismatch(format!("trained on features '{}', asp computes '{features}'", self.features));
         }
         Ok(())
+    }
+
+    /// Check that the model was trained on the labels of `run`, the checker of the run that
+    /// would use it: a one-line error naming the file and both checkers otherwise.
+    pub fn check_checker(&self, run: Checker) -> Result<()> {
+        if self.checker == run {
+            return Ok(());
+        }
+        Err(LearnError::Mismatch {
+            path: self.path.clone(),
+            mismatch: format!("trained on labels of the {} checker, this run uses the {run} checker", self.checker),
+        })
+    }
+
+    /// The checker whose labels the model was trained on (`asp.checker`; [`Checker::Default`]
+    /// for a file without the property).
+    pub fn checker(&self) -> Checker {
+        self.checker
     }
 
     /// What the model computes.
@@ -667,6 +739,32 @@ mod tests {
         let mut p = proto();
         set_meta(&mut p, "asp.edge_dim", Some("many"));
         assert_eq!(error_of(&p), "models/x.onnx: asp.edge_dim is 'many', expected a positive integer");
+    }
+
+    #[test]
+    fn the_checker_of_the_labels_is_read_and_must_match_the_run() {
+        // no `asp.checker` (every model written before it): the default checker's
+        let m = RemovabilityModel::from_proto(&proto(), "models/x.onnx", ModelKind::Removability).unwrap();
+        assert_eq!(m.checker(), Checker::Default);
+        m.check_checker(Checker::Default).unwrap();
+        let mut p = proto();
+        set_meta(&mut p, CHECKER_KEY, Some("physics"));
+        let m = RemovabilityModel::from_proto(&p, "models/x.onnx", ModelKind::Removability).unwrap();
+        assert_eq!(m.checker(), Checker::Physics);
+        m.check_checker(Checker::Physics).unwrap();
+        assert_eq!(
+            m.check_checker(Checker::Default).unwrap_err().to_string(),
+            "models/x.onnx: trained on labels of the physics checker, this run uses the default checker"
+        );
+        assert_eq!(
+            m.check_checker(Checker::Robot).unwrap_err().to_string(),
+            "models/x.onnx: trained on labels of the physics checker, this run uses the robot checker"
+        );
+        set_meta(&mut p, CHECKER_KEY, Some("Physics"));
+        assert_eq!(error_of(&p), "models/x.onnx: asp.checker is 'Physics', expected one of default, physics, robot");
+        for c in Checker::ALL {
+            assert_eq!(Checker::parse(c.name()), Some(c));
+        }
     }
 
     #[test]

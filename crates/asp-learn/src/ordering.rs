@@ -16,7 +16,7 @@ use asp_search::ordering::Shuffled;
 use asp_search::{OrderingFactory, OrderingSource, PartOrdering, SearchError};
 
 use crate::error::Result;
-use crate::model::RemovabilityModel;
+use crate::model::{Checker, RemovabilityModel};
 use crate::qnet::QNet;
 
 impl RemovabilityModel {
@@ -319,6 +319,34 @@ impl OrderingFactory for GnnFactory {
 /// The bytes of `models/removability.onnx`, the removability model shipped with asp.
 pub const SHIPPED_MODEL: &[u8] = include_bytes!("../../../models/removability.onnx");
 
+/// One removability model shipped with asp (embedded in the binary).
+#[derive(Debug, Clone, Copy)]
+pub struct ShippedModel {
+    /// The checker whose labels it was trained on (its `asp.checker`).
+    pub checker: Checker,
+    /// The ONNX file's bytes.
+    pub bytes: &'static [u8],
+    /// Its file in the repository, as errors name it.
+    pub file: &'static str,
+}
+
+/// The shipped removability models, one per checker that has its own; the first (the default
+/// checker's) ranks for every checker without one ([`shipped_model`]).
+pub const SHIPPED_MODELS: &[ShippedModel] = &[
+    ShippedModel { checker: Checker::Default, bytes: SHIPPED_MODEL, file: "models/removability.onnx" },
+    ShippedModel { checker: Checker::Physics, bytes: SHIPPED_PHYSICS_MODEL, file: "models/removability-physics.onnx" },
+];
+
+/// The bytes of `models/removability-physics.onnx`, the shipped model of the physics checker
+/// (`asp.checker` = physics; trained by `scripts/train-removability-physics`).
+pub const SHIPPED_PHYSICS_MODEL: &[u8] = include_bytes!("../../../models/removability-physics.onnx");
+
+/// The shipped model `--order gnn` uses under `checker`: the one trained on that checker's
+/// labels, else the default checker's.
+pub fn shipped_model(checker: Checker) -> &'static ShippedModel {
+    SHIPPED_MODELS.iter().find(|m| m.checker == checker).unwrap_or(&SHIPPED_MODELS[0])
+}
+
 /// The `gnn` ordering source: a removability model and the graph features it expects.
 #[derive(Debug)]
 pub struct GnnSource {
@@ -337,9 +365,25 @@ impl GnnSource {
     /// The model shipped with asp (`models/removability.onnx`, embedded in the binary; trained by
     /// `scripts/train-removability`), for graphs with the default features.
     pub fn shipped() -> Result<Self> {
-        let model = RemovabilityModel::from_bytes(SHIPPED_MODEL, "models/removability.onnx (shipped)")?;
+        Self::shipped_for(Checker::Default)
+    }
+
+    /// The shipped model for runs under `checker` ([`shipped_model`]), for graphs with the
+    /// default features.
+    pub fn shipped_for(checker: Checker) -> Result<Self> {
+        let shipped = shipped_model(checker);
+        let model = RemovabilityModel::from_bytes(shipped.bytes, &format!("{} (shipped)", shipped.file))?;
         let config = with_version_of(GraphConfig::default(), &model);
         Self::new(Arc::new(model), config)
+    }
+
+    /// [`load`](Self::load) for a run under `checker`: also fails, with one line naming the file
+    /// and both checkers, when the model was trained on another checker's labels
+    /// ([`RemovabilityModel::check_checker`]).
+    pub fn load_for(path: impl AsRef<std::path::Path>, config: GraphConfig, checker: Checker) -> Result<Self> {
+        let source = Self::load(path, config)?;
+        source.model.check_checker(checker)?;
+        Ok(source)
     }
 
     /// Load the model at `path` for graphs computed with `config`; whether edges carry contact

@@ -9,6 +9,10 @@ Needs only NumPy. A data set is one folder::
     <dir>/nodes.npy     float32 [N, node_dim]
     <dir>/edge_attr.npy float32 [E, edge_dim]
     <dir>/states.jsonl  one visited state per line: run, step, present, removable
+                        (and, when recorded, why the others failed: collision, gravity)
+
+``index.json``'s ``checker`` names the checker whose tests gave the labels (``default``,
+``physics``, ``robot``); a data set without it was labelled by the default checker.
 
 The arrays are memory-mapped and ``states.jsonl`` is read line by line, so a data set never has to
 fit in memory. Every problem is reported as a :class:`~asp.datasets.DataError` whose message is
@@ -25,7 +29,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -162,7 +166,13 @@ class Assembly:
         if np.any(self.fixed[removable]):
             bad = int(removable[self.fixed[removable]][0])
             raise DataError(f"{where}: removable part {bad} is fixed")
-        return State(self, int(obj["run"]), int(obj["step"]), present, removable)
+        reasons = []
+        for key in ("collision", "gravity"):
+            failed = part_list(obj, key, where, self.num_parts) if key in obj else np.zeros(0, dtype=np.int64)
+            if np.any(np.isin(failed, removable)) or not np.all(in_state[failed]):
+                raise DataError(f"{where}: '{key}' must name present parts that are not removable")
+            reasons.append(failed)
+        return State(self, int(obj["run"]), int(obj["step"]), present, removable, reasons[0], reasons[1])
 
 
 @dataclass(frozen=True)
@@ -179,6 +189,12 @@ class State:
     """int64, ascending part indices of the state."""
     removable: np.ndarray
     """int64 part indices labelled removable (present, non-fixed)."""
+    collision: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    """int64 labelled parts that are not removable because every motion tried collides (empty
+    when the data set does not record reasons)."""
+    gravity: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    """int64 labelled parts that could leave but leave the rest unstable (the data set's
+    checker's stability check; empty when the data set does not record reasons)."""
 
     def subgraph(self) -> tuple[np.ndarray, np.ndarray]:
         """``(edge_ids, edge_index)`` of the induced subgraph (see :func:`induced_subgraph`)."""
@@ -203,6 +219,10 @@ class State:
         )
 
 
+CHECKERS = ("default", "physics", "robot")
+"""The checkers a data set's labels (and a model's ``asp.checker``) can come from."""
+
+
 @dataclass(frozen=True)
 class RemovabilityDataset:
     """An opened ``asp-removability`` data set (validated ``index.json`` and model graphs)."""
@@ -221,6 +241,9 @@ class RemovabilityDataset:
     """Collection runs per assembly, when recorded."""
     assemblies: list[Assembly]
     """The assemblies, in index order."""
+    checker: str = "default"
+    """The checker whose tests labelled the states (``default``, ``physics``, ``robot``; a data
+    set written before ``index.json`` recorded it reads as ``default``)."""
 
     @classmethod
     def open(cls, root: os.PathLike | str) -> RemovabilityDataset:
@@ -235,7 +258,10 @@ class RemovabilityDataset:
             num_states = _int_field(index_path, entry, "states", where)
             assemblies.append(_open_assembly(root / sub, name, parts, num_edges, num_states, node_dim, edge_dim))
         seed, runs = _optional_int(index, "seed"), _optional_int(index, "runs")
-        return cls(root, features, node_dim, edge_dim, seed, runs, assemblies)
+        checker = index.get("checker", "default")
+        if checker not in CHECKERS:
+            raise _fail(index_path, f"checker {checker!r} is not one of {', '.join(CHECKERS)}")
+        return cls(root, features, node_dim, edge_dim, seed, runs, assemblies, checker)
 
     def assembly(self, name: str) -> Assembly:
         """The assembly called ``name``."""

@@ -181,8 +181,11 @@ def _fit_and_export(
     names = ", ".join(a.name for a in train_set)
     _log(f"training on {sum(len(a.states) for a in train_set)} states of {len(train_set)} assemblies ({names})")
     model, summary = train(train_set, node_dim, edge_dim, config, log=_log)
-    parity = export_onnx(model, out, features, aggregation=args.aggregation, tolerance=args.parity_tolerance)
-    _log(f"wrote {out} (ONNX matches PyTorch to {parity:.2g})")
+    checker = train_set[0].checker
+    parity = export_onnx(
+        model, out, features, aggregation=args.aggregation, tolerance=args.parity_tolerance, extra_metadata={"asp.checker": checker}
+    )
+    _log(f"wrote {out} for the {checker} checker (ONNX matches PyTorch to {parity:.2g})")
     if getattr(args, "parity_cases", None) is not None:
         write_parity_cases(model, args.parity_cases, features)
         _log(f"wrote {args.parity_cases}")
@@ -195,6 +198,7 @@ def _fit_and_export(
         print(f"median held-out accuracy: {median:.4f}")
     doc = {
         "kind": "removability",
+        "checker": checker,
         "features": features,
         "node_dim": node_dim,
         "edge_dim": edge_dim,

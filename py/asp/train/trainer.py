@@ -71,6 +71,8 @@ class AssemblyData:
     """The assembly (memory-mapped arrays)."""
     states: list[StateRecord] = field(default_factory=list)
     """Its states, in file order."""
+    checker: str = "default"
+    """The checker whose tests labelled its states (its data set's ``checker``)."""
 
     @property
     def name(self) -> str:
@@ -81,7 +83,8 @@ class AssemblyData:
 def load_assemblies(dirs: Sequence[str]) -> tuple[list[AssemblyData], str, int, int]:
     """Open data sets and read their states. Returns ``(assemblies, features, node_dim, edge_dim)``.
 
-    All data sets must share features and dimensions; assembly names must be unique across them.
+    All data sets must share features, dimensions and checker (the labels of one checker: a model
+    ranks for one); assembly names must be unique across them.
     """
     if not dirs:
         raise DataError("no data set given")
@@ -97,10 +100,15 @@ def load_assemblies(dirs: Sequence[str]) -> tuple[list[AssemblyData], str, int, 
                 f"{ds.root / 'index.json'}: features '{ds.features}' ({ds.node_dim}/{ds.edge_dim}) differ from "
                 f"{first}'s '{features}' ({node_dim}/{edge_dim})"
             )
+        elif out and ds.checker != out[0].checker:
+            raise DataError(
+                f"{ds.root / 'index.json'}: labelled by the {ds.checker} checker, {first}'s by the {out[0].checker} checker "
+                "(a model learns the labels of one checker)"
+            )
         for a in ds.assemblies:
             if any(o.name == a.name for o in out):
                 raise DataError(f"{ds.root / 'index.json'}: assembly '{a.name}' also appears in an earlier data set")
-            data = AssemblyData(a)
+            data = AssemblyData(a, checker=ds.checker)
             for s in a.states():
                 edge_ids, edge_index = s.subgraph()
                 labels, mask = s.labels()

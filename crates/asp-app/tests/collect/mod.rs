@@ -85,3 +85,55 @@ fn models_with_one_name_in_two_folders_get_distinct_names() {
     let names = asp_app::collect::unique_names(&[PathBuf::from("a/x.glb"), PathBuf::from("b/x.glb"), PathBuf::from("b/y.glb")]);
     assert_eq!(names, ["a_x", "b_x", "y"]);
 }
+
+/// The states of one data set's model, as JSON lines.
+fn state_lines(out: &Path, dir: &str) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(out.join(dir).join("states.jsonl")).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+}
+
+fn parts_of(line: &serde_json::Value, key: &str) -> Vec<usize> {
+    line[key].as_array().unwrap_or_else(|| panic!("no '{key}' in {line}")).iter().map(|v| v.as_u64().unwrap() as usize).collect()
+}
+
+#[test]
+fn labels_record_the_checker_and_why_each_part_failed() {
+    use asp_app::pipeline::{PlanSettings, StabilitySetting};
+    // the arch: pillar_a (1) slides out sideways, and the keystone (3) then rests on pillar_b
+    // alone: the contact graph keeps it, the simulation tips it over
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("arch.glb");
+    asp_geom::io::write_glb(&asp_geom::fixtures::arch(), &path).unwrap();
+    let physics = PlanSettings { stability: StabilitySetting::Physics { threshold: 0.01 }, ..PlanSettings::default() };
+    let runs = |plan: PlanSettings, out: &str| {
+        let out = dir.path().join(out);
+        let settings = CollectSettings { runs: 2, seed: 3, plan, ..CollectSettings::default() };
+        let index = collect(std::slice::from_ref(&path), &out, &settings, &|_| {}).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("index.json")).unwrap()).unwrap();
+        assert_eq!(json["checker"], index.checker);
+        (index.checker, state_lines(&out, "arch"))
+    };
+    let (checker, lines) = runs(physics, "phys");
+    assert_eq!(checker, "physics");
+    let full = lines.iter().find(|l| parts_of(l, "present") == [0, 1, 2, 3]).expect("the assembled state is recorded");
+    assert_eq!(parts_of(full, "removable"), [3]);
+    assert_eq!(parts_of(full, "gravity"), [1, 2], "either pillar out tips the keystone over");
+    assert_eq!(parts_of(full, "collision"), Vec::<usize>::new());
+    // pillar_b with the keystone on it: the keystone is blocked by nothing, the pillar from above
+    for l in &lines {
+        let present = parts_of(l, "present");
+        let (r, c, g) = (parts_of(l, "removable"), parts_of(l, "collision"), parts_of(l, "gravity"));
+        let mut labelled: Vec<usize> = r.iter().chain(&c).chain(&g).copied().collect();
+        labelled.sort();
+        assert_eq!(labelled, present.iter().copied().filter(|&p| p != 0).collect::<Vec<_>>(), "every part once: {l}");
+    }
+    let (checker, lines) = runs(PlanSettings::default(), "default");
+    assert_eq!(checker, "default");
+    let full = lines.iter().find(|l| parts_of(l, "present") == [0, 1, 2, 3]).unwrap();
+    assert_eq!(parts_of(full, "removable"), [1, 2, 3], "the contact graph lets either pillar go");
+    assert!(parts_of(full, "gravity").is_empty());
+    // a robot's labels are not collected: refused, not mislabelled
+    let robot = PlanSettings { checker: asp_learn::Checker::Robot, ..PlanSettings::default() };
+    let settings = CollectSettings { runs: 1, plan: robot, ..CollectSettings::default() };
+    let err = collect(std::slice::from_ref(&path), &dir.path().join("robot"), &settings, &|_| {}).unwrap_err().to_string();
+    assert!(err.starts_with("robot: ") && !err.contains('\n'), "{err}");
+}

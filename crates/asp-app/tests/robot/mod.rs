@@ -362,7 +362,7 @@ fn the_feasibility_bench_runs_under_the_robot_checker() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("near_and_far.glb");
     asp_geom::io::write_glb(&near_and_far(), &path).unwrap();
-    let methods = asp_app::bench::parse_methods("vanilla,bk", None).unwrap();
+    let methods = asp_app::bench::parse_methods("vanilla,bk", None, asp_learn::Checker::Robot).unwrap();
     let plain = asp_app::bench::bench_model(&path, "nf", &PlanSettings::default(), &methods, 2).unwrap();
     assert!(plain.iter().all(|r| r.found == 2), "{plain:?}");
     let setup = RobotSetup { base: Some(Vec3::new(-0.4, 0.0, 0.0)), ..RobotSetup::panda() };

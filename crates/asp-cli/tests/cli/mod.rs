@@ -598,3 +598,29 @@ fn plan_each_in_parallel_prints_in_model_order() {
     let strip = |t: &str| t.lines().filter(|l| !l.contains("found in")).collect::<Vec<_>>().join("\n");
     assert_eq!(strip(&table), strip(&tables.join("\n")));
 }
+
+/// Issue 26 item 2: `--model` trained on another checker's labels (its `asp.checker`) is one
+/// line naming the file and both checkers, exit status 2, for `asp plan` and `asp bench feasible`.
+#[test]
+fn issue_26_a_model_of_another_checker_exits_2_naming_both() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = fixture_file(dir.path(), &fixtures::arch(), "arch.glb");
+    // asp-learn's fixture with `asp.checker` = physics appended (ModelProto field 14)
+    let mut bytes = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/../asp-learn/tests/data/random_gnn.onnx")).unwrap();
+    let entry = [&[0x0a, 11][..], b"asp.checker", &[0x12, 7], b"physics"].concat();
+    bytes.extend_from_slice(&[0x72, entry.len() as u8]);
+    bytes.extend_from_slice(&entry);
+    let physics = dir.path().join("rem_physics.onnx");
+    std::fs::write(&physics, bytes).unwrap();
+    let (m, p) = (model.to_str().unwrap(), physics.to_str().unwrap());
+    for args in [vec!["plan", m, "--order", "gnn", "--model", p], vec!["bench", "feasible", m, "--orderings", "1", "--model", p]] {
+        let o = asp(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(p) && err.contains("trained on labels of the physics checker, this run uses the default checker"), "{err}");
+    }
+    // the same file under physics plans
+    let o = asp(&["plan", m, "--order", "gnn", "--model", p, "--stability", "physics", "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
