@@ -1,6 +1,7 @@
 //! The generic RRT-Connect on toy planar spaces.
 
 use super::*;
+use rand::RngExt;
 
 /// The unit square with a wall at x = 0.5 from y = 0 to 0.8.
 struct Square;
