@@ -65,7 +65,7 @@ impl Space for Boxed {
 
 #[test]
 fn an_enclosed_goal_is_not_reached() {
-    let cfg = RrtConnectConfig { step: 0.1, max_iterations: 300, seed: 1, ..Default::default() };
+    let cfg = RrtConnectConfig { step: 0.1, max_iterations: 300, seed: 1 };
     assert_eq!(rrt_connect(&Boxed, &[0.1, 0.1], &[0.8, 0.8], &cfg), Err(RrtFailure::Exhausted));
 }
 
