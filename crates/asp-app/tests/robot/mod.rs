@@ -418,6 +418,8 @@ fn transitions_are_collected_under_the_robot_with_robot_path_rewards() {
     for l in &lines {
         let r = l["rewards"][0].as_f64().unwrap();
         assert!(r < 0.0 && r > -20.0, "{l}");
+        // the learner's contract: the action taken is one of the state's admitted actions
+        assert!(l["actions"].as_array().unwrap().contains(&l["action"]), "{l}");
     }
     // the maps' keywords (plus what `q_graphs` adds) resolve to the same problem, robot included
     let mut request = maps.as_object().unwrap().clone();

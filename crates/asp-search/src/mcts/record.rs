@@ -28,8 +28,15 @@ impl Recorder {
         !self.capped
     }
 
-    /// Starts recording a step from `s` (before it is taken).
+    /// Starts recording a step from `s` (before it is taken). A step whose action is not among
+    /// `s`'s admitted ones is not recorded: the search tried a removal the filters refuse (a lazy
+    /// filter's candidate, a robot that cannot take the part), its reward is the objective's
+    /// penalty, not an outcome, and a learner reads `action ∈ actions` as the data's contract.
     pub fn begin(&mut self, kind: StepKind, present: PartSet, memory: &[u64], actions: &[usize], action: usize) {
+        if !actions.contains(&action) {
+            self.pending = None;
+            return;
+        }
         self.pending = Some(Transition {
             episode: self.episode,
             kind,
@@ -59,5 +66,37 @@ impl Recorder {
             t.next_actions = next_actions.to_vec();
             self.transitions.push(t);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn recorder() -> Recorder {
+        Recorder {
+            transitions: Vec::new(),
+            limit: 10,
+            capped: false,
+            episode: 0,
+            pending: None,
+            actions: Vec::new(),
+            counts: FilterCounts::default(),
+        }
+    }
+
+    #[test]
+    fn a_step_the_filters_refuse_is_not_recorded() {
+        let mut r = recorder();
+        let present = PartSet::full(4);
+        r.begin(StepKind::Expansion, present.clone(), &[], &[0, 1], 3);
+        r.taken(&[-20.0], &[], false);
+        r.finish(&[0, 1]);
+        assert!(r.transitions.is_empty());
+        r.begin(StepKind::Expansion, present, &[], &[0, 1], 1);
+        r.taken(&[-1.0], &[], false);
+        r.finish(&[0]);
+        assert_eq!(r.transitions.len(), 1);
+        assert_eq!((r.transitions[0].action, r.transitions[0].rewards[0]), (1, -1.0));
     }
 }
