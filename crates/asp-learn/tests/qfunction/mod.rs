@@ -215,3 +215,16 @@ fn a_model_the_rust_forward_pass_does_not_know_stays_on_tract() {
     reference.q_values(&mut PolicyContext { state: &mut state, memory: &memory, problem: &p }, &actions, &mut b).unwrap();
     assert_eq!(a, b);
 }
+
+/// Issue 24 item 2: the shipped robot-path Q (`models/q-robot-path.onnx`,
+/// `scripts/train-q-robot-path`) is what `asp plan --robot panda --objective robot-path --q` needs:
+/// the `robot-path` objective, the default maps' features (resolution 9), and the Rust forward pass
+/// (the trainer names its encoder's parameters `encoder.*`), giving tract's values.
+#[test]
+fn the_shipped_robot_path_q_runs_on_the_rust_forward_pass() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/q-robot-path.onnx");
+    let q = OnnxQ::load(&path, 81).unwrap();
+    assert_eq!(q.objective(), "robot-path");
+    assert_eq!(q.config().features(), "asp-q/1 directions=81 neighbours=8");
+    assert_eq!(q.rust_forward(), Ok(()));
+}
