@@ -322,27 +322,30 @@ impl Search<'_, '_, '_> {
     }
 }
 
-/// The largest set `C` of parts of a dead state such that each part of `C` either was blocked
-/// (in every direction tried) only by parts of `C` and fixed parts, or could leave but would
-/// leave a part of `C` without support. Straight-line blocking is a property of part pairs, so
-/// removing parts outside `C` never frees a part of `C`; and contact-graph support only shrinks
-/// when parts go, so a part of `C` left floating stays floating. Every state containing `C` is
-/// a dead end too. (With the path planner in play, or physics stability, this is a heuristic: a
-/// path that failed among these parts is taken to fail among more.)
+/// The largest set `C` of parts of a dead state such that each part of `C` was blocked (in
+/// every direction tried) only by parts of `C` and fixed parts. Straight-line blocking is a
+/// property of part pairs, so removing parts outside `C` never frees a part of `C`: every state
+/// containing `C` is a dead end too. (With the path planner in play, physics stability or a
+/// robot's refusals, which block a part by every other present part, this is a heuristic: a
+/// path or an arm's plan that failed among these parts is taken to fail among more.)
+///
+/// A part that could leave but would leave others without support is never in a core: in a
+/// state with more parts, the extra parts may hold the others up (a frame's crossbar that
+/// leaves two uprights standing alone in a 3-part state leaves freely while their neighbours
+/// stand), so such a set is not locked, and taking it for one made the search answer `no_plan`
+/// on assemblies that plan.
 fn locked_core(reasons: &[Stuck], is_fixed: impl Fn(usize) -> bool) -> Option<PartSet> {
-    let mut core: Vec<(usize, &StuckReason)> = reasons
+    let mut core: Vec<(usize, &PartSet)> = reasons
         .iter()
-        .filter(|s| matches!(s.reason, StuckReason::Blocked(_) | StuckReason::WouldLeaveUnsupported(_)))
-        .map(|s| (s.part, &s.reason))
+        .filter_map(|s| match &s.reason {
+            StuckReason::Blocked(b) => Some((s.part, b)),
+            _ => None,
+        })
         .collect();
     loop {
         let members: Vec<usize> = core.iter().map(|(p, _)| *p).collect();
         let before = core.len();
-        core.retain(|(_, reason)| match reason {
-            StuckReason::Blocked(b) => b.iter().all(|q| is_fixed(q) || members.contains(&q)),
-            StuckReason::WouldLeaveUnsupported(f) => f.iter().any(|q| members.contains(&q)),
-            StuckReason::DeadEnd | StuckReason::Refused(_) => false,
-        });
+        core.retain(|(_, b)| b.iter().all(|q| is_fixed(q) || members.contains(&q)));
         if core.len() == before {
             break;
         }
@@ -443,5 +446,60 @@ impl Dfs {
             }
             group.plan = Some(plan);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use asp_geom::math::Vec3;
+    use asp_geom::{CounterSnapshot, FeasibilityChecker, Motion, Stability};
+
+    /// A frame of four parts: 0 the fixed base, 1 a free support, 2 a crossbar, 3 an upright.
+    /// The crossbar blocks the upright; the upright stands while the crossbar or the support is
+    /// present. Taking the support first leaves {base, crossbar, upright}: a dead end (the
+    /// crossbar would leave the upright unsupported, the upright is blocked by the crossbar).
+    /// From the assembled state the crossbar leaves freely (the support holds the upright up).
+    struct Frame;
+
+    impl FeasibilityChecker for Frame {
+        fn num_parts(&self) -> usize {
+            4
+        }
+        fn is_fixed(&self, part: usize) -> bool {
+            part == 0
+        }
+        fn test_removal(&self, part: usize, state: &PartSet, _kind: MotionKind) -> Outcome {
+            let motion = Motion::Linear { direction: Vec3::Z, distance: 1.0 };
+            if part == 3 && state.contains(2) {
+                return Outcome::Collision { blockers: PartSet::from_indices(4, [2]) };
+            }
+            let rest = state.without(part);
+            match self.stability(&rest) {
+                Stability::Stable => Outcome::Removed(motion),
+                Stability::Unstable { floating } => Outcome::Unstable { floating, motion },
+            }
+        }
+        fn stability(&self, state: &PartSet) -> Stability {
+            if state.contains(3) && !state.contains(1) && !state.contains(2) {
+                Stability::Unstable { floating: PartSet::from_indices(4, [3]) }
+            } else {
+                Stability::Stable
+            }
+        }
+        fn counters(&self) -> CounterSnapshot {
+            CounterSnapshot::default()
+        }
+    }
+
+    #[test]
+    fn a_part_that_would_leave_others_unsupported_does_not_lock_a_core() {
+        // the given order takes the support first and reaches the dead end; a core of
+        // {crossbar, upright} would hold in the assembled state too and end the search there
+        let dfs = Dfs::builder().ordering(BuiltinOrder::Given).path_planner(false).subassemblies(false).build();
+        let outcome = dfs.solve(&Problem::full(&Frame), &Budget::default());
+        assert_eq!(outcome.status, Status::Found, "{:?}", outcome.status);
+        let order: Vec<usize> = outcome.removals.iter().map(|s| s.part).collect();
+        assert_eq!(order, [2, 3, 1]);
     }
 }
