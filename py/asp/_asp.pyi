@@ -181,7 +181,14 @@ def collect_item(
     settings: dict[str, Any],
     load: dict[str, Any] | None = None,
 ) -> str: ...
-def collect_index(out: str | PathLike[str], runs: int, seed: int, entries: Sequence[str]) -> str: ...
+def collect_index(
+    out: str | PathLike[str],
+    runs: int,
+    seed: int,
+    entries: Sequence[str],
+    settings: dict[str, Any],
+    load: dict[str, Any] | None = None,
+) -> str: ...
 def bench_item(
     path: str | PathLike[str],
     name: str,

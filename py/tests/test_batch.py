@@ -98,6 +98,20 @@ def test_collect_on_ray_writes_the_data_set_of_asp_collect(tmp_path, asp_cli, lo
     assert len(index["assemblies"]) == 3 and all(a["states"] > 0 for a in index["assemblies"])
 
 
+def test_a_collect_batch_names_the_checker_of_its_settings(tmp_path, asp_cli):
+    # the index of a physics batch says physics (it said default whatever the settings were)
+    models = soma_models(tmp_path, count=1)
+    cli, batch = tmp_path / "cli", tmp_path / "batch"
+    code, _, err = asp_cli("collect", "removability", str(models), "--runs", "1", "--max-tests", "300",
+                           "--stability", "physics", "--out", str(cli))
+    assert code == 0, err
+    outcome = run(CollectJob([models], runs=1, max_tests=300, settings={"stability": "physics"}), batch,
+                  ray="none", quiet=True)
+    assert outcome.ok
+    assert json.loads((batch / "index.json").read_text())["checker"] == "physics"
+    assert files(batch) == files(cli)
+
+
 def test_bench_on_ray_counts_the_tests_of_asp_bench(tmp_path, asp_cli, local_ray):
     models = soma_models(tmp_path, count=2)
     rows_cli = tmp_path / "rows.json"

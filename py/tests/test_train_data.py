@@ -263,6 +263,19 @@ def test_checker_and_failure_reasons_are_read(tmp_path):
     states = list(ds.states())
     assert list(states[0].collision) == [2] and list(states[0].gravity) == [3]
     assert len(states[1].collision) == 0 and len(states[1].gravity) == 0
+    # a robot data set: the arm's reasons are read, and checked like the others
+    index["checker"] = "robot"
+    (root / "index.json").write_text(json.dumps(index))
+    first.update(collision=[], gravity=[3], arm_no_grasp=[2], arm_blocked=[], arm_no_path=[])
+    (root / "small" / "states.jsonl").write_text("\n".join([json.dumps(first), *lines[1:]]) + "\n")
+    ds = RemovabilityDataset.open(root)
+    assert ds.checker == "robot"
+    state = next(iter(ds.states()))
+    assert list(state.arm_no_grasp) == [2] and len(state.arm_blocked) == 0 and list(state.gravity) == [3]
+    first.update(arm_no_path=[first["removable"][0]])
+    (root / "small" / "states.jsonl").write_text("\n".join([json.dumps(first), *lines[1:]]) + "\n")
+    with pytest.raises(DataError, match="'arm_no_path' must name present parts that are not removable"):
+        list(RemovabilityDataset.open(root).states())
     index["checker"] = "magic"
     (root / "index.json").write_text(json.dumps(index))
     with pytest.raises(DataError, match="checker 'magic'"):

@@ -114,7 +114,7 @@ struct PartFile<'a> {
     fixed: bool,
 }
 
-#[derive(Serialize)]
+#[derive(Serialize, Default)]
 struct StateLine {
     run: usize,
     step: usize,
@@ -125,14 +125,29 @@ struct StateLine {
     /// The labelled parts that could leave but leave the rest unstable (the stability check of
     /// the data set's checker: contact graph or physics simulation).
     gravity: Vec<usize>,
+    /// Under the robot checker: the labelled parts the geometry lets out but the arm cannot take
+    /// out, by the arm's reason (its lift collides; no grasp it reaches without collision; no
+    /// path to a grasp or to the drop-off). Absent from other checkers' data sets.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arm_blocked: Option<Vec<usize>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arm_no_grasp: Option<Vec<usize>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arm_no_path: Option<Vec<usize>>,
 }
 
-/// The checker whose labels a collection under `plan` records: the physics simulation under the
-/// physics stability check, else the default checker. Labels of the robot's checker are not
-/// collected (the arm's tests run inside the search only): a robot is an error.
+/// The checker whose labels a collection under `plan` records: the robot's with a robot (the
+/// arm must also take each part out), else the physics simulation under the physics stability
+/// check, else the default checker.
 pub fn label_checker(plan: &PlanSettings) -> Result<asp_learn::Checker> {
     if plan.checker == asp_learn::Checker::Robot {
-        return Err(AppError::setting("robot", "removability labels are collected without a robot (the default or physics checker)"));
+        if plan.checker_extension.is_none() {
+            return Err(AppError::config("the robot checker needs a robot (the settings name none)"));
+        }
+        return Ok(asp_learn::Checker::Robot);
+    }
+    if plan.checker_extension.is_some() {
+        return Err(AppError::setting("grippers", "removability labels are collected with one gripper (or a robot), not with held parts"));
     }
     Ok(match plan.stability {
         pipeline::StabilitySetting::Physics { .. } => asp_learn::Checker::Physics,
@@ -140,18 +155,36 @@ pub fn label_checker(plan: &PlanSettings) -> Result<asp_learn::Checker> {
     })
 }
 
-/// The label of every present, non-fixed part of `state` with the reason of each failure, as
-/// `(removable, collision, gravity)`.
-fn label_state(checker: &impl FeasibilityChecker, state: &PartSet) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
-    let (mut removable, mut collision, mut gravity) = (Vec::new(), Vec::new(), Vec::new());
+/// The label of every present, non-fixed part of `state` under `checker` (the run's: the
+/// collision world's, or a robot's on top of `plain`), with the reason of each failure. A
+/// robot's refusal is told from a collision by `plain`, the collision world's checker under
+/// it: a part it lets out that the robot's checker refuses is the arm's failure, by the
+/// robot's reason.
+fn label_state(checker: &dyn FeasibilityChecker, plain: Option<&dyn FeasibilityChecker>, state: &PartSet) -> StateLine {
+    let mut line = StateLine { present: state.iter().collect(), ..StateLine::default() };
+    let mut arm: [Vec<usize>; 3] = Default::default();
     for p in state.iter().filter(|&p| !checker.is_fixed(p)) {
         match checker.test_removal(p, state, MotionKind::Linear) {
-            Outcome::Removed(_) => removable.push(p),
-            Outcome::Collision { .. } => collision.push(p),
-            Outcome::Unstable { .. } => gravity.push(p),
+            Outcome::Removed(_) => line.removable.push(p),
+            Outcome::Unstable { .. } => line.gravity.push(p),
+            Outcome::Collision { .. } => match plain {
+                Some(plain) if !matches!(plain.test_removal(p, state, MotionKind::Linear), Outcome::Collision { .. }) => {
+                    let k = match checker.refusal_reason(p, state) {
+                        Some("no reachable grasp") => 1,
+                        Some("no path") => 2,
+                        _ => 0,
+                    };
+                    arm[k].push(p);
+                }
+                _ => line.collision.push(p),
+            },
         }
     }
-    (removable, collision, gravity)
+    if plain.is_some() {
+        let [blocked, no_grasp, no_path] = arm;
+        (line.arm_blocked, line.arm_no_grasp, line.arm_no_path) = (Some(blocked), Some(no_grasp), Some(no_path));
+    }
+    line
 }
 
 /// The models named by `paths`: each `.glb`/`.gltf` file; a folder holding glTF files gives each
@@ -308,36 +341,39 @@ pub fn collect_model(item: &ModelItem, out: &Path, settings: &CollectSettings) -
     let graph = AssemblyGraph::build(world, &settings.graph)?;
     let n = world.num_parts();
     let budget = Budget { max_tests: settings.max_tests, timeout: settings.timeout.map(Duration::from_secs_f64), cancel: None };
-    let runs: Vec<(Vec<PartSet>, bool)> = (0..settings.runs)
-        .into_par_iter()
-        .map(|r| {
-            // the thesis' linear sequences: the labelled states are reached one part at a time
-            let dfs = Dfs::builder()
-                .ordering(BuiltinOrder::Shuffled)
-                .path_planner(settings.plan.path_planner)
-                .subassemblies(false)
-                .seed(seed_of(settings.seed, m, r))
-                .build();
+    let robot = match label_checker(&settings.plan)? {
+        asp_learn::Checker::Robot => settings.plan.checker_extension.as_ref(),
+        _ => None,
+    };
+    // one run: a DFS from its own initial ordering, then every state it expanded labelled by
+    // the same checker (a robot's checker keeps the arm's plans, so the search's tests are
+    // not planned twice)
+    let run = |r: usize| -> Result<(Vec<StateLine>, bool)> {
+        let seed = seed_of(settings.seed, m, r);
+        // the thesis' linear sequences: the labelled states are reached one part at a time
+        let dfs = Dfs::builder()
+            .ordering(BuiltinOrder::Shuffled)
+            .path_planner(settings.plan.path_planner)
+            .subassemblies(false)
+            .seed(seed)
+            .build();
+        let mut lines = Vec::new();
+        let mut search = |c: &dyn FeasibilityChecker| {
             let mut states = Vec::new();
             let mut visit = |s: &PartSet| states.push(s.clone());
-            let outcome = dfs.solve_visiting(&Problem::full(&checker), &budget, Some(&mut visit));
-            (states, outcome.status == asp_search::Status::Found)
-        })
-        .collect();
-    let lines: Vec<Vec<StateLine>> = runs
-        .par_iter()
-        .enumerate()
-        .map(|(run, (states, _))| {
-            states
-                .iter()
-                .enumerate()
-                .map(|(step, state)| {
-                    let (removable, collision, gravity) = label_state(&checker, state);
-                    StateLine { run, step, present: state.iter().collect(), removable, collision, gravity }
-                })
-                .collect()
-        })
-        .collect();
+            let outcome = dfs.solve_visiting(&Problem::full(c), &budget, Some(&mut visit));
+            let plain: Option<&dyn FeasibilityChecker> = robot.map(|_| &checker as &dyn FeasibilityChecker);
+            lines = states.iter().enumerate().map(|(step, state)| StateLine { run: r, step, ..label_state(c, plain, state) }).collect();
+            outcome
+        };
+        let outcome = match robot {
+            Some(ext) => ext.solve(&checker, seed, &mut search)?.0,
+            None => search(&checker),
+        };
+        Ok((lines, outcome.status == asp_search::Status::Found))
+    };
+    let runs: Vec<(Vec<StateLine>, bool)> = (0..settings.runs).into_par_iter().map(run).collect::<Result<_>>()?;
+    let lines: Vec<&Vec<StateLine>> = runs.iter().map(|(lines, _)| lines).collect();
     let folder = out.join(dir);
     std::fs::create_dir_all(&folder).map_err(|e| io_error(&folder, e))?;
     let assembly = world.assembly();
@@ -353,7 +389,7 @@ pub fn collect_model(item: &ModelItem, out: &Path, settings: &CollectSettings) -
     write_atomic(&folder.join("edge_attr.npy"), &npy_f32(graph.edge_attr_flat(), graph.edges().len(), graph.edge_dim()))?;
     let mut text = Vec::new();
     let mut count = 0;
-    for line in lines.iter().flatten() {
+    for line in lines.into_iter().flatten() {
         serde_json::to_writer(&mut text, line).expect("state lines serialise");
         text.push(b'\n');
         count += 1;

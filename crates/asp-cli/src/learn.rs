@@ -16,10 +16,12 @@ pub fn collect(args: &CollectArgs) -> anyhow::Result<std::process::ExitCode> {
         CollectKind::Removability(a) => a,
         CollectKind::Transitions(a) => return transitions(a),
     };
+    let mut robot = crate::flags::Map::new();
+    a.robot.put(&mut robot);
     let settings = CollectSettings {
         runs: a.runs,
         seed: a.seed,
-        plan: model_settings(&a.load, crate::flags::Map::new())?,
+        plan: model_settings(&a.load, robot)?,
         max_tests: Some(a.max_tests),
         timeout: Some(positive("timeout", a.timeout)?),
         ..CollectSettings::default()

@@ -233,15 +233,26 @@ pub fn collect_item(
 }
 
 /// Writes the data set's `index.json` from the entries [`collect_item`] returned (in model
-/// order) and returns it as JSON.
+/// order) and returns it as JSON. `settings` and `load` are the items' (the index names the
+/// checker they labelled for: a physics or robot data set must not read as `default`).
 #[pyfunction]
-pub fn collect_index(py: Python<'_>, out: PathBuf, runs: usize, seed: u64, entries: Vec<String>) -> PyResult<String> {
+#[pyo3(signature = (out, runs, seed, entries, settings, load=None))]
+pub fn collect_index(
+    py: Python<'_>,
+    out: PathBuf,
+    runs: usize,
+    seed: u64,
+    entries: Vec<String>,
+    settings: &Bound<'_, PyDict>,
+    load: Option<&Bound<'_, PyDict>>,
+) -> PyResult<String> {
+    let plan = model_settings(settings, load).map_err(|e| e.into_py(py))?;
     let run = || -> Result<String, Error> {
         let entries = entries
             .iter()
             .map(|e| serde_json::from_str::<CollectedModel>(e).map_err(|e| json_error("index entry", e)))
             .collect::<Result<Vec<_>, _>>()?;
-        let settings = collect_settings(runs, seed, None, None, PlanSettings::default());
+        let settings = collect_settings(runs, seed, None, None, plan);
         let index = collect::write_index(&out, &settings, entries)?;
         Ok(serde_json::to_string(&index).expect("the index serialises"))
     };

@@ -167,6 +167,10 @@ impl FeasibilityChecker for RobotChecker<'_> {
     fn counters(&self) -> CounterSnapshot {
         self.inner.counters()
     }
+
+    fn refusal_reason(&self, part: usize, state: &PartSet) -> Option<&'static str> {
+        self.refusal(part, state).map(|f| RobotFailure::REASONS[f.index()])
+    }
 }
 
 /// A state and the parts removed from it, as bitset words (the held-parts cache key).

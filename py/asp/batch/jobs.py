@@ -273,7 +273,9 @@ class CollectJob(Job):
 
     def finish(self, out: Path, results: dict[str, dict[str, Any]]) -> str:
         entries = [json.dumps(results[i.key]["entry"]) for i in self.items()]
-        index = json.loads(_asp.collect_index(str(out), self.spec["runs"], self.spec["seed"], entries))
+        index = json.loads(_asp.collect_index(
+            str(out), self.spec["runs"], self.spec["seed"], entries, self.spec["settings"], load=self.spec["load"]
+        ))
         states = sum(a["states"] for a in index["assemblies"])
         return (f"{out}: {len(index['assemblies'])} models, {states} labelled states, features "
                 f"{index['features']} ({index['node_dim']} node, {index['edge_dim']} edge attributes)")

@@ -9,7 +9,8 @@ Needs only NumPy. A data set is one folder::
     <dir>/nodes.npy     float32 [N, node_dim]
     <dir>/edge_attr.npy float32 [E, edge_dim]
     <dir>/states.jsonl  one visited state per line: run, step, present, removable
-                        (and, when recorded, why the others failed: collision, gravity)
+                        (and, when recorded, why the others failed: collision, gravity;
+                        under the robot also arm_blocked, arm_no_grasp, arm_no_path)
 
 ``index.json``'s ``checker`` names the checker whose tests gave the labels (``default``,
 ``physics``, ``robot``); a data set without it was labelled by the default checker.
@@ -167,12 +168,12 @@ class Assembly:
             bad = int(removable[self.fixed[removable]][0])
             raise DataError(f"{where}: removable part {bad} is fixed")
         reasons = []
-        for key in ("collision", "gravity"):
+        for key in REASONS:
             failed = part_list(obj, key, where, self.num_parts) if key in obj else np.zeros(0, dtype=np.int64)
             if np.any(np.isin(failed, removable)) or not np.all(in_state[failed]):
                 raise DataError(f"{where}: '{key}' must name present parts that are not removable")
             reasons.append(failed)
-        return State(self, int(obj["run"]), int(obj["step"]), present, removable, reasons[0], reasons[1])
+        return State(self, int(obj["run"]), int(obj["step"]), present, removable, *reasons)
 
 
 @dataclass(frozen=True)
@@ -195,6 +196,15 @@ class State:
     gravity: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     """int64 labelled parts that could leave but leave the rest unstable (the data set's
     checker's stability check; empty when the data set does not record reasons)."""
+    arm_blocked: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    """int64 labelled parts the geometry lets out but the robot arm's lift collides (robot data
+    sets only)."""
+    arm_no_grasp: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    """int64 labelled parts the geometry lets out but the arm reaches no grasp of (robot data
+    sets only)."""
+    arm_no_path: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    """int64 labelled parts the geometry lets out but the arm finds no path to a grasp or to
+    the drop-off for (robot data sets only)."""
 
     def subgraph(self) -> tuple[np.ndarray, np.ndarray]:
         """``(edge_ids, edge_index)`` of the induced subgraph (see :func:`induced_subgraph`)."""
@@ -218,6 +228,10 @@ class State:
             mask=mask,
         )
 
+
+REASONS = ("collision", "gravity", "arm_blocked", "arm_no_grasp", "arm_no_path")
+"""The keys of ``states.jsonl`` that say why a labelled part is not removable (the ``arm_*`` keys
+in data sets of the ``robot`` checker only)."""
 
 CHECKERS = ("default", "physics", "robot")
 """The checkers a data set's labels (and a model's ``asp.checker``) can come from."""

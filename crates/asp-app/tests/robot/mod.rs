@@ -372,6 +372,44 @@ fn the_feasibility_bench_runs_under_the_robot_checker() {
     assert!(rows.iter().all(|r| r.found == 0 && r.failed_collision.mean > 0.0), "{rows:?}");
 }
 
+/// Issue 26 item 2: `asp collect removability --robot` labels by the robot's checker: the near
+/// block comes out; the far stack's top block is let out by the geometry but the arm reaches
+/// none of its grasps (`arm_no_grasp`); the low one would leave the top one unsupported
+/// (`gravity`). Every non-fixed part of a state is in exactly one list, the index says
+/// `robot`, and a second collection writes the same files.
+#[test]
+fn removability_labels_are_collected_under_the_robot_with_the_arms_reasons() {
+    use asp_app::collect::{collect, CollectSettings};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("near_and_far.glb");
+    asp_geom::io::write_glb(&near_and_far(), &path).unwrap();
+    let plan = resolved(r#"{"robot": "panda", "robot_base": [-0.4, 0.0, 0.0]}"#);
+    assert_eq!(plan.checker, asp_learn::Checker::Robot);
+    let settings = CollectSettings { runs: 2, seed: 4, plan, ..CollectSettings::default() };
+    let out = dir.path().join("rem");
+    let index = collect(std::slice::from_ref(&path), &out, &settings, &|_| {}).unwrap();
+    assert_eq!(index.checker, "robot");
+    let text = std::fs::read_to_string(out.join("near_and_far").join("states.jsonl")).unwrap();
+    let lines: Vec<serde_json::Value> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let parts = |l: &serde_json::Value, key: &str| -> Vec<usize> {
+        l[key].as_array().unwrap_or_else(|| panic!("no '{key}' in {l}")).iter().map(|v| v.as_u64().unwrap() as usize).collect()
+    };
+    let full = lines.iter().find(|l| parts(l, "present") == [0, 1, 2, 3]).expect("the assembled state is recorded");
+    assert_eq!(parts(full, "removable"), [1], "{full}");
+    assert_eq!(parts(full, "gravity"), [2], "{full}");
+    assert_eq!(parts(full, "arm_no_grasp"), [3], "{full}");
+    assert!(parts(full, "collision").is_empty() && parts(full, "arm_blocked").is_empty() && parts(full, "arm_no_path").is_empty());
+    for l in &lines {
+        let mut labelled: Vec<usize> =
+            ["removable", "collision", "gravity", "arm_blocked", "arm_no_grasp", "arm_no_path"].iter().flat_map(|k| parts(l, k)).collect();
+        labelled.sort();
+        assert_eq!(labelled, parts(l, "present").into_iter().filter(|&p| p != 0).collect::<Vec<_>>(), "every part once: {l}");
+    }
+    let again = dir.path().join("again");
+    collect(std::slice::from_ref(&path), &again, &settings, &|_| {}).unwrap();
+    assert_eq!(std::fs::read_to_string(again.join("near_and_far").join("states.jsonl")).unwrap(), text, "deterministic");
+}
+
 /// The `robot-path` Q model fixture (`python -m asp.train.fixture --only q`: features `asp-q/1
 /// directions=25 neighbours=8`, for maps of resolution 5).
 fn robot_q_fixture() -> std::path::PathBuf {

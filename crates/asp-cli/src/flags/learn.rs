@@ -93,6 +93,10 @@ pub struct RemovabilityArgs {
     /// Loading and testing.
     #[command(flatten)]
     pub load: ModelArgs,
+    /// A robot arm that must also take each part out: the labels of the robot checker, with
+    /// the arm's reason for each part the geometry lets out and the arm does not.
+    #[command(flatten)]
+    pub robot: super::PlanRobotArgs,
 }
 
 /// `asp bench`.
