@@ -335,7 +335,12 @@ pub struct ShippedModel {
 pub const SHIPPED_MODELS: &[ShippedModel] = &[
     ShippedModel { checker: Checker::Default, bytes: SHIPPED_MODEL, file: "models/removability.onnx" },
     ShippedModel { checker: Checker::Physics, bytes: SHIPPED_PHYSICS_MODEL, file: "models/removability-physics.onnx" },
+    ShippedModel { checker: Checker::Robot, bytes: SHIPPED_ROBOT_MODEL, file: "models/removability-robot.onnx" },
 ];
+
+/// The bytes of `models/removability-robot.onnx`, the shipped model of the robot checker
+/// (`asp.checker` = robot; trained by `scripts/train-removability-robot`).
+pub const SHIPPED_ROBOT_MODEL: &[u8] = include_bytes!("../../../models/removability-robot.onnx");
 
 /// The bytes of `models/removability-physics.onnx`, the shipped model of the physics checker
 /// (`asp.checker` = physics; trained by `scripts/train-removability-physics`).

@@ -119,8 +119,7 @@ fn a_model_of_another_checker_is_refused_and_the_shipped_one_follows_the_checker
         assert_eq!(s.checker, checker, "{json}");
         let source = asp_app::catalogue::gnn_source(None, s.checker).unwrap();
         assert_eq!(source.model().path(), format!("{} (shipped)", asp_learn::shipped_model(checker).file));
-        // physics has its own shipped model; the robot's labels are not collected yet
-        let trained_on = if checker == asp_learn::Checker::Robot { asp_learn::Checker::Default } else { checker };
-        assert_eq!(source.model().checker(), trained_on, "{json}");
+        // every checker has its own shipped model
+        assert_eq!(source.model().checker(), checker, "{json}");
     }
 }
