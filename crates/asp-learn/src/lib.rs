@@ -8,5 +8,8 @@ pub mod qnet;
 
 pub use error::{LearnError, Result};
 pub use model::{Checker, GraphModel, ModelKind, RemovabilityModel, ShapePolicy};
-pub use ordering::{shipped_model, GnnFactory, GnnOrdering, GnnSource, ShippedModel, SHIPPED_MODEL, SHIPPED_MODELS, SHIPPED_PHYSICS_MODEL, SHIPPED_ROBOT_MODEL};
+pub use ordering::{
+    shipped_model, GnnFactory, GnnOrdering, GnnSource, ShippedModel, SHIPPED_MODEL, SHIPPED_MODELS, SHIPPED_PHYSICS_MODEL,
+    SHIPPED_ROBOT_MODEL,
+};
 pub use qfunction::{epsilon_greedy, epsilon_greedy_models, open_q_models, OnnxQ};
