@@ -169,12 +169,9 @@ fn label_state(checker: &dyn FeasibilityChecker, plain: Option<&dyn FeasibilityC
             Outcome::Unstable { .. } => line.gravity.push(p),
             Outcome::Collision { .. } => match plain {
                 Some(plain) if !matches!(plain.test_removal(p, state, MotionKind::Linear), Outcome::Collision { .. }) => {
-                    let k = match checker.refusal_reason(p, state) {
-                        Some("no reachable grasp") => 1,
-                        Some("no path") => 2,
-                        _ => 0,
-                    };
-                    arm[k].push(p);
+                    // the arm's lists in the robot's reason order (blocked, no grasp, no path)
+                    let reason = checker.refusal_reason(p, state);
+                    arm[asp_robot::RobotFailure::REASONS.iter().position(|r| Some(*r) == reason).unwrap_or(0)].push(p);
                 }
                 _ => line.collision.push(p),
             },

@@ -226,9 +226,9 @@ pub trait FeasibilityChecker: Send + Sync {
 
     /// Why a checker that decorates another (a robot arm that must also carry the part out)
     /// refused the removal of `part` from `state` that its inner checker admitted, as a short
-    /// reason (`blocked`, `no reachable grasp`, `no path`), when the last test of that part in
-    /// that state was such a refusal (it then returned [`Outcome::Collision`]). Removability
-    /// labels record it. Default: `None` (nothing decorates).
+    /// reason (`blocked`, `no reachable grasp`, `no path`): its first such refusal of that part
+    /// in that state (the test then returned [`Outcome::Collision`]), `None` when it never
+    /// refused it there. Removability labels record it. Default: `None` (nothing decorates).
     fn refusal_reason(&self, part: usize, state: &PartSet) -> Option<&'static str> {
         let _ = (part, state);
         None
