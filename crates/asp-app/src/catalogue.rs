@@ -42,7 +42,7 @@ pub struct OrderingEntry {
 pub const ORDERINGS: &[OrderingEntry] = &[
     OrderingEntry {
         name: "auto",
-        help: "by what a removal test costs: `given` where tests are cheap (the default checker), `gnn` with bookkeeping where they are expensive (`stability` physics)",
+        help: "by what a removal test costs: `given` where tests are cheap (the default checker), `gnn` with bookkeeping where they are expensive (`stability` physics, or a `robot` checking the arm)",
         bookkeeping: false,
         takes_model: true,
         // the cheap case; `resolve` puts the learned ordering in for an expensive checker

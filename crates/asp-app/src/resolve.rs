@@ -148,7 +148,10 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
     };
     // `auto`: decided once per request from the checker, never from a clock, so one seed gives
     // one plan (ARCHITECTURE.md, "Cost-aware default ordering")
-    let expensive_tests = matches!(stability, StabilitySetting::Physics { .. });
+    // expensive: simulated stability (30-160 ms a test) or the arm's reach and path checks
+    // (20-100 ms); the plan search is the one that runs them (an optimiser scores, not checks)
+    let expensive_tests =
+        matches!(stability, StabilitySetting::Physics { .. }) || (robot.is_some() && optimise.is_none());
     let build = match (entry.name, expensive_tests) {
         ("auto", true) => catalogue::gnn,
         _ => entry.build,
@@ -168,7 +171,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
     if entry.name == "auto" && !expensive_tests && r.model.is_some() {
         return Err(AppError::setting(
             "model",
-            "the removability model of `order` gnn; `order` auto uses it only with `stability` physics (give `order` gnn to use it here)",
+            "the removability model of `order` gnn; `order` auto uses it only where removal tests are expensive (`stability` physics or a `robot`; give `order` gnn to use it here)",
         ));
     }
     let timeout = match r.timeout {
@@ -419,6 +422,12 @@ mod tests {
         assert!(s.bookkeeping && s.order.name() == "gnn");
         let s = resolve(&PlanRequest::from_json(r#"{"stability": "physics", "order": "given"}"#).unwrap()).unwrap();
         assert!(!s.bookkeeping && s.order.name() == "given");
+        // the arm's checks are expensive too: its own shipped model, with bookkeeping
+        let s = resolve(&PlanRequest::from_json(r#"{"robot": "panda"}"#).unwrap()).unwrap();
+        assert!(s.bookkeeping && s.order.name() == "gnn" && s.checker == asp_learn::Checker::Robot);
+        // an optimiser scores with the arm rather than checks with it: the cheap case
+        let s = resolve(&PlanRequest::from_json(r#"{"robot": "panda", "objective": "robot-path"}"#).unwrap()).unwrap();
+        assert!(!s.bookkeeping && s.order.name() == "given");
         let o = resolve(&PlanRequest::from_json(r#"{"objective": "access"}"#).unwrap()).unwrap().optimise.unwrap();
         let od = OptimiseSettings::default();
         assert_eq!(
@@ -481,7 +490,7 @@ mod tests {
             "model: the removability model of `order` gnn; it has no effect with `order` given"
         );
         assert!(err(r#"{"model": "m.onnx"}"#)
-            .starts_with("model: the removability model of `order` gnn; `order` auto uses it only with `stability` physics"));
+            .starts_with("model: the removability model of `order` gnn; `order` auto uses it only where removal tests are expensive"));
         assert!(err(r#"{"stability": "physics", "model": "/no/such.onnx"}"#).starts_with("model: "));
         assert!(err(r#"{"order": "gnn", "model": "/no/such.onnx"}"#).starts_with("model: "));
         assert_eq!(
