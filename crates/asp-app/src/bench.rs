@@ -57,7 +57,7 @@ pub fn parse_methods(list: &str, model: Option<&Path>, checker: asp_learn::Check
             AppError::config(format!("unknown method '{base}' (vanilla, bk, {}, each optionally +bk)", names.join(", ")))
         })?;
         let order = (entry.build)(if entry.takes_model { model } else { None }, checker)?;
-        out.push(Method { name: name.to_string(), order, bookkeeping: bookkeeping || entry.bookkeeping });
+        out.push(Method { name: name.to_string(), order, bookkeeping: bookkeeping || (entry.bookkeeping)(checker) });
     }
     if out.is_empty() {
         return Err(AppError::config(format!("the method list '{list}' names no method")));
@@ -213,6 +213,13 @@ mod tests {
         assert!(err.to_string().contains("/no/such/model.onnx"), "{err}");
         let gnn = parse_methods("gnn+bk", None, D).unwrap();
         assert_eq!((gnn[0].order.name().as_str(), gnn[0].bookkeeping), ("gnn", true));
+        // `auto` is what a plan request's default is under the benchmark's checker
+        let auto = parse_methods("auto", None, D).unwrap();
+        assert_eq!((auto[0].order.name().as_str(), auto[0].bookkeeping), ("given", false));
+        for checker in [asp_learn::Checker::Physics, asp_learn::Checker::Robot] {
+            let auto = parse_methods("auto", None, checker).unwrap();
+            assert_eq!((auto[0].order.name().as_str(), auto[0].bookkeeping), ("gnn", true), "{checker:?}");
+        }
         let err = parse_methods("vanilla,fastest", None, D).err().unwrap();
         assert!(err.to_string().contains("unknown method 'fastest'"), "{err}");
         assert!(parse_methods(" , ", None, D).is_err());

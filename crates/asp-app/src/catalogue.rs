@@ -7,7 +7,7 @@
 //! OrderingEntry {
 //!     name: "widest-first",
 //!     help: "parts by decreasing width",
-//!     bookkeeping: false,
+//!     bookkeeping: |_checker| false,
 //!     takes_model: false,
 //!     build: |_model, _checker| Ok(Arc::new(my_crate::WidestFirst)),
 //! },
@@ -29,8 +29,9 @@ pub struct OrderingEntry {
     pub name: &'static str,
     /// One line of help.
     pub help: &'static str,
-    /// Whether the name implies bookkeeping on top of the ordering.
-    pub bookkeeping: bool,
+    /// Whether the name implies bookkeeping on top of the ordering, for a search whose removals
+    /// the checker decides.
+    pub bookkeeping: fn(asp_learn::Checker) -> bool,
     /// Whether it reads a model file (`model`).
     pub takes_model: bool,
     /// Builds the ordering (with the model file, when it takes one and one is given) for a run
@@ -43,43 +44,45 @@ pub const ORDERINGS: &[OrderingEntry] = &[
     OrderingEntry {
         name: "auto",
         help: "by what a removal test costs: `given` where tests are cheap (the default checker), `gnn` with bookkeeping where they are expensive (`stability` physics, or a `robot` checking the arm)",
-        bookkeeping: false,
+        bookkeeping: auto_is_learned,
         takes_model: true,
-        // the cheap case; `resolve` puts the learned ordering in for an expensive checker
-        build: |_, _| Ok(Arc::new(BuiltinOrder::Given)),
+        build: |model, checker| match auto_is_learned(checker) {
+            true => gnn(model, checker),
+            false => Ok(Arc::new(BuiltinOrder::Given)),
+        },
     },
     OrderingEntry {
         name: "given",
         help: "the model's part order",
-        bookkeeping: false,
+        bookkeeping: |_| false,
         takes_model: false,
         build: |_, _| Ok(Arc::new(BuiltinOrder::Given)),
     },
     OrderingEntry {
         name: "shuffled",
         help: "one random order drawn from the seed at the start and kept (the thesis' vanilla AbD)",
-        bookkeeping: false,
+        bookkeeping: |_| false,
         takes_model: false,
         build: |_, _| Ok(Arc::new(BuiltinOrder::Shuffled)),
     },
     OrderingEntry {
         name: "random",
         help: "a fresh random order in every state (from the seed and the state)",
-        bookkeeping: false,
+        bookkeeping: |_| false,
         takes_model: false,
         build: |_, _| Ok(Arc::new(BuiltinOrder::Random)),
     },
     OrderingEntry {
         name: "bookkeeping",
         help: "the given order with bookkeeping: a blocked part is retested only after a blocker is gone",
-        bookkeeping: true,
+        bookkeeping: |_| true,
         takes_model: false,
         build: |_, _| Ok(Arc::new(BuiltinOrder::Given)),
     },
     OrderingEntry {
         name: "gnn",
         help: "parts in order of the removability a graph neural network predicts (`model`), predicted again after each removal (thesis 3.5.3)",
-        bookkeeping: false,
+        bookkeeping: |_| false,
         takes_model: true,
         build: gnn,
     },
@@ -91,6 +94,16 @@ pub const ORDERINGS: &[OrderingEntry] = &[
 /// `asp.checker`; a file without it counts as `default`) is an error naming it and both checkers.
 pub fn gnn(model: Option<&Path>, checker: asp_learn::Checker) -> Result<Arc<dyn OrderingSource>> {
     Ok(Arc::new(gnn_source(model, checker)?))
+}
+
+/// Whether `auto` is the learned ordering with bookkeeping (else `given`) for a search whose
+/// removals `checker` decides: where a test is expensive (the physics simulation, 30-160 ms; the
+/// arm's grasp and path, 20-100 ms) one inference (a fraction of a millisecond) pays as soon as it
+/// saves a test; the default checker answers from cached rows in microseconds, where it cannot.
+/// Decided from the checker, never from a clock, so one seed gives one plan (ARCHITECTURE.md,
+/// "Cost-aware default ordering").
+pub fn auto_is_learned(checker: asp_learn::Checker) -> bool {
+    checker != asp_learn::Checker::Default
 }
 
 /// The source [`gnn`] orders with: `model`, or the shipped model of `checker`.

@@ -146,29 +146,20 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
             threshold: positive("physics_threshold", r.physics_threshold)?.unwrap_or_else(default_physics_threshold),
         },
     };
-    // `auto`: decided once per request from the checker, never from a clock, so one seed gives
-    // one plan (ARCHITECTURE.md, "Cost-aware default ordering")
-    // expensive: simulated stability (30-160 ms a test) or the arm's reach and path checks
-    // (20-100 ms); the plan search is the one that runs them (an optimiser scores, not checks)
-    let expensive_tests =
-        matches!(stability, StabilitySetting::Physics { .. }) || (robot.is_some() && optimise.is_none());
-    let build = match (entry.name, expensive_tests) {
-        ("auto", true) => catalogue::gnn,
-        _ => entry.build,
-    };
-    let auto_bookkeeping = entry.name == "auto" && expensive_tests;
-    // which checker decides removals: a learned ordering needs a model trained on its labels
+    // which checker decides removals: a learned ordering needs a model trained on its labels, and
+    // `auto` is learned where that checker's tests are expensive (the arm checks removals in the
+    // depth-first search only; an optimiser scores with it)
     let checker = match (&robot, &stability) {
-        (Some(_), _) => asp_learn::Checker::Robot,
-        (None, StabilitySetting::Physics { .. }) => asp_learn::Checker::Physics,
-        (None, StabilitySetting::Contact) => asp_learn::Checker::Default,
+        (Some(_), _) if optimise.is_none() => asp_learn::Checker::Robot,
+        (_, StabilitySetting::Physics { .. }) => asp_learn::Checker::Physics,
+        _ => asp_learn::Checker::Default,
     };
     let model_error = |e: AppError| match &r.model {
         Some(_) => AppError::setting("model", e.to_string()),
         None => e,
     };
-    let order = build(r.model.as_deref(), checker).map_err(model_error)?;
-    if entry.name == "auto" && !expensive_tests && r.model.is_some() {
+    let order = (entry.build)(r.model.as_deref(), checker).map_err(model_error)?;
+    if entry.name == "auto" && !catalogue::auto_is_learned(checker) && r.model.is_some() {
         return Err(AppError::setting(
             "model",
             "the removability model of `order` gnn; `order` auto uses it only where removal tests are expensive (`stability` physics or a `robot`; give `order` gnn to use it here)",
@@ -196,7 +187,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         },
         stability,
         order,
-        bookkeeping: r.bookkeeping.unwrap_or(false) || entry.bookkeeping || auto_bookkeeping,
+        bookkeeping: r.bookkeeping.unwrap_or(false) || (entry.bookkeeping)(checker),
         seed: r.seed.unwrap_or(0),
         path_planner: r.path_planner.unwrap_or(d.path_planner),
         subassemblies: r.subassemblies.unwrap_or(d.subassemblies),
@@ -427,7 +418,7 @@ mod tests {
         assert!(s.bookkeeping && s.order.name() == "gnn" && s.checker == asp_learn::Checker::Robot);
         // an optimiser scores with the arm rather than checks with it: the cheap case
         let s = resolve(&PlanRequest::from_json(r#"{"robot": "panda", "objective": "robot-path"}"#).unwrap()).unwrap();
-        assert!(!s.bookkeeping && s.order.name() == "given");
+        assert!(!s.bookkeeping && s.order.name() == "given" && s.checker == asp_learn::Checker::Default);
         let o = resolve(&PlanRequest::from_json(r#"{"objective": "access"}"#).unwrap()).unwrap().optimise.unwrap();
         let od = OptimiseSettings::default();
         assert_eq!(

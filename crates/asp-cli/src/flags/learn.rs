@@ -127,7 +127,8 @@ pub struct FeasibleArgs {
     #[arg(long, default_value_t = 10)]
     pub orderings: usize,
     /// Methods, comma-separated: vanilla (shuffled), bk, random, random+bk, given, given+bk,
-    /// gnn, gnn+bk [default: vanilla,bk,random,random+bk, and gnn,gnn+bk when a model is given].
+    /// gnn, gnn+bk, auto (what `asp plan` orders with by default under the benchmark's checker)
+    /// [default: vanilla,bk,random,random+bk, and gnn,gnn+bk when a model is given].
     #[arg(long, value_name = "LIST")]
     pub methods: Option<String>,
     /// The removability model for the gnn methods.
