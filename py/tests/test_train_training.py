@@ -75,6 +75,40 @@ def test_seconds_caps_training(stacks):
     assert summary["seconds"] < 5
 
 
+def test_early_stopping_keeps_the_best_epochs_model(stacks):
+    assemblies, _, node_dim, edge_dim = load_assemblies([str(stacks)])
+    config = TrainConfig(epochs=40, seed=3, patience=2, lr=3e-2)
+    model, summary = train(assemblies[:2], node_dim, edge_dim, config, validation=assemblies[2:])
+    history, best = summary["validation_accuracy"], summary["best_epoch"]
+    assert len(history) == summary["epochs"] and best == history.index(max(history)) + 1
+    # it stops `patience` epochs after the best one (or at the last epoch)
+    assert summary["epochs"] == min(config.epochs, best + config.patience), summary
+    # the model returned is the best epoch's, not the last one's: the same weights as a run of
+    # exactly that many epochs (validation never touches the weights or the batch order)
+    again, _ = train(assemblies[:2], node_dim, edge_dim, TrainConfig(epochs=best, seed=3, lr=3e-2))
+    for (k, p1), p2 in zip(model.state_dict().items(), again.state_dict().values()):
+        assert torch.equal(p1, p2), k
+    pooled = sum(evaluate(model, a)["accuracy"] * evaluate(model, a)["labels"] for a in assemblies[2:])
+    assert pooled / sum(evaluate(model, a)["labels"] for a in assemblies[2:]) == pytest.approx(max(history))
+
+
+def test_cli_validation_data_sets(stacks, tmp_path, capsys):
+    val = write_stacks_dataset(tmp_path / "val", ["v1", "v2"], seed=9, runs=2)
+    out = tmp_path / "m.onnx"
+    argv = ["removability", str(stacks), "--out", str(out), "--epochs", "6", "--validation", str(val), "--patience", "2"]
+    assert main(argv) == 0
+    doc = json.loads(Path(str(out) + ".json").read_text())
+    assert doc["validation_assemblies"] == ["v1", "v2"] and doc["patience"] == 2
+    assert 1 <= doc["best_epoch"] <= doc["epochs"] and len(doc["validation_accuracy"]) == doc["epochs"]
+    assert "validation accuracy" in capsys.readouterr().err
+    assert main(argv[:-1] + ["0"]) == 2
+    assert "--patience must be at least 1, got 0" in capsys.readouterr().err
+    other = _with_checker(val, tmp_path / "phys", "physics")
+    assert main(["removability", str(stacks), "--out", str(out), "--validation", str(other)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--validation" in err and "physics checker" in err, err
+
+
 def test_cli_holdout_writes_model_and_summary(stacks, tmp_path, capsys):
     out = tmp_path / "m.onnx"
     code = main(["removability", str(stacks), "--out", str(out), "--epochs", "3", "--holdout", "c", "d", "--seed", "1"])

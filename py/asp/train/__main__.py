@@ -3,6 +3,7 @@
 Trains the removability GNN on ``asp-removability`` data sets and writes an ONNX model plus a
 JSON summary beside it (``model.onnx.json``: features, dimensions, epochs, seed, per-assembly
 accuracy). ``--holdout NAME...`` keeps assemblies out of training and reports their accuracy;
+``--validation DATA_DIR...`` stops early: the epoch with the best accuracy on those data sets is kept;
 ``--leave-one-out OUT_DIR`` trains one model per assembly on all the others
 (``OUT_DIR/<name>.onnx``) and reports each on its own assembly (the thesis' five-fold protocol).
 
@@ -69,6 +70,15 @@ def _parser() -> argparse.ArgumentParser:
         help="also write a few input graphs with the PyTorch outputs as JSON (for parity tests in other runtimes)",
     )
     r.add_argument("--pos-weight", type=float, default=1.0, help="weight of the removable class in the loss (default 1)")
+    r.add_argument(
+        "--validation", nargs="+", metavar="DATA_DIR", default=[],
+        help="data sets of other assemblies, never trained on: after every epoch their accuracy is measured "
+        "and the model of the best epoch is kept (early stopping)",
+    )
+    r.add_argument(
+        "--patience", type=int, default=5,
+        help="with --validation: stop after this many epochs without a better validation accuracy (default 5)",
+    )
     g = r.add_mutually_exclusive_group()
     g.add_argument("--holdout", nargs="+", metavar="NAME", default=[], help="assemblies to evaluate on, not train on")
     g.add_argument("--leave-one-out", type=Path, metavar="OUT_DIR", help="one model per assembly, trained on the others")
@@ -172,15 +182,17 @@ def _fit_and_export(
     node_dim: int,
     edge_dim: int,
     out: Path,
+    validation: list[AssemblyData] | None = None,
 ) -> dict:
+    validation = validation or []
     config = TrainConfig(
         epochs=args.epochs, lr=args.lr, batch=args.batch, seed=args.seed,
         width=args.width, layers=args.layers, seconds=args.seconds, threads=args.threads,
-        pos_weight=args.pos_weight,
+        pos_weight=args.pos_weight, patience=args.patience,
     )
     names = ", ".join(a.name for a in train_set)
     _log(f"training on {sum(len(a.states) for a in train_set)} states of {len(train_set)} assemblies ({names})")
-    model, summary = train(train_set, node_dim, edge_dim, config, log=_log)
+    model, summary = train(train_set, node_dim, edge_dim, config, log=_log, validation=validation)
     checker = train_set[0].checker
     parity = export_onnx(
         model, out, features, aggregation=args.aggregation, tolerance=args.parity_tolerance, extra_metadata={"asp.checker": checker}
@@ -213,6 +225,10 @@ def _fit_and_export(
         "aggregation": args.aggregation,
         "pos_weight": args.pos_weight,
         "final_loss": summary["loss"],
+        "best_epoch": summary.get("best_epoch"),
+        "patience": args.patience if validation else None,
+        "validation_assemblies": [a.name for a in validation],
+        "validation_accuracy": summary.get("validation_accuracy"),
         "train_seconds": summary["seconds"],
         "onnx_parity_max_abs_diff": parity,
         "train_assemblies": [a.name for a in train_set],
@@ -230,6 +246,21 @@ def _removability(args: argparse.Namespace) -> int:
         raise DataError("give --out MODEL.onnx, --leave-one-out OUT_DIR, or both")
     assemblies, features, node_dim, edge_dim = load_assemblies(args.data)
     by_name = {a.name: a for a in assemblies}
+    if args.patience < 1:
+        raise DataError(f"--patience must be at least 1, got {args.patience}")
+    validation: list[AssemblyData] = []
+    if args.validation:
+        validation, v_features, v_node, v_edge = load_assemblies(args.validation)
+        if (v_features, v_node, v_edge) != (features, node_dim, edge_dim):
+            raise DataError(
+                f"--validation {args.validation[0]}: features '{v_features}' ({v_node}/{v_edge}) differ from "
+                f"the training data's '{features}' ({node_dim}/{edge_dim})"
+            )
+        if validation[0].checker != assemblies[0].checker:
+            raise DataError(
+                f"--validation {args.validation[0]}: labelled by the {validation[0].checker} checker, "
+                f"the training data by the {assemblies[0].checker} checker"
+            )
     if args.leave_one_out is not None:
         if len(assemblies) < 2:
             raise DataError("--leave-one-out needs at least two assemblies")
@@ -239,7 +270,7 @@ def _removability(args: argparse.Namespace) -> int:
         for a in assemblies:
             _log(f"== leaving out {a.name}")
             others = [o for o in assemblies if o is not a]
-            doc = _fit_and_export(args, others, [a], features, node_dim, edge_dim, out_dir / f"{_safe(a.name)}.onnx")
+            doc = _fit_and_export(args, others, [a], features, node_dim, edge_dim, out_dir / f"{_safe(a.name)}.onnx", validation)
             results[a.name] = doc["holdout_accuracy"][a.name]
         median = statistics.median(results.values())
         print("leave-one-out accuracy: " + ", ".join(f"{k} {v:.4f}" for k, v in results.items()))
@@ -254,7 +285,7 @@ def _removability(args: argparse.Namespace) -> int:
         train_set = [a for a in assemblies if a.name not in args.holdout]
         if not train_set:
             raise DataError("--holdout leaves no assembly to train on")
-        _fit_and_export(args, train_set, test_set, features, node_dim, edge_dim, args.out)
+        _fit_and_export(args, train_set, test_set, features, node_dim, edge_dim, args.out, validation)
     return 0
 
 

@@ -8,6 +8,7 @@ disjoint graph. Training is seeded and deterministic on CPU (one thread by defau
 
 from __future__ import annotations
 
+import copy
 import math
 import time
 from collections.abc import Iterable, Sequence
@@ -45,6 +46,8 @@ class TrainConfig:
     """PyTorch CPU threads (results are reproducible for one thread count)."""
     pos_weight: float = 1.0
     """Weight of the removable class (label 1) in the loss; above 1 when removable parts are rare."""
+    patience: int = 5
+    """With a validation set: stop after this many epochs without a better validation accuracy."""
 
 
 @dataclass(frozen=True)
@@ -165,10 +168,15 @@ def train(
     edge_dim: int,
     config: TrainConfig,
     log: Callable[[str], None] | None = None,
+    validation: Sequence[AssemblyData] = (),
 ) -> tuple[RemovabilityGNN, dict]:
     """Train a model on every state of ``assemblies``. Returns ``(model, summary)``.
 
-    The summary holds the epochs run, the final epoch's mean loss and the seconds spent.
+    The summary holds the epochs run, the final epoch's mean loss and the seconds spent. With
+    ``validation`` assemblies (never trained on), the accuracy over all their labels is measured
+    after every epoch, training stops after ``config.patience`` epochs without a better one, and
+    the model returned is the one of the best epoch (early stopping; ``best_epoch`` and the
+    per-epoch ``validation_accuracy`` join the summary).
     """
     items = [(a, s) for a in assemblies for s in a.states if s.mask.any()]
     if not items:
@@ -185,6 +193,8 @@ def train(
     epochs_run = 0
     mean_loss = math.nan
     stopped = False
+    val_history: list[float] = []
+    best: tuple[float, int, dict] | None = None  # accuracy, epoch, weights
     for epoch in range(config.epochs):
         model.train()
         order = rng.permutation(len(items))
@@ -205,15 +215,37 @@ def train(
                 break
         epochs_run = epoch + 1
         mean_loss = total / max(count, 1)
+        note = ""
+        if validation:
+            acc = _pooled_accuracy(model, validation)
+            val_history.append(acc)
+            note = f", validation accuracy {acc:.4f}"
+            if best is None or acc > best[0]:
+                best = (acc, epochs_run, copy.deepcopy(model.state_dict()))
         if log:
-            log(f"epoch {epochs_run}/{config.epochs}: loss {mean_loss:.4f} ({time.monotonic() - start:.1f} s)")
+            log(f"epoch {epochs_run}/{config.epochs}: loss {mean_loss:.4f}{note} ({time.monotonic() - start:.1f} s)")
+        if best is not None and epochs_run - best[1] >= config.patience:
+            if log:
+                log(f"no better validation accuracy for {config.patience} epochs: keeping epoch {best[1]} ({best[0]:.4f})")
+            break
         if stopped:
             if log:
                 log(f"stopped after {config.seconds:g} s")
             break
+    if best is not None:
+        model.load_state_dict(best[2])
     model.eval()
     summary = {"epochs": epochs_run, "loss": mean_loss, "seconds": round(time.monotonic() - start, 3), "time_capped": stopped}
+    if best is not None:
+        summary |= {"best_epoch": best[1], "validation_accuracy": val_history}
     return model, summary
+
+
+def _pooled_accuracy(model: RemovabilityGNN, assemblies: Sequence[AssemblyData]) -> float:
+    """Accuracy over every label of ``assemblies`` together (leaves the model in eval mode)."""
+    results = [evaluate(model, a) for a in assemblies]
+    labels = sum(r["labels"] for r in results)
+    return sum(r["accuracy"] * r["labels"] for r in results if r["labels"]) / labels if labels else math.nan
 
 
 @torch.no_grad()
