@@ -293,6 +293,34 @@ fn issue_26_the_default_ordering_under_physics_is_gnn_with_bookkeeping_and_repea
     assert_eq!(run(&["--order", "gnn", "--bookkeeping"]), auto);
 }
 
+/// Issue 26: under `--robot` the default ordering is also the learned one with bookkeeping (the
+/// robot checker's shipped model): the same plan and tests as `--order gnn --bookkeeping`, twice
+/// for a seed, and fewer tests than the file's order, which tries the bottom of a stack first.
+#[test]
+fn issue_26_the_default_ordering_under_the_robot_is_gnn_with_bookkeeping_and_repeats() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut plate = fixtures::box_part("plate", [-0.1, -0.25, -0.02], [0.5, 0.25, 0.0]);
+    plate.fixed = true;
+    let bottom = fixtures::box_part("bottom", [0.1, -0.02, 0.0], [0.14, 0.02, 0.04]);
+    let top = fixtures::box_part("top", [0.1, -0.02, 0.04], [0.14, 0.02, 0.08]);
+    let side = fixtures::box_part("side", [0.1, 0.1, 0.0], [0.14, 0.14, 0.04]);
+    let parts = vec![plate, bottom, top, side];
+    let model = fixture_file(dir.path(), &fixtures::assemble("stack", parts, asp_geom::math::Axis::Z), "stack.glb");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["plan", model.to_str().unwrap(), "--json", "--robot", "panda", "--robot-base=-0.4,0,0", "--seed", "3"];
+        args.extend_from_slice(extra);
+        let o = asp(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (plan["disassembly_sequence"].clone(), plan["stats"]["removal_tests"].as_u64().unwrap())
+    };
+    let auto = run(&[]);
+    assert_eq!(run(&[]), auto, "the same seed gives the same plan");
+    assert_eq!(run(&["--order", "gnn", "--bookkeeping"]), auto);
+    let given = run(&["--order", "given"]);
+    assert!(given.1 > auto.1, "given {given:?}, auto {auto:?}");
+}
+
 #[test]
 fn issue_9_ctrl_c_prints_and_writes_the_best_result_so_far() {
     // cube81 one piece at a time: every piece is blocked, and the path planner is tried on each
