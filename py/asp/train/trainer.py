@@ -13,7 +13,7 @@ import math
 import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 import torch
@@ -235,7 +235,9 @@ def train(
     if best is not None:
         model.load_state_dict(best[2])
     model.eval()
-    summary = {"epochs": epochs_run, "loss": mean_loss, "seconds": round(time.monotonic() - start, 3), "time_capped": stopped}
+    summary: dict[str, Any] = {
+        "epochs": epochs_run, "loss": mean_loss, "seconds": round(time.monotonic() - start, 3), "time_capped": stopped
+    }
     if best is not None:
         summary |= {"best_epoch": best[1], "validation_accuracy": val_history}
     return model, summary
