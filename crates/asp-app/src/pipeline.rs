@@ -114,10 +114,10 @@ pub struct PlanSettings {
     pub cancel: Option<StopToken>,
     /// Wraps the depth-first search's checker (e.g. a robot that must also take each part out).
     pub checker_extension: Option<Arc<dyn CheckerExtension>>,
-    /// Which checker decides removals (`robot` with a robot in the feasibility search, else `physics` under the physics
-    /// stability check, else `default`): the labels `asp collect removability` records under
-    /// these settings, and the checker a removability model must have been trained on to order
-    /// this run's search. [`crate::resolve::resolve`] sets it from the same request as
+    /// Which checker decides removals (`robot` with a robot in the feasibility search, else
+    /// `physics` under the physics stability check, else `default`): the labels `asp collect
+    /// removability` records under these settings, and the checker a removability model must
+    /// have been trained on to order this run's search. [`crate::resolve::resolve`] sets it from the same request as
     /// `stability` and the robot.
     pub checker: asp_learn::Checker,
 }
