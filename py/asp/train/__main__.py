@@ -250,17 +250,11 @@ def _removability(args: argparse.Namespace) -> int:
         raise DataError(f"--patience must be at least 1, got {args.patience}")
     validation: list[AssemblyData] = []
     if args.validation:
-        validation, v_features, v_node, v_edge = load_assemblies(args.validation)
-        if (v_features, v_node, v_edge) != (features, node_dim, edge_dim):
-            raise DataError(
-                f"--validation {args.validation[0]}: features '{v_features}' ({v_node}/{v_edge}) differ from "
-                f"the training data's '{features}' ({node_dim}/{edge_dim})"
-            )
-        if validation[0].checker != assemblies[0].checker:
-            raise DataError(
-                f"--validation {args.validation[0]}: labelled by the {validation[0].checker} checker, "
-                f"the training data by the {assemblies[0].checker} checker"
-            )
+        like = (f"the training data {args.data[0]}", features, node_dim, edge_dim, assemblies[0].checker)
+        try:
+            validation, *_ = load_assemblies(args.validation, like=like)
+        except DataError as e:
+            raise DataError(f"--validation: {e}") from None
     if args.leave_one_out is not None:
         if len(assemblies) < 2:
             raise DataError("--leave-one-out needs at least two assemblies")

@@ -83,29 +83,36 @@ class AssemblyData:
         return self.assembly.name
 
 
-def load_assemblies(dirs: Sequence[str]) -> tuple[list[AssemblyData], str, int, int]:
+def load_assemblies(
+    dirs: Sequence[str], like: tuple[str, str, int, int, str] | None = None
+) -> tuple[list[AssemblyData], str, int, int]:
     """Open data sets and read their states. Returns ``(assemblies, features, node_dim, edge_dim)``.
 
     All data sets must share features, dimensions and checker (the labels of one checker: a model
-    ranks for one); assembly names must be unique across them.
+    ranks for one), with each other and with ``like``, ``(where, features, node_dim, edge_dim,
+    checker)`` of other data (the training data, when these are for validation); assembly names
+    must be unique across them.
     """
     if not dirs:
         raise DataError("no data set given")
     out: list[AssemblyData] = []
     features = node_dim = edge_dim = None
-    first = None
+    first: str | None = None
+    checker: str | None = None
+    if like is not None:
+        first, features, node_dim, edge_dim, checker = like
     for d in dirs:
         ds = RemovabilityDataset.open(d)
         if first is None:
-            first, features, node_dim, edge_dim = d, ds.features, ds.node_dim, ds.edge_dim
+            first, features, node_dim, edge_dim, checker = d, ds.features, ds.node_dim, ds.edge_dim, ds.checker
         elif (ds.features, ds.node_dim, ds.edge_dim) != (features, node_dim, edge_dim):
             raise DataError(
                 f"{ds.root / 'index.json'}: features '{ds.features}' ({ds.node_dim}/{ds.edge_dim}) differ from "
                 f"{first}'s '{features}' ({node_dim}/{edge_dim})"
             )
-        elif out and ds.checker != out[0].checker:
+        elif ds.checker != checker:
             raise DataError(
-                f"{ds.root / 'index.json'}: labelled by the {ds.checker} checker, {first}'s by the {out[0].checker} checker "
+                f"{ds.root / 'index.json'}: labelled by the {ds.checker} checker, {first}'s by the {checker} checker "
                 "(a model learns the labels of one checker)"
             )
         for a in ds.assemblies:
