@@ -4,7 +4,9 @@ use crate::error::{GeomError, Result};
 use crate::math::{aabb_of, Aabb, Axis};
 use crate::mesh::Mesh;
 use crate::meta::PartMeta;
+use crate::surface::PartFaces;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// One part of an assembly, its mesh baked in its assembled pose (world frame, metres).
 #[derive(Clone, Debug)]
@@ -20,6 +22,10 @@ pub struct Part {
     pub extras: serde_json::Value,
     /// The same metadata, typed and parsed once ([`PartMeta::from_extras`]).
     pub meta: PartMeta,
+    /// The part's faces and their analytic surfaces when the file keeps its B-rep (STEP, glTF
+    /// with `TM_brep_faces`), world frame, metres, one face index per triangle of `mesh`; `None`
+    /// otherwise (the planner then recognises surfaces from the triangles).
+    pub faces: Option<Arc<PartFaces>>,
 }
 
 impl Part {
@@ -27,7 +33,7 @@ impl Part {
     /// [`PartMeta::from_extras`] themselves to warn about them).
     pub fn new(name: impl Into<String>, mesh: Mesh, fixed: bool, extras: serde_json::Value) -> Part {
         let (meta, _) = PartMeta::from_extras(&extras);
-        Part { name: name.into(), mesh, fixed, extras, meta }
+        Part { name: name.into(), mesh, fixed, extras, meta, faces: None }
     }
 }
 

@@ -24,6 +24,7 @@ pub mod physics;
 pub mod puzzles;
 pub mod rrt;
 pub mod sample;
+pub mod surface;
 pub mod sweep;
 pub mod validate;
 pub mod voxel;
