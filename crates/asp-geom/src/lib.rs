@@ -8,6 +8,7 @@ pub mod erode;
 pub mod error;
 pub mod fastener;
 pub mod feasibility;
+pub mod fits;
 // test fixtures and puzzle models, public for the other crates' tests and examples
 #[doc(hidden)]
 pub mod fixtures;

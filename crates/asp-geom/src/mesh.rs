@@ -172,6 +172,12 @@ impl Mesh {
     /// face for flat shading) and drops triangles that became degenerate. Exact on purpose: a
     /// grid snap, however fine, can fuse distinct vertices of small features and open holes.
     pub fn weld(&mut self) {
+        self.weld_keeping();
+    }
+
+    /// [`Mesh::weld`], returning for each triangle kept its index before welding (so per-triangle
+    /// data such as B-rep face indices can follow).
+    pub fn weld_keeping(&mut self) -> Vec<u32> {
         let mut map: HashMap<[u32; 3], u32> = HashMap::new();
         let mut remap = Vec::with_capacity(self.vertices.len());
         let mut vertices = Vec::new();
@@ -186,10 +192,14 @@ impl Mesh {
         }
         self.vertices = vertices;
         let tris = std::mem::take(&mut self.triangles);
-        let mut tris: Vec<[u32; 3]> =
-            tris.into_iter().map(|t| t.map(|i| remap[i as usize])).filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]).collect();
-        tris.retain(|t| self.triangle_normal(t).length_squared() > 0.0);
+        let (kept, tris): (Vec<u32>, Vec<[u32; 3]>) = tris
+            .into_iter()
+            .enumerate()
+            .map(|(k, t)| (k as u32, t.map(|i| remap[i as usize])))
+            .filter(|(_, t)| t[0] != t[1] && t[1] != t[2] && t[0] != t[2] && self.triangle_normal(t).length_squared() > 0.0)
+            .unzip();
         self.triangles = tris;
+        kept
     }
 
     /// Counts boundary, non-manifold and misoriented edges.

@@ -2,6 +2,7 @@
 
 mod distmap;
 mod fastener;
+mod fits;
 mod fuzz;
 mod graph;
 mod loaders;

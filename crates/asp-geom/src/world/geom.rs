@@ -3,6 +3,8 @@
 
 use super::*;
 use crate::erode::{eroded_mesh, eroded_near};
+use crate::fits::Surfaces;
+use crate::surface::PartFaces;
 
 /// One part's collision geometry.
 pub(super) struct Geom {
@@ -19,13 +21,21 @@ pub(super) struct Geom {
     pub(super) samples: OnceLock<Vec<Vec3>>,
     /// The axis of near rotational symmetry (fasteners), made when first needed.
     pub(super) axis: OnceLock<Option<SymmetryAxis>>,
+    /// The file's B-rep faces, one face index per triangle of `mesh` (after welding).
+    pub(super) faces: Option<PartFaces>,
+    /// The part's cylinders and planes ([`crate::fits::recognise`]), made when first needed.
+    pub(super) surfaces: OnceLock<Surfaces>,
 }
 
 impl Geom {
     /// The collision geometry of `mesh`, and the topology of its welded surface.
-    pub(super) fn new(mesh: &Mesh) -> Result<(Geom, Topology)> {
+    pub(super) fn new(mesh: &Mesh, faces: Option<&PartFaces>) -> Result<(Geom, Topology)> {
         let mut m = mesh.clone();
-        m.weld();
+        let kept = m.weld_keeping();
+        // the file's faces follow the triangles that welding keeps
+        let faces = faces
+            .filter(|f| f.fits(mesh.triangles.len()))
+            .map(|f| PartFaces { triangle_face: kept.iter().map(|&k| f.triangle_face[k as usize]).collect(), faces: f.faces.clone() });
         m.orient_outward();
         let topology = m.topology();
         let closed = topology.is_closed_manifold();
@@ -40,6 +50,8 @@ impl Geom {
             boxes: None,
             samples: OnceLock::new(),
             axis: OnceLock::new(),
+            faces,
+            surfaces: OnceLock::new(),
         };
         Ok((geom, topology))
     }
@@ -55,7 +67,14 @@ impl Geom {
             boxes: self.boxes.clone(),
             samples: self.samples.clone(),
             axis: self.axis.clone(),
+            faces: self.faces.clone(),
+            surfaces: self.surfaces.clone(),
         }
+    }
+
+    /// The part's cylinders and planes (made once).
+    pub(super) fn surfaces(&self) -> &Surfaces {
+        self.surfaces.get_or_init(|| crate::fits::recognise::surfaces(self.mesh.vertices(), self.mesh.indices(), self.faces.as_ref()))
     }
 
     pub(super) fn eroded_cached(&self, amount: f32) -> bool {

@@ -14,6 +14,7 @@
 //! (mesh preparation, contacts and overlap measurement, threads) and answers the blocking rows.
 
 mod directions;
+mod fits;
 mod geom;
 mod removal;
 
@@ -110,6 +111,13 @@ pub struct World {
     policy: OverlapPolicy,
     /// Threaded contacts (ordered pairs), found with the world.
     threads: BTreeMap<(usize, usize), Thread>,
+    /// Coaxial fits per pair (low, high), found with the world ([`crate::fits`]).
+    fits: BTreeMap<(usize, usize), Vec<crate::fits::Fit>>,
+    /// Per ordered pair with a fit that is not a clearance fit: the first part's samples for the
+    /// fit test (whole surface and dense near the other), made when first needed.
+    fit_samples: BTreeMap<(usize, usize), OnceLock<Vec<Vec3>>>,
+    /// What each part is (nut, washer, bolt, pin, other), from its shape and name.
+    roles: Vec<crate::fits::Role>,
     fixed: PartSet,
     rows: Vec<OnceLock<Vec<PartSet>>>,
     warnings: Vec<String>,
@@ -143,7 +151,7 @@ impl World {
                 if let Some(reason) = crate::validate::collapsed(p) {
                     return Err(GeomError::Assembly { path: assembly.source.clone(), reason });
                 }
-                let made = Geom::new(&p.mesh)
+                let made = Geom::new(&p.mesh, p.faces.as_deref())
                     .map_err(|e| GeomError::Assembly { path: assembly.source.clone(), reason: format!("part '{}': {e}", p.name) })?;
                 Ok((made, PartShape::classify(p, config.exact_boxes)))
             })
@@ -164,7 +172,7 @@ impl World {
         let mut fixed = PartSet::from_indices(n + 1, assembly.parts.iter().enumerate().filter(|(_, p)| p.fixed).map(|(i, _)| i));
         let ground = if fixed.is_empty() {
             let bb = assembly.aabb().expect("validated assembly has vertices");
-            let (mut g, _) = Geom::new(&ground_box(&bb, assembly.up.vector(), diag))?;
+            let (mut g, _) = Geom::new(&ground_box(&bb, assembly.up.vector(), diag), None)?;
             g.boxes = config.exact_boxes.then(|| vec![g.aabb]);
             geoms.push(g);
             fixed.insert(n);
@@ -189,6 +197,9 @@ impl World {
             notes: Vec::new(),
             policy: config.overlaps,
             threads: BTreeMap::new(),
+            fits: BTreeMap::new(),
+            fit_samples: BTreeMap::new(),
+            roles: vec![crate::fits::Role::Other; n],
             fixed,
             rows,
             warnings,
@@ -196,6 +207,7 @@ impl World {
         };
         world.measure_contacts(config.max_overlap_fraction, config.overlaps)?;
         if config.fasteners {
+            world.find_fits();
             world.find_threads();
         }
         world.prepare_pair_shapes();
@@ -229,6 +241,9 @@ impl World {
             notes,
             policy: OverlapPolicy::Lenient,
             threads: self.threads.clone(),
+            fits: self.fits.clone(),
+            fit_samples: self.fit_samples.keys().map(|&k| (k, OnceLock::new())).collect(),
+            roles: self.roles.clone(),
             fixed: self.fixed.clone(),
             rows: (0..self.num_parts()).map(|_| OnceLock::new()).collect(),
             warnings: self.warnings.clone(),
@@ -682,6 +697,12 @@ impl World {
             // diameter, as CAD draws them) would have to turn about the fastener to leave along
             // its axis: the fastener leaves first
             return true;
+        }
+        let fits = self.fits_along(p, q, dir);
+        if !fits.is_empty() {
+            // along a fit's axis the fit is carried (pressed out, unscrewed, slid), with the
+            // fit's band exempt from the strict rule and nothing else entering new material
+            return self.fit_blocks(p, q, &fits, dir, t1);
         }
         if self.is_strict_pair(p, q) && self.strict_entry(p, q, Vec3::ZERO, dir, t1, true).is_some() {
             return true;

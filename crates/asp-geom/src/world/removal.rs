@@ -22,6 +22,9 @@ impl World {
             if let Some(t) = partner.filter(|t| t.axis.direction.dot(direction).abs() > SCREW_ALIGNED) {
                 return Ok(Motion::Screw { axis_point: t.axis.point, direction, distance });
             }
+            if let Some(f) = self.turned_on(p, present, direction) {
+                return Ok(Motion::Screw { axis_point: f.point, direction, distance });
+            }
         }
         Ok(motion)
     }

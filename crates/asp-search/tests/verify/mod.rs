@@ -23,6 +23,8 @@ fn shrunk(world: &World, p: usize, amount: f32) -> TriMesh {
 /// chose for it (the moving part, or for input overlaps the one that separates more easily).
 /// A screw step's threaded partners are not tested here (their threads are invariant under the
 /// screw motion, which is not a translation); `screw` says whether the step is one.
+/// Pairs in `fits` (a coaxial fit along the motion, see [`fit_band`]) are checked by the
+/// strict rule with their band instead.
 fn penetrates(
     world: &World,
     p: usize,
@@ -30,25 +32,31 @@ fn penetrates(
     present: &PartSet,
     shrunk_cache: &mut HashMap<(usize, u32), TriMesh>,
     screw: bool,
+    fits: &HashMap<(usize, usize), Band>,
 ) -> Option<usize> {
-    present.iter().filter(|&q| q != p && !world.ignores(p, q) && !(screw && world.thread(p, q).is_some())).find(|&q| {
-        let (k, amount) = world.pair_erosion(p, q);
-        let shrunk_k = shrunk_cache.entry((k, amount.to_bits())).or_insert_with(|| shrunk(world, k, amount)).clone();
-        let id = Pose::IDENTITY;
-        let (shrunk_pose, raw, raw_pose) = if k == p { (*pose, world.mesh(q).clone(), id) } else { (id, world.mesh(p).clone(), *pose) };
-        let closed_raw = world.is_closed(if k == p { q } else { p });
-        let (bs, br) = (shrunk_k.aabb(&shrunk_pose), raw.aabb(&raw_pose));
-        let nests = |a: &parry3d::bounding_volume::Aabb, b: &parry3d::bounding_volume::Aabb| {
-            (0..3).all(|i| a.mins[i] >= b.mins[i] && a.maxs[i] <= b.maxs[i])
-        };
-        // one wholly inside the other: only for closed surfaces whose boxes nest
-        // static crossing tests of the placed meshes (exact triangle pairs; parry's mesh-mesh
-        // intersection test reports surfaces a tolerance apart as crossing)
-        let crossing = if k == p { meshes_cross_at(&shrunk_k, pose, &raw) } else { meshes_cross_at(&raw, pose, &shrunk_k) };
-        crossing
-            || (closed_raw && nests(&bs, &br) && raw.contains_point(&raw_pose, shrunk_pose.transform_point(shrunk_k.vertices()[0])))
-            || (world.is_closed(k) && nests(&br, &bs) && shrunk_k.contains_point(&shrunk_pose, raw_pose.transform_point(raw.vertices()[0])))
-    })
+    present
+        .iter()
+        .filter(|&q| q != p && !world.ignores(p, q) && !(screw && world.thread(p, q).is_some()) && !fits.contains_key(&(p, q)))
+        .find(|&q| {
+            let (k, amount) = world.pair_erosion(p, q);
+            let shrunk_k = shrunk_cache.entry((k, amount.to_bits())).or_insert_with(|| shrunk(world, k, amount)).clone();
+            let id = Pose::IDENTITY;
+            let (shrunk_pose, raw, raw_pose) = if k == p { (*pose, world.mesh(q).clone(), id) } else { (id, world.mesh(p).clone(), *pose) };
+            let closed_raw = world.is_closed(if k == p { q } else { p });
+            let (bs, br) = (shrunk_k.aabb(&shrunk_pose), raw.aabb(&raw_pose));
+            let nests = |a: &parry3d::bounding_volume::Aabb, b: &parry3d::bounding_volume::Aabb| {
+                (0..3).all(|i| a.mins[i] >= b.mins[i] && a.maxs[i] <= b.maxs[i])
+            };
+            // one wholly inside the other: only for closed surfaces whose boxes nest
+            // static crossing tests of the placed meshes (exact triangle pairs; parry's mesh-mesh
+            // intersection test reports surfaces a tolerance apart as crossing)
+            let crossing = if k == p { meshes_cross_at(&shrunk_k, pose, &raw) } else { meshes_cross_at(&raw, pose, &shrunk_k) };
+            crossing
+                || (closed_raw && nests(&bs, &br) && raw.contains_point(&raw_pose, shrunk_pose.transform_point(shrunk_k.vertices()[0])))
+                || (world.is_closed(k)
+                    && nests(&br, &bs)
+                    && shrunk_k.contains_point(&shrunk_pose, raw_pose.transform_point(raw.vertices()[0])))
+        })
 }
 
 /// Each triangle's centroid and each vertex of part `p`, moved inward by the tolerance (vertices
@@ -74,6 +82,94 @@ fn inner_points(world: &World, p: usize) -> Vec<Vec3> {
     out
 }
 
+/// A coaxial fit band: samples whose distance from the line through `point` along the motion
+/// lies within `[lo, hi]` carry the fit along.
+#[derive(Clone, Copy, Debug)]
+pub struct Band {
+    point: Vec3,
+    lo: f32,
+    hi: f32,
+}
+
+/// The replay referee's fit band of the pair (`p`, `q`) for a motion along unit `dir`, found
+/// from the geometry alone (not the planner's surfaces): the samples of either part (moved
+/// inward by the tolerance) that lie inside the other in the input — their overlap — projected
+/// on the plane normal to the motion, form a thin shell all around one centre (a circle fitted
+/// by least squares; no angular gap over a quarter turn). The referee allows a shell up to 0.35
+/// of its radius wide; this re-check allows a fifth (a coarse thread drawn at its minor
+/// diameter overlaps by about 0.17 of the radius), so a pin pulled a few degrees off its axis
+/// (whose overlap, seen along the motion, smears into a thick ring) is no fit. `None` for every
+/// other pair, and for pairs that do not overlap beyond the tolerance (the shrunk sweep holds
+/// them).
+fn fit_band(world: &World, p: usize, q: usize, dir: Vec3, samples: &mut HashMap<usize, Vec<Vec3>>) -> Option<Band> {
+    let tol = world.tolerance();
+    let mut shell = Vec::new();
+    for (a, b) in [(p, q), (q, p)] {
+        // the check's own samples and, as the referee takes them, about 6,000 area-weighted
+        // surface points moved inward by the tolerance: the overlap of a fit is a thin shell
+        // that centroids of long facets miss
+        let mut pts = samples.entry(a).or_insert_with(|| inner_points(world, a)).clone();
+        let m = world.mesh(a);
+        let dense = asp_geom::sample::sample_triangles(m.vertices(), m.indices(), 6000);
+        pts.extend(dense.points.iter().zip(&dense.normals).map(|(x, n)| *x - *n * tol));
+        let mesh = world.mesh(b);
+        let bb = world.aabb(b);
+        for x in pts {
+            if (0..3).all(|i| x[i] >= bb.mins[i] - 3.0 * tol && x[i] <= bb.maxs[i] + 3.0 * tol) {
+                if mesh.contains_local_point(x) {
+                    shell.push(x);
+                }
+            }
+        }
+    }
+    if shell.len() < 12 {
+        return None;
+    }
+    let u = dir.any_orthonormal_pair();
+    let uv: Vec<[f64; 2]> = shell.iter().map(|x| [x.dot(u.0) as f64, x.dot(u.1) as f64]).collect();
+    // algebraic circle fit: u^2 + v^2 + D u + E v + F = 0, normal equations
+    let mut m = [[0.0f64; 3]; 3];
+    let mut rhs = [0.0f64; 3];
+    for c in &uv {
+        let row = [c[0], c[1], 1.0];
+        let b = -(c[0] * c[0] + c[1] * c[1]);
+        for i in 0..3 {
+            for j in 0..3 {
+                m[i][j] += row[i] * row[j];
+            }
+            rhs[i] += row[i] * b;
+        }
+    }
+    let det = |m: &[[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d0 = det(&m);
+    if d0.abs() < 1e-300 {
+        return None;
+    }
+    let solve = |k: usize| {
+        let mut mk = m;
+        for i in 0..3 {
+            mk[i][k] = rhs[i];
+        }
+        det(&mk) / d0
+    };
+    let (dd, ee, ff) = (solve(0), solve(1), solve(2));
+    let (cu, cv) = (-0.5 * dd, -0.5 * ee);
+    let r = (cu * cu + cv * cv - ff).max(0.0).sqrt();
+    let rad: Vec<f64> = uv.iter().map(|c| (c[0] - cu).hypot(c[1] - cv)).collect();
+    let mut ang: Vec<f64> = uv.iter().map(|c| (c[1] - cv).atan2(c[0] - cu)).collect();
+    ang.sort_by(f64::total_cmp);
+    let gap = ang.windows(2).map(|w| w[1] - w[0]).chain([ang[0] + std::f64::consts::TAU - ang[ang.len() - 1]]).fold(0.0, f64::max);
+    let (lo, hi) = (rad.iter().copied().fold(f64::INFINITY, f64::min) - tol as f64, rad.iter().copied().fold(0.0, f64::max) + tol as f64);
+    if r <= 0.0 || gap > std::f64::consts::FRAC_PI_2 || hi - lo > 0.2 * r {
+        return None;
+    }
+    let point = u.0 * cu as f32 + u.1 * cv as f32;
+    Some(Band { point, lo: lo as f32, hi: hi as f32 })
+}
+
 /// The strict overlap rule, re-checked by point containment at the sampled poses (the replay's
 /// rule): for each pair of a mover and a present part that overlap in the input under the
 /// strict policy, no sample of either (moved inward by the tolerance) that is outside the other
@@ -84,6 +180,7 @@ fn inner_points(world: &World, p: usize) -> Vec<Vec3> {
 /// thread's radius, where the threads turn in each other): a bolt's head, a nut's faces, the
 /// material around a tapped hole may enter nothing, whether the pair overlaps in the input or
 /// only touches. Every other pair of a screw step is checked as for a straight line.
+#[allow(clippy::too_many_arguments)] // the step, its parts, poses, caches and motion
 fn check_strict(
     world: &World,
     k: usize,
@@ -92,11 +189,14 @@ fn check_strict(
     poses: &[Pose],
     samples: &mut HashMap<usize, Vec<Vec3>>,
     screw: Option<Vec3>,
+    fits: &HashMap<(usize, usize), Band>,
+    dir: Option<Vec3>,
 ) {
     for &p in movers {
         for q in others.iter() {
             let thread = screw.and_then(|_| world.thread(p, q));
-            if thread.is_none() && !world.is_strict_pair(p, q) {
+            let band = fits.get(&(p, q)).copied();
+            if thread.is_none() && band.is_none() && !world.is_strict_pair(p, q) {
                 continue;
             }
             if let (Some(t), Some(dir)) = (thread, screw) {
@@ -108,6 +208,15 @@ fn check_strict(
                 if let Some(t) = thread {
                     // both parts' samples in the assembled pose: outside the zone only
                     pts.retain(|&x| t.axis.radial(x) > t.radius);
+                }
+                if let (Some(b), Some(d)) = (band, dir) {
+                    // a coaxial fit carried along its axis: outside the band only (a sample
+                    // keeps its distance from the line along the motion)
+                    pts.retain(|&x| {
+                        let r = x - b.point;
+                        let r = (r - d * r.dot(d)).length();
+                        r < b.lo || r > b.hi
+                    });
                 }
                 // `a`'s samples in the frame of `b`: the mover's moved by the pose, the other's
                 // by its inverse
@@ -204,20 +313,45 @@ pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: 
             Motion::Screw { direction, .. } => Some(direction),
             _ => None,
         };
-        if let Motion::Screw { axis_point, direction, .. } = step.motion {
-            // a screw step's part has a threaded partner present, and turns about that axis
-            let t = others.iter().find_map(|q| world.thread(step.part, q));
-            let t = t.unwrap_or_else(|| panic!("step {k}: '{}' screws with no threaded partner", world.name(step.part)));
-            assert!(
-                t.axis.direction.dot(direction).abs() > 0.9999 && t.axis.radial(axis_point) < 1e-3 * t.axis.radius.max(1e-9) + 1e-6,
-                "step {k}: '{}' screws off its axis",
-                world.name(step.part)
-            );
+        // straight motions: the pairs that carry a coaxial fit along them, found here
+        let dir = match step.motion {
+            Motion::Linear { direction, .. } | Motion::Screw { direction, .. } => Some(direction),
+            Motion::Path { .. } => None,
+        };
+        let mut fits = HashMap::new();
+        if let Some(d) = dir {
+            for &p in &movers {
+                for q in others.iter().filter(|&q| q < world.num_parts() && world.contacts(p).contains(q)) {
+                    if let Some(b) = fit_band(world, p, q, d, &mut samples) {
+                        fits.insert((p, q), b);
+                    }
+                }
+            }
         }
-        check_strict(world, k, &movers, &others, &poses, &mut samples, screw);
+        if let Motion::Screw { axis_point, direction, .. } = step.motion {
+            // a screw step's part has a threaded partner present, and turns about that axis:
+            // a modelled thread, or a coaxial fit along the motion (a nut on its bolt as CAD
+            // draws it)
+            match others.iter().find_map(|q| world.thread(step.part, q)) {
+                Some(t) => assert!(
+                    t.axis.direction.dot(direction).abs() > 0.9999 && t.axis.radial(axis_point) < 1e-3 * t.axis.radius.max(1e-9) + 1e-6,
+                    "step {k}: '{}' screws off its axis",
+                    world.name(step.part)
+                ),
+                None => assert!(
+                    others.iter().any(|q| world
+                        .fits(step.part, q)
+                        .iter()
+                        .any(|f| f.turns == Some(step.part) && f.axis.dot(direction).abs() > 0.9999)),
+                    "step {k}: '{}' screws with no threaded partner and no fit it turns on along its motion",
+                    world.name(step.part)
+                ),
+            }
+        }
+        check_strict(world, k, &movers, &others, &poses, &mut samples, screw, &fits, dir);
         for pose in &poses {
             for &p in &movers {
-                if let Some(q) = penetrates(world, p, pose, &others, &mut cache, matches!(step.motion, Motion::Screw { .. })) {
+                if let Some(q) = penetrates(world, p, pose, &others, &mut cache, matches!(step.motion, Motion::Screw { .. }), &fits) {
                     panic!("step {k}: part '{}' hits '{}' at {pose:?}", world.name(p), world.name(q));
                 }
             }

@@ -1,0 +1,136 @@
+//! Coaxial fits in the collision world ([`crate::fits`]): found with the world, their axes
+//! among the candidate directions, and the pair test along an axis with the fit band exempt.
+
+use super::*;
+use crate::fits::{self, Fit, Role};
+
+/// A direction is a fit's axis when their cosine exceeds this (0.1°): the exact axis joins the
+/// candidates unless one lies this close.
+const AXIS_ALIGNED: f32 = 0.999_998_5;
+
+impl World {
+    /// Finds every fit between parts in contact (touching or overlapping in the input; meshes
+    /// only, unions of boxes have no round faces) and adds each fit's axis, both ways, to the
+    /// candidate directions.
+    pub(super) fn find_fits(&mut self) {
+        let n = self.num_parts();
+        let pairs: Vec<(usize, usize)> = (0..n)
+            .flat_map(|p| self.contacts[p].iter().filter(move |&q| q < n && q > p).map(move |q| (p, q)))
+            .filter(|&(p, q)| self.geoms[p].boxes.is_none() && self.geoms[q].boxes.is_none())
+            .collect();
+        let parts: BTreeSet<usize> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
+        // each part's surfaces and role once, in parallel
+        let roles: Vec<(usize, Role)> = parts
+            .into_iter()
+            .collect::<Vec<_>>()
+            .par_iter()
+            .map(|&p| {
+                let g = &self.geoms[p];
+                (p, fits::role(self.name(p), g.surfaces(), g.mesh.vertices()))
+            })
+            .collect();
+        for (p, r) in roles {
+            self.roles[p] = r;
+        }
+        let found: Vec<((usize, usize), Vec<Fit>)> = pairs
+            .par_iter()
+            .filter_map(|&(p, q)| {
+                let (gp, gq) = (&self.geoms[p], &self.geoms[q]);
+                let f = fits::fits_between(
+                    p,
+                    gp.surfaces(),
+                    self.roles[p],
+                    q,
+                    gq.surfaces(),
+                    self.roles[q],
+                    self.tolerance,
+                    self.contact_distance,
+                );
+                (!f.is_empty()).then_some(((p, q), f))
+            })
+            .collect();
+        for (pair, f) in found {
+            for fit in &f {
+                for d in [fit.axis, -fit.axis] {
+                    if !self.directions.iter().any(|e| e.dot(d) > AXIS_ALIGNED) {
+                        self.directions.push(d);
+                    }
+                }
+                if fit.class != fits::FitClass::Clearance {
+                    self.fit_samples.entry((fit.shaft, fit.hole)).or_default();
+                    self.fit_samples.entry((fit.hole, fit.shaft)).or_default();
+                }
+            }
+            self.fits.insert(pair, f);
+        }
+    }
+
+    /// The fits between `p` and `q` (either order).
+    pub fn fits(&self, p: usize, q: usize) -> &[Fit] {
+        self.fits.get(&(p.min(q), p.max(q))).map_or(&[], Vec::as_slice)
+    }
+
+    /// Every pair with fits, (low, high), and its fits.
+    pub fn all_fits(&self) -> &BTreeMap<(usize, usize), Vec<Fit>> {
+        &self.fits
+    }
+
+    /// What part `p` is (a nut, a washer, a bolt, a pin; [`Role::Other`] for parts in no mesh
+    /// contact).
+    pub fn role(&self, p: usize) -> Role {
+        self.roles.get(p).copied().unwrap_or(Role::Other)
+    }
+
+    /// The fits of `p` and `q` that are not clearance fits and whose axis the motion along unit
+    /// `dir` follows.
+    pub(super) fn fits_along(&self, p: usize, q: usize, dir: Vec3) -> Vec<&Fit> {
+        self.fits(p, q).iter().filter(|f| f.class != fits::FitClass::Clearance && f.axis.dot(dir).abs() > AXIS_ALIGNED).collect()
+    }
+
+    /// The pair test of `p` moving along unit `dir` (up to `t_max`) against `q` when the motion
+    /// follows the axis of their `fits`: blocked when `q` must turn to move along it (the part
+    /// holding a fastener's thread, a bolt whose nut is still on), else the strict sample rule
+    /// on the samples of both parts outside every fit's band (see [`crate::fits`]).
+    pub(super) fn fit_blocks(&self, p: usize, q: usize, fits: &[&Fit], dir: Vec3, t_max: f32) -> bool {
+        if fits.iter().any(|f| f.turns == Some(q)) {
+            return true;
+        }
+        // each band about the line through the fit's axis point along the motion: a sample
+        // moving along `dir` keeps its distance from that line
+        let outside = |s: &[Vec3]| -> Vec<Vec3> {
+            s.iter()
+                .copied()
+                .filter(|&x| {
+                    !fits.iter().any(|f| {
+                        let r = crate::surface::radial(x, f.point, dir);
+                        r >= f.band.0 && r <= f.band.1
+                    })
+                })
+                .collect()
+        };
+        let (sp, sq) = (outside(self.fit_pair_samples(p, q)), outside(self.fit_pair_samples(q, p)));
+        overlap::strict_entry(&sp, &self.geoms[p].mesh, &sq, &self.geoms[q].mesh, Vec3::ZERO, dir, t_max, true).is_some()
+    }
+
+    /// Part `p`'s samples for its fit tests with `q`: its whole-surface samples and dense ones
+    /// near `q` (made once per pair).
+    fn fit_pair_samples(&self, p: usize, q: usize) -> &[Vec3] {
+        let Some(cell) = self.fit_samples.get(&(p, q)) else { return self.strict_pair_samples(p, q) };
+        cell.get_or_init(|| {
+            let mut all = self.strict_samples(p).to_vec();
+            let (a, b) = (self.geoms[p].mesh.local_aabb(), self.geoms[q].mesh.local_aabb());
+            all.extend(overlap::local_inward_samples(&self.geoms[p].mesh, &a, &b, self.tolerance));
+            all
+        })
+    }
+
+    /// The partner of `p` among `present` along whose fit axis `direction` runs and which `p`
+    /// must turn on (a nut on its bolt, a screw in its tapped hole): its removal there is a
+    /// `screw` motion about the fit's axis.
+    pub(super) fn turned_on(&self, p: usize, present: &PartSet, direction: Vec3) -> Option<&Fit> {
+        present
+            .iter()
+            .filter(|&q| q != p && q < self.num_parts())
+            .find_map(|q| self.fits(p, q).iter().find(|f| f.turns == Some(p) && f.axis.dot(direction).abs() > AXIS_ALIGNED))
+    }
+}
