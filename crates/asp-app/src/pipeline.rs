@@ -533,6 +533,7 @@ fn unit_sets(assembly: &Assembly, groups: &[Vec<String>]) -> Result<Vec<PartSet>
 /// where the time went (loading is timed by the caller).
 fn finish_report(report: &mut PlanReport, world: &asp_geom::World, outcome: &PlanOutcome, world_seconds: f64) {
     report.overlaps = asp_search::report::OverlapsEntry::of(world);
+    report.fits = asp_search::report::FitEntry::of(world);
     report.stats.timings =
         Some(Timings { load: 0.0, world: world_seconds, search: outcome.stats.seconds, path_planner: outcome.stats.path_planner_seconds });
 }

@@ -15,7 +15,7 @@ pub mod text;
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.9";
+pub const FORMAT_VERSION: &str = "1.10";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -60,6 +60,11 @@ pub struct PlanReport {
     /// treated them (feasibility planning; absent when no pair overlaps). Since format 1.5.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub overlaps: Option<OverlapsEntry>,
+    /// Every coaxial fit between two parts (a shaft of one in a hole of the other), classified,
+    /// and the fasteners among the parts (feasibility planning; absent when there is none).
+    /// Since format 1.10.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fits: Vec<FitEntry>,
     /// Non-fatal problems found in the model, one line each.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
@@ -207,6 +212,53 @@ impl OverlapsEntry {
             })
             .collect();
         Some(OverlapsEntry { policy: world.overlap_policy(), pairs })
+    }
+}
+
+/// One coaxial fit of a plan (format 1.10): a shaft of one part in a hole of another.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct FitEntry {
+    /// The part with the shaft and the part with the hole.
+    pub parts: [usize; 2],
+    /// Their names.
+    pub names: [String; 2],
+    /// `clearance`, `line_to_line`, `press` or `thread` (a thread drawn without its helix).
+    pub class: asp_geom::fits::FitClass,
+    /// A point on the axis, model units.
+    pub point: [f64; 3],
+    /// The axis direction (unit).
+    pub axis: [f64; 3],
+    /// The shaft's and the hole's radius, model units.
+    pub radii: [f64; 2],
+    /// What each part is: `bolt`, `nut`, `washer`, `pin` or `other`.
+    pub roles: [asp_geom::fits::Role; 2],
+    /// The part that turns to move along the axis (a nut on its bolt, a screw in its tapped
+    /// hole); the other cannot slide along the axis while it is present. Absent: either slides.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub turns: Option<usize>,
+}
+
+impl FitEntry {
+    /// Every fit `world` found, in pair order.
+    pub fn of(world: &asp_geom::World) -> Vec<FitEntry> {
+        let units = &world.assembly().units;
+        let len = |m: f32| units.from_metres(m as f64);
+        let v = |x: asp_geom::math::Vec3| [x.x as f64, x.y as f64, x.z as f64];
+        world
+            .all_fits()
+            .values()
+            .flatten()
+            .map(|f| FitEntry {
+                parts: [f.shaft, f.hole],
+                names: [world.name(f.shaft).to_string(), world.name(f.hole).to_string()],
+                class: f.class,
+                point: v(f.point).map(|c| units.from_metres(c)),
+                axis: v(f.axis),
+                radii: [len(f.shaft_radius), len(f.hole_radius)],
+                roles: [world.role(f.shaft), world.role(f.hole)],
+                turns: f.turns,
+            })
+            .collect()
     }
 }
 
@@ -482,6 +534,7 @@ impl PlanReport {
             explanation,
             locked_cores,
             overlaps: None,
+            fits: Vec::new(),
             warnings: warnings.to_vec(),
             pareto_front: None,
             optimisation: None,

@@ -177,7 +177,12 @@ fn broken_glb_containers_and_accessors() {
         "duplicate.glb",
         glb(doc(json!([{"name": "a", "mesh": 0}, {"name": "a", "mesh": 0}])).to_string().as_bytes(), &bin),
     );
-    plan_refused(dir.path(), &twice, &[], "parts 'a' and 'a_2' are the same mesh at the same place");
+    // ... is a common export slip: planned with one copy, and a warning in the plan
+    let (o, _) = asp(&["plan", twice.to_str().unwrap(), "--json", "--quiet"]);
+    assert_ne!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(plan["parts"].as_array().unwrap().len(), 1);
+    assert!(plan["warnings"].to_string().contains("parts 'a' and 'a_2' are the same mesh at the same place (a duplicate)"), "{plan}");
     // an accessor count past the buffer's end
     let mut over = doc(json!([{"name": "a", "mesh": 0}]));
     over["accessors"][0]["count"] = json!(3000);

@@ -29,6 +29,8 @@ pub struct LoadOptions {
     pub allow_outside_files: bool,
     /// Caps on what a file may make asp allocate.
     pub limits: Limits,
+    /// Make each separate body of a part's mesh a part of its own (`name#1`, `name#2`, ...).
+    pub split_bodies: bool,
 }
 
 /// The default cap on triangles over all parts ([`Limits::max_triangles`]).
@@ -128,7 +130,14 @@ fn finish(mut assembly: Assembly, options: &LoadOptions) -> Result<Assembly> {
     assembly.dedupe_names();
     assembly.set_fixed(&options.fixed)?;
     assembly.validate()?;
-    crate::validate::check_model(&assembly)?;
+    crate::validate::check_model(&mut assembly)?;
+    if options.split_bodies {
+        let split = crate::validate::split_bodies(&mut assembly);
+        if !split.is_empty() {
+            assembly.warnings.retain(|w| !split.iter().any(|n| w.starts_with(&format!("part '{n}' holds "))));
+            assembly.warnings.push(format!("split into one part per body (--split-bodies): {}", split.join(", ")));
+        }
+    }
     let (_, unknown) = assembly.fastenings();
     assembly.warnings.extend(unknown);
     Ok(assembly)

@@ -7,6 +7,15 @@ use crate::fits::{self, Fit, Role};
 /// A direction is a fit's axis when their cosine exceeds this (0.1°): the exact axis joins the
 /// candidates unless one lies this close.
 const AXIS_ALIGNED: f32 = 0.999_998_5;
+/// The most directions the pairs' planar contacts add to the candidates.
+const MAX_CONTACT_DIRECTIONS: usize = 48;
+
+/// Whether the plane through `point` with unit `normal` meets box `b`.
+fn plane_meets_box(point: Vec3, normal: Vec3, b: &Aabb) -> bool {
+    let c = (b.mins + b.maxs) * 0.5;
+    let h = (b.maxs - b.mins) * 0.5;
+    (c - point).dot(normal).abs() <= h.dot(normal.abs())
+}
 
 impl World {
     /// Finds every fit between parts in contact (touching or overlapping in the input; meshes
@@ -49,6 +58,7 @@ impl World {
                 (!f.is_empty()).then_some(((p, q), f))
             })
             .collect();
+        self.add_contact_directions(&pairs);
         for (pair, f) in found {
             for fit in &f {
                 for d in [fit.axis, -fit.axis] {
@@ -62,6 +72,81 @@ impl World {
                 }
             }
             self.fits.insert(pair, f);
+        }
+    }
+
+    /// Adds the directions the pairs' own planar contacts define: each contact plane's normal
+    /// (a panel lifts off along it, also when the two are sunk a little into each other) and
+    /// the line two non-parallel contact planes of one part share (a slide along a rail, in a
+    /// T-slot or a channel), both ways, unless a candidate lies within 0.1°. Model-wide normal clusters
+    /// average a lift 2° off an axis into the axis; these are the pair's exact ones. At most
+    /// [`MAX_CONTACT_DIRECTIONS`] are added, the largest contacts first.
+    fn add_contact_directions(&mut self, pairs: &[(usize, usize)]) {
+        let slack = self.contact_distance;
+        // per pair, its planar contacts (weight, the first part's outward normal)
+        let per_pair: Vec<((usize, usize), Vec<(f32, Vec3)>)> = pairs
+            .par_iter()
+            .map(|&(p, q)| {
+                let (gp, gq) = (&self.geoms[p], &self.geoms[q]);
+                let depth = self.notes.iter().find(|n| n.parts == (p, q)).map_or(0.0, |n| n.depth);
+                let reach = slack + depth;
+                let common =
+                    Aabb::new(gp.aabb.mins.max(gq.aabb.mins) - Vec3::splat(reach), gp.aabb.maxs.min(gq.aabb.maxs) + Vec3::splat(reach));
+                let large = |planes: &[fits::Plane]| {
+                    let total: f32 = planes.iter().map(|x| x.area).sum();
+                    planes.iter().filter(|x| x.area >= 0.005 * total).cloned().collect::<Vec<_>>()
+                };
+                let (pp, pq) = (large(&gp.surfaces().planes), large(&gq.surfaces().planes));
+                // opposite planes of the two parts within reach of each other, meeting the
+                // pair's common box: a planar contact (or a slab)
+                let mut contacts: Vec<(f32, Vec3)> = Vec::new();
+                for a in &pp {
+                    for b in &pq {
+                        if a.normal.dot(b.normal) <= -0.9995
+                            && (b.point - a.point).dot(a.normal).abs() <= reach
+                            && plane_meets_box(a.point, a.normal, &common)
+                        {
+                            contacts.push((a.area.min(b.area), a.normal));
+                        }
+                    }
+                }
+                ((p, q), contacts)
+            })
+            .collect();
+        // per part, the normals of all its planar contacts: each normal, and the line any two
+        // non-parallel ones share (the part slides along it between them)
+        let mut per_part: BTreeMap<usize, Vec<(f32, Vec3)>> = BTreeMap::new();
+        for ((p, q), contacts) in per_pair {
+            for (w, n) in contacts {
+                per_part.entry(p).or_default().push((w, n));
+                per_part.entry(q).or_default().push((w, -n));
+            }
+        }
+        let mut found: Vec<(f32, Vec3)> = Vec::new();
+        for (_, mut contacts) in per_part {
+            contacts.sort_by(|a, b| b.0.total_cmp(&a.0));
+            contacts.truncate(8);
+            found.extend(contacts.iter().flat_map(|&(w, n)| [(w, n), (w, -n)]));
+            for (i, &(wa, na)) in contacts.iter().enumerate() {
+                for &(wb, nb) in &contacts[i + 1..] {
+                    let line = na.cross(nb);
+                    if line.length() > 0.05 {
+                        let l = line.normalize();
+                        found.extend([(wa.min(wb), l), (wa.min(wb), -l)]);
+                    }
+                }
+            }
+        }
+        found.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let mut added = 0;
+        for (_, d) in found {
+            if added >= MAX_CONTACT_DIRECTIONS {
+                break;
+            }
+            if !self.directions.iter().any(|e| e.dot(d) > AXIS_ALIGNED) {
+                self.directions.push(d);
+                added += 1;
+            }
         }
     }
 

@@ -114,3 +114,41 @@ fn a_pressed_pin_is_pressed_out_along_its_axis_and_never_dragged_sideways() {
         }
     }
 }
+
+/// A slider in a closed channel whose axis lies `angle` degrees off +x in the xy plane (floor,
+/// ceiling and two walls, fixed, each touching the slider face to face).
+fn channel(angle: f32) -> asp_geom::Assembly {
+    use asp_geom::fixtures::part;
+    use asp_geom::math::{Pose, Rot};
+    let turn = Pose::from_parts(Vec3::ZERO, Rot::from_rotation_z(angle.to_radians()));
+    let b = |name: &str, lo: [f32; 3], hi: [f32; 3], fixed: bool| {
+        part(name, asp_geom::Mesh::cuboid(Vec3::from(lo), Vec3::from(hi)).transformed(&turn), fixed)
+    };
+    let parts = vec![
+        b("floor", [-0.1, -0.03, -0.01], [0.1, 0.03, 0.0], true),
+        b("ceiling", [-0.1, -0.03, 0.02], [0.1, 0.03, 0.03], true),
+        b("left wall", [-0.1, 0.01, 0.0], [0.1, 0.03, 0.02], true),
+        b("right wall", [-0.1, -0.03, 0.0], [0.1, -0.01, 0.02], true),
+        b("slider", [-0.02, -0.01, 0.0], [0.02, 0.01, 0.02], false),
+    ];
+    fixtures::assemble("channel", parts, asp_geom::math::Axis::Z)
+}
+
+#[test]
+fn a_slide_along_the_line_two_planar_contacts_share_is_tried_a_fraction_of_a_degree_off_an_axis() {
+    for angle in [0.4f32, 2.4] {
+        let w = world(channel(angle), true);
+        let all = PartSet::full(5);
+        let u = Vec3::new(angle.to_radians().cos(), angle.to_radians().sin(), 0.0);
+        match w.linear_removal(4, &all) {
+            Ok(Motion::Linear { direction, .. }) => assert!(direction.dot(u).abs() > 0.99999, "{angle}: {direction:?}"),
+            other => panic!("{angle}: the slider slides out along its channel, got {other:?}"),
+        }
+        // without the pair's own directions only the model's (axes, normal clusters merged
+        // within a degree of them) are tried
+        if angle < 1.0 {
+            let w = world(channel(angle), false);
+            assert!(w.linear_removal(4, &all).is_err(), "{angle}");
+        }
+    }
+}
