@@ -262,6 +262,7 @@ pub fn load(path: &Path, settings: &PlanSettings) -> Result<Assembly> {
         fixed: settings.fixed.clone(),
         allow_outside_files: settings.allow_outside_files,
         limits: settings.limits,
+        split_bodies: false,
     };
     Ok(asp_geom::io::load(path, &options)?)
 }

@@ -44,7 +44,7 @@ pub fn check_model(assembly: &mut Assembly) -> Result<()> {
         let key = mesh_hash(&part.mesh);
         if let Some(&first) = seen.get(&key) {
             let other = &assembly.parts[first];
-            if same_mesh(&other.mesh, &part.mesh) && !(other.fixed && !part.fixed) {
+            if (part.fixed || !other.fixed) && same_mesh(&other.mesh, &part.mesh) {
                 assembly.warnings.push(format!(
                     "parts '{}' and '{}' are the same mesh at the same place (a duplicate); '{}' is left out and one copy planned",
                     other.name, part.name, part.name

@@ -261,9 +261,13 @@ pub fn fits_between(p: usize, sp: &Surfaces, rp: Role, q: usize, sq: &Surfaces, 
                     (FitClass::Thread, Role::Bolt | Role::Pin, _) => Some(shaft),
                     _ => None,
                 };
-                // one fit per pair and axis: the tightest class wins, bands join
+                // one fit per pair, axis and radius (a stepped shaft in a stepped bore has one
+                // per step): the tightest class wins, bands that meet join
                 if let Some(f) = out.iter_mut().find(|f| {
-                    f.axis.dot(a.axis).abs() >= parallel && crate::surface::radial(a.point, f.point, f.axis) <= MAX_OFFSET * a.radius
+                    f.axis.dot(a.axis).abs() >= parallel
+                        && crate::surface::radial(a.point, f.point, f.axis) <= MAX_OFFSET * a.radius
+                        && f.band.0 <= band.1
+                        && band.0 <= f.band.1
                 }) {
                     if (f.shaft, f.hole) == (shaft, hole) {
                         f.band = (f.band.0.min(band.0), f.band.1.max(band.1));

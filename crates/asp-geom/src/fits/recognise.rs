@@ -1,13 +1,16 @@
 //! A part's cylinders and planes, read from its B-rep faces where the file has them and
 //! recognised from its triangles where it does not.
 //!
-//! **From triangles.** A tessellated cylinder is a ring of flat facets that meet along lines
-//! parallel to its axis, each crease a fraction of a turn (360°/n for an n-gon). So the triangles
-//! are first grouped into flat facets (edge-adjacent, normals within [`FLAT_DEG`]), then facets
-//! into cylinder candidates: two facets meeting at a crease of at most [`CREASE_DEG`] whose shared
-//! edge runs along the axis the group already has (within [`AXIS_DEG`]) join. A candidate of at
-//! least [`MIN_FACETS`] facets is a cylinder when its vertices, projected on the plane normal to
-//! the axis, lie on a circle (the least-squares fit, within [`RESIDUAL`] of its radius). Its
+//! **From triangles.** A tessellated cylinder is a ring of triangles whose normals are all
+//! normal to its axis, each crease between neighbours a fraction of a turn (360°/n for an
+//! n-gon; its two rims may be tessellated independently, so creases need not run along the
+//! axis). So smooth regions are grown from each triangle: a neighbour joins across a crease of
+//! at most [`CREASE_DEG`] when its normal is normal (within twice [`AXIS_DEG`]) to the region's
+//! axis, the line the first two differing normals span; neighbours within [`FLAT_DEG`] of each
+//! other share a flat facet. A region of one facet is a plane; a region of at least
+//! [`MIN_FACETS`] facets is a cylinder when its vertices, projected on the plane normal to the
+//! axis (refined over all its normals), lie on a circle (the least-squares fit, within
+//! [`RESIDUAL`] of its radius). Its
 //! tolerance is the chord's *sagitta*, `r (1 − cos(Δ/2))` for the widest facet's angle `Δ`: two
 //! coaxial cylinders of one radius, faceted differently, overlap by up to the sum of theirs.
 //!
@@ -23,37 +26,18 @@ use parry3d::math::Mat3;
 use std::collections::HashMap;
 
 /// Adjacent triangles whose normals differ by less than this (degrees) lie in one flat facet.
-const FLAT_DEG: f32 = 0.5;
+pub const FLAT_DEG: f32 = 0.5;
 /// Two facets of one cylinder meet at a crease of at most this (degrees): an octagon's 45°.
-const CREASE_DEG: f32 = 50.0;
+pub const CREASE_DEG: f32 = 50.0;
 /// A crease joins a cylinder when it runs along the cylinder's axis within this (degrees).
-const AXIS_DEG: f32 = 2.0;
+pub const AXIS_DEG: f32 = 2.0;
+/// While a region's axis rests on a narrow angle, a normal may stray from normal to it by at
+/// most this (the sine of 15°).
+pub const MAX_STRAY: f32 = 0.26;
 /// A cylinder has at least this many facets.
-const MIN_FACETS: usize = 3;
+pub const MIN_FACETS: usize = 3;
 /// Its vertices lie within this fraction of its radius of the fitted circle.
-const RESIDUAL: f32 = 0.02;
-
-/// Union-find over indices.
-struct Sets(Vec<usize>);
-
-impl Sets {
-    fn new(n: usize) -> Sets {
-        Sets((0..n).collect())
-    }
-    fn find(&mut self, mut i: usize) -> usize {
-        while self.0[i] != i {
-            self.0[i] = self.0[self.0[i]];
-            i = self.0[i];
-        }
-        i
-    }
-    fn union(&mut self, a: usize, b: usize) -> usize {
-        let (a, b) = (self.find(a), self.find(b));
-        let (lo, hi) = (a.min(b), a.max(b));
-        self.0[hi] = lo;
-        lo
-    }
-}
+pub const RESIDUAL: f32 = 0.02;
 
 /// The cylinders and planes of a closed, outward-oriented mesh (`vertices`, `triangles`), with
 /// the file's B-rep `faces` (one face index per triangle of this mesh) when it has them.
@@ -74,50 +58,75 @@ pub fn surfaces(vertices: &[Vec3], triangles: &[[u32; 3]], faces: Option<&PartFa
         }
     }
     let same_face = |a: u32, b: u32| faces.is_none_or(|f| f.triangle_face[a as usize] == f.triangle_face[b as usize]);
-    let manifold_pairs = || edges.iter().filter(|(_, ts)| ts.len() == 2).map(|(e, ts)| (*e, ts[0], ts[1]));
-
-    // flat facets
+    // triangle adjacency across manifold edges
+    let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); triangles.len()];
+    let mut pairs: Vec<(u32, u32)> = edges.values().filter(|ts| ts.len() == 2).map(|ts| (ts[0], ts[1])).collect();
+    pairs.sort_unstable(); // HashMap order is not deterministic
+    for (a, b) in pairs {
+        neighbours[a as usize].push(b);
+        neighbours[b as usize].push(a);
+    }
+    // smooth regions grown from each unassigned triangle in order: a neighbour joins across a
+    // crease of at most CREASE_DEG (within one B-rep face) when its normal is normal to the
+    // region's axis, the line two of the region's differing normals span (a cylinder's
+    // triangles, however its rims are tessellated); a region of one normal is a plane
     let flat = FLAT_DEG.to_radians().cos();
-    let mut facets = Sets::new(triangles.len());
-    for (_, a, b) in manifold_pairs() {
-        if normals[a as usize].dot(normals[b as usize]) >= flat && same_face(a, b) {
-            facets.union(a as usize, b as usize);
-        }
-    }
-    let facet_of: Vec<usize> = (0..triangles.len()).map(|t| facets.find(t)).collect();
-
-    // facets into cylinder candidates, each group with the axis its creases run along
     let crease = CREASE_DEG.to_radians().cos();
-    let along = AXIS_DEG.to_radians().cos();
-    let mut groups = Sets::new(triangles.len());
+    let across = (2.0 * AXIS_DEG).to_radians().sin();
+    let mut region_of = vec![usize::MAX; triangles.len()];
     let mut axis: HashMap<usize, Vec3> = HashMap::new();
-    let mut creases: Vec<((u32, u32), u32, u32)> = manifold_pairs().collect();
-    creases.sort_unstable(); // HashMap order is not deterministic
-    for ((i, j), a, b) in creases {
-        let (fa, fb) = (facet_of[a as usize], facet_of[b as usize]);
-        if fa == fb || !same_face(a, b) {
+    let mut facet_of = vec![0usize; triangles.len()];
+    for seed in 0..triangles.len() {
+        if region_of[seed] != usize::MAX || normals[seed] == Vec3::ZERO {
             continue;
         }
-        let c = normals[a as usize].dot(normals[b as usize]);
-        if c < crease || c >= flat {
-            continue;
+        region_of[seed] = seed;
+        facet_of[seed] = seed;
+        // the axis: the seed's normal crossed with the region's normal most unlike it (the
+        // wider the angle, the less the triangles' own noise tilts it), and how far a normal
+        // may stray from normal to it while the angle is still narrow
+        let n0 = normals[seed];
+        let mut widest = Vec3::ZERO;
+        let mut region_axis: Option<Vec3> = None;
+        let mut queue = std::collections::VecDeque::from([seed as u32]);
+        while let Some(t) = queue.pop_front() {
+            for &u in &neighbours[t as usize] {
+                if region_of[u as usize] != usize::MAX || !same_face(t, u) || normals[u as usize] == Vec3::ZERO {
+                    continue;
+                }
+                let (nt, nu) = (normals[t as usize], normals[u as usize]);
+                let c = nt.dot(nu);
+                if c < crease {
+                    continue;
+                }
+                if c >= flat {
+                    // the same flat facet as `t` (and so normal to the region's axis, if any)
+                    facet_of[u as usize] = facet_of[t as usize];
+                } else {
+                    if let Some(a) = region_axis {
+                        let spread = widest.length();
+                        if nu.dot(a).abs() > (across + 0.01 / spread.max(1e-3)).min(MAX_STRAY) {
+                            continue;
+                        }
+                    }
+                    let w = n0.cross(nu);
+                    if w.length() > widest.length() {
+                        widest = w;
+                        region_axis = Some(w.normalize_or_zero());
+                    }
+                    facet_of[u as usize] = u as usize;
+                }
+                region_of[u as usize] = seed;
+                queue.push_back(u);
+            }
         }
-        let e = (vertices[j as usize] - vertices[i as usize]).normalize_or_zero();
-        let (ga, gb) = (groups.find(fa), groups.find(fb));
-        let fits = |g: usize| axis.get(&g).is_none_or(|x| x.dot(e).abs() >= along);
-        if ga != gb && fits(ga) && fits(gb) {
-            let x = axis.get(&ga).or(axis.get(&gb)).copied().unwrap_or(e);
-            let g = groups.union(ga, gb);
-            axis.insert(g, x);
-        } else if ga == gb && !fits(ga) {
-            // a crease across the group's axis: a cone or a sphere, not a cylinder
-            axis.insert(ga, Vec3::ZERO);
+        if let Some(a) = region_axis {
+            axis.insert(seed, a);
         }
     }
-
     let mut members: HashMap<usize, Vec<u32>> = HashMap::new();
-    for t in 0..triangles.len() {
-        members.entry(groups.find(facet_of[t])).or_default().push(t as u32);
+    for (t, &r) in region_of.iter().enumerate() {
+        members.entry(if r == usize::MAX { t } else { r }).or_default().push(t as u32);
     }
     let mut keys: Vec<usize> = members.keys().copied().collect();
     keys.sort_unstable();
@@ -174,7 +183,7 @@ pub fn surfaces(vertices: &[Vec3], triangles: &[[u32; 3]], faces: Option<&PartFa
             continue;
         }
         let area: f32 = tris.iter().map(|&t| areas[t as usize]).sum();
-        if !(area > 0.0) {
+        if area.is_nan() || area <= 0.0 {
             continue;
         }
         let distinct_facets = {
@@ -247,7 +256,7 @@ pub(super) fn fit_cylinder(
     let (values, vectors) = symmetric_eigen(m);
     let k = (0..3).min_by(|&a, &b| values[a].total_cmp(&values[b])).unwrap_or(0);
     let mut axis = vectors[k].normalize_or_zero();
-    if axis == Vec3::ZERO || axis.dot(axis_hint).abs() < AXIS_DEG.to_radians().cos() {
+    if axis == Vec3::ZERO {
         axis = axis_hint.normalize_or_zero();
     }
     if axis.dot(axis_hint) < 0.0 {
@@ -276,7 +285,7 @@ pub(super) fn fit_cylinder(
     let radius = r as f32;
     let centre = origin + u * cx as f32 + v * cy as f32;
     let residual = pts.iter().map(|p| ((p[0] - cx).hypot(p[1] - cy) - r).abs()).fold(0.0f64, f64::max) as f32;
-    if !(radius > 0.0) || residual > RESIDUAL * radius {
+    if radius.is_nan() || radius <= 0.0 || residual > RESIDUAL * radius {
         return None;
     }
     // the angular span must not be a sliver of the circle (two nearly flat facets)

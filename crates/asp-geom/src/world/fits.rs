@@ -84,7 +84,8 @@ impl World {
     fn add_contact_directions(&mut self, pairs: &[(usize, usize)]) {
         let slack = self.contact_distance;
         // per pair, its planar contacts (weight, the first part's outward normal)
-        let per_pair: Vec<((usize, usize), Vec<(f32, Vec3)>)> = pairs
+        type Contacts = Vec<(f32, Vec3)>;
+        let per_pair: Vec<((usize, usize), Contacts)> = pairs
             .par_iter()
             .map(|&(p, q)| {
                 let (gp, gq) = (&self.geoms[p], &self.geoms[q]);
@@ -148,6 +149,11 @@ impl World {
                 added += 1;
             }
         }
+    }
+
+    /// Part `p`'s cylinders and planes ([`crate::fits::recognise`]; made once when first asked).
+    pub fn surfaces(&self, p: usize) -> &fits::Surfaces {
+        self.geoms[p].surfaces()
     }
 
     /// The fits between `p` and `q` (either order).

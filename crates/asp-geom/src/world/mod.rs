@@ -702,7 +702,23 @@ impl World {
         if !fits.is_empty() {
             // along a fit's axis the fit is carried (pressed out, unscrewed, slid), with the
             // fit's band exempt from the strict rule and nothing else entering new material
-            return self.fit_blocks(p, q, &fits, dir, t1);
+            if self.fit_blocks(p, q, &fits, dir, t1) {
+                return true;
+            }
+            if self.ignores(p, q) {
+                return false;
+            }
+            // the samples may miss a collision away from the fits (a collar, a flange): the
+            // pair is swept exactly, one part shrunk past the deepest fit's band
+            let band = fits.iter().map(|f| f.band.1 - f.band.0).fold(0.0f32, f32::max);
+            let (k, amount) = self.pair_erosion(p, q);
+            let amount = amount.max(band + self.tolerance);
+            let (moving, fixed) = if k == p {
+                (self.eroded(p, amount), self.geoms[q].mesh.clone())
+            } else {
+                (self.geoms[p].mesh.clone(), self.eroded(q, amount))
+            };
+            return sweep::sweep_hits(&moving, dir, &fixed, t1);
         }
         if self.is_strict_pair(p, q) && self.strict_entry(p, q, Vec3::ZERO, dir, t1, true).is_some() {
             return true;

@@ -90,7 +90,28 @@ fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
         writeln!(out, "overlapping in the input ({} pairs, policy {}):", o.pairs.len(), o.policy.name())?;
         for p in &o.pairs {
             let bound = if p.gross { "more than " } else { "" };
-            writeln!(out, "  {} / {}: {}, {bound}{:.4} deep, {}", p.names[0], p.names[1], p.kind, p.depth, p.handling.name())?;
+            writeln!(out, "  {} / {}: {}, {bound}{} deep, {}", p.names[0], p.names[1], p.kind, sig(p.depth), p.handling.name())?;
+        }
+    }
+    if !r.fits.is_empty() {
+        writeln!(out, "fits ({}; a shaft in a hole about one axis, taken apart along it):", r.fits.len())?;
+        for f in &r.fits {
+            let turns = match f.turns {
+                Some(t) if t == f.parts[0] => format!(", {} turns out", f.names[0]),
+                Some(_) => format!(", {} turns off", f.names[1]),
+                None => String::new(),
+            };
+            writeln!(
+                out,
+                "  {} ({}) in {} ({}): {}, radii {} / {}{turns}",
+                f.names[0],
+                f.roles[0].name(),
+                f.names[1],
+                f.roles[1].name(),
+                f.class.describe(),
+                sig(f.radii[0]),
+                sig(f.radii[1])
+            )?;
         }
     }
     if !r.assembly_sequence.is_empty() {
@@ -246,11 +267,11 @@ fn write_why(out: &mut impl Write, r: &PlanReport, core: &LockedCore, why: &Core
     for o in overlaps.into_iter().take(WHY_ITEMS) {
         let bound = if o.gross { "more than " } else { "" };
         let verdict = if o.artefact {
-            format!("deeper than {:.4}: a modelling artefact, not an interlock", why.artefact_depth)
+            format!("deeper than {}: a modelling artefact, not an interlock", sig(why.artefact_depth))
         } else {
-            format!("within {:.4}: a fit, not an artefact", why.artefact_depth)
+            format!("within {}: a fit, not an artefact", sig(why.artefact_depth))
         };
-        writeln!(out, "    overlap {} / {}: {bound}{:.4} deep, {verdict}", o.names[0], o.names[1], o.depth)?;
+        writeln!(out, "    overlap {} / {}: {bound}{} deep, {verdict}", o.names[0], o.names[1], sig(o.depth))?;
     }
     if why.overlaps.len() > WHY_ITEMS {
         writeln!(out, "    ... and {} more overlapping pairs", why.overlaps.len() - WHY_ITEMS)?;
@@ -308,4 +329,13 @@ fn write_why(out: &mut impl Write, r: &PlanReport, core: &LockedCore, why: &Core
         writeln!(out, "    ... and {} more parts (the plan JSON lists them)", why.blocks.len() - WHY_PARTS)?;
     }
     Ok(())
+}
+
+/// `x` with three significant digits and no exponent (0.0000412, 1.25, 1250): lengths in any unit.
+fn sig(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (2 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.decimals$}")
 }

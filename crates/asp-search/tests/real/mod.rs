@@ -96,14 +96,13 @@ fn pump_without_subassemblies_ends_in_no_plan_with_its_stuck_core_explained_and_
     let Status::NoPlan { stuck, state } = &outcome.status else { panic!("{:?}", outcome.status) };
     let w = checker.world();
     let name = |p: usize| w.name(p).trim_start_matches("PumpAssembly - ").to_string();
-    // the screws, lids, shaft and ring leave; the body, the back lid and the large screw through
-    // both stay: body and lid are blocked (blockers named), and the screw is all that links them
-    // to the ground below (the model lies on its side)
+    // the screws, lids, shaft and ring leave, the screws and the shaft along the axes of their
+    // fits (one nominal radius, faceted differently: they overlap by the sagitta); the body,
+    // the back lid and the large screw through both stay: body and lid are blocked (blockers
+    // named), and the screw is all that links them to the ground below (the model lies on its
+    // side)
     let left = short_names(w, state.iter());
-    // issue 9, strict overlaps: LargeScrew1-1 no longer leaves +z through the back lid it
-    // overlaps (its head lies under the lid: the replay tool failed that step), so it stays in
-    // the core with its twin; the shaft (pressed 0.12 mm into the body) and the ring on it stay too
-    assert_eq!(left, ["BackLid2-1", "LargeScrew1-1", "LargeScrew2-1", "Pump-1", "Ring-1", "Shaft-1"]);
+    assert_eq!(left, ["BackLid2-1", "LargeScrew2-1", "Pump-1"]);
     assert_eq!(stuck.len(), state.len());
     for s in stuck {
         match &s.reason {
@@ -117,10 +116,11 @@ fn pump_without_subassemblies_ends_in_no_plan_with_its_stuck_core_explained_and_
             StuckReason::DeadEnd | StuckReason::Refused(_) => panic!("{s:?}"),
         }
     }
-    // issue 9: the three parts are a locked core (two blocked only by each other and the
-    // ground, the third holding them up), found on the first dead end: the search stops there
-    // instead of trying every order of the other twelve parts (7,979 tests before)
-    assert!(outcome.stats.counters.removal_tests < 200, "{:?}", outcome.stats);
+    // the model lies on the tips of its two large screws: either can leave first, and the one
+    // left is then the last support of body and back lid. Which part stays depends on the
+    // order, so no dead end proves a locked core at once, and the search tries the orders of
+    // the other parts before it gives up (7,979 tests; 200 while both screws were locked in)
+    assert!(outcome.stats.counters.removal_tests < 10_000, "{:?}", outcome.stats);
     // the result carries the partial disassembly that reached the stuck core: its removals pass
     // the independent sweep and leave exactly the core (issue 9: a no_plan is not an empty plan)
     assert_eq!(outcome.removals.len(), checker.num_parts() - left.len());
@@ -172,15 +172,15 @@ fn issue_9_the_pumps_lift_their_stuck_core_off_as_one_subassembly_built_on_the_b
         let (checker, outcome) = found_with_groups(rel);
         let w = checker.world();
         let found = groups(&outcome.removals);
-        // strict overlaps: the pump's core group (6 parts) cannot be taken apart on its base
-        // (it goes in as one unit); the extension adds a second group of its own
+        // the body, the back lid and the screw they stand on go as one group, built on the
+        // body; the extension adds a second group of its own
         assert!(!found.is_empty(), "{rel}: {found:?}");
         let body = w.assembly().parts.iter().position(|p| p.name.ends_with("Pump-1")).unwrap();
         let (parts, status) = found.iter().find(|(g, _)| g.contains(body)).expect("a group holds the body");
-        // strict overlaps (issue 9): both large screws stay with the body and back lid (the
-        // first no longer leaves through the back lid it overlaps)
+        // the other large screw leaves along the axis of its fits in back lid and body
         let names = short_names(w, parts.iter());
-        for n in ["BackLid2-1", "LargeScrew1-1", "LargeScrew2-1", "Pump-1"] {
+        assert!(!names.iter().any(|x| x == "LargeScrew1-1"), "{rel}: {names:?}");
+        for n in ["BackLid2-1", "LargeScrew2-1", "Pump-1"] {
             assert!(names.iter().any(|x| x == n), "{rel}: {names:?}");
         }
         eprintln!("{rel}: subassembly {names:?}, its own plan {status:?}");
@@ -199,18 +199,18 @@ fn issue_9_the_pumps_lift_their_stuck_core_off_as_one_subassembly_built_on_the_b
 }
 
 #[test]
-fn pump_extension_without_subassemblies_stops_at_its_locked_core_at_once() {
+fn pump_extension_without_subassemblies_ends_at_its_locked_core() {
     // before issue 9: 490,539 removal tests in 17 s to the same answer
     let planner = Dfs::builder().subassemblies(false).path_planner(false).build();
     let (checker, outcome) = plan(world("pump-extension", Some("mm"), OverlapPolicy::Strict).unwrap(), &planner);
     let Status::NoPlan { state, .. } = &outcome.status else { panic!("{:?}", outcome.status) };
-    // strict overlaps (issue 9): the screws and shaft that overlap the body or back lid stay,
-    // and with them what sits on them (measured; see docs/benchmarks.md)
+    // the screws and the shaft leave along their fits; the body, the back lid and the large
+    // screw they stand on stay (the model lies on its side on that screw's head)
     let left = short_names(checker.world(), state.iter());
-    for n in ["BackLid2-1", "LargeScrew1-1", "LargeScrew2-1", "Pump-1", "Shaft-1"] {
-        assert!(left.iter().any(|x| x == n), "{left:?}");
-    }
-    assert!(outcome.stats.counters.removal_tests < 400, "{:?}", outcome.stats);
+    assert_eq!(left, ["BackLid2-1", "LargeScrew2-1", "Pump-1"]);
+    // either large screw may leave first (see the pump's test above), so no dead end proves
+    // the core at once: about 451,000 tests, 1 s (fewer than 400 while both were locked in)
+    assert!(outcome.stats.counters.removal_tests < 600_000, "{:?}", outcome.stats);
     assert_eq!(verify_removals(checker.world(), &outcome.removals), *state);
 }
 

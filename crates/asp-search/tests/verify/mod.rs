@@ -36,7 +36,7 @@ fn penetrates(
 ) -> Option<usize> {
     present
         .iter()
-        .filter(|&q| q != p && !world.ignores(p, q) && !(screw && world.thread(p, q).is_some()) && !fits.contains_key(&(p, q)))
+        .filter(|&q| !(q == p || world.ignores(p, q) || fits.contains_key(&(p, q)) || screw && world.thread(p, q).is_some()))
         .find(|&q| {
             let (k, amount) = world.pair_erosion(p, q);
             let shrunk_k = shrunk_cache.entry((k, amount.to_bits())).or_insert_with(|| shrunk(world, k, amount)).clone();
@@ -83,24 +83,42 @@ fn inner_points(world: &World, p: usize) -> Vec<Vec3> {
 }
 
 /// A coaxial fit band: samples whose distance from the line through `point` along the motion
-/// lies within `[lo, hi]` carry the fit along.
-#[derive(Clone, Copy, Debug)]
+/// lies within one of the `rings` (`[lo, hi]`; a stepped shaft in a stepped bore has one per
+/// step) carry the fit along.
+#[derive(Clone, Debug)]
 pub struct Band {
     point: Vec3,
-    lo: f32,
-    hi: f32,
+    rings: Vec<(f32, f32)>,
+    /// `None`: samples in the rings may enter (the shell was seen all around); `Some(d)`: they
+    /// may enter no deeper than `d`, the pair's measured input overlap or the fit band's width,
+    /// the larger (a fit the planner reports whose overlap the samples see only in part: the
+    /// same fit carried along enters no deeper than its polygons' sagittas).
+    max_depth: Option<f32>,
+}
+
+/// The band of a fit `world` reports for the pair along unit `dir`, its samples allowed to
+/// enter only as deep as the pair overlaps in the input or the band is wide (see
+/// [`Band::max_depth`]).
+fn reported_band(world: &World, p: usize, q: usize, dir: Vec3) -> Option<Band> {
+    let f = world.fits(p, q).iter().find(|f| f.axis.dot(dir).abs() > 0.9999)?;
+    let overlap = world.overlap_notes().iter().find(|n| n.parts == (p.min(q), p.max(q))).map_or(0.0, |n| n.depth);
+    // two polygons drawn at one radius enter each other by up to their sagittas, whether or
+    // not the input shows it (the band spans them)
+    Some(Band { point: f.point, rings: vec![f.band], max_depth: Some(overlap.max(f.band.1 - f.band.0) + world.tolerance()) })
 }
 
 /// The replay referee's fit band of the pair (`p`, `q`) for a motion along unit `dir`, found
 /// from the geometry alone (not the planner's surfaces): the samples of either part (moved
 /// inward by the tolerance) that lie inside the other in the input — their overlap — projected
-/// on the plane normal to the motion, form a thin shell all around one centre (a circle fitted
-/// by least squares; no angular gap over a quarter turn). The referee allows a shell up to 0.35
-/// of its radius wide; this re-check allows a fifth (a coarse thread drawn at its minor
-/// diameter overlaps by about 0.17 of the radius), so a pin pulled a few degrees off its axis
-/// (whose overlap, seen along the motion, smears into a thick ring) is no fit. `None` for every
-/// other pair, and for pairs that do not overlap beyond the tolerance (the shrunk sweep holds
-/// them).
+/// on the plane normal to the motion, form thin shells all around one centre (a circle fitted
+/// by least squares gives the centre; the distances from it fall into rings, each with no
+/// angular gap over a quarter turn). The referee fits one circle, so it sees a stepped shaft
+/// (two shells about one axis) as no fit; this re-check takes each step's shell on its own.
+/// The referee allows a shell up to 0.35 of its radius wide; this re-check allows a fifth (a
+/// coarse thread drawn at its minor diameter overlaps by about 0.17 of the radius), so a pin
+/// pulled a few degrees off its axis (whose overlap, seen along the motion, smears into a thick
+/// ring) is no fit. `None` for every other pair, and for pairs that do not overlap beyond the
+/// tolerance (the shrunk sweep holds them).
 fn fit_band(world: &World, p: usize, q: usize, dir: Vec3, samples: &mut HashMap<usize, Vec<Vec3>>) -> Option<Band> {
     let tol = world.tolerance();
     let mut shell = Vec::new();
@@ -115,10 +133,8 @@ fn fit_band(world: &World, p: usize, q: usize, dir: Vec3, samples: &mut HashMap<
         let mesh = world.mesh(b);
         let bb = world.aabb(b);
         for x in pts {
-            if (0..3).all(|i| x[i] >= bb.mins[i] - 3.0 * tol && x[i] <= bb.maxs[i] + 3.0 * tol) {
-                if mesh.contains_local_point(x) {
-                    shell.push(x);
-                }
+            if (0..3).all(|i| x[i] >= bb.mins[i] - 3.0 * tol && x[i] <= bb.maxs[i] + 3.0 * tol) && mesh.contains_local_point(x) {
+                shell.push(x);
             }
         }
     }
@@ -157,17 +173,33 @@ fn fit_band(world: &World, p: usize, q: usize, dir: Vec3, samples: &mut HashMap<
     };
     let (dd, ee, ff) = (solve(0), solve(1), solve(2));
     let (cu, cv) = (-0.5 * dd, -0.5 * ee);
-    let r = (cu * cu + cv * cv - ff).max(0.0).sqrt();
-    let rad: Vec<f64> = uv.iter().map(|c| (c[0] - cu).hypot(c[1] - cv)).collect();
-    let mut ang: Vec<f64> = uv.iter().map(|c| (c[1] - cv).atan2(c[0] - cu)).collect();
-    ang.sort_by(f64::total_cmp);
-    let gap = ang.windows(2).map(|w| w[1] - w[0]).chain([ang[0] + std::f64::consts::TAU - ang[ang.len() - 1]]).fold(0.0, f64::max);
-    let (lo, hi) = (rad.iter().copied().fold(f64::INFINITY, f64::min) - tol as f64, rad.iter().copied().fold(0.0, f64::max) + tol as f64);
-    if r <= 0.0 || gap > std::f64::consts::FRAC_PI_2 || hi - lo > 0.2 * r {
+    if cu * cu + cv * cv - ff <= 0.0 {
         return None;
     }
+    // (distance from the centre, angle about it), by distance; a new ring starts where the
+    // distances jump by more than four tolerances
+    let mut polar: Vec<(f64, f64)> = uv.iter().map(|c| ((c[0] - cu).hypot(c[1] - cv), (c[1] - cv).atan2(c[0] - cu))).collect();
+    polar.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut rings = Vec::new();
+    let mut start = 0;
+    for i in 1..=polar.len() {
+        if i < polar.len() && polar[i].0 - polar[i - 1].0 <= 4.0 * tol as f64 {
+            continue;
+        }
+        let ring = &polar[start..i];
+        start = i;
+        let (lo, hi) = (ring[0].0 - tol as f64, ring[ring.len() - 1].0 + tol as f64);
+        let mut ang: Vec<f64> = ring.iter().map(|x| x.1).collect();
+        ang.sort_by(f64::total_cmp);
+        let gap = ang.windows(2).map(|w| w[1] - w[0]).chain([ang[0] + std::f64::consts::TAU - ang[ang.len() - 1]]).fold(0.0, f64::max);
+        let r = 0.5 * (lo + hi);
+        if ring.len() < 12 || gap > std::f64::consts::FRAC_PI_2 || hi - lo > 0.2 * r {
+            return None; // some of the overlap is no thin shell all around the axis
+        }
+        rings.push((lo as f32, hi as f32));
+    }
     let point = u.0 * cu as f32 + u.1 * cv as f32;
-    Some(Band { point, lo: lo as f32, hi: hi as f32 })
+    Some(Band { point, rings, max_depth: None })
 }
 
 /// The strict overlap rule, re-checked by point containment at the sampled poses (the replay's
@@ -195,7 +227,7 @@ fn check_strict(
     for &p in movers {
         for q in others.iter() {
             let thread = screw.and_then(|_| world.thread(p, q));
-            let band = fits.get(&(p, q)).copied();
+            let band = fits.get(&(p, q)).cloned();
             if thread.is_none() && band.is_none() && !world.is_strict_pair(p, q) {
                 continue;
             }
@@ -209,14 +241,27 @@ fn check_strict(
                     // both parts' samples in the assembled pose: outside the zone only
                     pts.retain(|&x| t.axis.radial(x) > t.radius);
                 }
-                if let (Some(b), Some(d)) = (band, dir) {
-                    // a coaxial fit carried along its axis: outside the band only (a sample
-                    // keeps its distance from the line along the motion)
-                    pts.retain(|&x| {
+                // how deep each sample may enter: touching is not entering
+                let half = 0.5 * world.tolerance();
+                let mut allowed = vec![half; pts.len()];
+                if let (Some(b), Some(d)) = (&band, dir) {
+                    // a coaxial fit carried along its axis: the band's samples (a sample keeps
+                    // its distance from the line along the motion) are exempt, or held to the
+                    // pair's input overlap
+                    let in_band = |x: Vec3| {
                         let r = x - b.point;
                         let r = (r - d * r.dot(d)).length();
-                        r < b.lo || r > b.hi
-                    });
+                        b.rings.iter().any(|&(lo, hi)| r >= lo && r <= hi)
+                    };
+                    let (kept, depths): (Vec<Vec3>, Vec<f32>) = pts
+                        .iter()
+                        .filter_map(|&x| match (in_band(x), b.max_depth) {
+                            (false, _) => Some((x, half)),
+                            (true, Some(m)) => Some((x, m)),
+                            (true, None) => None,
+                        })
+                        .unzip();
+                    (pts, allowed) = (kept, depths);
                 }
                 // `a`'s samples in the frame of `b`: the mover's moved by the pose, the other's
                 // by its inverse
@@ -228,17 +273,15 @@ fn check_strict(
                 // a sample on the other's surface (within half the tolerance) counts as inside
                 // at the start and outside later: touching is not entering
                 let depth = |x: Vec3| (mesh.project_local_point(x, false).point - x).length();
-                let half = 0.5 * world.tolerance();
                 let start: Vec<bool> = pts.iter().map(|&x| near(x) && (mesh.contains_local_point(x) || depth(x) <= half)).collect();
                 for pose in &poses[1..] {
-                    if let Some(x) = pts.iter().zip(&start).find(|(x, inside)| {
+                    if let Some(((x, _), allow)) = pts.iter().zip(&start).zip(&allowed).find(|((x, inside), allow)| {
                         let y = place(pose, **x);
-                        !**inside && near(y) && mesh.contains_local_point(y) && depth(y) > half
+                        !**inside && near(y) && mesh.contains_local_point(y) && depth(y) > **allow
                     }) {
                         panic!(
-                            "step {k}: strict: a sample of '{}' at {:?} enters '{}', which the pair overlaps in the input, at {pose:?}",
+                            "step {k}: strict: a sample of '{}' at {x:?} enters '{}' deeper than {allow}, which the pair overlaps in the input, at {pose:?}",
                             world.name(a),
-                            x.0,
                             world.name(b)
                         );
                     }
@@ -322,7 +365,7 @@ pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: 
         if let Some(d) = dir {
             for &p in &movers {
                 for q in others.iter().filter(|&q| q < world.num_parts() && world.contacts(p).contains(q)) {
-                    if let Some(b) = fit_band(world, p, q, d, &mut samples) {
+                    if let Some(b) = fit_band(world, p, q, d, &mut samples).or_else(|| reported_band(world, p, q, d)) {
                         fits.insert((p, q), b);
                     }
                 }
