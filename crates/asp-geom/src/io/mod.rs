@@ -1,14 +1,18 @@
-//! Loading assemblies from files (glTF 2.0, folders of OBJ/STL) and writing GLB.
+//! Loading assemblies from files (glTF 2.0, STEP through OpenCASCADE, folders of OBJ/STL) and
+//! writing GLB.
 
 mod atomic;
+mod brep_faces;
 mod folder;
 mod glb_write;
 mod gltf_read;
 mod refs;
+pub mod step;
 
 pub use atomic::{write_atomic, write_atomic_with};
 pub use glb_write::write_glb;
 pub use refs::{canonical, resolve_inside, Refused, OUTSIDE_FLAG};
+pub use step::Tessellation;
 
 use crate::assembly::{Assembly, Units};
 use crate::error::{GeomError, Result};
@@ -20,7 +24,7 @@ use std::path::Path;
 pub struct LoadOptions {
     /// The unit of the file's coordinates (default: metres for glTF per its spec, metres for folders).
     pub unit: Option<Units>,
-    /// The up axis (default: the file's `extras.asp.up`, else +Y for glTF, +Z for OBJ/STL folders).
+    /// The up axis (default: the file's `extras.asp.up`, else +Y for glTF, +Z for STEP and OBJ/STL).
     pub up: Option<Axis>,
     /// Names of base parts, on top of those the file marks as fixed.
     pub fixed: Vec<String>,
@@ -29,6 +33,8 @@ pub struct LoadOptions {
     pub allow_outside_files: bool,
     /// Caps on what a file may make asp allocate.
     pub limits: Limits,
+    /// How finely a STEP file's B-rep is tessellated (other formats come as triangles).
+    pub tessellation: Tessellation,
 }
 
 /// The default cap on triangles over all parts ([`Limits::max_triangles`]).
@@ -76,7 +82,8 @@ impl Limits {
     }
 }
 
-/// Loads `path`: a `.glb`/`.gltf` file or a folder of `.obj`/`.stl` files (one part per file).
+/// Loads `path`: a `.glb`/`.gltf` file, a `.step`/`.stp` file ([`step`]) or a folder of
+/// `.obj`/`.stl` files (one part per file).
 /// Meshes come back in metres, world frame, part names unique; the assembly is validated.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Assembly> {
     let meta = std::fs::metadata(path).map_err(|source| io_error(path, source))?;
@@ -107,6 +114,10 @@ pub fn load_bytes_with(
     let assembly = match check_extension(path)? {
         FileKind::Gltf => gltf_read::read_gltf_bytes(path, bytes, options, external)?,
         FileKind::Mesh => folder::single_file_from_bytes(path, bytes, options)?,
+        FileKind::Step => {
+            let glb = step::convert(path, bytes, &options.tessellation)?;
+            return step::assemble(path, bytes, &glb, options);
+        }
     };
     finish(assembly, options)
 }
@@ -114,17 +125,19 @@ pub fn load_bytes_with(
 enum FileKind {
     Gltf,
     Mesh,
+    Step,
 }
 
 fn check_extension(path: &Path) -> Result<FileKind> {
     match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
         Some("glb") | Some("gltf") => Ok(FileKind::Gltf),
         Some("obj") | Some("stl") => Ok(FileKind::Mesh),
-        _ => Err(GeomError::format(path, "unknown file type (expected .glb, .gltf, or a folder of .obj/.stl files)")),
+        Some("step") | Some("stp") => Ok(FileKind::Step),
+        _ => Err(GeomError::format(path, "unknown file type (expected .glb, .gltf, .step, .stp, or a folder of .obj/.stl files)")),
     }
 }
 
-fn finish(mut assembly: Assembly, options: &LoadOptions) -> Result<Assembly> {
+pub(crate) fn finish(mut assembly: Assembly, options: &LoadOptions) -> Result<Assembly> {
     assembly.dedupe_names();
     assembly.set_fixed(&options.fixed)?;
     assembly.validate()?;
