@@ -24,7 +24,7 @@ fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
         assert_eq!(order, (0..r.report.parts.len()).collect::<Vec<_>>(), "{name}");
         let last = r.report.assembly_sequence.last().unwrap();
         assert_eq!(last.moves.len(), moves, "{name}: the first separation's moves, in assembly order");
-        assert_eq!(r.report.format_version, "1.9");
+        assert_eq!(r.report.format_version, "1.10");
     }
     // a voxel model the straight-line search answers keeps its plan (no grid entry)
     let r = plan_assembly(asp_geom::puzzles::burr_key(), &settings, None).unwrap();
