@@ -8,3 +8,4 @@ mod loaders;
 mod overlap;
 mod physics;
 mod removal;
+mod step;

@@ -77,10 +77,14 @@ pub fn python() -> String {
 /// converter run in [`python`]. Errors name the file and the cause: no Python, no cascadio (with
 /// [`INSTALL`]), or OpenCASCADE's own words on a file it cannot read.
 pub fn convert(path: &Path, step: &[u8], tessellation: &Tessellation) -> Result<Vec<u8>> {
+    convert_with(&python(), path, step, tessellation)
+}
+
+/// [`convert`] in the Python `python`.
+pub fn convert_with(python: &str, path: &Path, step: &[u8], tessellation: &Tessellation) -> Result<Vec<u8>> {
     tessellation.validate().map_err(|reason| GeomError::format(path, reason))?;
-    let python = python();
     let fail = |reason: String| GeomError::format(path, reason);
-    let mut child = Command::new(&python)
+    let mut child = Command::new(python)
         .arg("-c")
         .arg(CONVERTER)
         .arg(tessellation.relative.to_string())
@@ -171,6 +175,9 @@ pub fn assemble(path: &Path, step: &[u8], glb: &[u8], options: &LoadOptions) -> 
     })?;
     assembly.units = units;
     assembly.warnings.extend(unit_warning);
+    if options.up.is_none() {
+        assembly.warnings.push("a STEP file has no up axis: +z is assumed, as most CAD draws; --up overrides".into());
+    }
     for part in &mut assembly.parts {
         part.tessellation = Some(options.tessellation);
     }
@@ -274,10 +281,12 @@ fn length(body: &str, entities: &HashMap<u64, String>, depth: usize) -> Option<U
     // CONVERSION_BASED_UNIT('INCH', #m) with #m = LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.4), #mm)
     let rest = body.split("CONVERSION_BASED_UNIT(").nth(1)?;
     let name = rest.split('\'').nth(1)?.trim().to_ascii_lowercase();
+    // the measure: LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.4), #mm) or (25.4, #mm)
     let measure = entities.get(references(rest).first()?)?;
-    let value: f64 = measure.split("LENGTH_MEASURE(").nth(1)?.split(')').next()?.trim().parse().ok()?;
-    let base =
-        references(measure.split("LENGTH_MEASURE(").nth(1)?).into_iter().find_map(|id| length(entities.get(&id)?, entities, depth + 1))?;
+    let args = measure.split("MEASURE_WITH_UNIT(").nth(1)?;
+    let number = args.trim_start().trim_start_matches("LENGTH_MEASURE(").trim_start_matches("POSITIVE_LENGTH_MEASURE(");
+    let value: f64 = number.split([')', ',']).next()?.trim().parse().ok()?;
+    let base = references(args).into_iter().find_map(|id| length(entities.get(&id)?, entities, depth + 1))?;
     let metres = value * base.metres;
     if !(metres.is_finite() && metres > 0.0) {
         return None;
@@ -302,6 +311,9 @@ mod tests {
         let u = length_unit(inch).unwrap();
         assert_eq!(u.name, "in");
         assert!((u.metres - 0.0254).abs() < 1e-12);
+        // OpenCASCADE writes the measure without its type
+        let bare = String::from_utf8_lossy(inch).replace("LENGTH_MEASURE(25.4)", "25.4");
+        assert!((length_unit(bare.as_bytes()).unwrap().metres - 0.0254).abs() < 1e-12);
         assert!(length_unit(b"DATA;\n#1 = CARTESIAN_POINT('',(0.,0.,0.));\nENDSEC;").is_err());
     }
 
