@@ -15,6 +15,7 @@ timestamp, so the output is byte for byte the same from run to run.
 from __future__ import annotations
 
 import argparse
+import copy
 import filecmp
 import sys
 import tempfile
@@ -65,6 +66,22 @@ def bolted_plates() -> Compound:
         n = named(Pos(x, y, -5) * nut(3, 10, 5), "nut")
         fasteners.append(group(f"fastener_{k}", [b, n]))
     return group("bolted_plates", [lower, upper, *fasteners])
+
+
+def bolt_grid() -> Compound:
+    """Fifty parts: two plates joined by a 4 x 6 grid of M6 bolts and nuts, each pair a
+    subassembly (the benchmark's model of 50 parts)."""
+    holes = [(x, y) for x in (-75, -45, -15, 15, 45, 75) for y in (-45, -15, 15, 45)]
+    lower = named(plate(180, 120, 10, holes, 3), "lower_plate")
+    upper = named(Pos(0, 0, 10) * plate(180, 120, 10, holes, 3), "upper_plate")
+    # one bolt and one nut, placed 24 times (instances of one product each, as CAD writes them)
+    the_bolt, the_nut = bolt(26, 3, 5, 4), nut(3, 10, 5)
+    fasteners = []
+    for k, (x, y) in enumerate(holes, 1):
+        b, n = copy.copy(the_bolt), copy.copy(the_nut)
+        b.location, n.location = Location((x, y, 20)), Location((x, y, -5))
+        fasteners.append(group(f"fastener_{k}", [named(b, "bolt"), named(n, "nut")]))
+    return group("bolt_grid", [lower, upper, *fasteners])
 
 
 def tapped_screws() -> Compound:
@@ -135,6 +152,7 @@ def inch_bracket() -> Compound:
 
 MODELS = {
     "bolted_plates.step": (bolted_plates, Unit.MM),
+    "bolt_grid.step": (bolt_grid, Unit.MM),
     "tapped_screws.step": (tapped_screws, Unit.MM),
     "pins_and_dowels.step": (pins_and_dowels, Unit.MM),
     "shaft_bearings.step": (shaft_bearings, Unit.MM),
