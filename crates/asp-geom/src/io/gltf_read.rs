@@ -287,6 +287,10 @@ struct LocalMesh {
     face_warnings: Vec<String>,
 }
 
+/// A primitive's `TM_brep_faces`: per triangle its face, per face its surface, and how many
+/// entries were malformed.
+type PrimitiveBrep = (Vec<u32>, Vec<Option<Surface64>>, usize);
+
 /// A mesh's faces in its own frame: per triangle its face, per face its surface.
 #[derive(Clone, Default)]
 struct LocalFaces {
@@ -475,12 +479,7 @@ impl<'a> PartBuilder<'a> {
     /// The `TM_brep_faces` of a primitive of `triangles` triangles: per triangle its face, and
     /// the faces' surfaces (as many as the largest index needs), and how many entries were
     /// malformed. `Ok(None)` without the extension; an error says why it cannot be used.
-    fn primitive_faces(
-        &self,
-        mesh: &gltf::Mesh,
-        primitive: &Primitive,
-        triangles: usize,
-    ) -> Res<Option<(Vec<u32>, Vec<Option<Surface64>>, usize)>> {
+    fn primitive_faces(&self, mesh: &gltf::Mesh, primitive: &Primitive, triangles: usize) -> Res<Option<PrimitiveBrep>> {
         let Some(ext) = self.brep.get(mesh.index()).and_then(|m| m.get(primitive.index())).and_then(Option::as_ref) else {
             return Ok(None);
         };

@@ -205,7 +205,7 @@ pub fn length_unit(step: &[u8]) -> std::result::Result<Units, String> {
             }
         }
     }
-    counts.sort_by(|a, b| b.1.cmp(&a.1));
+    counts.sort_by_key(|c| std::cmp::Reverse(c.1));
     counts.into_iter().next().map(|(u, _)| u).ok_or_else(|| "the STEP file names no length unit; lengths are reported in metres".into())
 }
 
