@@ -7,6 +7,9 @@ from typing import Any, final
 __all__ = [
     "__version__",
     "PLAN_FORMAT_VERSION",
+    "STEP_ANGULAR",
+    "STEP_RELATIVE",
+    "STEP_CONVERTER",
     "load",
     "default_settings",
     "order_names",
@@ -32,6 +35,9 @@ __all__ = [
 
 __version__: str
 PLAN_FORMAT_VERSION: str
+STEP_ANGULAR: float
+STEP_RELATIVE: float
+STEP_CONVERTER: str
 
 def load(
     path: str | PathLike[str],
@@ -41,6 +47,8 @@ def load(
     max_triangles: int | None = None,
     max_parts: int | None = None,
     allow_outside_files: bool | None = None,
+    tessellation: float | None = None,
+    step_glb: bytes | None = None,
 ) -> Assembly: ...
 def default_settings() -> dict[str, Any]: ...
 def order_names() -> list[str]: ...

@@ -7,9 +7,9 @@ import inspect
 import os
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Union
+from typing import TYPE_CHECKING, Any, Literal, Union
 
-from asp import _asp
+from asp import _asp, step
 from asp.errors import ConfigError
 from asp.graph import Graph
 from asp.qgraphs import QGraphs
@@ -43,14 +43,16 @@ def load(
     max_triangles: int | None = None,
     max_parts: int | None = None,
     allow_outside_files: bool | None = None,
+    tessellation: float | None = None,
 ) -> Assembly:
-    """Loads a model: a ``.glb``/``.gltf`` file, or a folder of ``.obj``/``.stl`` files (one part
-    per file).
+    """Loads a model: a ``.glb``/``.gltf`` file, a ``.step``/``.stp`` file (read and tessellated by
+    OpenCASCADE through ``cascadio``: ``pip install cascadio``), or a folder of ``.obj``/``.stl``
+    files (one part per file).
 
     :param unit: the unit of the coordinates: ``m``, ``cm``, ``mm``, ``in``, ``ft`` or metres per
         unit (default: what the file says, else metres).
     :param up: the up axis, ``x``, ``y``, ``z``, ``-x``, ``-y``, ``-z`` (default: what the file
-        says, else +Y for glTF and +Z for OBJ/STL).
+        says, else +Y for glTF and +Z for STEP, which has none, and OBJ/STL).
     :param fixed: names of base parts, on top of those the file marks as fixed. Without any, a
         ground plane under the lowest point is the base.
     :param max_triangles: most triangles the model may have over all its parts (default 20 M);
@@ -58,14 +60,20 @@ def load(
     :param max_parts: most parts the model may have (default 10,000).
     :param allow_outside_files: let the model read files outside its folder (absolute paths,
         ``..`` that climbs out, symlinks pointing out); refused by default (``docs/security.md``).
+    :param tessellation: STEP files only: the chord tolerance of each edge and face relative to
+        its own size (default 0.001).
     :raises LoadError: the file cannot be read, is not a model, is over a cap or names a file
         outside its folder (the message names the file).
     :raises ConfigError: an unknown unit or axis, or a fixed part the model does not have.
     """
     if isinstance(fixed, str):
         fixed = [fixed]
+    glb = None
+    if step.is_step(path) and not os.path.isdir(path):
+        glb = step.convert(path, tessellation)
     native = _asp.load(os.fspath(path), unit=unit, up=up, fixed=list(fixed), max_triangles=max_triangles,
-                       max_parts=max_parts, allow_outside_files=allow_outside_files)
+                       max_parts=max_parts, allow_outside_files=allow_outside_files, tessellation=tessellation,
+                       step_glb=glb)
     return Assembly(native)
 
 
@@ -141,7 +149,7 @@ class Assembly:
         stability: Stability | None = None,
         physics_threshold: float | None = None,
         path_planner: bool | None = None,
-        subassemblies: bool | None = None,
+        subassemblies: bool | Literal["from-file"] | None = None,
         grid: bool | None = None,
         unit_group: str | Sequence[str | Sequence[str]] | None = None,
         rrt_iterations: int | None = None,
@@ -193,7 +201,9 @@ class Assembly:
             may move (0.01).
         :param path_planner: try the RRT path planner when no straight line works (True).
         :param subassemblies: let groups of parts leave together as one rigid subassembly when
-            no single part can (True).
+            no single part can (True); ``"from-file"`` follows the file's product tree: each
+            subassembly of the file is planned on its own base, then the level above with each as
+            one unit (the plan's ``file_subassemblies`` lists every one with its own plan).
         :param grid: plan voxel models by grid moves (True).
         :param unit_group: parts planned as one part each, on purpose (a purchased motor, a
             pressed-in bearing): a list of groups, each a comma-separated string or a list of

@@ -37,7 +37,7 @@ class PlanSettings(TypedDict, total=False):
     stability: Stability
     physics_threshold: float
     path_planner: bool
-    subassemblies: bool
+    subassemblies: bool | Literal["from-file"]
     grid: bool
     unit_group: str | Sequence[str | Sequence[str]]
     rrt_iterations: int

@@ -184,8 +184,8 @@ fn label_state(checker: &dyn FeasibilityChecker, plain: Option<&dyn FeasibilityC
     line
 }
 
-/// The models named by `paths`: each `.glb`/`.gltf` file; a folder holding glTF files gives each
-/// of them (sorted); any other folder (of OBJ/STL parts) is one model.
+/// The models named by `paths`: each `.glb`/`.gltf`/`.step`/`.stp` file; a folder holding such
+/// files gives each of them (sorted); any other folder (of OBJ/STL parts) is one model.
 pub fn model_paths(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
     let mut out = Vec::new();
     for p in paths {
@@ -194,7 +194,8 @@ pub fn model_paths(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
             let mut gltf: Vec<PathBuf> = entries
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|f| {
-                    f.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"))
+                    let e = f.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+                    matches!(e.as_deref(), Some("glb" | "gltf" | "step" | "stp"))
                 })
                 .collect();
             gltf.sort();

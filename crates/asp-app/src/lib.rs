@@ -11,6 +11,7 @@ pub mod pipeline;
 pub mod request;
 pub mod resolve;
 pub mod stepped;
+pub mod tree;
 pub mod why;
 
 pub use catalogue::{PolicySource, QPolicy};

@@ -69,6 +69,9 @@ pub struct PlanSettings {
     pub allow_outside_files: bool,
     /// Caps on the model's size, checked before its data is read.
     pub limits: asp_geom::io::Limits,
+    /// A STEP file's chord tolerance relative to each edge's and face's size (default
+    /// [`asp_geom::io::step::DEFAULT_RELATIVE`]); an error for other files.
+    pub tessellation: Option<f64>,
     /// Contact tolerance in model units (default 1e-4 × the model's diagonal).
     pub tolerance: Option<f64>,
     /// Contact distance for stability, model units (default 1e-3 × the diagonal).
@@ -92,6 +95,9 @@ pub struct PlanSettings {
     pub path_planner: bool,
     /// Let groups of parts leave together as rigid subassemblies when no single part can.
     pub subassemblies: bool,
+    /// Follow the file's product tree ([`crate::tree`]): each subassembly planned on its own,
+    /// then the level above with each as one unit.
+    pub from_file: bool,
     /// Groups of parts (by name) planned as one part each, on purpose ([`asp_search::units`]).
     pub unit_groups: Vec<Vec<String>>,
     /// Plan voxel models by moves of parts and groups on their grid ([`asp_search::grid`]) when
@@ -130,6 +136,7 @@ impl Default for PlanSettings {
             fixed: Vec::new(),
             allow_outside_files: false,
             limits: asp_geom::io::Limits::default(),
+            tessellation: None,
             tolerance: None,
             contact_distance: None,
             normals: WorldConfig::default().normal_clusters,
@@ -141,6 +148,7 @@ impl Default for PlanSettings {
             seed: 0,
             path_planner: true,
             subassemblies: true,
+            from_file: false,
             unit_groups: Vec::new(),
             grid: true,
             rrt_iterations: RrtConfig::default().max_iterations,
@@ -256,15 +264,29 @@ fn positive(name: &str, v: f64) -> Result<f64> {
 /// Loads the model at `path` with the settings' unit, up axis, fixed parts, file rule
 /// ([`PlanSettings::allow_outside_files`]) and caps ([`PlanSettings::limits`]).
 pub fn load(path: &Path, settings: &PlanSettings) -> Result<Assembly> {
-    let options = LoadOptions {
+    Ok(asp_geom::io::load(path, &load_options(path, settings)?)?)
+}
+
+/// The loader's options of `settings` for the model at `path`: a tessellation tolerance is an
+/// error for a model that is not STEP (it comes as triangles).
+pub fn load_options(path: &Path, settings: &PlanSettings) -> Result<LoadOptions> {
+    if settings.tessellation.is_some() && !asp_geom::io::step::is_step(path) {
+        return Err(AppError::setting("tessellation", format!("applies to STEP files only (.step, .stp), not to {}", path.display())));
+    }
+    let tessellation = asp_geom::io::Tessellation {
+        relative: settings.tessellation.unwrap_or(asp_geom::io::step::DEFAULT_RELATIVE),
+        ..asp_geom::io::Tessellation::default()
+    };
+    tessellation.validate().map_err(|e| AppError::setting("tessellation", e))?;
+    Ok(LoadOptions {
         unit: settings.unit.clone(),
         up: settings.up,
         fixed: settings.fixed.clone(),
         allow_outside_files: settings.allow_outside_files,
         limits: settings.limits,
         split_bodies: false,
-    };
-    Ok(asp_geom::io::load(path, &options)?)
+        tessellation,
+    })
 }
 
 /// The collision world's settings, converted to metres.
@@ -352,6 +374,9 @@ pub fn plan_file(path: &Path, settings: &PlanSettings, progress: Option<&(dyn Fn
 pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Option<&(dyn Fn(&Progress) + Sync)>) -> Result<PlanResult> {
     if let Some(optimise) = &settings.optimise {
         return self::optimise(Arc::new(assembly), settings, optimise);
+    }
+    if settings.from_file {
+        return crate::tree::plan(assembly, settings, progress);
     }
     let budget = budget(settings)?;
     let units = unit_sets(&assembly, &settings.unit_groups)?;

@@ -104,6 +104,60 @@ choice!(
     }
 );
 
+/// The `subassemblies` setting: on, off, or the file's own product tree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Subassemblies {
+    /// Groups of parts the search finds leave together when no single part can (the default).
+    On,
+    /// Single parts only.
+    Off,
+    /// Each subassembly of the file's product tree planned on its own, then the level above with
+    /// each as one unit.
+    FromFile,
+}
+
+impl Subassemblies {
+    /// The name of the tree mode, as the flag and the request spell it.
+    pub const FROM_FILE: &'static str = "from-file";
+
+    /// Whether groups may leave together (everything but `Off`).
+    pub fn allowed(self) -> bool {
+        self != Subassemblies::Off
+    }
+}
+
+impl Serialize for Subassemblies {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        match self {
+            Subassemblies::On => s.serialize_bool(true),
+            Subassemblies::Off => s.serialize_bool(false),
+            Subassemblies::FromFile => s.serialize_str(Subassemblies::FROM_FILE),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Subassemblies {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            Switch(bool),
+            Mode(String),
+        }
+        match Raw::deserialize(d) {
+            Ok(Raw::Switch(true)) => Ok(Subassemblies::On),
+            Ok(Raw::Switch(false)) => Ok(Subassemblies::Off),
+            Ok(Raw::Mode(m)) if m == Subassemblies::FROM_FILE => Ok(Subassemblies::FromFile),
+            _ => Err(serde::de::Error::custom("must be true, false or 'from-file'")),
+        }
+    }
+}
+
+/// [`Subassemblies`], optional.
+fn subassemblies<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Subassemblies>, D::Error> {
+    Option::<Subassemblies>::deserialize(d)
+}
+
 /// Every setting of a planning run (see the module documentation). Lengths are in model units.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -121,6 +175,9 @@ pub struct PlanRequest {
     pub max_triangles: Option<usize>,
     /// Most parts a model may have (default 10,000).
     pub max_parts: Option<usize>,
+    /// A STEP file's tessellation: the chord tolerance of each edge and face relative to its
+    /// own size (default 0.001; STEP files only).
+    pub tessellation: Option<f64>,
     /// Let the model and the robot's URDF read files outside their folders: absolute paths, `..`
     /// that climbs out, symlinks that point out (default: refused).
     pub allow_outside_files: Option<bool>,
@@ -143,8 +200,12 @@ pub struct PlanRequest {
     pub physics_threshold: Option<f64>,
     /// Try the path planner when no straight line works (`--no-path-planner`: false).
     pub path_planner: Option<bool>,
-    /// Let groups of parts leave together as rigid subassemblies (`--no-subassemblies`: false).
-    pub subassemblies: Option<bool>,
+    /// Let groups of parts leave together as rigid subassemblies: `true` (the search finds
+    /// them), `false` (`--no-subassemblies`: single parts only) or `"from-file"` (`--subassemblies
+    /// from-file`: plan each subassembly of the file's product tree on its own, then the level
+    /// above with each as one unit).
+    #[serde(deserialize_with = "subassemblies")]
+    pub subassemblies: Option<Subassemblies>,
     /// Plan voxel models by grid moves (`--no-grid`: false).
     pub grid: Option<bool>,
     /// Path planner iterations per call.
@@ -223,7 +284,7 @@ pub struct PlanRequest {
 }
 
 /// The keys that belong to loading a model only (`asp.load` in Python, not `Assembly.plan`).
-pub const LOAD_KEYS: [&str; 5] = ["unit", "up", "fixed", "max_triangles", "max_parts"];
+pub const LOAD_KEYS: [&str; 6] = ["unit", "up", "fixed", "max_triangles", "max_parts", "tessellation"];
 
 impl PlanRequest {
     /// Every key of a request, in alphabetical order.
@@ -424,7 +485,7 @@ mod tests {
     #[test]
     fn keys_are_every_field_and_json_round_trips() {
         let keys = PlanRequest::keys();
-        assert_eq!(keys.len(), 45, "{keys:?}");
+        assert_eq!(keys.len(), 46, "{keys:?}");
         assert!(keys.iter().any(|k| k == "time_limit") && keys.iter().any(|k| k == "robot_base"));
         let r = PlanRequest {
             objective: Some(vec!["access".into()]),

@@ -6,7 +6,7 @@
 use crate::catalogue::{self, QPolicy, DEFAULT_EPSILON};
 use crate::error::{AppError, Result};
 use crate::pipeline::{OptimiseSettings, PlanSettings, StabilitySetting, DEFAULT_TIMEOUT};
-use crate::request::{Overlaps, PlanRequest, QUse, Stability, Support};
+use crate::request::{Overlaps, PlanRequest, QUse, Stability, Subassemblies, Support};
 use asp_geom::math::{Axis, Vec3};
 use asp_geom::Units;
 use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES, DEFAULT_EXPLORATION, DEFAULT_POLISH};
@@ -86,7 +86,10 @@ fn check_applies(r: &PlanRequest) -> Result<()> {
     needs("physics_threshold", r.stability == Some(Stability::Physics), "`stability` physics")?;
     needs("epsilon", r.q.is_some(), "learned Q-functions (`q`)")?;
     needs("q_use", r.q.is_some(), "learned Q-functions (`q`)")?;
-    needs("unit_group", r.subassemblies != Some(false), "`subassemblies` (a unit leaves as one rigid group)")?;
+    needs("unit_group", r.subassemblies != Some(Subassemblies::Off), "`subassemblies` (a unit leaves as one rigid group)")?;
+    if r.subassemblies == Some(Subassemblies::FromFile) && !r.unit_group.is_empty() {
+        return Err(AppError::setting("unit_group", "does not combine with `subassemblies` from-file (its subassemblies are the units)"));
+    }
     for key in ["robot_base", "drop_off", "replans", "package_path"] {
         needs(key, r.robot.is_some(), "a robot (`robot`)")?;
     }
@@ -176,6 +179,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         fixed: r.fixed.clone(),
         allow_outside_files: r.allow_outside_files.unwrap_or(false),
         limits: limits(r)?,
+        tessellation: positive("tessellation", r.tessellation)?,
         tolerance: positive("tolerance", r.tolerance)?,
         contact_distance: positive("contact_distance", r.contact_distance)?,
         normals: r.normals.unwrap_or(d.normals),
@@ -190,7 +194,8 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         bookkeeping: r.bookkeeping.unwrap_or(false) || (entry.bookkeeping)(checker),
         seed: r.seed.unwrap_or(0),
         path_planner: r.path_planner.unwrap_or(d.path_planner),
-        subassemblies: r.subassemblies.unwrap_or(d.subassemblies),
+        subassemblies: r.subassemblies.map_or(d.subassemblies, Subassemblies::allowed),
+        from_file: r.subassemblies == Some(Subassemblies::FromFile),
         unit_groups: unit_groups(&r.unit_group)?,
         grid: r.grid.unwrap_or(d.grid),
         rrt_iterations: at_least_one("rrt_iterations", r.rrt_iterations)?.unwrap_or(d.rrt_iterations),
@@ -336,12 +341,13 @@ fn robot_keys(r: &PlanRequest) -> serde_json::Map<String, Value> {
 /// `asp._asp.default_settings()` and the docs show these.
 pub fn defaults() -> serde_json::Map<String, Value> {
     let d = PlanSettings::default();
-    let defaults: [(&str, Value); 45] = [
+    let defaults: [(&str, Value); 46] = [
         ("unit", Value::Null),
         ("up", Value::Null),
         ("fixed", json!([])),
         ("max_triangles", json!(asp_geom::io::DEFAULT_MAX_TRIANGLES)),
         ("max_parts", json!(asp_geom::io::DEFAULT_MAX_PARTS)),
+        ("tessellation", json!(asp_geom::io::step::DEFAULT_RELATIVE)),
         ("allow_outside_files", json!(false)),
         ("tolerance", Value::Null),
         ("contact_distance", Value::Null),

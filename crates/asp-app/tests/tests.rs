@@ -15,4 +15,5 @@ mod robot;
 mod stepped;
 mod stress;
 mod transitions;
+mod tree;
 mod voxel;

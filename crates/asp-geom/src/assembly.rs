@@ -26,6 +26,13 @@ pub struct Part {
     /// with `TM_brep_faces`), world frame, metres, one face index per triangle of `mesh`; `None`
     /// otherwise (the planner then recognises surfaces from the triangles).
     pub faces: Option<Arc<PartFaces>>,
+    /// Where the part sits in the file's product tree: the names of the assemblies that hold
+    /// it, outermost first (a STEP file's subassembly instances, a glTF node's named ancestors);
+    /// empty when the file has no tree.
+    pub path: Vec<String>,
+    /// How the part's B-rep was tessellated into `mesh` when asp did it (STEP); `None` for
+    /// parts that came as triangles.
+    pub tessellation: Option<crate::io::Tessellation>,
 }
 
 impl Part {
@@ -33,8 +40,14 @@ impl Part {
     /// [`PartMeta::from_extras`] themselves to warn about them).
     pub fn new(name: impl Into<String>, mesh: Mesh, fixed: bool, extras: serde_json::Value) -> Part {
         let (meta, _) = PartMeta::from_extras(&extras);
-        Part { name: name.into(), mesh, fixed, extras, meta, faces: None }
+        Part { name: name.into(), mesh, fixed, extras, meta, faces: None, path: Vec::new(), tessellation: None }
     }
+}
+
+/// `part`'s name after the innermost `k` assemblies of its path, joined by `/`.
+fn qualified(part: &Part, k: usize) -> String {
+    let start = part.path.len().saturating_sub(k);
+    part.path[start..].iter().chain(std::iter::once(&part.name)).cloned().collect::<Vec<_>>().join("/")
 }
 
 /// The unit the model was given in; asp works in metres and reports in this unit.
@@ -151,8 +164,28 @@ impl Assembly {
         Ok(())
     }
 
-    /// Makes part names unique by appending `_2`, `_3`, ... to repeats.
+    /// Makes part names unique. Parts of one name in different subassemblies (two instances
+    /// of one bolt) are told apart by the innermost assemblies of their [`Part::path`] that
+    /// differ (`l-bracket-assembly_1/nut-bolt-assembly_2/bolt_1`); repeats left after that get
+    /// `_2`, `_3`, ... appended.
     pub fn dedupe_names(&mut self) {
+        let mut by_name = std::collections::BTreeMap::<String, Vec<usize>>::new();
+        for (i, p) in self.parts.iter().enumerate() {
+            by_name.entry(p.name.clone()).or_default().push(i);
+        }
+        for group in by_name.into_values().filter(|g| g.len() > 1) {
+            let depth = group.iter().map(|&i| self.parts[i].path.len()).max().unwrap_or(0);
+            for k in 1..=depth {
+                let names: Vec<String> = group.iter().map(|&i| qualified(&self.parts[i], k)).collect();
+                let distinct: std::collections::HashSet<&String> = names.iter().collect();
+                if distinct.len() == names.len() {
+                    for (&i, name) in group.iter().zip(names) {
+                        self.parts[i].name = name;
+                    }
+                    break;
+                }
+            }
+        }
         let mut seen = std::collections::HashMap::<String, usize>::new();
         for p in &mut self.parts {
             let n = seen.entry(p.name.clone()).or_insert(0);

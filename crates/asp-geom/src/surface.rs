@@ -168,6 +168,28 @@ impl PartFaces {
         self.triangle_face.len() == triangles && self.triangle_face.iter().all(|&f| (f as usize) < self.faces.len())
     }
 
+    /// The largest distance between a triangle of `mesh` (its centroid and edge midpoints) and
+    /// its face's surface, over the faces on curved surfaces (a plane's triangles lie on it):
+    /// how far the tessellation strays from the exact shape. `None` when no face is curved and
+    /// analytic, or when the faces do not fit the mesh.
+    pub fn chord_error(&self, mesh: &crate::mesh::Mesh) -> Option<f32> {
+        if !self.fits(mesh.triangles.len()) {
+            return None;
+        }
+        let mut worst: Option<f32> = None;
+        for (t, &f) in mesh.triangles.iter().zip(&self.triangle_face) {
+            let Some(surface) = self.faces[f as usize].surface else { continue };
+            if matches!(surface, Surface::Plane { .. }) {
+                continue;
+            }
+            let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
+            let points = [(a + b + c) / 3.0, (a + b) / 2.0, (b + c) / 2.0, (c + a) / 2.0];
+            let d = points.iter().map(|&x| surface.distance(x)).fold(0.0f32, f32::max);
+            worst = Some(worst.map_or(d, |w| w.max(d)));
+        }
+        worst
+    }
+
     /// The faces moved by `pose`.
     pub fn transformed(&self, pose: &Pose) -> PartFaces {
         PartFaces {

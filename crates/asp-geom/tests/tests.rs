@@ -9,3 +9,4 @@ mod loaders;
 mod overlap;
 mod physics;
 mod removal;
+mod step;

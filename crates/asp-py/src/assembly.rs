@@ -46,12 +46,14 @@ impl PyAssembly {
     }
 }
 
-/// Loads the model at `path` (a `.glb`/`.gltf` file or a folder of `.obj`/`.stl` files, one part
-/// each) with an optional unit (`m`, `mm`, ... or metres per unit), up axis (`z`, `-y`, ...) and
-/// base part names, under the caps and the file rule of `docs/security.md`; errors are
-/// `asp.LoadError` (naming the file) or `asp.ConfigError`.
+/// Loads the model at `path` (a `.glb`/`.gltf` file, a `.step`/`.stp` file or a folder of
+/// `.obj`/`.stl` files, one part each) with an optional unit (`m`, `mm`, ... or metres per unit),
+/// up axis (`z`, `-y`, ...), base part names and STEP tessellation tolerance, under the caps and
+/// the file rule of `docs/security.md`; errors are `asp.LoadError` (naming the file) or
+/// `asp.ConfigError`. `step_glb`: the GLB that cascadio made of the STEP file in this process
+/// (`asp.load` passes it), read instead of running the converter.
 #[pyfunction]
-#[pyo3(signature = (path, unit=None, up=None, fixed=Vec::new(), max_triangles=None, max_parts=None, allow_outside_files=None))]
+#[pyo3(signature = (path, unit=None, up=None, fixed=Vec::new(), max_triangles=None, max_parts=None, allow_outside_files=None, tessellation=None, step_glb=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn load(
     py: Python<'_>,
@@ -62,8 +64,11 @@ pub fn load(
     max_triangles: Option<usize>,
     max_parts: Option<usize>,
     allow_outside_files: Option<bool>,
+    tessellation: Option<f64>,
+    step_glb: Option<Vec<u8>>,
 ) -> PyResult<PyAssembly> {
     let request = asp_app::PlanRequest {
+        tessellation,
         unit: unit.map(String::from),
         up: up.map(String::from),
         fixed,
@@ -73,7 +78,13 @@ pub fn load(
         ..Default::default()
     };
     let settings = asp_app::resolve(&request).map_err(|e| Error::from(e).into_py(py))?;
-    let assembly = py.detach(|| pipeline::load(&path, &settings)).map_err(|e| Error::from(e).into_py(py))?;
+    let load = || -> asp_app::Result<asp_geom::Assembly> {
+        let Some(glb) = &step_glb else { return pipeline::load(&path, &settings) };
+        let options = pipeline::load_options(&path, &settings)?;
+        let step = std::fs::read(&path).map_err(|source| asp_geom::GeomError::Io { path: path.clone(), source })?;
+        Ok(asp_geom::io::step::assemble(&path, &step, glb, &options)?)
+    };
+    let assembly = py.detach(load).map_err(|e| Error::from(e).into_py(py))?;
     Ok(PyAssembly { inner: Arc::new(assembly), graph: Mutex::new(None) })
 }
 

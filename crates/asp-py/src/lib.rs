@@ -72,6 +72,9 @@ fn asp_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("PLAN_FORMAT_VERSION", asp_search::report::FORMAT_VERSION)?;
     m.add_function(wrap_pyfunction!(assembly::load, m)?)?;
+    m.add("STEP_ANGULAR", asp_geom::io::step::DEFAULT_ANGULAR)?;
+    m.add("STEP_RELATIVE", asp_geom::io::step::DEFAULT_RELATIVE)?;
+    m.add("STEP_CONVERTER", asp_geom::io::step::CONVERTER)?;
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(order_names, m)?)?;
     m.add_function(wrap_pyfunction!(choices, m)?)?;

@@ -11,7 +11,10 @@ use asp_geom::overlap::{OverlapHandling, OverlapPolicy};
 use asp_geom::{Assembly, Motion, PartSet};
 use serde::{Deserialize, Serialize};
 
+mod parts;
 pub mod text;
+
+pub use parts::{FaceEntry, PartEntry, SurfaceEntry, TessellationEntry};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
@@ -82,6 +85,11 @@ pub struct PlanReport {
     /// effort. Since format 1.6.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grid: Option<GridEntry>,
+    /// Plans that follow the file's product tree (`--subassemblies from-file`): every
+    /// subassembly of the file, outermost first, with its own plan on its base (whether or not
+    /// the plan above could put it in as one unit). Since format 1.10.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub file_subassemblies: Vec<SubassemblyEntry>,
 }
 
 /// Parts that go in together as one unit because asp could not take them apart (format 1.8):
@@ -135,6 +143,23 @@ pub struct MoveEntry {
 }
 
 impl PlanReport {
+    /// Recomputes `status` and `locked_cores` from the steps, after subassemblies' own plans
+    /// were put into them (plans that follow the file's product tree): a `found` plan holding a
+    /// subassembly not taken apart becomes `partial`. A core keeps the `why` of the core of
+    /// `known` (or of this report) with the same base and parts.
+    pub fn settle(&mut self, known: &[LockedCore]) {
+        let steps = if self.assembly_sequence.is_empty() { &self.partial_assembly_sequence } else { &self.assembly_sequence };
+        self.status = complete(self.status, steps);
+        let parts = &self.parts;
+        let name = |i: usize| parts.get(i).map_or_else(|| "ground".to_string(), |p| p.name.clone());
+        let mut cores = if self.status == PlanStatus::Partial { locked_cores(steps, &name) } else { Vec::new() };
+        for core in &mut cores {
+            let same = |k: &&LockedCore| k.base == core.base && k.parts == core.parts;
+            core.why = known.iter().chain(&self.locked_cores).find(same).and_then(|k| k.why.clone());
+        }
+        self.locked_cores = cores;
+    }
+
     /// Attaches a robot's entries: each removal's entry to its assembly step (assembly order is
     /// the removal order reversed; the partial sequence when no plan was found).
     pub fn attach_robot(&mut self, robot: RobotReport) {
@@ -262,17 +287,6 @@ impl FitEntry {
     }
 }
 
-/// A part of the model.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct PartEntry {
-    /// Index (position in the model).
-    pub index: usize,
-    /// Name.
-    pub name: String,
-    /// Base part, never moved.
-    pub fixed: bool,
-}
-
 /// One assembly step.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct AssemblyStep {
@@ -304,6 +318,10 @@ pub struct AssemblyStep {
 /// A subassembly: parts that go in together, rigidly, as one step.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct SubassemblyEntry {
+    /// The subassembly's name in the file's product tree, when the plan follows it
+    /// (`--subassemblies from-file`). Since format 1.10.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
     /// Every part of it, by index (the step's part, its base, among them).
     pub parts: Vec<usize>,
     /// How it is built on its base: `found` (its `assembly_sequence` builds it part by part),
@@ -516,7 +534,7 @@ impl PlanReport {
             up: assembly.up.to_string(),
             tolerance: u(tolerance),
             status,
-            parts: assembly.parts.iter().enumerate().map(|(index, p)| PartEntry { index, name: p.name.clone(), fixed: p.fixed }).collect(),
+            parts: assembly.parts.iter().enumerate().map(|(index, p)| PartEntry::of(index, p, &assembly.units)).collect(),
             assembly_sequence,
             disassembly_sequence: removed,
             partial_assembly_sequence,
@@ -540,6 +558,7 @@ impl PlanReport {
             optimisation: None,
             robot: None,
             grid: None,
+            file_subassemblies: Vec::new(),
         }
     }
 }
@@ -564,7 +583,7 @@ fn assembly_steps(removals: &[Step], name: &dyn Fn(usize) -> String, u: &dyn Fn(
                         (SubassemblyStatus::from(complete(status_name(&plan.status), &steps)), steps, explain(&plan.status, name, &named))
                     }
                 };
-                Box::new(SubassemblyEntry { parts: g.parts.iter().collect(), status, assembly_sequence, explanation })
+                Box::new(SubassemblyEntry { name: None, parts: g.parts.iter().collect(), status, assembly_sequence, explanation })
             }),
             robot: None,
             held: Vec::new(),

@@ -277,6 +277,14 @@ const items = steps.map((s, k) => {
   const how = (s.motion ? (s.motion.kind === 'path' ? ' (path)' : '') : '') +
     (s.group.length > 1 ? ` + ${s.group.length - 1} parts (subassembly)` : '');
   li.appendChild(document.createTextNode(s.name + how));
+  if (parts[s.part].path) {
+    // where the part sits in the file's product tree (STEP subassemblies)
+    const tree = document.createElement('span');
+    tree.className = 'asp-tree';
+    tree.style.opacity = '0.6';
+    tree.textContent = ` in ${parts[s.part].path}`;
+    li.appendChild(tree);
+  }
   li.addEventListener('click', () => { pause(); goto(k + 1); });
   list.appendChild(li);
   return li;

@@ -58,7 +58,15 @@ pub fn load_model(report: &PlanReport, plan_path: &Path, model: Option<&Path>) -
     let unit = Units::parse(&report.units).ok_or_else(|| VizError::input(plan_path, format!("unknown unit '{}'", report.units)))?;
     let up = Axis::parse(&report.up).ok_or_else(|| VizError::input(plan_path, format!("'{}' is not an up axis", report.up)))?;
     let fixed = report.parts.iter().filter(|p| p.fixed).map(|p| p.name.clone()).collect();
-    let assembly = load(&path, &LoadOptions { unit: Some(unit), up: Some(up), fixed, ..LoadOptions::default() })?;
+    let mut options = LoadOptions { unit: Some(unit), up: Some(up), fixed, ..LoadOptions::default() };
+    if asp_geom::io::step::is_step(&path) {
+        // a STEP file names its unit, and is tessellated again as the plan records
+        options.unit = None;
+        if let Some(t) = report.parts.iter().find_map(|p| p.tessellation.as_ref()) {
+            options.tessellation = asp_geom::io::Tessellation { relative: t.relative, angular: t.angular };
+        }
+    }
+    let assembly = load(&path, &options)?;
     check_parts(&assembly, report, &path)?;
     Ok(assembly)
 }

@@ -79,6 +79,7 @@ fn page_data(scene: &Scene) -> Value {
             };
             json!({
                 "name": p.name,
+                "path": p.path.join("/"),
                 "fixed": scene.is_base(i),
                 "stuck": scene.stuck.contains(&i),
                 "colour": colour,

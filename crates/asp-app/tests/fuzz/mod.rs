@@ -385,7 +385,8 @@ fn request(rng: &mut ChaCha8Rng, diagonal: f64) -> (PlanRequest, String) {
         5 => {
             r.grid = Some(false);
             r.path_planner = Some(false);
-            r.subassemblies = Some(rng.random_bool(0.5));
+            r.subassemblies =
+                Some(if rng.random_bool(0.5) { asp_app::request::Subassemblies::On } else { asp_app::request::Subassemblies::Off });
             "no grid, no path planner".into()
         }
         6..=8 => {

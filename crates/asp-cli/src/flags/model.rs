@@ -12,7 +12,8 @@ pub struct ModelArgs {
     /// [default: m, or what the file says].
     #[arg(long)]
     pub unit: Option<String>,
-    /// The up axis: x, y, z, -x, -y, -z [default: +y for glTF, +z for OBJ/STL, or what the file says].
+    /// The up axis: x, y, z, -x, -y, -z [default: +y for glTF, +z for STEP (it has none; most
+    /// CAD is Z up) and OBJ/STL, or what the file says].
     #[arg(long)]
     pub up: Option<String>,
     /// Base parts that stay in place (names). Without any, a ground plane under the lowest point
@@ -29,6 +30,9 @@ pub struct ModelArgs {
     /// Most parts a model may have.
     #[arg(long, value_name = "N")]
     pub max_parts: Option<usize>,
+    /// STEP files: the chord tolerance of each edge and face relative to its own size.
+    #[arg(long, value_name = "RELATIVE")]
+    pub tessellation: Option<f64>,
     /// Contact tolerance in model units: motions may push a part this deep into another
     /// [default: 1e-4 × the model's diagonal].
     #[arg(long)]
@@ -61,6 +65,10 @@ pub struct ModelArgs {
     /// Never let a group of parts leave together as one rigid subassembly (single parts only).
     #[arg(long)]
     pub no_subassemblies: bool,
+    /// `from-file`: follow the file's product tree: plan each subassembly of the file on its
+    /// own, then the level above with each as one unit (a hierarchical plan).
+    #[arg(long, value_name = "MODE", value_parser = ["from-file"], conflicts_with = "no_subassemblies")]
+    pub subassemblies: Option<String>,
     /// Never plan voxel models by grid moves (interlocking puzzles whose parts must slide in
     /// turn before anything can leave).
     #[arg(long)]
@@ -84,6 +92,8 @@ impl ModelArgs {
             up,
             max_triangles,
             max_parts,
+            tessellation,
+            subassemblies,
             tolerance,
             contact_distance,
             overlaps,

@@ -5,12 +5,14 @@
 //! JSON; buffer data is read here with explicit bounds checks, because the crate's accessor
 //! iterators panic on some malformed files.
 
+use super::brep_faces::{self, BrepFaces, Surface64};
 use super::{lowercase_first, refs, Limits, LoadOptions, MAX_ZERO_FILLED};
 use crate::assembly::{Assembly, Part, Units};
 use crate::error::{GeomError, Result};
 use crate::math::{Axis, Pose, Vec3};
 use crate::mesh::Mesh;
 use crate::meta::PartMeta;
+use crate::surface::{Face, PartFaces, SurfaceSource};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 use gltf::scene::Transform;
@@ -19,6 +21,7 @@ use parry3d::glamx::{DMat4, DQuat, DVec3};
 use serde_json::Value;
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Inside this module a failure is just its reason; [`read_gltf_bytes`] adds the file name.
 type Res<T> = std::result::Result<T, String>;
@@ -41,12 +44,16 @@ fn read_gltf(path: &Path, bytes: &[u8], options: &LoadOptions, external: &Extern
         (bytes, None)
     };
     let document = parse_document(json)?;
+    let brep = match document.extensions_used().any(|e| e == brep_faces::EXTENSION) {
+        true => brep_faces::read(json)?,
+        false => Vec::new(),
+    };
     let buffers = load_buffers(&document, path, blob, options.allow_outside_files, external)?;
     let scene = document.default_scene().or_else(|| document.scenes().next());
     let settings = scene.as_ref().map(scene_settings).transpose()?.unwrap_or_default();
     let units = options.unit.clone().or(settings.unit).unwrap_or_else(Units::metres);
     let up = options.up.or(settings.up).unwrap_or(Axis::Y);
-    let mut builder = PartBuilder::new(&document, buffers, units.metres, options.limits);
+    let mut builder = PartBuilder::new(&document, buffers, units.metres, options.limits, brep);
     if let Some(scene) = &scene {
         check_announced(&document, scene, &options.limits)?;
         builder.add_scene(scene)?;
@@ -273,6 +280,22 @@ struct LocalMesh {
     triangles: Vec<[u32; 3]>,
     /// Descriptions of skipped (point or line) primitives.
     skipped: Vec<String>,
+    /// The B-rep face of each triangle and the faces' surfaces (`TM_brep_faces`), when a
+    /// primitive of the mesh has them.
+    faces: Option<LocalFaces>,
+    /// Problems with the mesh's `TM_brep_faces` (one line each, without the part's name).
+    face_warnings: Vec<String>,
+}
+
+/// A primitive's `TM_brep_faces`: per triangle its face, per face its surface, and how many
+/// entries were malformed.
+type PrimitiveBrep = (Vec<u32>, Vec<Option<Surface64>>, usize);
+
+/// A mesh's faces in its own frame: per triangle its face, per face its surface.
+#[derive(Clone, Default)]
+struct LocalFaces {
+    triangle_face: Vec<u32>,
+    surfaces: Vec<Option<Surface64>>,
 }
 
 /// Walks the scene and collects one part per mesh instance.
@@ -288,10 +311,14 @@ struct PartBuilder<'a> {
     limits: Limits,
     /// Triangles of the parts so far (checked against `limits` before each mesh is baked).
     triangles: usize,
+    /// The `TM_brep_faces` extension of each mesh's primitives.
+    brep: BrepFaces,
+    /// The document (for the accessors the extension names).
+    document: &'a Document,
 }
 
 impl<'a> PartBuilder<'a> {
-    fn new(document: &Document, buffers: Vec<Cow<'a, [u8]>>, scale: f64, limits: Limits) -> Self {
+    fn new(document: &'a Document, buffers: Vec<Cow<'a, [u8]>>, scale: f64, limits: Limits, brep: BrepFaces) -> Self {
         PartBuilder {
             buffers,
             scale,
@@ -301,6 +328,8 @@ impl<'a> PartBuilder<'a> {
             warnings: Vec::new(),
             limits,
             triangles: 0,
+            brep,
+            document,
         }
     }
 
@@ -308,24 +337,30 @@ impl<'a> PartBuilder<'a> {
     /// file order, composing transforms from the roots down.
     fn add_scene(&mut self, scene: &Scene) -> Res<()> {
         let mut seen = vec![false; self.node_count];
-        let mut stack: Vec<(Node, DMat4)> = scene.nodes().map(|node| (node, DMat4::IDENTITY)).collect();
+        let mut stack: Vec<(Node, DMat4, Arc<Vec<String>>)> =
+            scene.nodes().map(|node| (node, DMat4::IDENTITY, Arc::new(Vec::new()))).collect();
         stack.reverse();
-        while let Some((node, parent)) = stack.pop() {
+        while let Some((node, parent, path)) = stack.pop() {
             if std::mem::replace(&mut seen[node.index()], true) {
                 return Err(format!("invalid node hierarchy: node {} is reached twice (a cycle or several parents)", node.index()));
             }
             let world = parent * local_matrix(&node)?;
             if let Some(mesh) = node.mesh() {
-                self.add_instance(&node, &mesh, &world)?;
+                self.add_instance(&node, &mesh, &world, &path)?;
             }
+            // a named node with children is an assembly: its name is on its parts' paths
+            let inner = match node.name() {
+                Some(name) if node.children().len() > 0 => Arc::new(path.iter().cloned().chain([name.to_string()]).collect()),
+                _ => path,
+            };
             let first_child = stack.len();
-            stack.extend(node.children().map(|child| (child, world)));
+            stack.extend(node.children().map(|child| (child, world, inner.clone())));
             stack[first_child..].reverse();
         }
         Ok(())
     }
 
-    fn add_instance(&mut self, node: &Node, mesh: &gltf::Mesh, world: &DMat4) -> Res<()> {
+    fn add_instance(&mut self, node: &Node, mesh: &gltf::Mesh, world: &DMat4, path: &[String]) -> Res<()> {
         let name = node.name().or(mesh.name()).map(str::to_string).unwrap_or_else(|| format!("part_{}", self.parts.len()));
         if name.len() > MAX_NAME_BYTES {
             return Err(format!("node {}: its name has {} bytes (at most {MAX_NAME_BYTES}); shorten it", node.index(), name.len()));
@@ -352,6 +387,28 @@ impl<'a> PartBuilder<'a> {
         let pose = Pose::from_parts((translation * self.scale).as_vec3(), rotation.as_quat());
         let mut part = Part::new(name, mesh, fixed, extras);
         part.meta = meta.transformed(&pose, self.scale as f32);
+        part.path = path.to_vec();
+        for problem in &local.face_warnings {
+            self.warnings.push(format!("part '{}': {problem}", part.name));
+        }
+        if let Some(faces) = &local.faces {
+            let s = brep_faces::similarity(world, self.scale);
+            if s.is_none() && faces.surfaces.iter().any(Option::is_some) {
+                self.warnings.push(format!(
+                    "part '{}': its node transform shears or scales unevenly; its faces' exact surfaces are not used",
+                    part.name
+                ));
+            }
+            let faces = faces
+                .surfaces
+                .iter()
+                .map(|f| Face {
+                    surface: s.and_then(|s| f.as_ref().map(|f| brep_faces::place(f, world, self.scale, s))),
+                    source: SurfaceSource::Exact,
+                })
+                .collect();
+            part.faces = Some(Arc::new(PartFaces { triangle_face: faces_of(&local), faces }));
+        }
         self.parts.push(part);
         Ok(())
     }
@@ -365,7 +422,9 @@ impl<'a> PartBuilder<'a> {
             Some(name) => format!("mesh '{name}'"),
             None => format!("mesh {}", mesh.index()),
         };
-        let mut local = LocalMesh { vertices: Vec::new(), triangles: Vec::new(), skipped: Vec::new() };
+        let mut local =
+            LocalMesh { vertices: Vec::new(), triangles: Vec::new(), skipped: Vec::new(), faces: None, face_warnings: Vec::new() };
+        let mut faces = LocalFaces::default();
         for primitive in mesh.primitives() {
             let context = format!("{label}, primitive {}", primitive.index());
             if !is_triangles(primitive.mode()) {
@@ -378,6 +437,28 @@ impl<'a> PartBuilder<'a> {
                 .check_triangles(self.triangles + local.triangles.len() + announced)
                 .map_err(|reason| format!("{context}: {reason}"))?;
             let (vertices, triangles) = self.read_primitive(&primitive).map_err(|reason| format!("{context}: {reason}"))?;
+            match self.primitive_faces(mesh, &primitive, triangles.len()) {
+                Ok(Some((indices, surfaces, malformed))) => {
+                    if malformed > 0 {
+                        local.face_warnings.push(format!(
+                            "{context}: {malformed} faces of {} have malformed surfaces; they are used as free-form faces",
+                            brep_faces::EXTENSION
+                        ));
+                    }
+                    let offset = faces.surfaces.len() as u32;
+                    faces.triangle_face.extend(indices.iter().map(|f| f + offset));
+                    faces.surfaces.extend(surfaces);
+                    local.faces = Some(LocalFaces::default());
+                }
+                outcome => {
+                    if let Err(problem) = outcome {
+                        local.face_warnings.push(format!("{context}: {problem}; its triangles have no b-rep faces"));
+                    }
+                    // one face without a surface for the whole primitive
+                    faces.triangle_face.extend(std::iter::repeat_n(faces.surfaces.len() as u32, triangles.len()));
+                    faces.surfaces.push(None);
+                }
+            }
             // the running total is checked below, so the previous one fits in u32
             let base = local.vertices.len() as u32;
             local.vertices.extend(vertices);
@@ -386,10 +467,39 @@ impl<'a> PartBuilder<'a> {
             }
             local.triangles.extend(triangles.iter().map(|t| t.map(|i| i + base)));
         }
+        if local.faces.is_some() {
+            local.faces = Some(faces);
+        }
         if let Some(slot) = self.meshes.get_mut(mesh.index()) {
             *slot = Some(local.clone());
         }
         Ok(local)
+    }
+
+    /// The `TM_brep_faces` of a primitive of `triangles` triangles: per triangle its face, and
+    /// the faces' surfaces (as many as the largest index needs), and how many entries were
+    /// malformed. `Ok(None)` without the extension; an error says why it cannot be used.
+    fn primitive_faces(&self, mesh: &gltf::Mesh, primitive: &Primitive, triangles: usize) -> Res<Option<PrimitiveBrep>> {
+        let Some(ext) = self.brep.get(mesh.index()).and_then(|m| m.get(primitive.index())).and_then(Option::as_ref) else {
+            return Ok(None);
+        };
+        if primitive.mode() != Mode::Triangles {
+            return Err(format!("{} applies to triangle lists only", brep_faces::EXTENSION));
+        }
+        let accessor = self
+            .document
+            .accessors()
+            .nth(ext.face_indices)
+            .ok_or_else(|| format!("its faceIndices accessor {} does not exist", ext.face_indices))?;
+        let unsigned = matches!(accessor.data_type(), DataType::U8 | DataType::U16 | DataType::U32);
+        if accessor.dimensions() != Dimensions::Scalar || !unsigned || accessor.normalized() || accessor.count() != triangles {
+            return Err(format!("its faceIndices accessor {} is not one unsigned integer per triangle", ext.face_indices));
+        }
+        let indices: Vec<u32> = read_accessor(&accessor, &self.buffers)?.into_iter().map(|f| f as u32).collect();
+        let count = indices.iter().map(|&f| f as usize + 1).max().unwrap_or(0).max(ext.faces.len());
+        let mut surfaces = ext.faces.clone();
+        surfaces.resize(count, None);
+        Ok(Some((indices, surfaces, ext.malformed)))
     }
 
     fn read_primitive(&self, primitive: &Primitive) -> Res<(Vec<DVec3>, Vec<[u32; 3]>)> {
@@ -426,6 +536,11 @@ fn check_announced(document: &Document, scene: &Scene, limits: &Limits) -> Res<(
     }
     limits.check_parts(parts)?;
     limits.check_triangles(triangles)
+}
+
+/// The merged face index of each triangle of `local` (checked to match its triangles).
+fn faces_of(local: &LocalMesh) -> Vec<u32> {
+    local.faces.as_ref().map(|f| f.triangle_face.clone()).unwrap_or_default()
 }
 
 /// The longest part name accepted (bytes): names are printed in tables, errors and pages.

@@ -1,14 +1,18 @@
-//! Loading assemblies from files (glTF 2.0, folders of OBJ/STL) and writing GLB.
+//! Loading assemblies from files (glTF 2.0, STEP through OpenCASCADE, folders of OBJ/STL) and
+//! writing GLB.
 
 mod atomic;
+mod brep_faces;
 mod folder;
 mod glb_write;
 mod gltf_read;
 mod refs;
+pub mod step;
 
 pub use atomic::{write_atomic, write_atomic_with};
 pub use glb_write::write_glb;
 pub use refs::{canonical, resolve_inside, Refused, OUTSIDE_FLAG};
+pub use step::Tessellation;
 
 use crate::assembly::{Assembly, Units};
 use crate::error::{GeomError, Result};
@@ -20,7 +24,7 @@ use std::path::Path;
 pub struct LoadOptions {
     /// The unit of the file's coordinates (default: metres for glTF per its spec, metres for folders).
     pub unit: Option<Units>,
-    /// The up axis (default: the file's `extras.asp.up`, else +Y for glTF, +Z for OBJ/STL folders).
+    /// The up axis (default: the file's `extras.asp.up`, else +Y for glTF, +Z for STEP and OBJ/STL).
     pub up: Option<Axis>,
     /// Names of base parts, on top of those the file marks as fixed.
     pub fixed: Vec<String>,
@@ -31,6 +35,8 @@ pub struct LoadOptions {
     pub limits: Limits,
     /// Make each separate body of a part's mesh a part of its own (`name#1`, `name#2`, ...).
     pub split_bodies: bool,
+    /// How finely a STEP file's B-rep is tessellated (other formats come as triangles).
+    pub tessellation: Tessellation,
 }
 
 /// The default cap on triangles over all parts ([`Limits::max_triangles`]).
@@ -78,7 +84,8 @@ impl Limits {
     }
 }
 
-/// Loads `path`: a `.glb`/`.gltf` file or a folder of `.obj`/`.stl` files (one part per file).
+/// Loads `path`: a `.glb`/`.gltf` file, a `.step`/`.stp` file ([`step`]) or a folder of
+/// `.obj`/`.stl` files (one part per file).
 /// Meshes come back in metres, world frame, part names unique; the assembly is validated.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Assembly> {
     let meta = std::fs::metadata(path).map_err(|source| io_error(path, source))?;
@@ -109,6 +116,10 @@ pub fn load_bytes_with(
     let assembly = match check_extension(path)? {
         FileKind::Gltf => gltf_read::read_gltf_bytes(path, bytes, options, external)?,
         FileKind::Mesh => folder::single_file_from_bytes(path, bytes, options)?,
+        FileKind::Step => {
+            let glb = step::convert(path, bytes, &options.tessellation)?;
+            return step::assemble(path, bytes, &glb, options);
+        }
     };
     finish(assembly, options)
 }
@@ -116,17 +127,19 @@ pub fn load_bytes_with(
 enum FileKind {
     Gltf,
     Mesh,
+    Step,
 }
 
 fn check_extension(path: &Path) -> Result<FileKind> {
     match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
         Some("glb") | Some("gltf") => Ok(FileKind::Gltf),
         Some("obj") | Some("stl") => Ok(FileKind::Mesh),
-        _ => Err(GeomError::format(path, "unknown file type (expected .glb, .gltf, or a folder of .obj/.stl files)")),
+        Some("step") | Some("stp") => Ok(FileKind::Step),
+        _ => Err(GeomError::format(path, "unknown file type (expected .glb, .gltf, .step, .stp, or a folder of .obj/.stl files)")),
     }
 }
 
-fn finish(mut assembly: Assembly, options: &LoadOptions) -> Result<Assembly> {
+pub(crate) fn finish(mut assembly: Assembly, options: &LoadOptions) -> Result<Assembly> {
     assembly.dedupe_names();
     assembly.set_fixed(&options.fixed)?;
     assembly.validate()?;
@@ -135,7 +148,7 @@ fn finish(mut assembly: Assembly, options: &LoadOptions) -> Result<Assembly> {
         let split = crate::validate::split_bodies(&mut assembly);
         if !split.is_empty() {
             assembly.warnings.retain(|w| !split.iter().any(|n| w.starts_with(&format!("part '{n}' holds "))));
-            assembly.warnings.push(format!("split into one part per body (--split-bodies): {}", split.join(", ")));
+            assembly.warnings.push(format!("split into one part per body (LoadOptions::split_bodies): {}", split.join(", ")));
         }
     }
     let (_, unknown) = assembly.fastenings();

@@ -126,6 +126,25 @@ fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
         )?;
         write_steps(out, r, &r.partial_assembly_sequence, width, "")?;
     }
+    if !r.file_subassemblies.is_empty() {
+        writeln!(out, "subassemblies of the file, each planned on its own base:")?;
+        for g in &r.file_subassemblies {
+            let how = match g.status {
+                SubassemblyStatus::Found => "found".to_string(),
+                SubassemblyStatus::Partial => "partial (a group in it is not taken apart)".to_string(),
+                SubassemblyStatus::NoPlan => "no plan (nothing more comes off its base)".to_string(),
+                other => other.as_str().replace('_', " "),
+            };
+            writeln!(out, "  {} ({} parts): {how}", g.name.as_deref().unwrap_or("?"), g.parts.len())?;
+            if !g.assembly_sequence.is_empty() {
+                write_steps(out, r, &g.assembly_sequence, width, "    ")?;
+            }
+            for e in &g.explanation {
+                let others: Vec<&str> = e.parts.iter().map(|p| p.name.as_str()).collect();
+                writeln!(out, "      {} {} {}", e.name, e.reason.as_str().replace('_', " "), others.join(", "))?;
+            }
+        }
+    }
     if let Some(robot) = &r.robot {
         writeln!(out, "robot {}: total path length {:.3} {}", robot.name, robot.total_path_length, r.units)?;
     }
@@ -165,8 +184,17 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
         Some(g) => format!("{} + {} more (subassembly)", step.name, g.parts.len() - 1),
     };
     let width = sequence.iter().map(|s| label(s).len()).fold(width, usize::max);
+    // the file's product tree: where each part sits, when the file has one
+    let tree = r.parts.iter().any(|p| !p.path.is_empty());
+    let place = |step: &AssemblyStep| match (&step.subassembly, r.parts.get(step.part)) {
+        (Some(g), _) if g.name.is_some() => format!("{}  ", g.name.as_deref().unwrap_or_default()),
+        (_, Some(p)) if tree => format!("{}  ", if p.path.is_empty() { "-".to_string() } else { p.path.join("/") }),
+        _ => String::new(),
+    };
+    let place_width = sequence.iter().map(|s| place(s).len()).max().unwrap_or(0).max(if tree { 16 } else { 0 });
     if indent.is_empty() {
-        writeln!(out, "{:>4}  {:<width$}  motion (insertion, {})", "step", "part", r.units)?;
+        let header = if tree { "in (file tree)" } else { "" };
+        writeln!(out, "{:>4}  {:<width$}  {header:<place_width$}motion (insertion, {})", "step", "part", r.units)?;
     }
     for (k, step) in sequence.iter().enumerate() {
         let motion = match &step.motion {
@@ -184,7 +212,7 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
         } else {
             format!("{robot}; holding {}", step.held.iter().map(|&p| name(p)).collect::<Vec<_>>().join(", "))
         };
-        writeln!(out, "{indent}{:>4}  {:<width$}  {motion}{robot}", k + 1, label(step))?;
+        writeln!(out, "{indent}{:>4}  {:<width$}  {:<place_width$}{motion}{robot}", k + 1, label(step), place(step))?;
         if let Some(g) = &step.subassembly {
             let inner = format!("{indent}      ");
             let members: Vec<&str> = g.parts.iter().map(|&p| name(p)).collect();
