@@ -65,7 +65,7 @@ impl Space for Boxed {
 
 #[test]
 fn an_enclosed_goal_is_not_reached() {
-    let cfg = RrtConnectConfig { step: 0.1, max_iterations: 300, seed: 1 };
+    let cfg = RrtConnectConfig { step: 0.1, max_iterations: 300, seed: 1, lazy: false };
     assert_eq!(rrt_connect(&Boxed, &[0.1, 0.1], &[0.8, 0.8], &cfg), Err(RrtFailure::Exhausted));
 }
 
@@ -150,4 +150,45 @@ fn the_step_check_replaces_the_node_and_edge_checks() {
     let path =
         connect_trees(&ExactEdges, &[[0.2, 0.1]], &[[0.8, 0.1]], &growth, &mut ChaCha8Rng::seed_from_u64(0)).expect("every step is free");
     assert_eq!((path.first(), path.last()), (Some(&[0.2, 0.1]), Some(&[0.8, 0.1])));
+}
+
+/// Lazy edges: a wall thinner than a step lets nodes stand on both sides of it, so the trees
+/// meet across it and the edge check cuts the crossing edge off; the path returned still passes
+/// every edge check, around the wall, with fewer samples checked than growing edge by edge.
+#[test]
+fn lazy_edges_find_a_valid_path_with_fewer_checks() {
+    struct Thin(std::cell::Cell<usize>);
+    impl Space for Thin {
+        type State = [f64; 2];
+        fn sample(&self, rng: &mut ChaCha8Rng) -> [f64; 2] {
+            Square.sample(rng)
+        }
+        fn valid(&self, s: &[f64; 2]) -> bool {
+            self.0.set(self.0.get() + 1);
+            !((s[0] - 0.5).abs() < 0.003 && s[1] < 0.8)
+        }
+        fn interpolate(&self, a: &[f64; 2], b: &[f64; 2], t: f64) -> [f64; 2] {
+            Square.interpolate(a, b, t)
+        }
+        fn distance(&self, a: &[f64; 2], b: &[f64; 2]) -> f64 {
+            Square.distance(a, b)
+        }
+        fn edge_resolution(&self) -> f64 {
+            0.002
+        }
+    }
+    let mut checks = Vec::new();
+    for lazy in [false, true] {
+        let space = Thin(std::cell::Cell::new(0));
+        let cfg = RrtConnectConfig { step: 0.1, max_iterations: 3000, seed: 5, lazy };
+        let path = rrt_connect(&space, &[0.2, 0.1], &[0.8, 0.1], &cfg).expect("a path around the wall");
+        checks.push(space.0.get());
+        assert_eq!((path.first(), path.last()), (Some(&[0.2, 0.1]), Some(&[0.8, 0.1])));
+        for w in path.windows(2) {
+            assert!(space.edge_valid(&w[0], &w[1]), "lazy {lazy}: {path:?}");
+        }
+        assert!(path.iter().any(|s| s[1] > 0.79), "lazy {lazy}: through the wall: {path:?}");
+        assert_eq!(path, rrt_connect(&Thin(std::cell::Cell::new(0)), &[0.2, 0.1], &[0.8, 0.1], &cfg).unwrap());
+    }
+    assert!(checks[1] < checks[0], "lazy {} checks, eager {}", checks[1], checks[0]);
 }
