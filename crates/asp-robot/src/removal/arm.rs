@@ -36,9 +36,10 @@ pub(super) struct ArmSpace<'a, W: Borrow<World>> {
     poses: std::cell::RefCell<Vec<Pose>>,
     /// A configuration between two others (reused buffer of the edge walk).
     between: std::cell::RefCell<Vec<f64>>,
-    /// The sphere check (`None` when [`RemovalConfig::sphere_check`] is off).
+    /// The sphere check (`None` in an exact space, and when [`RemovalConfig::sphere_check`] is
+    /// off).
     spheres: Option<SphereSpace<'a, W>>,
-    /// Verdicts by the exact shapes (the sphere check then only bounds the clearance).
+    /// Verdicts by the exact shapes alone (clearance from the boxes).
     exact: bool,
     checks: std::cell::Cell<(u64, u64)>,
     /// Every 32nd check and edge walk is timed: (checks timed, nanoseconds).
@@ -112,7 +113,8 @@ impl<'a, W: Borrow<World>> ArmSpace<'a, W> {
             resolution: resolution as f64,
             poses: std::cell::RefCell::new(Vec::with_capacity(planner.arm.len())),
             between: std::cell::RefCell::new(Vec::with_capacity(levers_len)),
-            spheres: planner.config.sphere_check.then(|| SphereSpace::new(planner, part, shrunk, grasp, opening, obstacles)),
+            spheres: (planner.config.sphere_check && check == Check::Spheres)
+                .then(|| SphereSpace::new(planner, part, shrunk, grasp, opening, obstacles)),
             exact: check == Check::Exact || !planner.config.sphere_check,
             checks: std::cell::Cell::new((0, 0)),
             timed: std::cell::Cell::new((0, 0)),
@@ -137,16 +139,8 @@ impl<'a, W: Borrow<World>> ArmSpace<'a, W> {
     }
 
     fn check_untimed(&self, q: &[f64], clearance: Option<f32>) -> Option<f32> {
+        // an exact space has no sphere check: the exact verdict and the boxes' clearance
         let Some(spheres) = &self.spheres else { return self.check_exact(q, clearance) };
-        if self.exact {
-            // the exact verdict; the spheres' clearance (a bound for the exact shapes too, as
-            // they hold them) to skip samples by
-            self.check_exact(q, None)?;
-            return match clearance.map(|need| spheres.check(q, Some(need))) {
-                Some(Found::Free(c)) => Some(c),
-                _ => Some(0.0),
-            };
-        }
         let (robot, held) = self.checks.get();
         match spheres.check(q, clearance) {
             Found::Robot => {
@@ -269,7 +263,7 @@ impl<W: Borrow<World>> Space for ArmSpace<'_, W> {
     /// every sample.
     fn edge_valid(&self, a: &Vec<f64>, b: &Vec<f64>) -> bool {
         let n = (self.distance(a, b) / self.resolution).ceil().max(1.0) as usize;
-        if let (Some(spheres), false, true) = (&self.spheres, self.exact, self.planner.config.clearance_skipping) {
+        if let (Some(spheres), true) = (&self.spheres, self.planner.config.clearance_skipping) {
             // shape by shape: each evaluated only where its clearance has run out
             let timed = self.edges.get().is_multiple_of(32);
             self.edges.set(self.edges.get() + 1);
