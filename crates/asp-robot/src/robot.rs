@@ -496,7 +496,7 @@ impl Robot {
     }
 
     /// Index of the first link that moves rigidly with the tool centre (after the last movable joint).
-    fn first_tool_link(&self) -> usize {
+    pub(crate) fn first_tool_link(&self) -> usize {
         self.movable.last().map_or(0, |&m| m + 1)
     }
 

@@ -543,6 +543,12 @@ impl RobotExtension {
         RobotExtension { setup, model: Mutex::new(None) }
     }
 
+    /// The robot of the last model [`RobotExtension::model`] built, if any (its planner's
+    /// [`RemovalPlanner::stats`] say what the searches on it cost).
+    pub fn current_model(&self) -> Option<Arc<RobotModel>> {
+        self.model.lock().expect("not poisoned").as_ref().map(|(_, m)| m.clone())
+    }
+
     /// The robot on `model` (built once per assembly).
     pub fn model(&self, model: &ModelContext<'_>) -> asp_search::Result<Arc<RobotModel>> {
         let id = Arc::as_ptr(model.assembly) as usize;

@@ -63,21 +63,27 @@ pub struct Growth {
     pub deadline: Option<Instant>,
 }
 
-/// A forest: nodes with their parents, roots without.
+/// A forest: nodes with their parents, roots without. A lazy tree also knows which edges to
+/// their parents were checked, and which nodes were cut off (an edge above them failed).
 struct Tree<S> {
     nodes: Vec<S>,
     parent: Vec<Option<usize>>,
+    checked: Vec<bool>,
+    dead: Vec<bool>,
 }
 
 impl<S: Clone> Tree<S> {
     fn new(roots: &[S]) -> Self {
-        Tree { nodes: roots.to_vec(), parent: vec![None; roots.len()] }
+        Tree { nodes: roots.to_vec(), parent: vec![None; roots.len()], checked: vec![true; roots.len()], dead: vec![false; roots.len()] }
     }
 
-    /// The first node nearest `q`.
+    /// The first live node nearest `q`.
     fn nearest<P: Space<State = S>>(&self, space: &P, q: &S) -> usize {
         let mut best = (f64::INFINITY, 0);
         for (i, n) in self.nodes.iter().enumerate() {
+            if self.dead[i] {
+                continue;
+            }
             let d = space.distance(n, q);
             if d < best.0 {
                 best = (d, i);
@@ -86,10 +92,45 @@ impl<S: Clone> Tree<S> {
         best.1
     }
 
-    fn push(&mut self, s: S, parent: usize) -> usize {
+    fn push(&mut self, s: S, parent: usize, checked: bool) -> usize {
         self.nodes.push(s);
         self.parent.push(Some(parent));
+        self.checked.push(checked);
+        self.dead.push(false);
         self.nodes.len() - 1
+    }
+
+    /// Cuts node `i` and everything below it off the tree (children come after their parents).
+    fn cut(&mut self, i: usize) {
+        self.dead[i] = true;
+        for k in i + 1..self.nodes.len() {
+            if let Some(p) = self.parent[k] {
+                if self.dead[p] {
+                    self.dead[k] = true;
+                }
+            }
+        }
+    }
+
+    /// Checks the unchecked edges from a root to node `i`, root first; cuts the tree below the
+    /// first that fails and returns false.
+    fn validate<P: Space<State = S>>(&mut self, space: &P, i: usize) -> bool {
+        let mut chain = vec![i];
+        while let Some(p) = self.parent[chain[chain.len() - 1]] {
+            chain.push(p);
+        }
+        for &k in chain.iter().rev() {
+            if self.checked[k] {
+                continue;
+            }
+            let p = self.parent[k].expect("only roots have no parent, and roots are checked");
+            if !space.edge_valid(&self.nodes[p], &self.nodes[k]) {
+                self.cut(k);
+                return false;
+            }
+            self.checked[k] = true;
+        }
+        true
     }
 
     /// The states from the root to node `i`.
@@ -110,16 +151,18 @@ enum Extend {
     Reached(usize),
 }
 
-/// Grows `tree` from its node nearest `q` by at most one step towards `q`.
-fn extend<P: Space>(space: &P, tree: &mut Tree<P::State>, q: &P::State, step: f64) -> Extend {
+/// Grows `tree` from its node nearest `q` by at most one step towards `q` (`lazy`: only the new
+/// node is checked, its edge when a path uses it).
+fn extend<P: Space>(space: &P, tree: &mut Tree<P::State>, q: &P::State, step: f64, lazy: bool) -> Extend {
     let near = tree.nearest(space, q);
     let from = &tree.nodes[near];
     let d = space.distance(from, q);
     let (target, reached) = if d <= step { (q.clone(), true) } else { (space.interpolate(from, q, step / d), false) };
-    if !space.step_valid(from, &target) {
+    let ok = if lazy { space.valid(&target) } else { space.step_valid(from, &target) };
+    if !ok {
         return Extend::Trapped;
     }
-    let i = tree.push(target, near);
+    let i = tree.push(target, near, !lazy);
     if reached {
         Extend::Reached(i)
     } else {
@@ -139,6 +182,33 @@ pub fn connect_trees<P: Space>(
     growth: &Growth,
     rng: &mut ChaCha8Rng,
 ) -> Option<Vec<P::State>> {
+    grow(space, starts, goals, growth, rng, false)
+}
+
+/// [`connect_trees`] with lazy edges (lazy RRT-Connect): a new node is checked with
+/// [`Space::valid`] alone; when the trees meet, the edges of the path between the two roots are
+/// checked ([`Space::edge_valid`], from each root outwards), and an edge that fails cuts its
+/// node and everything below it off its tree, which then grows on. Every edge of the path it
+/// returns passed [`Space::edge_valid`], as with [`connect_trees`]; the edges the trees grew
+/// but no path used are never checked.
+pub fn connect_trees_lazy<P: Space>(
+    space: &P,
+    starts: &[P::State],
+    goals: &[P::State],
+    growth: &Growth,
+    rng: &mut ChaCha8Rng,
+) -> Option<Vec<P::State>> {
+    grow(space, starts, goals, growth, rng, true)
+}
+
+fn grow<P: Space>(
+    space: &P,
+    starts: &[P::State],
+    goals: &[P::State],
+    growth: &Growth,
+    rng: &mut ChaCha8Rng,
+    lazy: bool,
+) -> Option<Vec<P::State>> {
     let mut a = Tree::new(starts);
     let mut b = Tree::new(goals);
     let mut a_is_start = true;
@@ -147,7 +217,7 @@ pub fn connect_trees<P: Space>(
             break;
         }
         let q = space.sample(rng);
-        let new = match extend(space, &mut a, &q, growth.step) {
+        let new = match extend(space, &mut a, &q, growth.step, lazy) {
             Extend::Trapped => None,
             Extend::Advanced(i) | Extend::Reached(i) => Some(i),
         };
@@ -155,10 +225,14 @@ pub fn connect_trees<P: Space>(
             let target = a.nodes[i].clone();
             // connect: extend b toward the new node until reached or trapped
             loop {
-                match extend(space, &mut b, &target, growth.step) {
+                match extend(space, &mut b, &target, growth.step, lazy) {
                     Extend::Advanced(_) => continue,
                     Extend::Trapped => break,
                     Extend::Reached(j) => {
+                        // lazy: the path's edges now, both trees (a failure cuts and grows on)
+                        if lazy && !(a.validate(space, i) && b.validate(space, j)) {
+                            break;
+                        }
                         let mut pa = a.branch(i);
                         let mut pb = b.branch(j);
                         pb.pop(); // the meeting state is the end of both branches
@@ -187,11 +261,14 @@ pub struct RrtConnectConfig {
     pub max_iterations: usize,
     /// Seed of the samples.
     pub seed: u64,
+    /// Check tree edges only when a path between the roots uses them
+    /// ([`connect_trees_lazy`]); false: every edge as it is grown ([`connect_trees`]).
+    pub lazy: bool,
 }
 
 impl Default for RrtConnectConfig {
     fn default() -> Self {
-        RrtConnectConfig { step: 0.3, max_iterations: 2000, seed: 0 }
+        RrtConnectConfig { step: 0.3, max_iterations: 2000, seed: 0, lazy: false }
     }
 }
 
@@ -221,8 +298,8 @@ pub fn rrt_connect<P: Space>(space: &P, start: &P::State, goal: &P::State, confi
         return Ok(vec![start.clone(), goal.clone()]);
     }
     let growth = Growth { step: config.step, max_iterations: config.max_iterations, deadline: None };
-    let path =
-        connect_trees(space, std::slice::from_ref(start), std::slice::from_ref(goal), &growth, &mut rng).ok_or(RrtFailure::Exhausted)?;
+    let path = grow(space, std::slice::from_ref(start), std::slice::from_ref(goal), &growth, &mut rng, config.lazy)
+        .ok_or(RrtFailure::Exhausted)?;
     Ok(shortcut(space, path))
 }
 

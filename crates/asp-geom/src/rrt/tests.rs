@@ -65,7 +65,7 @@ impl Space for Boxed {
 
 #[test]
 fn an_enclosed_goal_is_not_reached() {
-    let cfg = RrtConnectConfig { step: 0.1, max_iterations: 300, seed: 1 };
+    let cfg = RrtConnectConfig { step: 0.1, max_iterations: 300, seed: 1, lazy: false };
     assert_eq!(rrt_connect(&Boxed, &[0.1, 0.1], &[0.8, 0.8], &cfg), Err(RrtFailure::Exhausted));
 }
 
@@ -150,4 +150,76 @@ fn the_step_check_replaces_the_node_and_edge_checks() {
     let path =
         connect_trees(&ExactEdges, &[[0.2, 0.1]], &[[0.8, 0.1]], &growth, &mut ChaCha8Rng::seed_from_u64(0)).expect("every step is free");
     assert_eq!((path.first(), path.last()), (Some(&[0.2, 0.1]), Some(&[0.8, 0.1])));
+}
+
+/// A wall at `|x − 0.5| < half`, `y < 0.8` in the unit square, checked every 2 mm along edges;
+/// counts the configurations checked.
+struct Wall {
+    half: f64,
+    checks: std::cell::Cell<usize>,
+}
+
+impl Wall {
+    fn new(half: f64) -> Wall {
+        Wall { half, checks: std::cell::Cell::new(0) }
+    }
+}
+
+impl Space for Wall {
+    type State = [f64; 2];
+    fn sample(&self, rng: &mut ChaCha8Rng) -> [f64; 2] {
+        Square.sample(rng)
+    }
+    fn valid(&self, s: &[f64; 2]) -> bool {
+        self.checks.set(self.checks.get() + 1);
+        !((s[0] - 0.5).abs() < self.half && s[1] < 0.8)
+    }
+    fn interpolate(&self, a: &[f64; 2], b: &[f64; 2], t: f64) -> [f64; 2] {
+        Square.interpolate(a, b, t)
+    }
+    fn distance(&self, a: &[f64; 2], b: &[f64; 2]) -> f64 {
+        Square.distance(a, b)
+    }
+    fn edge_resolution(&self) -> f64 {
+        0.002
+    }
+}
+
+/// Plans around `space`'s wall with and without lazy edges; every path returned passes every
+/// edge check, goes around the wall and is the same for the same seed. Returns the
+/// configurations checked, eager then lazy.
+fn around_the_wall(half: f64, seed: u64) -> [usize; 2] {
+    [false, true].map(|lazy| {
+        let space = Wall::new(half);
+        let cfg = RrtConnectConfig { step: 0.1, max_iterations: 3000, seed, lazy };
+        let path = rrt_connect(&space, &[0.2, 0.1], &[0.8, 0.1], &cfg).expect("a path around the wall");
+        let checks = space.checks.get();
+        assert_eq!((path.first(), path.last()), (Some(&[0.2, 0.1]), Some(&[0.8, 0.1])));
+        for w in path.windows(2) {
+            assert!(space.edge_valid(&w[0], &w[1]), "lazy {lazy}: {path:?}");
+        }
+        assert!(path.iter().any(|s| s[1] > 0.79), "lazy {lazy}: through the wall: {path:?}");
+        assert_eq!(path, rrt_connect(&Wall::new(half), &[0.2, 0.1], &[0.8, 0.1], &cfg).unwrap());
+        checks
+    })
+}
+
+/// Lazy edges: a wall thinner than a step lets nodes stand on both sides of it, so the trees
+/// meet across it and only the check of the path's edges finds the crossing, which it cuts off;
+/// the path returned still passes every edge check, around the wall.
+#[test]
+fn lazy_edges_cut_what_crosses_a_thin_wall() {
+    for seed in 0..4 {
+        around_the_wall(0.003, seed);
+    }
+}
+
+/// Lazy edges check fewer configurations where the trees grow edges no path uses: around a
+/// wall thicker than a step, every seed.
+#[test]
+fn lazy_edges_check_fewer_configurations() {
+    for seed in 0..4 {
+        let [eager, lazy] = around_the_wall(0.15, seed);
+        assert!(lazy < eager, "seed {seed}: lazy {lazy} checks, eager {eager}");
+    }
 }

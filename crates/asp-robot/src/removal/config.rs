@@ -43,6 +43,11 @@ pub struct RemovalConfig {
     /// distances to the parts and the floor, exact distances between the arm's own shapes):
     /// the same answers with fewer tests (false: test every sample; for comparisons).
     pub clearance_skipping: bool,
+    /// Check configurations while planning with the arm as spheres against the parts' boxes,
+    /// the exact test only where a sphere comes near something: the exact verdict at a
+    /// fraction of the cost (false: the exact shapes at every configuration, as before; for
+    /// comparisons). The final re-check of a path is exact either way.
+    pub sphere_check: bool,
 }
 
 impl Default for RemovalConfig {
@@ -53,7 +58,7 @@ impl Default for RemovalConfig {
             path_grasps: 6,
             ik: IkConfig { max_iterations: 60, restarts: 3, position_tolerance: 1e-4, rotation_tolerance: 1e-3, ..IkConfig::default() },
             grasp: GraspConfig::default(),
-            rrt: RrtConnectConfig { step: 0.4, max_iterations: 1500, seed: 0 },
+            rrt: RrtConnectConfig { step: 0.4, max_iterations: 1500, seed: 0, lazy: false },
             edge_resolution: 0.04,
             repair_resolution: 0.01,
             check_resolution: 0.002,
@@ -62,6 +67,7 @@ impl Default for RemovalConfig {
             gripper_precheck: true,
             per_joint_levers: true,
             clearance_skipping: true,
+            sphere_check: true,
         }
     }
 }

@@ -40,12 +40,19 @@
 //! ([`Robot::lever_arms`]). [`RemovalPlanner::stats`] times each phase.
 
 mod arm;
+mod bodies;
 mod config;
+mod fast;
+mod grid;
+mod plan;
 mod shapes;
 mod stats;
 
-use arm::ArmSpace;
+pub use arm::ArmCheck;
+use arm::{ArmSpace, Check};
+use bodies::ArmModel;
 pub use config::{RemovalConfig, RobotCell, RobotFailure, RobotRemoval};
+use grid::{Field, PartGrid};
 use shapes::{box_gap, lowest, shapes_touch, world_shapes, Prepared};
 pub use stats::PlanStats;
 use stats::{Counters, C};
@@ -88,6 +95,8 @@ struct Obstacles {
     ground: Option<usize>,
     /// The union of the boxes of `ids` (broad phase).
     bounds: Option<Aabb>,
+    /// Their distances, filled as the sphere check asks (`ids` as bits).
+    field: Field,
 }
 
 /// The arm's configurations for one grasp and lift direction ([`RemovalPlanner::grasp_ik`]).
@@ -100,6 +109,9 @@ struct GraspIk {
 
 /// A part, a grasp and a lift direction (its bits).
 type IkKey = (usize, usize, [u32; 3]);
+
+/// The side of the cells of the grid over the parts' boxes, metres.
+const GRID_CELL: f32 = 0.03;
 
 /// Plans robot removals of the parts of one collision world (`W`: a `&World`, an
 /// `Arc<World>`, or anything else that borrows one).
@@ -129,6 +141,10 @@ pub struct RemovalPlanner<W: Borrow<World>> {
     held_cuboids: Vec<Option<Vec<Placed>>>,
     /// Inverse kinematics per part, grasp and lift direction (state-independent).
     ik_cache: Mutex<HashMap<IkKey, Arc<GraspIk>>>,
+    /// The robot as bodies of spheres (the sphere check's arm).
+    model: ArmModel,
+    /// The parts' boxes in a grid over the cell (the sphere check's parts).
+    grid: PartGrid,
     counters: Counters,
 }
 
@@ -213,6 +229,10 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         let held_shrink = config.margin.max(w.tolerance());
         let cuboids = (0..w.num_parts()).map(|p| cuboids_of(w, p, 0.0)).collect();
         let held_cuboids = (0..w.num_parts()).map(|p| cuboids_of(w, p, held_shrink)).collect();
+        let model = ArmModel::new(robot, &arm);
+        // every small sphere of the arm or of a held part (box cells of at most a piece a side)
+        let reach = model.largest.max(crate::spheres::SPHERE_PIECE * 0.8661) + 2.0 * crate::spheres::SPHERE_SLACK;
+        let grid = PartGrid::new(w, GRID_CELL, reach);
         RemovalPlanner {
             world,
             cell,
@@ -227,6 +247,8 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
             cuboids,
             held_cuboids,
             ik_cache: Mutex::new(HashMap::new()),
+            model,
+            grid,
             counters: Counters::default(),
         }
     }
@@ -261,6 +283,20 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         &self.self_pairs
     }
 
+    /// Runs `f` with the check of the arm holding part `p` with `grasp` (its opening, the tool
+    /// centre at the grasp's pose) among the parts of `present` but `p` (the fixed ones and the
+    /// ground included): the planner's sphere check and the exact one, configuration by
+    /// configuration.
+    pub fn with_arm_check<R>(&self, p: usize, present: &PartSet, grasp: &Grasp, f: impl FnOnce(&ArmCheck<'_, W>) -> R) -> R {
+        let world = self.world();
+        let obstacles = self.obstacles(present, p);
+        let shrunk = world.eroded(p, self.config.margin.max(world.tolerance()));
+        let pose = Pose::from_parts(grasp.position, grasp.orientation);
+        let space = |resolution, check| ArmSpace::new(self, p, &shrunk, pose, grasp.width, &obstacles, resolution, check);
+        let check = ArmCheck::new(space(self.config.edge_resolution, Check::Spheres), space(self.config.check_resolution, Check::Exact));
+        f(&check)
+    }
+
     /// Work and time by phase of every plan so far.
     pub fn stats(&self) -> PlanStats {
         self.counters.snapshot()
@@ -286,7 +322,11 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         let ids: Vec<usize> = world.with_fixed(present).iter().filter(|&q| q != held && Some(q) != ground).collect();
         let bounds = ids.iter().map(|&o| *world.aabb(o)).reduce(|a, b| a.merged(&b));
         let ground = ground.filter(|&g| world.with_fixed(present).contains(g) && g != held);
-        Obstacles { ids, ground, bounds }
+        let mut bits = vec![0u64; world.num_parts().div_ceil(64).max(1)];
+        for &o in ids.iter().filter(|&&o| o < world.num_parts()) {
+            bits[o / 64] |= 1 << (o % 64);
+        }
+        Obstacles { ids, ground, bounds, field: Field::new(bits) }
     }
 
     /// Whether robot shapes `first..first + placed.len()` (in [`Robot::collision_shapes`]
@@ -301,17 +341,13 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
             let prepared = &self.arm[k];
             let on_base = k < self.base_shapes;
             if !on_base {
-                if lowest(&bb, up) <= self.cell.floor
-                    && query::intersection_test(&pose, &*prepared.shape, &self.floor.0, &*self.floor.1).is_ok_and(|i| i.intersecting)
-                {
+                if lowest(&bb, up) <= self.cell.floor && prepared.meets(&pose, &self.floor.0, &*self.floor.1) {
                     // the box may reach below the floor: exact test against the half-space
                     return true;
                 }
                 // the base stands on the ground
                 if let Some(g) = obstacles.ground {
-                    if bb.intersects(world.aabb(g))
-                        && query::intersection_test(&pose, &*prepared.shape, &Pose::IDENTITY, world.mesh(g)).is_ok_and(|i| i.intersecting)
-                    {
+                    if bb.intersects(world.aabb(g)) && prepared.meets(&pose, &Pose::IDENTITY, world.mesh(g)) {
                         return true;
                     }
                 }
@@ -324,11 +360,8 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
                     continue;
                 }
                 let hit = match &self.cuboids[o] {
-                    Some(boxes) => boxes.iter().any(|c| {
-                        bb.intersects(&c.aabb)
-                            && query::intersection_test(&pose, &*prepared.shape, &c.centre, &c.cuboid).is_ok_and(|i| i.intersecting)
-                    }),
-                    None => query::intersection_test(&pose, &*prepared.shape, &Pose::IDENTITY, world.mesh(o)).is_ok_and(|i| i.intersecting),
+                    Some(boxes) => boxes.iter().any(|c| bb.intersects(&c.aabb) && prepared.meets(&pose, &c.centre, &c.cuboid)),
+                    None => prepared.meets(&pose, &Pose::IDENTITY, world.mesh(o)),
                 };
                 if hit {
                     return true;
@@ -524,183 +557,5 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
             }
         }
         Err(RobotFailure::Blocked { by: hit })
-    }
-
-    /// The arm's configurations for grasp `gi` of part `p` lifted along `direction`, computed
-    /// once: inverse kinematics of the grasp and lifted poses (seeded by the part and grasp
-    /// only, so the same in every state and thread) and of the drop-off poses (the lifted
-    /// orientation, then the gripper pointing down, turned twice), each started from the
-    /// lifted configuration.
-    fn grasp_ik(&self, p: usize, gi: usize, direction: Vec3) -> Arc<GraspIk> {
-        let key = (p, gi, direction.to_array().map(f32::to_bits));
-        if let Some(k) = self.ik_cache.lock().expect("not poisoned").get(&key) {
-            return k.clone();
-        }
-        let robot = &self.cell.robot;
-        let g = &self.grasps(p)[gi];
-        let tool = Pose::from_parts(g.position, g.orientation);
-        let lifted = Pose::from_translation(direction * self.config.lift) * tool;
-        let seed = self.config.ik.seed ^ (p as u64).wrapping_mul(0x2545_f491_4f6c_dd1d) ^ (gi as u64).wrapping_mul(0x9e37_79b9);
-        // computed once per grasp, so it can afford more restarts than a per-state test did
-        let ik = IkConfig { seed, restarts: self.config.ik.restarts.max(12), ..self.config.ik.clone() };
-        let arm = robot.ik(&tool, None, &ik).solution().map(|s| s.joints.clone()).and_then(|qg| {
-            let ql = robot.ik(&lifted, Some(&qg), &IkConfig { restarts: 0, ..ik.clone() }).solution().map(|s| s.joints.clone())?;
-            Some((qg, ql))
-        });
-        let mut drop = Vec::new();
-        if let Some((_, ql)) = &arm {
-            let down = Rot::from_rotation_arc(Vec3::Z, -self.cell.up);
-            for (k, rot) in [lifted.rotation, down, down * Rot::from_rotation_z(std::f32::consts::FRAC_PI_2)].into_iter().enumerate() {
-                let target = Pose::from_parts(self.cell.drop_off, rot);
-                let cfg = IkConfig { seed: ik.seed ^ (k as u64 + 1), ..ik.clone() };
-                if let Some(s) = robot.ik(&target, Some(ql), &cfg).solution() {
-                    drop.push(s.joints.clone());
-                }
-            }
-        }
-        let k = Arc::new(GraspIk { arm, drop });
-        self.ik_cache.lock().expect("not poisoned").insert(key, k.clone());
-        k
-    }
-
-    #[allow(clippy::too_many_arguments)] // the plan's inputs, the search mode and its bound
-    fn plan_grasps(
-        &self,
-        p: usize,
-        present: &PartSet,
-        direction: Vec3,
-        seed: u64,
-        replans: usize,
-        mode: Mode,
-        below: f64,
-    ) -> Result<RobotRemoval, RobotFailure> {
-        let exhaustive = mode == Mode::Exhaustive;
-        let counters = &self.counters;
-        counters.add(C::Plans, 1);
-        let world = self.world();
-        let robot = &self.cell.robot;
-        let direction = counters.timed(C::Lift, || self.lift_direction(p, present, Some(direction)))?;
-        let lift = Pose::from_translation(direction * self.config.lift);
-        let obstacles = self.obstacles(present, p);
-        let grasps = self.grasps(p);
-        let shrunk = world.eroded(p, self.config.margin.max(world.tolerance()));
-        // The tool centre travels from the grasp (within the position tolerance) through the
-        // lifted pose to the drop-off: the sampled polyline is at least as long as the lift plus
-        // the straight distance, less twice the tolerance at each of the three ends.
-        let slack = 6.0 * self.config.ik.position_tolerance + 1e-5;
-        let mut order: Vec<(f64, usize)> = grasps
-            .iter()
-            .enumerate()
-            .map(|(gi, g)| {
-                let lifted = lift * Pose::from_parts(g.position, g.orientation);
-                (self.config.lift as f64 + (lifted.translation - self.cell.drop_off).length() as f64 - slack, gi)
-            })
-            .collect();
-        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let cap = if exhaustive { usize::MAX } else { self.config.path_grasps.max(1) };
-        let (mut unreachable, mut colliding, mut no_drop, mut reached, mut tried) = (0, 0, 0, 0, 0);
-        let mut best: Option<RobotRemoval> = None;
-        for (n, &(bound, gi)) in order.iter().enumerate() {
-            let found = mode == Mode::FirstPath && best.is_some();
-            let shortest = best.as_ref().map_or(below, |b| b.length);
-            if found || !exhaustive && (tried >= cap || shortest <= bound) {
-                counters.add(C::Pruned, (order.len() - n) as u64);
-                break;
-            }
-            counters.add(C::Examined, 1);
-            let g = &grasps[gi];
-            let tool = Pose::from_parts(g.position, g.orientation);
-            let lifted = lift * tool;
-            // 1. the gripper alone at the grasp and lifted poses: no inverse kinematics needed
-            if self.config.gripper_precheck
-                && counters.timed(C::Gripper, || {
-                    self.gripper_collides(&tool, g.width, &obstacles) || self.gripper_collides(&lifted, g.width, &obstacles)
-                })
-            {
-                counters.add(C::GripperRejected, 1);
-                colliding += 1;
-                continue;
-            }
-            // 2. inverse kinematics of both poses (per grasp and lift, once: it does not depend
-            // on the state, so an arm out of reach stays out of reach)
-            let ik = counters.timed(C::Ik, || self.grasp_ik(p, gi, direction));
-            let Some((qg, ql)) = ik.arm.as_ref() else {
-                counters.add(C::Unreachable, 1);
-                unreachable += 1;
-                continue;
-            };
-            let (qg, ql) = (qg.clone(), ql.clone());
-            // 3. the whole arm and the held part at both poses and between them
-            let grasp_pose = robot.tool_pose(&qg);
-            let space = ArmSpace::new(self, p, &shrunk, grasp_pose, g.width, &obstacles, self.config.edge_resolution);
-            if counters.timed(C::Reach, || !space.valid(&qg) || !space.valid(&ql) || !space.edge_valid(&qg, &ql)) {
-                colliding += 1;
-                continue;
-            }
-            reached += 1;
-            // 4. drop-off: the first of its configurations (lifted orientation, then the
-            // gripper pointing down) where the arm and the part in hand are collision-free
-            let qd = counters.timed(C::DropOff, || ik.drop.iter().find(|q| space.valid(q)).cloned());
-            let Some(qd) = qd else {
-                no_drop += 1;
-                continue;
-            };
-            // 5. paths to the drop-off, k times
-            tried += 1;
-            counters.add(C::Planned, 1);
-            let fine = ArmSpace::new(self, p, &shrunk, grasp_pose, g.width, &obstacles, self.config.check_resolution);
-            let repair = ArmSpace::new(self, p, &shrunk, grasp_pose, g.width, &obstacles, self.config.repair_resolution);
-            for r in 0..replans.max(1) {
-                let cfg = RrtConnectConfig {
-                    seed: seed ^ ((gi as u64) << 20) ^ (r as u64).wrapping_mul(0x5851_f42d_4c95_7f2d),
-                    ..self.config.rrt.clone()
-                };
-                // the tree on coarse edges; when the fine re-check refuses its path, once more
-                // on the repair resolution's edges (same seed)
-                let mut kept = None;
-                for (attempt, tree) in [&space, &repair].into_iter().enumerate() {
-                    let Ok(path) = counters.timed(C::Rrt, || rrt_connect(tree, &ql, &qd, &cfg)) else { break };
-                    let mut joints = vec![qg.clone()];
-                    joints.extend(path);
-                    // the length first (forward kinematics only): a path that cannot be the
-                    // best needs no re-check
-                    let (length, better, valid) = counters.timed(C::Recheck, || {
-                        let length = fine.tool_travel(&joints);
-                        let better = length < best.as_ref().map_or(below, |b| b.length);
-                        (length, better, better && joints.windows(2).all(|w| fine.edge_valid(&w[0], &w[1])))
-                    });
-                    if valid {
-                        kept = Some((joints, length));
-                    } else if better && attempt == 0 {
-                        counters.add(C::Refused, 1);
-                        continue;
-                    }
-                    break;
-                }
-                if let Some((joints, length)) = kept {
-                    let gripper_path = repair.tool_samples(&joints);
-                    best = Some(RobotRemoval {
-                        grasp: g.clone(),
-                        grasp_index: gi,
-                        direction,
-                        joints,
-                        gripper_path,
-                        length,
-                        reachable_grasps: reached,
-                    });
-                    if mode == Mode::FirstPath {
-                        break;
-                    }
-                }
-            }
-        }
-        if let Some(mut b) = best {
-            b.reachable_grasps = reached;
-            return Ok(b);
-        }
-        if reached == 0 {
-            return Err(RobotFailure::NoReachableGrasp { grasps: grasps.len(), unreachable, colliding });
-        }
-        Err(RobotFailure::NoPath { reachable: reached, drop_off_blocked: no_drop, grasps_tried: tried })
     }
 }

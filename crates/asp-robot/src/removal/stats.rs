@@ -43,9 +43,39 @@ pub struct PlanStats {
     /// Paths of the coarse tree the fine re-check refused (each planned again on the repair
     /// resolution's edges).
     pub rechecks_refused: u64,
+    /// Of `robot_checks`, those made with the exact shapes alone (the final re-check of a
+    /// path; every check when [`RemovalConfig::sphere_check`] is off).
+    pub exact_checks: u64,
+    /// Every 32nd check of the sphere check timed: how many, and their nanoseconds (wall
+    /// clock of the calling thread) — the mean cost of one check without timing every one.
+    pub sphere_checks_timed: u64,
+    /// The nanoseconds of `sphere_checks_timed`.
+    pub sphere_check_ns: u64,
+    /// The same for the exact checks: how many were timed.
+    pub exact_checks_timed: u64,
+    /// The nanoseconds of `exact_checks_timed`.
+    pub exact_check_ns: u64,
+    /// The exact check of returned paths (once per path returned, after the sphere check
+    /// accepted it).
+    pub exact_ns: u64,
+    /// Paths the sphere check accepted and the exact check refused (then the next shortest is
+    /// taken; none is expected: the sphere check gives the exact verdict).
+    pub exact_refused: u64,
 }
 
-pub(super) const N_COUNTERS: usize = 17;
+impl PlanStats {
+    /// The mean time of one sphere check in nanoseconds (`None` before any was timed).
+    pub fn sphere_check_mean_ns(&self) -> Option<f64> {
+        (self.sphere_checks_timed > 0).then(|| self.sphere_check_ns as f64 / self.sphere_checks_timed as f64)
+    }
+
+    /// The mean time of one exact check in nanoseconds (`None` before any was timed).
+    pub fn exact_check_mean_ns(&self) -> Option<f64> {
+        (self.exact_checks_timed > 0).then(|| self.exact_check_ns as f64 / self.exact_checks_timed as f64)
+    }
+}
+
+pub(super) const N_COUNTERS: usize = 24;
 
 #[derive(Default)]
 pub(super) struct Counters([AtomicU64; N_COUNTERS]);
@@ -69,6 +99,13 @@ pub(super) enum C {
     HeldChecks,
     Skipped,
     Refused,
+    ExactChecks,
+    SphereTimed,
+    SphereNs,
+    ExactTimed,
+    ExactNs,
+    Exact,
+    ExactRefused,
 }
 
 impl Counters {
@@ -110,6 +147,13 @@ impl Counters {
             held_checks: v(C::HeldChecks),
             skipped_samples: v(C::Skipped),
             rechecks_refused: v(C::Refused),
+            exact_checks: v(C::ExactChecks),
+            sphere_checks_timed: v(C::SphereTimed),
+            sphere_check_ns: v(C::SphereNs),
+            exact_checks_timed: v(C::ExactTimed),
+            exact_check_ns: v(C::ExactNs),
+            exact_ns: v(C::Exact),
+            exact_refused: v(C::ExactRefused),
         }
     }
 }

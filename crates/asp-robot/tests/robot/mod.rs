@@ -5,6 +5,7 @@ mod load;
 mod recheck;
 mod removal;
 mod reuse;
+mod spheres;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
