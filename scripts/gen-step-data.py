@@ -136,8 +136,9 @@ def shaft_bearings() -> Compound:
 
 def inch_bracket() -> Compound:
     """An angle bracket bolted to a base with two 1/4-20 bolts and nuts, drawn in inches
-    (written with the file's unit `in`)."""
-    mm = 25.4
+    (written with the file's unit `in`). The shape's numbers are inches: OpenCASCADE writes them
+    as they are and names the unit, it does not convert them."""
+    mm = 1.0  # one inch, in the model's numbers
     holes = [(-1.0 * mm, 0), (1.0 * mm, 0)]
     base = named(plate(3 * mm, 1.5 * mm, 0.25 * mm, holes, 0.125 * mm), "base")
     angle = Pos(0, 0, 0.25 * mm) * plate(3 * mm, 1.5 * mm, 0.25 * mm, holes, 0.125 * mm)
@@ -167,7 +168,7 @@ def write(folder: Path) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     STEPControl_Controller.Init_s()
     for name, (make, unit) in MODELS.items():
-        # build123d models in millimetres; OpenCASCADE writes the file in `write.step.unit`
+        # OpenCASCADE names `write.step.unit` as the file's unit; the numbers stay the shape's
         Interface_Static.SetCVal_s("write.step.unit", "INCH" if unit == Unit.IN else "MM")
         export_step(make(), folder / name, unit=unit, timestamp=STAMP)
     Interface_Static.SetCVal_s("write.step.unit", "MM")

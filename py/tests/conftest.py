@@ -44,6 +44,41 @@ def without_seconds(plan_json: str) -> str:
     return _SECONDS.sub(r"\g<1>0", plan_json)
 
 
+def _box_stl(name: str, lo: tuple[float, float, float], hi: tuple[float, float, float]) -> str:
+    """An axis-aligned box as ASCII STL, its triangles wound outwards."""
+    (x0, y0, z0), (x1, y1, z1) = lo, hi
+    v = [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0), (x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
+    faces = [(0, 2, 1), (0, 3, 2), (4, 5, 6), (4, 6, 7), (0, 1, 5), (0, 5, 4),
+             (1, 2, 6), (1, 6, 5), (2, 3, 7), (2, 7, 6), (3, 0, 4), (3, 4, 7)]
+    lines = [f"solid {name}"]
+    for tri in faces:
+        lines += ["facet normal 0 0 0", " outer loop", *(f"  vertex {v[i][0]} {v[i][1]} {v[i][2]}" for i in tri)]
+        lines += [" endloop", "endfacet"]
+    return "\n".join([*lines, f"endsolid {name}", ""])
+
+
+#: The crossed-bars model (millimetres, +z up): a plate, a cap standing on it, and a bar pushed
+#: through a cross standing on the plate, as a modelling slip draws them (5 mm into each other,
+#: no fit): every shipped real model now comes apart, so this is the model with a locked core.
+CROSSED_BARS = {
+    "plate": ((0, 0, 0), (100, 60, 5)),
+    "bar": ((10, 20, 10), (70, 30, 20)),
+    "cross": ((35, 10, 5), (45, 40, 25)),
+    "cap": ((80, 40, 5), (95, 55, 15)),
+}
+
+
+@pytest.fixture
+def crossed_bars(tmp_path: Path) -> str:
+    """A folder of STL files, one per part of `CROSSED_BARS` (load it with unit mm, up z): plate
+    and cap come off, bar and cross stay in a locked core that `overlaps="lenient"` frees."""
+    folder = tmp_path / "crossed_bars"
+    folder.mkdir()
+    for name, (lo, hi) in CROSSED_BARS.items():
+        (folder / f"{name}.stl").write_text(_box_stl(name, lo, hi))
+    return str(folder)
+
+
 @pytest.fixture
 def root(monkeypatch: pytest.MonkeyPatch) -> Path:
     """The repository root, also made the working directory (model paths as the CLI gets them)."""

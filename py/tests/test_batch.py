@@ -250,13 +250,13 @@ def test_a_batch_joins_a_cluster_by_address(tmp_path, asp_cli):
         shutil.rmtree(temp, ignore_errors=True)
 
 
-def test_partial_plans_are_counted_apart(tmp_path):
-    # issue 28: the pump's plan holds a locked core (a partial plan); the summary says so
+def test_partial_plans_are_counted_apart(tmp_path, crossed_bars):
+    # issue 28: the crossed bars' plan holds a locked core (a partial plan); the summary says so
     # instead of counting it as planned
     from asp.batch.jobs import LoadSettings
 
     out = tmp_path / "plans"
-    outcome = run(PlanJob([ROOT / "tests/data/pump"], load=LoadSettings(unit="mm", up="z")), out, ray="none", quiet=True)
+    outcome = run(PlanJob([Path(crossed_bars)], load=LoadSettings(unit="mm", up="z")), out, ray="none", quiet=True)
     assert outcome.ran == 1 and not outcome.failed
     summary = json.loads((out / "summary.json").read_text())
     assert [(p["status"], p["found"]) for p in summary["plans"]] == [("partial", False)]
