@@ -48,6 +48,7 @@ def load(
     max_parts: int | None = None,
     allow_outside_files: bool | None = None,
     tessellation: float | None = None,
+    split_bodies: bool | None = None,
     step_glb: bytes | None = None,
 ) -> Assembly: ...
 def default_settings() -> dict[str, Any]: ...

@@ -44,6 +44,7 @@ def load(
     max_parts: int | None = None,
     allow_outside_files: bool | None = None,
     tessellation: float | None = None,
+    split_bodies: bool | None = None,
 ) -> Assembly:
     """Loads a model: a ``.glb``/``.gltf`` file, a ``.step``/``.stp`` file (read and tessellated by
     OpenCASCADE through ``cascadio``: ``pip install cascadio``), or a folder of ``.obj``/``.stl``
@@ -62,6 +63,9 @@ def load(
         ``..`` that climbs out, symlinks pointing out); refused by default (``docs/security.md``).
     :param tessellation: STEP files only: the chord tolerance of each edge and face relative to
         its own size (default 0.001).
+    :param split_bodies: make each separate body of a part's mesh (pieces that do not touch, such
+        as shelf pins stored in a shelf's mesh) a part of its own, ``NAME#1``, ``NAME#2``, ...
+        (default: a warning names the part, which moves as one).
     :raises LoadError: the file cannot be read, is not a model, is over a cap or names a file
         outside its folder (the message names the file).
     :raises ConfigError: an unknown unit or axis, or a fixed part the model does not have.
@@ -73,7 +77,7 @@ def load(
         glb = step.convert(path, tessellation)
     native = _asp.load(os.fspath(path), unit=unit, up=up, fixed=list(fixed), max_triangles=max_triangles,
                        max_parts=max_parts, allow_outside_files=allow_outside_files, tessellation=tessellation,
-                       step_glb=glb)
+                       split_bodies=split_bodies, step_glb=glb)
     return Assembly(native)
 
 
@@ -407,10 +411,14 @@ def plan(
     fixed: Iterable[str] = (),
     max_triangles: int | None = None,
     max_parts: int | None = None,
+    tessellation: float | None = None,
+    split_bodies: bool | None = None,
     **settings: Any,
 ) -> Plan:
-    """Loads the model at ``path`` (:func:`load`) and plans it (:meth:`Assembly.plan`, whose
-    keywords ``settings`` are; ``allow_outside_files`` counts for both)."""
+    """Loads the model at ``path`` (:func:`load`, whose keywords the named ones are) and plans it
+    (:meth:`Assembly.plan`, whose keywords ``settings`` are; ``allow_outside_files`` counts for
+    both)."""
     outside = settings.get("allow_outside_files")
-    model = load(path, unit=unit, up=up, fixed=fixed, max_triangles=max_triangles, max_parts=max_parts, allow_outside_files=outside)
+    model = load(path, unit=unit, up=up, fixed=fixed, max_triangles=max_triangles, max_parts=max_parts,
+                 allow_outside_files=outside, tessellation=tessellation, split_bodies=split_bodies)
     return model.plan(**settings)

@@ -270,3 +270,29 @@ def test_steps_are_typed_frozen_views_of_the_sequence(root, crossed_bars):
     assert hook.moves == (asp.Move((2, 3), (0.0, 0.0, -0.01)),)
     assert hook.robot is not None and hook.robot.joint_trajectory == ((0.1, 0.2), (0.3, 0.4))
     assert hook.robot.path_length == 0.05
+
+
+def test_split_bodies_makes_each_body_of_a_mesh_a_part(tmp_path):
+    # issue 38 item 4: a shelf whose mesh also holds two pins stored beside it: named in a
+    # warning and moved as one part, or, with split_bodies, one part per body
+    from conftest import _box_stl
+
+    folder = tmp_path / "shelf"
+    folder.mkdir()
+    bodies = [_box_stl("shelf", lo, hi) for lo, hi in [((0, 0, 0), (400, 200, 20)), ((500, 0, 0), (520, 20, 100)),
+                                                        ((600, 0, 0), (620, 20, 100))]]
+    # one solid of all three bodies' facets
+    facets = [line for b in bodies for line in b.splitlines()[1:-1]]
+    (folder / "shelf.stl").write_text("\n".join(["solid shelf", *facets, "endsolid shelf", ""]))
+    (folder / "side.stl").write_text(_box_stl("side", (0, 0, 20), (20, 200, 300)))
+    whole = asp.load(folder, unit="mm", up="z")
+    assert [p.name for p in whole.parts] == ["shelf", "side"]
+    assert any(w.startswith("part 'shelf' holds 3 separate bodies") and "--split-bodies" in w for w in whole.warnings)
+    split = asp.load(folder, unit="mm", up="z", split_bodies=True)
+    assert [p.name for p in split.parts] == ["shelf#1", "shelf#2", "shelf#3", "side"]
+    assert split.warnings == ("split into one part per body (--split-bodies): shelf",)
+    plan = split.plan()
+    assert plan.found and len(plan.assembly_sequence) == 4
+    assert without_seconds(asp.plan(folder, unit="mm", up="z", split_bodies=True).json) == without_seconds(plan.json)
+    with pytest.raises(TypeError, match="split_bodies"):
+        whole.plan(split_bodies=True)  # type: ignore[call-arg]

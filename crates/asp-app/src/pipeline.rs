@@ -72,6 +72,8 @@ pub struct PlanSettings {
     /// A STEP file's chord tolerance relative to each edge's and face's size (default
     /// [`asp_geom::io::step::DEFAULT_RELATIVE`]); an error for other files.
     pub tessellation: Option<f64>,
+    /// Make each separate body of a part's mesh a part of its own (`NAME#1`, `NAME#2`, ...).
+    pub split_bodies: bool,
     /// Contact tolerance in model units (default 1e-4 × the model's diagonal).
     pub tolerance: Option<f64>,
     /// Contact distance for stability, model units (default 1e-3 × the diagonal).
@@ -137,6 +139,7 @@ impl Default for PlanSettings {
             allow_outside_files: false,
             limits: asp_geom::io::Limits::default(),
             tessellation: None,
+            split_bodies: false,
             tolerance: None,
             contact_distance: None,
             normals: WorldConfig::default().normal_clusters,
@@ -284,7 +287,7 @@ pub fn load_options(path: &Path, settings: &PlanSettings) -> Result<LoadOptions>
         fixed: settings.fixed.clone(),
         allow_outside_files: settings.allow_outside_files,
         limits: settings.limits,
-        split_bodies: false,
+        split_bodies: settings.split_bodies,
         tessellation,
     })
 }

@@ -178,6 +178,9 @@ pub struct PlanRequest {
     /// A STEP file's tessellation: the chord tolerance of each edge and face relative to its
     /// own size (default 0.001; STEP files only).
     pub tessellation: Option<f64>,
+    /// Make each separate body of a part's mesh a part of its own, `NAME#1`, `NAME#2`, ...
+    /// (default: a warning names the part, which moves as one).
+    pub split_bodies: Option<bool>,
     /// Let the model and the robot's URDF read files outside their folders: absolute paths, `..`
     /// that climbs out, symlinks that point out (default: refused).
     pub allow_outside_files: Option<bool>,
@@ -284,7 +287,7 @@ pub struct PlanRequest {
 }
 
 /// The keys that belong to loading a model only (`asp.load` in Python, not `Assembly.plan`).
-pub const LOAD_KEYS: [&str; 6] = ["unit", "up", "fixed", "max_triangles", "max_parts", "tessellation"];
+pub const LOAD_KEYS: [&str; 7] = ["unit", "up", "fixed", "max_triangles", "max_parts", "tessellation", "split_bodies"];
 
 impl PlanRequest {
     /// Every key of a request, in alphabetical order.
@@ -485,7 +488,7 @@ mod tests {
     #[test]
     fn keys_are_every_field_and_json_round_trips() {
         let keys = PlanRequest::keys();
-        assert_eq!(keys.len(), 46, "{keys:?}");
+        assert_eq!(keys.len(), 47, "{keys:?}");
         assert!(keys.iter().any(|k| k == "time_limit") && keys.iter().any(|k| k == "robot_base"));
         let r = PlanRequest {
             objective: Some(vec!["access".into()]),

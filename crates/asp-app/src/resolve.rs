@@ -180,6 +180,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         allow_outside_files: r.allow_outside_files.unwrap_or(false),
         limits: limits(r)?,
         tessellation: positive("tessellation", r.tessellation)?,
+        split_bodies: r.split_bodies.unwrap_or(false),
         tolerance: positive("tolerance", r.tolerance)?,
         contact_distance: positive("contact_distance", r.contact_distance)?,
         normals: r.normals.unwrap_or(d.normals),
@@ -341,13 +342,14 @@ fn robot_keys(r: &PlanRequest) -> serde_json::Map<String, Value> {
 /// `asp._asp.default_settings()` and the docs show these.
 pub fn defaults() -> serde_json::Map<String, Value> {
     let d = PlanSettings::default();
-    let defaults: [(&str, Value); 46] = [
+    let defaults: [(&str, Value); 47] = [
         ("unit", Value::Null),
         ("up", Value::Null),
         ("fixed", json!([])),
         ("max_triangles", json!(asp_geom::io::DEFAULT_MAX_TRIANGLES)),
         ("max_parts", json!(asp_geom::io::DEFAULT_MAX_PARTS)),
         ("tessellation", json!(asp_geom::io::step::DEFAULT_RELATIVE)),
+        ("split_bodies", json!(false)),
         ("allow_outside_files", json!(false)),
         ("tolerance", Value::Null),
         ("contact_distance", Value::Null),

@@ -6,7 +6,7 @@
 //! Two common export slips are warnings, not errors: a duplicate part (the same mesh at the same
 //! place) is left out, one copy planned; a part whose mesh holds several separate bodies (shelf
 //! pins stored inside a shelf's mesh) is named, and split into one part per body on request
-//! ([`split_bodies`], `LoadOptions::split_bodies`; not yet a command-line setting).
+//! ([`split_bodies`], `LoadOptions::split_bodies`, `--split-bodies`).
 //!
 //! A part embedded in another's material — every vertex of it strictly inside the other's closed
 //! surface, deeper than a thousandth of the model's diagonal — is refused too: no motion takes it
@@ -66,7 +66,7 @@ pub fn check_model(assembly: &mut Assembly) -> Result<()> {
         let n = bodies(&part.mesh).len();
         if n > 1 {
             assembly.warnings.push(format!(
-                "part '{}' holds {n} separate bodies (pieces of its mesh that do not touch); they move as one part (export them as parts of their own to plan them apart)",
+                "part '{}' holds {n} separate bodies (pieces of its mesh that do not touch); they move as one part (--split-bodies plans each as a part of its own)",
                 part.name
             ));
         }

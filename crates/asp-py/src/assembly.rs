@@ -48,12 +48,13 @@ impl PyAssembly {
 
 /// Loads the model at `path` (a `.glb`/`.gltf` file, a `.step`/`.stp` file or a folder of
 /// `.obj`/`.stl` files, one part each) with an optional unit (`m`, `mm`, ... or metres per unit),
-/// up axis (`z`, `-y`, ...), base part names and STEP tessellation tolerance, under the caps and
+/// up axis (`z`, `-y`, ...), base part names, STEP tessellation tolerance and whether each body
+/// of a part's mesh becomes a part of its own (`split_bodies`), under the caps and
 /// the file rule of `docs/security.md`; errors are `asp.LoadError` (naming the file) or
 /// `asp.ConfigError`. `step_glb`: the GLB that cascadio made of the STEP file in this process
 /// (`asp.load` passes it), read instead of running the converter.
 #[pyfunction]
-#[pyo3(signature = (path, unit=None, up=None, fixed=Vec::new(), max_triangles=None, max_parts=None, allow_outside_files=None, tessellation=None, step_glb=None))]
+#[pyo3(signature = (path, unit=None, up=None, fixed=Vec::new(), max_triangles=None, max_parts=None, allow_outside_files=None, tessellation=None, split_bodies=None, step_glb=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn load(
     py: Python<'_>,
@@ -65,10 +66,12 @@ pub fn load(
     max_parts: Option<usize>,
     allow_outside_files: Option<bool>,
     tessellation: Option<f64>,
+    split_bodies: Option<bool>,
     step_glb: Option<Vec<u8>>,
 ) -> PyResult<PyAssembly> {
     let request = asp_app::PlanRequest {
         tessellation,
+        split_bodies,
         unit: unit.map(String::from),
         up: up.map(String::from),
         fixed,

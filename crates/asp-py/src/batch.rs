@@ -99,7 +99,7 @@ pub fn model_items(py: Python<'_>, paths: Vec<PathBuf>) -> PyResult<Vec<(String,
 }
 
 /// Plan settings from `asp.Assembly.plan`'s keywords and `asp.load`'s (`load`: `unit`, `up`,
-/// `fixed`, `max_triangles`, `max_parts`, `tessellation`).
+/// `fixed`, `max_triangles`, `max_parts`, `tessellation`, `split_bodies`).
 fn model_settings(dict: &Bound<'_, PyDict>, load: Option<&Bound<'_, PyDict>>) -> Result<PlanSettings, Error> {
     let mut request = settings::request(dict, false)?;
     if let Some(load) = load {
@@ -110,8 +110,8 @@ fn model_settings(dict: &Bound<'_, PyDict>, load: Option<&Bound<'_, PyDict>>) ->
             }
         }
         let l = settings::request(load, true)?;
-        (request.unit, request.up, request.fixed, request.max_triangles, request.max_parts, request.tessellation) =
-            (l.unit, l.up, l.fixed, l.max_triangles, l.max_parts, l.tessellation);
+        (request.unit, request.up, request.fixed, request.max_triangles, request.max_parts, request.tessellation, request.split_bodies) =
+            (l.unit, l.up, l.fixed, l.max_triangles, l.max_parts, l.tessellation, l.split_bodies);
     }
     Ok(asp_app::resolve(&request)?)
 }

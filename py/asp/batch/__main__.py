@@ -60,6 +60,10 @@ def _models(p: argparse.ArgumentParser) -> None:
     p.add_argument("--fixed", nargs="+", default=[], metavar="PART", help="base part names")
     p.add_argument("--max-triangles", type=int, metavar="N", help="most triangles a model may have (default 20 M; docs/security.md)")
     p.add_argument("--max-parts", type=int, metavar="N", help="most parts a model may have (default 10,000)")
+    p.add_argument("--tessellation", type=float, metavar="RELATIVE",
+                   help="STEP files: the chord tolerance of each edge and face relative to its own size (default 0.001)")
+    p.add_argument("--split-bodies", action="store_true",
+                   help="make each separate body of a part's mesh a part of its own (NAME#1, NAME#2, ...)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="any keyword of asp.Assembly.plan (repeatable), e.g. --set normals=20 --set stability=physics")
 
@@ -127,7 +131,8 @@ def job_of(args: argparse.Namespace) -> Job:
         if args.generator == "stress":
             return GenJob.stress(args.kind, count=args.count, seed=args.seed)
         return GenJob.profiles(args.preset, _pairs(args.param, "param"), count=args.count, seed=args.seed)
-    load = LoadSettings(unit=args.unit, up=args.up, fixed=list(args.fixed), max_triangles=args.max_triangles, max_parts=args.max_parts)
+    load = LoadSettings(unit=args.unit, up=args.up, fixed=list(args.fixed), max_triangles=args.max_triangles,
+                        max_parts=args.max_parts, tessellation=args.tessellation, split_bodies=args.split_bodies)
     settings = _pairs(args.set, "set")
     if args.command == "plan":
         for key in ("order", "model", "seed", "max_tests", "timeout"):

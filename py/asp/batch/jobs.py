@@ -161,12 +161,18 @@ class LoadSettings:
     """The cap on a model's triangles (``None``: asp's, docs/security.md)."""
     max_parts: int | None = None
     """The cap on a model's parts (``None``: asp's)."""
+    tessellation: float | None = None
+    """STEP files: the chord tolerance relative to each edge's and face's size (``None``: 0.001)."""
+    split_bodies: bool = False
+    """Make each separate body of a part's mesh a part of its own (``NAME#1``, ``NAME#2``, ...)."""
 
     def as_dict(self) -> dict[str, Any]:
         d: dict[str, Any] = {"unit": self.unit, "up": self.up, "fixed": list(self.fixed)}
-        for key in ("max_triangles", "max_parts"):
+        for key in ("max_triangles", "max_parts", "tessellation"):
             if getattr(self, key) is not None:
                 d[key] = getattr(self, key)
+        if self.split_bodies:
+            d["split_bodies"] = True
         return d
 
 

@@ -33,6 +33,10 @@ pub struct ModelArgs {
     /// STEP files: the chord tolerance of each edge and face relative to its own size.
     #[arg(long, value_name = "RELATIVE")]
     pub tessellation: Option<f64>,
+    /// Make each separate body of a part's mesh (pieces that do not touch, such as shelf pins
+    /// stored in a shelf's mesh) a part of its own, named `NAME#1`, `NAME#2`, ...
+    #[arg(long)]
+    pub split_bodies: bool,
     /// Contact tolerance in model units: motions may push a part this deep into another
     /// [default: 1e-4 × the model's diagonal].
     #[arg(long)]
@@ -107,8 +111,10 @@ impl ModelArgs {
         if !self.fixed.is_empty() {
             map.insert("fixed".into(), self.fixed.clone().into());
         }
-        if self.allow_outside_files {
-            map.insert("allow_outside_files".into(), true.into());
+        for (key, on) in [("allow_outside_files", self.allow_outside_files), ("split_bodies", self.split_bodies)] {
+            if on {
+                map.insert(key.into(), true.into());
+            }
         }
         if self.ignore_overlapping {
             map.insert("overlaps".into(), "lenient".into());

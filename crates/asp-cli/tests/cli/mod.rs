@@ -652,3 +652,48 @@ fn issue_26_a_model_of_another_checker_exits_2_naming_both() {
     let o = asp(&["plan", m, "--order", "gnn", "--model", p, "--stability", "physics", "--json"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
+
+/// Issue 38 item 4: a part whose mesh holds several bodies (pins stored beside a shelf in the
+/// shelf's mesh) is named in a warning and moves as one; `--split-bodies` plans each body as a
+/// part of its own, named `NAME#1`, `NAME#2`, ...
+#[test]
+fn issue_38_split_bodies_makes_each_body_a_part() {
+    use asp_geom::math::{Axis, Vec3};
+    use asp_geom::{Mesh, Part, Units};
+    let dir = tempfile::tempdir().unwrap();
+    let mut shelf = Mesh::cuboid(Vec3::ZERO, Vec3::new(0.4, 0.2, 0.02));
+    shelf.append(&Mesh::cuboid(Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.52, 0.02, 0.1)));
+    shelf.append(&Mesh::cuboid(Vec3::new(0.6, 0.0, 0.0), Vec3::new(0.62, 0.02, 0.1)));
+    let side = Mesh::cuboid(Vec3::new(0.0, 0.0, 0.02), Vec3::new(0.02, 0.2, 0.3));
+    let a = Assembly {
+        parts: vec![Part::new("shelf", shelf, false, serde_json::Value::Null), Part::new("side", side, false, serde_json::Value::Null)],
+        units: Units::metres(),
+        up: Axis::Z,
+        source: "shelf.glb".into(),
+        warnings: Vec::new(),
+    };
+    let model = fixture_file(dir.path(), &a, "shelf.glb");
+    let path = model.to_str().unwrap();
+    let o = asp(&["plan", path, "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let names: Vec<&str> = plan["parts"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["shelf", "side"]);
+    assert!(stderr(&o).contains("part 'shelf' holds 3 separate bodies") && stderr(&o).contains("--split-bodies"), "{}", stderr(&o));
+    let o = asp(&["plan", path, "--json", "--split-bodies"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let names: Vec<&str> = plan["parts"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["shelf#1", "shelf#2", "shelf#3", "side"], "{plan}");
+    assert_eq!(plan["status"], "found", "{plan}");
+    assert_eq!(plan["assembly_sequence"].as_array().unwrap().len(), 4, "{plan}");
+    let err = stderr(&o);
+    assert!(err.contains("split into one part per body (--split-bodies): shelf") && !err.contains("holds 3 separate bodies"), "{err}");
+    // the same through a plan request file
+    let request = dir.path().join("request.json");
+    std::fs::write(&request, r#"{"split_bodies": true}"#).unwrap();
+    let o = asp(&["plan", path, "--json", "--settings", request.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(plan["parts"].as_array().unwrap().len(), 4, "{plan}");
+}

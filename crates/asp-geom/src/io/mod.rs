@@ -148,7 +148,7 @@ pub(crate) fn finish(mut assembly: Assembly, options: &LoadOptions) -> Result<As
         let split = crate::validate::split_bodies(&mut assembly);
         if !split.is_empty() {
             assembly.warnings.retain(|w| !split.iter().any(|n| w.starts_with(&format!("part '{n}' holds "))));
-            assembly.warnings.push(format!("split into one part per body (LoadOptions::split_bodies): {}", split.join(", ")));
+            assembly.warnings.push(format!("split into one part per body (--split-bodies): {}", split.join(", ")));
         }
     }
     let (_, unknown) = assembly.fastenings();
