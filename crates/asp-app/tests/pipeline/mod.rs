@@ -24,7 +24,7 @@ fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
         assert_eq!(order, (0..r.report.parts.len()).collect::<Vec<_>>(), "{name}");
         let last = r.report.assembly_sequence.last().unwrap();
         assert_eq!(last.moves.len(), moves, "{name}: the first separation's moves, in assembly order");
-        assert_eq!(r.report.format_version, "1.9");
+        assert_eq!(r.report.format_version, "1.11");
     }
     // a voxel model the straight-line search answers keeps its plan (no grid entry)
     let r = plan_assembly(asp_geom::puzzles::burr_key(), &settings, None).unwrap();
@@ -371,5 +371,38 @@ fn issue_26_generated_profile_assemblies_plan_under_physics() {
         let what = format!("{connectors:?} seed {seed}: {}", r.report.to_text());
         assert_eq!(r.report.status, PlanStatus::Found, "{what}");
         assert!(r.report.locked_cores.is_empty(), "{what}");
+    }
+}
+
+/// The plan says which learned guidance ran (format 1.11): the Q models, where they guided and,
+/// for guided rollouts, ε; without Q models there is no `guidance`.
+#[test]
+fn the_plan_says_which_guidance_ran() {
+    use asp_app::pipeline::OptimiseSettings;
+    use asp_app::QPolicy;
+    use asp_search::report::GuidanceEntry;
+    use std::sync::Arc;
+    let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../asp-learn/tests/data/random_q_access.onnx");
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(3);
+    let cube = asp_gen::SomaCube::random(3, &mut rng).unwrap().to_assembly(0.05, "soma3");
+    let run = |policy: Option<QPolicy>| {
+        let o = OptimiseSettings {
+            objectives: "access".into(),
+            episodes: 5,
+            threads: Some(1),
+            resolution: 5,
+            policy: policy.map(|p| Arc::new(p) as Arc<dyn asp_app::PolicySource>),
+            ..OptimiseSettings::default()
+        };
+        let settings = PlanSettings { optimise: Some(o), ..PlanSettings::default() };
+        let r = plan_assembly(cube.clone(), &settings, None).unwrap();
+        assert!(r.found(), "{}", r.report.to_json());
+        r.report.optimisation.unwrap().guidance
+    };
+    assert_eq!(run(None), None);
+    for (uses, epsilon) in [(asp_search::QUse::Priors, None), (asp_search::QUse::Rollouts, Some(0.2))] {
+        let q = QPolicy::new(&[model.clone()], &["access"], 0.2, uses).unwrap();
+        let want = GuidanceEntry { kind: "q".into(), models: vec![model.display().to_string()], q_use: uses.name().into(), epsilon };
+        assert_eq!(run(Some(q)), Some(want));
     }
 }
