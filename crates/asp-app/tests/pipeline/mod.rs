@@ -401,7 +401,7 @@ fn the_plan_says_which_guidance_ran() {
     };
     assert_eq!(run(None), None);
     for (uses, epsilon) in [(asp_search::QUse::Priors, None), (asp_search::QUse::Rollouts, Some(0.2))] {
-        let q = QPolicy::new(&[model.clone()], &["access"], 0.2, uses).unwrap();
+        let q = QPolicy::new(std::slice::from_ref(&model), &["access"], 0.2, uses).unwrap();
         let want = GuidanceEntry { kind: "q".into(), models: vec![model.display().to_string()], q_use: uses.name().into(), epsilon };
         assert_eq!(run(Some(q)), Some(want));
     }
