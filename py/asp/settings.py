@@ -23,7 +23,7 @@ Stability = Literal["contact", "physics"]
 #: The optimiser's gravity check (``support=``).
 Support = Literal["below", "contact"]
 #: Where learned Q-functions guide the optimiser (``q_use=``).
-QUse = Literal["rollouts", "expansions", "both"]
+QUse = Literal["rollouts", "expansions", "both", "priors"]
 
 
 class PlanSettings(TypedDict, total=False):

@@ -527,3 +527,37 @@ def test_online_and_offline_training_share_one_set_of_learning_settings():
     assert QConfig(**tuned.learning()).learning() == tuned.learning()
     with pytest.raises(asp.ConfigError, match="objective"):
         OnlineConfig()
+
+
+# -- distillation ------------------------------------------------------------------------------
+
+
+def test_ranking_kept_measures_the_teachers_order():
+    from asp.train.q import ranking_kept
+
+    t = [np.array([1.0, 2.0, 3.0]), np.array([5.0, 0.0, 1.0, 4.0])]
+    same = ranking_kept(t, t)
+    assert same["states"] == 2 and same["top1"] == 1.0 and same["regret"] == 0.0 and same["spearman"] == pytest.approx(1.0)
+    reverse = ranking_kept([-v for v in t], t)
+    assert reverse["top1"] == 0.0 and reverse["regret"] == 1.0 and reverse["spearman"] == pytest.approx(-1.0)
+    assert same["chance"] == pytest.approx((1 / 3 + 1 / 4) / 2)
+    assert ranking_kept([], [])["top1"] is None
+
+
+def test_a_distilled_student_keeps_the_teachers_ranking(tmp_path):
+    torch = _torch()
+    from asp.train.q import DistillConfig, distill_q
+
+    teacher, _, assemblies, _, graphs = _train(tmp_path, steps=40)
+    run = lambda steps: distill_q(teacher, assemblies, DistillConfig(width=8, layers=1, steps=steps, batch=16, states=60, seed=0), graphs)  # noqa: E731
+    student, summary = run(300)
+    assert summary["student_parameters"] < summary["teacher_parameters"]
+    assert summary["held_out_states"] > 0 and len(summary["loss_curve"]) > 0
+    kept = summary["ranking_kept"]
+    _, untrained = run(1)
+    # fitting moves the student's ranking towards the teacher's, beyond an unfitted network's
+    assert kept["spearman"] > untrained["ranking_kept"]["spearman"] + 0.1, (kept, untrained["ranking_kept"])
+    assert kept["top1"] > kept["chance"], kept
+    # reproducible for a seed
+    again, _ = run(300)
+    assert all(torch.equal(a, b) for a, b in zip(student.state_dict().values(), again.state_dict().values()))

@@ -195,6 +195,11 @@ pub trait PolicySource: Send + Sync + std::fmt::Debug {
     fn name(&self) -> &str;
     /// The policy for `mdp`.
     fn prepare(&self, mdp: &Mdp) -> Result<Arc<dyn Policy>>;
+    /// The learned guidance this policy is, as the plan JSON states it (default `None`: no
+    /// learned guidance).
+    fn guidance(&self) -> Option<asp_search::report::GuidanceEntry> {
+        None
+    }
 }
 
 /// A named rollout policy (`q` selects the learned one).
@@ -254,6 +259,16 @@ impl PolicySource for QPolicy {
         let directions = mdp.maps().num_directions();
         asp_learn::epsilon_greedy_models(&self.models, &names, self.epsilon, directions, self.uses)
             .map_err(|e| AppError::setting("q", e.to_string()))
+    }
+
+    fn guidance(&self) -> Option<asp_search::report::GuidanceEntry> {
+        let rollouts = matches!(self.uses, asp_search::QUse::Rollouts | asp_search::QUse::Both);
+        Some(asp_search::report::GuidanceEntry {
+            kind: "q".into(),
+            models: self.models.iter().map(|m| m.path().to_string()).collect(),
+            q_use: self.uses.name().into(),
+            epsilon: rollouts.then_some(self.epsilon),
+        })
     }
 }
 

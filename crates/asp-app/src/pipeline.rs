@@ -770,6 +770,7 @@ pub fn optimise_problem(
         d_max: maps.d_max() as f64,
         map_seconds,
         search_seconds: s.seconds,
+        guidance: o.policy.as_ref().and_then(|p| p.guidance()),
     });
     Ok(PlanResult { report, status: plan.status, search: Some(outcome) })
 }

@@ -101,6 +101,8 @@ choice!(
         Expansions = "expansions": "the Q-values of each state the search adds order its expansions; rollouts stay random (one evaluation per node)",
         /// Both.
         Both = "both": "ε-greedy rollouts and Q-ordered expansions",
+        /// PUCT priors at expansions, a greedy seed of the local search, random rollouts.
+        Priors = "priors": "the Q-values of each state the search adds are PUCT priors (expansion order and a bonus in the tree policy), a greedy sequence on them seeds the local search; rollouts stay random (one evaluation per node, cached by state)",
     }
 );
 
@@ -529,7 +531,7 @@ mod tests {
         assert_eq!(r.robot_base, Some([1.0, 2.0, 3.0]));
         assert_eq!(r.timeout, None);
         assert_eq!(Overlaps::parse("error"), Some(Overlaps::Error));
-        assert_eq!(QUse::names(), "rollouts, expansions, both");
+        assert_eq!(QUse::names(), "rollouts, expansions, both, priors");
         assert_eq!(Support::Below.name(), "below");
     }
 }

@@ -282,6 +282,7 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
                 QUse::Rollouts => asp_search::QUse::Rollouts,
                 QUse::Expansions => asp_search::QUse::Expansions,
                 QUse::Both => asp_search::QUse::Both,
+                QUse::Priors => asp_search::QUse::Priors,
             };
             let objectives: Vec<&str> = names.iter().map(String::as_str).collect();
             let q = QPolicy::new(paths, &objectives, r.epsilon.unwrap_or(DEFAULT_EPSILON), uses)?;

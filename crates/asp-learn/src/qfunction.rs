@@ -13,6 +13,7 @@
 use crate::error::{LearnError, Result};
 use crate::model::{GraphModel, ModelKind};
 use crate::qnet::{QNet, Scratch};
+use asp_geom::distmap::{DirMask, MapState};
 use asp_search::policy::{EpsilonGreedy, Policy, PolicyContext, QFunction, QUse, QWorker};
 use asp_search::qgraph::{self, QGraph, QGraphBuilder, QGraphConfig};
 use asp_search::SearchError;
@@ -111,28 +112,125 @@ pub fn parse_features(features: &str) -> Option<QGraphConfig> {
 
 impl QFunction for OnnxQ {
     fn q_values(&self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], out: &mut [f64]) -> asp_search::Result<()> {
-        self.worker().q_values(ctx, actions, out)
+        GraphWorker::new(std::slice::from_ref(self)).q_values(ctx, actions, out)
     }
 
     fn for_worker(&self, _thread: usize) -> asp_search::Result<Box<dyn QWorker + '_>> {
-        Ok(Box::new(self.worker()))
+        Ok(Box::new(GraphWorker::new(std::slice::from_ref(self))))
     }
 }
 
-impl OnnxQ {
-    fn worker(&self) -> OnnxQWorker<'_> {
-        OnnxQWorker { q: self, builder: None, graph: QGraph::default(), fast: PairCache::default() }
+/// The product of several Q models' values (one per objective, thesis 6.4.4: the hypervolume of
+/// one point against the origin), evaluated on one state graph per state: models that read the
+/// same features share the graph's nodes and edge list, and each runs its own forward pass on
+/// them. Each value is clamped to at least [`MIN_Q`] before the product, so the product equals
+/// that of the models evaluated one by one, to the bit.
+#[derive(Debug, Clone)]
+pub struct QProduct {
+    models: Vec<OnnxQ>,
+}
+
+impl QProduct {
+    /// The product over `models` (at least one).
+    pub fn new(models: Vec<OnnxQ>) -> Result<Self> {
+        if models.is_empty() {
+            return Err(LearnError::Input { path: "q".into(), reason: "a product of Q models needs at least one model".into() });
+        }
+        Ok(QProduct { models })
+    }
+
+    /// The models, in the product's order.
+    pub fn models(&self) -> &[OnnxQ] {
+        &self.models
     }
 }
 
-/// One thread's evaluator: the graph builder of the maps it met first, and reused buffers.
-struct OnnxQWorker<'q> {
-    q: &'q OnnxQ,
+impl QFunction for QProduct {
+    fn q_values(&self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], out: &mut [f64]) -> asp_search::Result<()> {
+        GraphWorker::new(&self.models).q_values(ctx, actions, out)
+    }
+
+    fn for_worker(&self, _thread: usize) -> asp_search::Result<Box<dyn QWorker + '_>> {
+        Ok(Box::new(GraphWorker::new(&self.models)))
+    }
+}
+
+/// One thread's evaluator of one or more Q models: per distinct feature set a graph builder (made
+/// on the first call, for the maps it meets) and its reused graph, and per model its pair cache.
+struct GraphWorker<'q> {
+    groups: Vec<Group<'q>>,
+    values: Vec<f64>,
+}
+
+/// The models of one feature set (`K` neighbours): they share the state graph.
+struct Group<'q> {
+    config: QGraphConfig,
     builder: Option<QGraphBuilder>,
     graph: QGraph,
-    fast: PairCache,
+    members: Vec<Member<'q>>,
 }
 
+/// One model of a group and its per-thread caches.
+struct Member<'q> {
+    q: &'q OnnxQ,
+    fast: PairCache,
+    nodes: NodeCache,
+}
+
+/// Ways per part of [`NodeCache`].
+const NODE_WAYS: usize = 4;
+
+/// The node encodings (the first layer's output) of one model, per part: a part node's
+/// attributes are a function of the part, its [`MapState::row_key`] and whether it is asked
+/// about, so each part keeps the encodings of its last [`NODE_WAYS`] keys. The encoding of one
+/// row is the same bits as that row encoded among others, so the values do not depend on what
+/// the cache held.
+#[derive(Default)]
+struct NodeCache {
+    parts: usize,
+    keys: Vec<([u64; 4], bool)>,
+    filled: Vec<bool>,
+    next: Vec<u8>,
+    encodings: Vec<f32>,
+    /// The encoded nodes of the current state, and scratch.
+    h0: Vec<f32>,
+    asked: Vec<bool>,
+    row: Vec<f32>,
+    scratch: Vec<f32>,
+}
+
+impl NodeCache {
+    /// The slot of part `i`'s encoding for `key`, encoding it when it is not kept.
+    fn slot(&mut self, net: &QNet, builder: &QGraphBuilder, state: &mut MapState<'_>, i: usize, key: ([u64; 4], bool)) -> usize {
+        let first = i * NODE_WAYS;
+        if let Some(w) = (first..first + NODE_WAYS).find(|&s| self.filled[s] && self.keys[s] == key) {
+            return w;
+        }
+        let s = first + self.next[i] as usize;
+        self.next[i] = ((self.next[i] as usize + 1) % NODE_WAYS) as u8;
+        self.row.resize(builder.config().node_dim(), 0.0);
+        builder.node_row(state, i, key.1, &mut self.row);
+        let w = net.width();
+        net.encode_nodes(&self.row, 1, &mut self.encodings[s * w..(s + 1) * w], &mut self.scratch);
+        self.keys[s] = key;
+        self.filled[s] = true;
+        s
+    }
+}
+
+impl<'q> GraphWorker<'q> {
+    fn new(models: &'q [OnnxQ]) -> Self {
+        let mut groups: Vec<Group<'q>> = Vec::new();
+        for q in models {
+            let member = Member { q, fast: PairCache::default(), nodes: NodeCache::default() };
+            match groups.iter_mut().find(|g| g.config == q.config) {
+                Some(g) => g.members.push(member),
+                None => groups.push(Group { config: q.config, builder: None, graph: QGraph::default(), members: vec![member] }),
+            }
+        }
+        GraphWorker { groups, values: Vec::new() }
+    }
+}
 /// The Rust forward pass's per-thread state: each part pair's edge encoding, computed the first
 /// time the pair is an edge (an edge's attributes depend on its two parts only), and buffers.
 #[derive(Default)]
@@ -183,25 +281,141 @@ impl PairCache {
     }
 }
 
-impl QWorker for OnnxQWorker<'_> {
+impl QWorker for GraphWorker<'_> {
     fn q_values(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], out: &mut [f64]) -> asp_search::Result<()> {
-        let plugin = |reason: String| SearchError::plugin(format!("Q-function {}", self.q.model.path()), reason);
         let maps = ctx.maps();
-        if maps.num_directions() != self.q.config.directions {
-            return Err(plugin(format!(
-                "trained on maps with {} directions, the search's have {}",
-                self.q.config.directions,
-                maps.num_directions()
-            )));
-        }
-        let builder = self.builder.get_or_insert_with(|| QGraphBuilder::new(maps, self.q.config.neighbours));
         let history = qgraph::direction_history(ctx.problem, ctx.memory);
+        out.fill(1.0);
+        self.values.resize(actions.len(), 0.0);
+        for group in &mut self.groups {
+            if maps.num_directions() != group.config.directions {
+                let q = group.members[0].q;
+                return Err(SearchError::plugin(
+                    format!("Q-function {}", q.model.path()),
+                    format!("trained on maps with {} directions, the search's have {}", group.config.directions, maps.num_directions()),
+                ));
+            }
+            let builder = group.builder.get_or_insert_with(|| QGraphBuilder::new(maps, group.config.neighbours));
+            let fast = group.members.iter().all(|m| m.q.net.is_ok());
+            // the Rust forward passes need the nodes and edges only (node encodings are cached by
+            // part and row key); tract needs the edge attributes too
+            if fast {
+                builder.build_edges(ctx.state, &mut group.graph);
+            } else {
+                builder.build(ctx.state, history, actions, &mut group.graph);
+            }
+            for member in &mut group.members {
+                if fast {
+                    member.encoded_values(builder, &group.graph, ctx.state, history, actions, &mut self.values)?;
+                } else {
+                    member.values(builder, &group.graph, maps, actions, &mut self.values)?;
+                }
+                for (o, v) in out.iter_mut().zip(&self.values) {
+                    *o *= v;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Member<'_> {
+    /// [`values`](Self::values) from the state's nodes and edges only (`g` by
+    /// [`QGraphBuilder::build_edges`]): part nodes' encodings come from the node cache, the
+    /// context node's is made for `history`.
+    #[allow(clippy::too_many_arguments)]
+    fn encoded_values(
+        &mut self,
+        builder: &QGraphBuilder,
+        g: &QGraph,
+        state: &mut MapState<'_>,
+        history: Option<DirMask>,
+        actions: &[usize],
+        out: &mut [f64],
+    ) -> asp_search::Result<()> {
+        let plugin = |reason: String| SearchError::plugin(format!("Q-function {}", self.q.model.path()), reason);
+        let Ok(net) = &self.q.net else { return Err(plugin("no Rust forward pass".into())) };
+        let maps = state.maps();
+        let (n, e) = (g.num_nodes(), g.num_edges());
+        let parts = &g.nodes[..n - 1];
+        let w = net.width();
+        let cache = &mut self.nodes;
+        if cache.parts != maps.num_parts() {
+            let slots = maps.num_parts() * NODE_WAYS;
+            *cache = NodeCache {
+                parts: maps.num_parts(),
+                keys: vec![([0; 4], false); slots],
+                filled: vec![false; slots],
+                next: vec![0; maps.num_parts()],
+                encodings: vec![0.0; slots * w],
+                ..NodeCache::default()
+            };
+        }
+        self.fast.wanted.clear();
+        for &a in actions {
+            let k = parts.binary_search(&(a as i64)).map_err(|_| plugin(format!("action {a} is not a present part")))?;
+            self.fast.wanted.push(k);
+        }
+        cache.h0.resize(n * w, 0.0);
+        cache.asked.clear();
+        cache.asked.resize(n, false);
+        for &k in &self.fast.wanted {
+            cache.asked[k] = true;
+        }
+        for (k, &i) in parts.iter().enumerate() {
+            let flag = cache.asked[k];
+            let i = i as usize;
+            let s = cache.slot(net, builder, state, i, (state.row_key(i), flag));
+            cache.h0[k * w..(k + 1) * w].copy_from_slice(&cache.encodings[s * w..(s + 1) * w]);
+        }
+        cache.row.resize(builder.config().node_dim(), 0.0);
+        builder.context_row(history, &mut cache.row);
+        net.encode_nodes(&cache.row, 1, &mut cache.h0[(n - 1) * w..n * w], &mut cache.scratch);
+        let c = &mut self.fast;
+        c.prepare(net, builder, maps);
+        let context = n - 1;
+        c.edges.clear();
+        c.sources.clear();
+        c.targets.clear();
+        for k in 0..e {
+            let (s_pos, t_pos) = (g.edge_index[k] as usize, g.edge_index[e + k] as usize);
+            c.sources.push(s_pos as u32);
+            c.targets.push(t_pos as u32);
+            if s_pos == context {
+                c.edges.extend_from_slice(&c.context);
+            } else {
+                let at = c.pair(net, builder, maps, g.nodes[t_pos] as usize, g.nodes[s_pos] as usize);
+                c.edges.extend_from_slice(&c.encodings[at..at + w]);
+            }
+        }
+        c.values.resize(actions.len(), 0.0);
+        net.forward_encoded(&cache.h0, &[], n, &c.sources, &c.targets, &c.edges, &c.wanted, &mut c.values, &mut c.scratch);
+        for (o, (&v, &a)) in out.iter_mut().zip(c.values.iter().zip(actions)) {
+            let v = f64::from(v);
+            if !v.is_finite() {
+                return Err(plugin(format!("the model gave {v} for part {a}")));
+            }
+            *o = v.max(MIN_Q);
+        }
+        Ok(())
+    }
+
+    /// The model's values of `actions` in the state whose graph is `g` (its structure; with edge
+    /// attributes when the model runs on tract), each at least [`MIN_Q`].
+    fn values(
+        &mut self,
+        builder: &QGraphBuilder,
+        g: &QGraph,
+        maps: &asp_geom::distmap::DistanceMaps,
+        actions: &[usize],
+        out: &mut [f64],
+    ) -> asp_search::Result<()> {
+        let plugin = |reason: String| SearchError::plugin(format!("Q-function {}", self.q.model.path()), reason);
+        let (n, e) = (g.num_nodes(), g.num_edges());
+        let parts = &g.nodes[..n - 1];
         if let Ok(net) = &self.q.net {
-            builder.build_structure(ctx.state, history, actions, &mut self.graph);
-            let g = &self.graph;
             let c = &mut self.fast;
             c.prepare(net, builder, maps);
-            let (n, e) = (g.num_nodes(), g.num_edges());
             let context = n - 1;
             c.edges.clear();
             c.sources.clear();
@@ -217,7 +431,6 @@ impl QWorker for OnnxQWorker<'_> {
                     c.edges.extend_from_slice(&c.encodings[at..at + net.width()]);
                 }
             }
-            let parts = &g.nodes[..n - 1];
             c.wanted.clear();
             for &a in actions {
                 let k = parts.binary_search(&(a as i64)).map_err(|_| plugin(format!("action {a} is not a present part")))?;
@@ -234,11 +447,7 @@ impl QWorker for OnnxQWorker<'_> {
             }
             return Ok(());
         }
-        builder.build(ctx.state, history, actions, &mut self.graph);
-        let g = &self.graph;
-        let (n, e) = (g.num_nodes(), g.num_edges());
         let scores = self.q.model.score(&g.x, n, &g.edge_index, e, &g.edge_attr).map_err(|err| plugin(err.to_string()))?;
-        let parts = &g.nodes[..n - 1];
         for (o, &a) in out.iter_mut().zip(actions) {
             let k = parts.binary_search(&(a as i64)).map_err(|_| plugin(format!("action {a} is not a present part")))?;
             let v = f64::from(scores[k]);
@@ -292,7 +501,7 @@ pub fn epsilon_greedy_models(
     directions: usize,
     uses: QUse,
 ) -> Result<Arc<dyn Policy>> {
-    let mut qs: Vec<Arc<dyn QFunction>> = Vec::with_capacity(models.len());
+    let mut qs = Vec::with_capacity(models.len());
     for (model, objective) in models.iter().zip(objectives) {
         let q = OnnxQ::new(model.clone(), directions)?;
         if q.objective() != *objective {
@@ -301,9 +510,12 @@ pub fn epsilon_greedy_models(
                 mismatch: format!("estimates objective '{}', but its place in the list is that of '{objective}'", q.objective()),
             });
         }
-        qs.push(Arc::new(q));
+        qs.push(q);
     }
-    let policy = EpsilonGreedy::new(epsilon, qs).map_err(|e| LearnError::Input { path: "epsilon".into(), reason: e.to_string() })?;
+    // one product over one state graph per state: the same values as one Q-function per model
+    let product: Arc<dyn QFunction> = Arc::new(QProduct::new(qs)?);
+    let policy =
+        EpsilonGreedy::new(epsilon, vec![product]).map_err(|e| LearnError::Input { path: "epsilon".into(), reason: e.to_string() })?;
     Ok(Arc::new(policy.using(uses)))
 }
 

@@ -55,32 +55,42 @@ impl Dense {
 }
 
 /// `out[r, :] = bias + x[r, :] W` for row-major `x [rows, k]`, `W [k, cols]` and `out [rows,
-/// cols]`. Tiles of four rows by two SIMD vectors of columns are summed in registers with fused
-/// multiply-adds, so each load of a row of `W` serves four rows of `x`; columns past the last
-/// whole tile (all of them without SIMD) are summed one by one.
+/// cols]`. Tiles of four rows by two SIMD vectors of columns (then by one vector) are summed in
+/// registers with fused multiply-adds, so each load of a row of `W` serves four rows of `x`;
+/// columns past the last whole vector (all of them without SIMD) are summed row by row over
+/// contiguous columns, in the same order per value.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn gemm<S: Simd>(simd: S, x: &[f32], rows: usize, k: usize, w: &[f32], cols: usize, bias: Option<&[f32]>, out: &mut [f32]) {
-    let tile = 2 * lanes::<S>();
+    let lanes = lanes::<S>();
     // without SIMD (one lane) every column takes the plain loop below: a scalar mul_add would be
     // a library call
-    let whole = if tile > 2 { cols / tile * tile } else { 0 };
+    let (two, one) = if lanes > 1 { (cols / (2 * lanes) * 2 * lanes, cols / lanes * lanes) } else { (0, 0) };
     let mut r0 = 0;
     while r0 + 4 <= rows {
-        gemm_rows::<S, 4>(simd, x, r0, k, w, cols, whole, bias, out);
+        gemm_rows::<S, 4, 2>(simd, x, r0, k, w, cols, 0..two, bias, out);
+        gemm_rows::<S, 4, 1>(simd, x, r0, k, w, cols, two..one, bias, out);
         r0 += 4;
     }
     while r0 < rows {
-        gemm_rows::<S, 1>(simd, x, r0, k, w, cols, whole, bias, out);
+        gemm_rows::<S, 1, 2>(simd, x, r0, k, w, cols, 0..two, bias, out);
+        gemm_rows::<S, 1, 1>(simd, x, r0, k, w, cols, two..one, bias, out);
         r0 += 1;
     }
+    if one == cols {
+        return;
+    }
     for r in 0..rows {
-        for c in whole..cols {
-            let mut v = bias.map_or(0.0, |b| b[c]);
-            for j in 0..k {
-                v += x[r * k + j] * w[j * cols + c];
+        let o = &mut out[r * cols + one..(r + 1) * cols];
+        match bias {
+            Some(b) => o.copy_from_slice(&b[one..cols]),
+            None => o.fill(0.0),
+        }
+        for (j, row) in w[..k * cols].chunks_exact(cols).enumerate() {
+            let xv = x[r * k + j];
+            for (o, &wv) in o.iter_mut().zip(&row[one..]) {
+                *o += xv * wv;
             }
-            out[r * cols + c] = v;
         }
     }
 }
@@ -91,34 +101,35 @@ fn lanes<S: Simd>() -> usize {
     std::mem::size_of::<S::f32s>() / std::mem::size_of::<f32>()
 }
 
-/// Rows `r0..r0 + R` of [`gemm`], columns `0..whole` (whole tiles of two vectors): `R × 2`
+/// Rows `r0..r0 + R` of [`gemm`], the columns `span` (whole tiles of `V` vectors): `R × V`
 /// accumulators in registers, so each load of a row of `W` serves `R` rows of `x`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn gemm_rows<S: Simd, const R: usize>(
+fn gemm_rows<S: Simd, const R: usize, const V: usize>(
     simd: S,
     x: &[f32],
     r0: usize,
     k: usize,
     w: &[f32],
     cols: usize,
-    whole: usize,
+    span: std::ops::Range<usize>,
     bias: Option<&[f32]>,
     out: &mut [f32],
 ) {
-    let tile = 2 * lanes::<S>();
+    let tile = V * lanes::<S>();
     let xs: [&[f32]; R] = std::array::from_fn(|r| &x[(r0 + r) * k..(r0 + r + 1) * k]);
-    for c0 in (0..whole).step_by(tile) {
+    for c0 in span.step_by(tile) {
         let c1 = c0 + tile;
-        let start = bias.map_or([simd.splat_f32s(0.0); 2], |b| pair::<S>(&b[c0..c1]));
+        let start = bias.map_or([simd.splat_f32s(0.0); V], |b| vectors::<S, V>(&b[c0..c1]));
         let mut acc = [start; R];
         for (j, row) in w[..k * cols].chunks_exact(cols).enumerate() {
-            let [w0, w1] = pair::<S>(&row[c0..c1]);
+            let wv = vectors::<S, V>(&row[c0..c1]);
             #[allow(clippy::needless_range_loop)] // unrolled: the accumulators stay in registers
             for r in 0..R {
                 let xv = simd.splat_f32s(xs[r][j]);
-                acc[r][0] = simd.mul_add_f32s(xv, w0, acc[r][0]);
-                acc[r][1] = simd.mul_add_f32s(xv, w1, acc[r][1]);
+                for v in 0..V {
+                    acc[r][v] = simd.mul_add_f32s(xv, wv[v], acc[r][v]);
+                }
             }
         }
         for (r, acc) in acc.iter().enumerate() {
@@ -129,12 +140,12 @@ fn gemm_rows<S: Simd, const R: usize>(
     }
 }
 
-/// Two SIMD vectors from `2 · lanes` floats (a function, not a closure: closures are not
+/// `V` SIMD vectors from `V · lanes` floats (a function, not a closure: closures are not
 /// inlined into the SIMD-compiled caller).
 #[inline(always)]
-fn pair<S: Simd>(v: &[f32]) -> [S::f32s; 2] {
+fn vectors<S: Simd, const V: usize>(v: &[f32]) -> [S::f32s; V] {
     let v: &[S::f32s] = pulp::bytemuck::cast_slice(v);
-    [v[0], v[1]]
+    std::array::from_fn(|k| v[k])
 }
 
 /// `e^x` for `x <= SCORE_CLAMP` (Cephes' `expf` polynomial after reduction by `ln 2`; within a
@@ -502,6 +513,15 @@ impl QNet {
 
     fn normalise_nodes(&self, x: &[f32], xs: &mut [f32]) {
         let nd = self.node_dim;
+        if !self.node_log.contains(&true) {
+            // no log1p column (every Q model): a loop the compiler vectorises without `ln`
+            for (o, row) in xs.chunks_exact_mut(nd).zip(x.chunks_exact(nd)) {
+                for (((o, &v), &mean), &std) in o.iter_mut().zip(row).zip(&self.node_mean).zip(&self.node_std) {
+                    *o = (v - mean) / std;
+                }
+            }
+            return;
+        }
         for (o, row) in xs.chunks_exact_mut(nd).zip(x.chunks_exact(nd)) {
             for (k, (o, &v)) in o.iter_mut().zip(row).enumerate() {
                 let v = if self.node_log[k] { (1.0 + v.max(0.0)).ln() } else { v };

@@ -16,6 +16,7 @@ pub mod ordering;
 pub mod policy;
 pub mod polish;
 pub mod problem;
+pub mod qcache;
 pub mod qgraph;
 pub mod report;
 pub mod step;

@@ -16,6 +16,7 @@
 
 use crate::error::{Result, SearchError};
 use crate::mdp::Mdp;
+use crate::qcache::{QCache, DEFAULT_QCACHE_BYTES};
 use crate::step::{StepContext, StepKind};
 use asp_geom::distmap::{DistanceMaps, MapState};
 use asp_geom::PartSet;
@@ -116,6 +117,21 @@ pub trait PolicyWorker {
         out.fill(0.0);
         Ok(())
     }
+
+    /// The PUCT weight this policy's priors are meant for, used when the search's own
+    /// ([`crate::mcts::SearchBuilder::prior_weight`]) is 0. Default `None` (priors only order
+    /// expansions).
+    fn prior_weight(&self) -> Option<f64> {
+        None
+    }
+
+    /// The index into `actions` (the feasible removals of `ctx`'s state, never empty) of the
+    /// removal this policy ranks first, without randomness, or `None` when it ranks none
+    /// (default). A search whose policy ranks asks it, before its first episode, for one greedy
+    /// sequence from the assembled state and gives it to its local search (`--polish`) as a seed.
+    fn greedy(&mut self, _ctx: &mut PolicyContext<'_, '_>, _actions: &[usize]) -> Result<Option<usize>> {
+        Ok(None)
+    }
 }
 
 /// The index of the largest value (the first of equals; 0 for an empty or all-NaN slice).
@@ -190,18 +206,27 @@ pub enum QUse {
     Expansions,
     /// Both: ε-greedy rollouts and Q-ordered expansions.
     Both,
+    /// PUCT priors: the Q-values of each state the search adds (normalised) order its
+    /// expansions and add the bonus `w · P(a) · √N(s) / (1 + N(s, a))` to the tree policy, with
+    /// `w` = [`DEFAULT_PRIOR_WEIGHT`] unless the search sets one; rollouts stay random, and a
+    /// greedy sequence on the Q-values seeds the local search. One evaluation per node.
+    Priors,
 }
+
+/// The PUCT weight of [`QUse::Priors`] (the scale of UCT's exploration term for a
+/// unit prior at a node's first visits).
+pub const DEFAULT_PRIOR_WEIGHT: f64 = 1.0;
 
 impl QUse {
     /// The names, as the command line and Python take them.
-    pub const NAMES: [&'static str; 3] = ["rollouts", "expansions", "both"];
+    pub const NAMES: [&'static str; 4] = ["rollouts", "expansions", "both", "priors"];
 
     fn rollouts(self) -> bool {
         matches!(self, QUse::Rollouts | QUse::Both)
     }
 
     fn expansions(self) -> bool {
-        matches!(self, QUse::Expansions | QUse::Both)
+        matches!(self, QUse::Expansions | QUse::Both | QUse::Priors)
     }
 
     /// The name ([`QUse::NAMES`]).
@@ -218,7 +243,8 @@ impl std::str::FromStr for QUse {
             "rollouts" => Ok(QUse::Rollouts),
             "expansions" => Ok(QUse::Expansions),
             "both" => Ok(QUse::Both),
-            other => Err(SearchError::config(format!("unknown Q use '{other}' (rollouts, expansions or both)"))),
+            "priors" => Ok(QUse::Priors),
+            other => Err(SearchError::config(format!("unknown Q use '{other}' (rollouts, expansions, both or priors)"))),
         }
     }
 }
@@ -231,6 +257,7 @@ pub struct EpsilonGreedy {
     epsilon: f64,
     q_functions: Vec<Arc<dyn QFunction>>,
     uses: QUse,
+    cache_bytes: usize,
 }
 
 impl EpsilonGreedy {
@@ -242,7 +269,15 @@ impl EpsilonGreedy {
         if q_functions.is_empty() {
             return Err(SearchError::config("the epsilon-greedy policy needs a Q-function"));
         }
-        Ok(EpsilonGreedy { epsilon, q_functions, uses: QUse::Rollouts })
+        Ok(EpsilonGreedy { epsilon, q_functions, uses: QUse::Rollouts, cache_bytes: DEFAULT_QCACHE_BYTES })
+    }
+
+    /// The same policy keeping at most about `bytes` of Q-values by state per search thread
+    /// ([`QCache`]; default [`DEFAULT_QCACHE_BYTES`], 0: none). The cache changes no value, only
+    /// how often the Q-functions run.
+    pub fn cache_bytes(mut self, bytes: usize) -> Self {
+        self.cache_bytes = bytes;
+        self
     }
 
     /// The same policy spending its Q evaluations where `uses` says (default: rollouts).
@@ -265,7 +300,15 @@ impl EpsilonGreedy {
 impl Policy for EpsilonGreedy {
     fn for_worker(&self, thread: usize) -> Result<Box<dyn PolicyWorker + '_>> {
         let q = self.q_functions.iter().map(|q| q.for_worker(thread)).collect::<Result<Vec<_>>>()?;
-        Ok(Box::new(EpsilonGreedyWorker { epsilon: self.epsilon, uses: self.uses, q, values: Vec::new(), product: Vec::new() }))
+        Ok(Box::new(EpsilonGreedyWorker {
+            epsilon: self.epsilon,
+            uses: self.uses,
+            q,
+            values: Vec::new(),
+            product: Vec::new(),
+            cache: None,
+            cache_bytes: self.cache_bytes,
+        }))
     }
 }
 
@@ -276,14 +319,23 @@ struct EpsilonGreedyWorker<'q> {
     q: Vec<Box<dyn QWorker + 'q>>,
     values: Vec<f64>,
     product: Vec<f64>,
+    /// Products by state, made for the problem of the first call.
+    cache: Option<QCache>,
+    cache_bytes: usize,
 }
 
 impl EpsilonGreedyWorker<'_> {
-    /// The product of the Q-values of `actions` in `self.product`.
+    /// The product of the Q-values of `actions` in `self.product` (kept by state, so a state met
+    /// again costs a lookup).
     fn evaluate(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize]) -> Result<()> {
         let n = actions.len();
         self.product.clear();
         self.product.resize(n, 1.0);
+        let cache = self.cache.get_or_insert_with(|| QCache::new(ctx.maps().num_parts(), self.cache_bytes));
+        let key = QCache::key(ctx.problem, &ctx.present(), ctx.memory, actions);
+        if cache.get(&key, &mut self.product) {
+            return Ok(());
+        }
         self.values.resize(n, 0.0);
         for q in &mut self.q {
             q.q_values(ctx, actions, &mut self.values[..n])?;
@@ -291,6 +343,7 @@ impl EpsilonGreedyWorker<'_> {
                 *p *= v;
             }
         }
+        cache.put(&key, &self.product);
         Ok(())
     }
 }
@@ -319,6 +372,18 @@ impl PolicyWorker for EpsilonGreedyWorker<'_> {
 
     fn has_priors(&self) -> bool {
         self.uses.expansions()
+    }
+
+    fn prior_weight(&self) -> Option<f64> {
+        (self.uses == QUse::Priors).then_some(DEFAULT_PRIOR_WEIGHT)
+    }
+
+    fn greedy(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize]) -> Result<Option<usize>> {
+        if self.uses != QUse::Priors {
+            return Ok(None);
+        }
+        self.evaluate(ctx, actions)?;
+        Ok(Some(argmax(&self.product)))
     }
 
     /// The Q-value products, normalised to sum 1 (uniform when they are all 0 or not finite).

@@ -170,15 +170,52 @@ impl QGraphBuilder {
     /// ([`direction_history`]), `actions` the feasible removals a Q-function is asked about
     /// (flagged on their nodes). Parts in `actions` must be present.
     pub fn build(&mut self, state: &mut MapState<'_>, history: Option<DirMask>, actions: &[usize], out: &mut QGraph) {
-        self.build_with(state, history, actions, out, true);
+        self.build_with(state, history, actions, out);
     }
 
-    /// [`build`](Self::build) without the edge attributes (`out.edge_attr` stays empty): the
-    /// nodes, their attributes and the edges. An edge's attributes depend only on its two parts
-    /// ([`edge_attributes`](Self::edge_attributes)), so an evaluator that caches them per pair
-    /// needs no more than this per state.
-    pub fn build_structure(&mut self, state: &mut MapState<'_>, history: Option<DirMask>, actions: &[usize], out: &mut QGraph) {
-        self.build_with(state, history, actions, out, false);
+    /// Only the nodes and the edges of `state`'s graph (`out.x` and `out.edge_attr` stay empty).
+    /// A part node's attributes are a function of the part, [`MapState::row_key`] and whether it
+    /// is asked about ([`node_row`](Self::node_row)), so an evaluator that caches what it makes
+    /// of them per part and key needs no more than this per state.
+    pub fn build_edges(&mut self, state: &MapState<'_>, out: &mut QGraph) {
+        let present = state.present();
+        self.place(&present, out);
+        self.edges(state.maps(), out, false);
+    }
+
+    /// The attributes of part `i`'s node in `state` (`row` has `node_dim` floats); `asked` says
+    /// whether the part is one of the removals a Q-function is asked about.
+    pub fn node_row(&self, state: &mut MapState<'_>, i: usize, asked: bool, row: &mut [f32]) {
+        let maps = state.maps();
+        let d = self.config.directions;
+        let d_max = maps.d_max();
+        row.fill(0.0);
+        row[0] = 1.0;
+        row[2] = f32::from(u8::from(maps.is_fixed(i)));
+        row[3] = f32::from(u8::from(asked));
+        row[4..NODE_HEAD].copy_from_slice(&self.corners[i]);
+        let min_map = state.min_map(i);
+        for (o, v) in row[NODE_HEAD..NODE_HEAD + d].iter_mut().zip(min_map) {
+            *o = (v / d_max).clamp(0.0, 1.0);
+        }
+        let free = state.free_mask(i);
+        for (dir, o) in row[NODE_HEAD + d..NODE_HEAD + 2 * d].iter_mut().enumerate() {
+            *o = f32::from(u8::from(free.contains(dir)));
+        }
+    }
+
+    /// The attributes of the context node (`row` has `node_dim` floats) for the direction
+    /// history `history`.
+    pub fn context_row(&self, history: Option<DirMask>, row: &mut [f32]) {
+        let d = self.config.directions;
+        row.fill(0.0);
+        row[0] = 1.0;
+        row[1] = 1.0;
+        if let Some(h) = history {
+            for dir in h.iter().filter(|&dir| dir < d) {
+                row[NODE_HEAD + d + dir] = 1.0;
+            }
+        }
     }
 
     /// The attributes of the edge from part `s` to part `t` (`row` has `edge_dim` floats), or of
@@ -207,13 +244,9 @@ impl QGraphBuilder {
         }
     }
 
-    fn build_with(&mut self, state: &mut MapState<'_>, history: Option<DirMask>, actions: &[usize], out: &mut QGraph, attributes: bool) {
-        let maps = state.maps();
-        let d = self.config.directions;
-        let (node_dim, edge_dim) = (self.config.node_dim(), self.config.edge_dim());
-        let n_parts = maps.num_parts();
-        let present = state.present();
-        let d_max = maps.d_max();
+    /// The nodes of `present` (increasing part index, then the context node, `-1`) in `out`, and
+    /// each part's position among them in `self.position`.
+    fn place(&mut self, present: &asp_geom::PartSet, out: &mut QGraph) {
         out.nodes.clear();
         out.x.clear();
         out.edge_index.clear();
@@ -222,47 +255,39 @@ impl QGraphBuilder {
         for p in self.position.iter_mut() {
             *p = u32::MAX;
         }
-        for i in 0..n_parts {
-            if present.contains(i) {
-                self.position[i] = out.nodes.len() as u32;
-                out.nodes.push(i as i64);
-            }
+        for i in present.iter() {
+            self.position[i] = out.nodes.len() as u32;
+            out.nodes.push(i as i64);
         }
-        let parts = out.nodes.len();
+        out.nodes.push(-1);
+    }
+
+    fn build_with(&mut self, state: &mut MapState<'_>, history: Option<DirMask>, actions: &[usize], out: &mut QGraph) {
+        let present = state.present();
+        self.place(&present, out);
+        let node_dim = self.config.node_dim();
+        let parts = out.nodes.len() - 1;
         out.x.resize((parts + 1) * node_dim, 0.0);
-        for (k, &i) in out.nodes.iter().enumerate() {
-            let i = i as usize;
-            let row = &mut out.x[k * node_dim..(k + 1) * node_dim];
-            row[0] = 1.0;
-            row[2] = f32::from(u8::from(maps.is_fixed(i)));
-            row[4..NODE_HEAD].copy_from_slice(&self.corners[i]);
-            let min_map = state.min_map(i);
-            for (o, v) in row[NODE_HEAD..NODE_HEAD + d].iter_mut().zip(min_map) {
-                *o = (v / d_max).clamp(0.0, 1.0);
-            }
-            let free = state.free_mask(i);
-            for (dir, o) in row[NODE_HEAD + d..NODE_HEAD + 2 * d].iter_mut().enumerate() {
-                *o = f32::from(u8::from(free.contains(dir)));
-            }
+        for k in 0..parts {
+            let i = out.nodes[k] as usize;
+            // flagged below (actions are few; a search per node would cost more)
+            self.node_row(state, i, false, &mut out.x[k * node_dim..(k + 1) * node_dim]);
         }
         for &a in actions {
             if let Some(&k) = self.position.get(a).filter(|&&k| k != u32::MAX) {
                 out.x[k as usize * node_dim + 3] = 1.0;
             }
         }
-        let context = parts;
-        {
-            let row = &mut out.x[context * node_dim..(context + 1) * node_dim];
-            row[0] = 1.0;
-            row[1] = 1.0;
-            if let Some(h) = history {
-                for dir in h.iter().filter(|&dir| dir < d) {
-                    row[NODE_HEAD + d + dir] = 1.0;
-                }
-            }
-        }
-        out.nodes.push(-1);
+        self.context_row(history, &mut out.x[parts * node_dim..(parts + 1) * node_dim]);
+        self.edges(state.maps(), out, true);
+    }
 
+    /// The edges of the nodes in `out` (placed by [`place`](Self::place)), with their attributes
+    /// when `attributes` is set.
+    fn edges(&self, maps: &DistanceMaps, out: &mut QGraph, attributes: bool) {
+        let edge_dim = self.config.edge_dim();
+        let parts = out.nodes.len() - 1;
+        let context = parts;
         for t_pos in 0..parts {
             let t = out.nodes[t_pos] as usize;
             let mut taken = 0;
@@ -292,9 +317,7 @@ impl QGraphBuilder {
                 out.edge_attr[start] = 1.0;
             }
         }
-        let targets = std::mem::take(&mut out.targets);
-        out.edge_index.extend_from_slice(&targets);
-        out.targets = targets;
+        out.edge_index.extend_from_slice(&out.targets);
         out.targets.clear();
     }
 }

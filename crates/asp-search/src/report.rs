@@ -18,7 +18,7 @@ pub use parts::{FaceEntry, PartEntry, SurfaceEntry, TessellationEntry};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.10";
+pub const FORMAT_VERSION: &str = "1.11";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -502,6 +502,26 @@ pub struct OptimisationEntry {
     pub map_seconds: f64,
     /// Seconds of search.
     pub search_seconds: f64,
+    /// The learned guidance the search ran with (absent: none, random rollouts and
+    /// expansions). Since format 1.11.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub guidance: Option<GuidanceEntry>,
+}
+
+/// Which learned guidance an optimising run used (format 1.11).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct GuidanceEntry {
+    /// `q`: learned Q-functions, one per objective, their values multiplied.
+    pub kind: String,
+    /// The Q model files, one per objective in the objectives' order, as given.
+    pub models: Vec<String>,
+    /// Where the Q-values guided the search: `rollouts` (ε-greedy rollouts), `expansions`
+    /// (they order expansions), `both`, or `priors` (PUCT priors at expansions and a greedy
+    /// seed of the local search; rollouts random).
+    pub q_use: String,
+    /// The probability of a random removal in guided rollouts (`rollouts` and `both` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub epsilon: Option<f64>,
 }
 
 impl PlanReport {

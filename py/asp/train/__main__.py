@@ -12,6 +12,11 @@ one objective by deep Q-learning on ``asp-transitions`` data sets (:mod:`asp.tra
 ONNX Q model plus ``q.onnx.json`` (settings, loss curve, ranking quality per held-out assembly) and
 ``q.onnx.pt`` (the weights, for retraining).
 
+``python -m asp.train distill DATA_DIR... --teacher q.onnx --out small.onnx [options]`` fits a
+smaller Q network (default 16 wide, one layer) to a trained one's values of every action of the data
+sets' states (:mod:`asp.train.q.distill`) and writes it with ``small.onnx.json`` (the ranking of the
+teacher it keeps on held-out states) and ``small.onnx.pt``.
+
 ``python -m asp.train q-online MODEL --objective LIST --seconds S --out DIR [--q PRETRAINED...]`` runs
 the optimiser on MODEL with its Q-functions trained after every episode (thesis 6.5's online
 setting; ``--q``: the retrained setting, :mod:`asp.train.online`).
@@ -83,6 +88,7 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--holdout", nargs="+", metavar="NAME", default=[], help="assemblies to evaluate on, not train on")
     g.add_argument("--leave-one-out", type=Path, metavar="OUT_DIR", help="one model per assembly, trained on the others")
     _q_parser(sub)
+    _distill_parser(sub)
     _online_parsers(sub)
     return p
 
@@ -164,6 +170,46 @@ def _q_parser(sub: argparse._SubParsersAction) -> None:
         "--parity-tolerance", type=float, default=1e-5,
         help="largest ONNX/PyTorch difference the export check accepts (default 1e-5)",
     )
+
+
+def _distill_parser(sub: argparse._SubParsersAction) -> None:
+    d = sub.add_parser("distill", help="a smaller Q network fitted to a trained one's values (its ranking kept is measured)")
+    d.add_argument("data", nargs="+", metavar="DATA_DIR", help="asp-transitions data set folders (the states to fit on)")
+    d.add_argument("--teacher", type=Path, required=True, help="the trained Q model (its weights TEACHER.pt beside it)")
+    d.add_argument("--out", type=Path, required=True, help="the ONNX student to write (its summary goes to OUT.json)")
+    d.add_argument("--width", type=int, default=16, help="the student's hidden width (default 16)")
+    d.add_argument("--layers", type=int, default=1, help="the student's GNN layers (default 1)")
+    d.add_argument("--steps", type=int, default=2000, help="gradient steps (default 2000)")
+    d.add_argument("--batch", type=int, default=32, help="states per step (default 32)")
+    d.add_argument("--lr", type=float, default=3e-3, help="Adam learning rate (default 3e-3)")
+    d.add_argument("--states", type=int, default=1500, help="distinct states per assembly (default 1500)")
+    d.add_argument("--seed", type=int, default=0, help="seed of weights and sampling (default 0)")
+    d.add_argument("--threads", type=int, default=1, help="PyTorch CPU threads (default 1)")
+
+
+def _distill(args: argparse.Namespace) -> int:
+    from .q import BindingGraphs, DistillConfig, distill_q, export_q, load_q_weights, open_q_assemblies, save_q_weights
+
+    teacher, features, objective = load_q_weights(str(args.teacher) + ".pt")
+    assemblies, data_features, node_dim, edge_dim = open_q_assemblies(args.data, objective)
+    if (data_features, node_dim, edge_dim) != (features, teacher.node_dim, teacher.edge_dim):
+        raise DataError(f"{args.teacher}: trained on features '{features}', the data sets have '{data_features}'")
+    config = DistillConfig(
+        width=args.width, layers=args.layers, steps=args.steps, batch=args.batch, lr=args.lr,
+        states=args.states, seed=args.seed, threads=args.threads,
+    )
+    graphs = BindingGraphs(features, node_dim, edge_dim)
+    _log(f"distilling '{objective}' from {args.teacher} into width {config.width}, {config.layers} layer(s)")
+    student, summary = distill_q(teacher, assemblies, config, graphs, log=_log)
+    parity = export_q(student, args.out, features, objective)
+    save_q_weights(student, str(args.out) + ".pt", features, objective)
+    kept = summary["ranking_kept"]
+    print(f"{args.out}: keeps the teacher's best action in {kept['top1']:.4f} of {kept['states']} held-out states "
+          f"(chance {kept['chance']:.4f}), rank correlation {kept['spearman']:.4f}")
+    doc = {"kind": "q-distilled", "objective": objective, "features": features, "teacher": str(args.teacher),
+           "data": [str(d) for d in args.data], "onnx_parity_max_abs_diff": parity, **summary}
+    Path(str(args.out) + ".json").write_text(json.dumps(doc, indent=2) + "\n")
+    return 0
 
 
 def _log(message: str) -> None:
@@ -399,7 +445,7 @@ def main(argv: list[str] | None = None) -> int:
         if value is not None and value < 1:
             print(f"error: --{flag.replace('_', '-')} must be at least 1", file=sys.stderr)
             return 2
-    if isinstance(args.seconds, float) and args.seconds <= 0:
+    if isinstance(getattr(args, "seconds", None), float) and args.seconds <= 0:
         print("error: --seconds must be positive", file=sys.stderr)
         return 2
     if getattr(args, "steps_per_episode", 1) < 0:
@@ -408,6 +454,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "q":
             return _q(args)
+        if args.command == "distill":
+            return _distill(args)
         if args.command == "q-online":
             return _q_online(args)
         if args.command == "bench-mcts":

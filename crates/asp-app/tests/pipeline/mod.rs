@@ -373,3 +373,36 @@ fn issue_26_generated_profile_assemblies_plan_under_physics() {
         assert!(r.report.locked_cores.is_empty(), "{what}");
     }
 }
+
+/// The plan says which learned guidance ran (format 1.11): the Q models, where they guided and,
+/// for guided rollouts, ε; without Q models there is no `guidance`.
+#[test]
+fn the_plan_says_which_guidance_ran() {
+    use asp_app::pipeline::OptimiseSettings;
+    use asp_app::QPolicy;
+    use asp_search::report::GuidanceEntry;
+    use std::sync::Arc;
+    let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../asp-learn/tests/data/random_q_access.onnx");
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(3);
+    let cube = asp_gen::SomaCube::random(3, &mut rng).unwrap().to_assembly(0.05, "soma3");
+    let run = |policy: Option<QPolicy>| {
+        let o = OptimiseSettings {
+            objectives: "access".into(),
+            episodes: 5,
+            threads: Some(1),
+            resolution: 5,
+            policy: policy.map(|p| Arc::new(p) as Arc<dyn asp_app::PolicySource>),
+            ..OptimiseSettings::default()
+        };
+        let settings = PlanSettings { optimise: Some(o), ..PlanSettings::default() };
+        let r = plan_assembly(cube.clone(), &settings, None).unwrap();
+        assert!(r.found(), "{}", r.report.to_json());
+        r.report.optimisation.unwrap().guidance
+    };
+    assert_eq!(run(None), None);
+    for (uses, epsilon) in [(asp_search::QUse::Priors, None), (asp_search::QUse::Rollouts, Some(0.2))] {
+        let q = QPolicy::new(std::slice::from_ref(&model), &["access"], 0.2, uses).unwrap();
+        let want = GuidanceEntry { kind: "q".into(), models: vec![model.display().to_string()], q_use: uses.name().into(), epsilon };
+        assert_eq!(run(Some(q)), Some(want));
+    }
+}

@@ -415,6 +415,14 @@ impl<'m> MapState<'m> {
         self.sum_keys[first..first + SUM_WAYS].iter().position(|k| k == key).map(|w| first + w)
     }
 
+    /// A key of part `i`'s minimum map and free directions in this state: the set of its present
+    /// blockers (parts whose maps are below `d_max` somewhere), as bit words. Over the same maps,
+    /// equal keys of a part mean equal minimum maps and free directions, so callers cache what
+    /// they derive from them by it.
+    pub fn row_key(&self, i: usize) -> [u64; 4] {
+        self.maps.blocker_set[i].and(&self.present).0
+    }
+
     /// Whether the kept minimum map of part `i` was computed for its present blockers.
     #[inline]
     fn row_is_current(&self, i: usize) -> bool {

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use asp_geom::distmap::{DistanceMaps, MapConfig, MapState};
-use asp_learn::{epsilon_greedy, GraphModel, ModelKind, OnnxQ};
+use asp_learn::{epsilon_greedy, GraphModel, ModelKind, OnnxQ, QProduct};
 use asp_search::exact::exact_front;
 use asp_search::objective::parse_objectives;
 use asp_search::policy::{PolicyContext, QFunction, QUse};
@@ -183,6 +183,30 @@ fn the_rust_forward_pass_gives_tracts_values() {
             assert!(worst <= 1e-5, "{name} on {} parts: fast and tract differ by {worst}", assembly.parts.len());
         }
     }
+}
+
+#[test]
+fn a_product_of_q_models_on_one_graph_is_the_product_of_their_values() {
+    // two models sharing the state graph (same features) in one worker: each state's values are
+    // the product of the models' values evaluated one by one, each at least its floor
+    let access = OnnxQ::load(fixture("random_q_access.onnx"), 25).unwrap();
+    let dirchange = OnnxQ::load(fixture("random_q_dirchange.onnx"), 25).unwrap();
+    let product = QProduct::new(vec![access.clone(), dirchange.clone()]).unwrap();
+    assert!(QProduct::new(Vec::new()).is_err());
+    let p = problem(&soma(5), "access,dirchange");
+    let mut worker = product.for_worker(0).unwrap();
+    let mut states = 0;
+    walk_states(&p, 4, |state, memory, actions| {
+        let mut got = vec![0.0; actions.len()];
+        worker.q_values(&mut PolicyContext { state: &mut *state, memory, problem: &p }, actions, &mut got).unwrap();
+        let (mut a, mut d) = (vec![0.0; actions.len()], vec![0.0; actions.len()]);
+        access.q_values(&mut PolicyContext { state: &mut *state, memory, problem: &p }, actions, &mut a).unwrap();
+        dirchange.q_values(&mut PolicyContext { state: &mut *state, memory, problem: &p }, actions, &mut d).unwrap();
+        let want: Vec<f64> = a.iter().zip(&d).map(|(x, y)| x * y).collect();
+        assert_eq!(got, want);
+        states += 1;
+    });
+    assert!(states >= 10, "{states}");
 }
 
 #[test]

@@ -8,6 +8,9 @@ use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hash, Hasher};
 
 pub(crate) const NONE: u32 = u32::MAX;
+/// The prior span of a node added while the policy gives priors, before they are asked for
+/// (when the search first expands from it).
+pub(crate) const PENDING: (u32, u32) = (NONE, NONE - 1);
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Status {
@@ -62,7 +65,8 @@ pub(crate) struct Tree<V> {
     pub index: HashMap<u64, u32, BuildHasherDefault<KeyHasher>>,
     pub m: usize,
     /// With a policy that gives priors: per node, its feasible actions' priors (a range of
-    /// `node_priors`), and per edge its action's prior.
+    /// `node_priors`; [`PENDING`] until the search first expands from it, `(NONE, NONE)` for a
+    /// node added while the policy gave none), and per edge its action's prior.
     pub prior_spans: Vec<(u32, u32)>,
     pub node_priors: Vec<(u16, f32)>,
     pub edge_priors: Vec<f32>,
@@ -76,6 +80,11 @@ impl<V> Tree<V> {
     /// Whether node `n` has priors (it was added while the policy gave priors).
     pub fn has_priors(&self, n: u32) -> bool {
         self.prior_spans.get(n as usize).is_some_and(|s| s.0 != NONE)
+    }
+
+    /// Whether node `n`'s priors are still to be asked for.
+    pub fn priors_pending(&self, n: u32) -> bool {
+        self.prior_spans.get(n as usize) == Some(&PENDING)
     }
 
     /// The prior node `n` gave `action` (0 when it gave none).

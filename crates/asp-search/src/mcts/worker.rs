@@ -1,7 +1,7 @@
 //! One thread's search: a [`Worker`] grows its graph episode by episode; an iteration is
 //! [`Worker::select`], [`Worker::expand`], [`Worker::rollout`] and [`Worker::backup`].
 
-use super::graph::{state_hash, Bounds, Edge, Node, NodeSets, SelectContext, Status, Tree, Variant, NONE};
+use super::graph::{state_hash, Bounds, Edge, Node, NodeSets, SelectContext, Status, Tree, Variant, NONE, PENDING};
 use super::outcome::{EpisodeEnd, EpisodeHook, Next, SearchStats, TracePoint};
 use super::record::Recorder;
 use super::settings::SearchSettings;
@@ -50,6 +50,8 @@ pub(super) struct Worker<'p, V: Variant> {
     thread: usize,
     /// Whether the current policy gives priors.
     priors: bool,
+    /// The PUCT weight the current policy's priors are meant for.
+    policy_weight: Option<f64>,
     actions: Vec<usize>,
     candidates: Vec<u32>,
     /// Scratch: a node's untried actions and their priors, and the priors of new nodes.
@@ -150,6 +152,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             sim,
             thread,
             priors: false,
+            policy_weight: None,
             actions,
             candidates: Vec::with_capacity(n),
             untried: Vec::with_capacity(n),
@@ -187,33 +190,38 @@ impl<'p, V: Variant> Worker<'p, V> {
     }
 
     /// Takes `policy` (this thread's worker of the search's policy, or of a policy swapped in
-    /// between episodes) as the one the next episodes use. A policy that gives priors asks for
-    /// the root's at the start (the simulated state is the root's then); nodes added while the
+    /// between episodes) as the one the next episodes use. A policy that gives priors is asked
+    /// for a node's when the search first expands from it (the root's too); nodes added while the
     /// policy gave none have none ([`Tree::prior_of`]).
     fn adopt(&mut self, policy: &mut dyn PolicyWorker) -> Result<()> {
         self.priors = policy.has_priors();
+        self.policy_weight = policy.prior_weight();
         if !self.priors {
             return Ok(());
         }
         if self.tree.prior_spans.is_empty() && self.tree.nodes.len() == 1 && self.stats.iterations == 0 {
-            return self.record_priors(policy);
+            self.tree.prior_spans.push(PENDING);
+            return Ok(());
         }
         self.tree.prior_spans.resize(self.tree.nodes.len(), (NONE, NONE));
         self.tree.edge_priors.resize(self.tree.edges.len(), 0.0);
         Ok(())
     }
 
-    /// Asks the policy for the priors of `self.actions` in the simulated state (that of the
-    /// node just added) and keeps them for that node.
-    fn record_priors(&mut self, policy: &mut dyn PolicyWorker) -> Result<()> {
-        let count = self.actions.len();
+    /// Asks the policy for the priors of `node`'s feasible removals `actions` in the simulated
+    /// state (which must be that node's) and keeps them for that node. Priors are asked for
+    /// lazily, when the search first expands from a node, so a node it never expands from costs
+    /// no evaluation; they are a function of the state, so the search is the same as if they had
+    /// been asked for when the node was added.
+    fn record_priors(&mut self, policy: &mut dyn PolicyWorker, node: u32, actions: &[usize]) -> Result<()> {
+        let count = actions.len();
         self.prior_buf.clear();
         self.prior_buf.resize(count, 0.0);
         let mut ctx = PolicyContext { state: &mut self.sim, memory: &self.memory, problem: self.problem };
-        policy.priors(&mut ctx, &self.actions, &mut self.prior_buf)?;
+        policy.priors(&mut ctx, actions, &mut self.prior_buf)?;
         let from = self.tree.node_priors.len() as u32;
-        self.tree.node_priors.extend(self.actions.iter().zip(&self.prior_buf).map(|(&a, &p)| (a as u16, p as f32)));
-        self.tree.prior_spans.push((from, self.tree.node_priors.len() as u32));
+        self.tree.node_priors.extend(actions.iter().zip(&self.prior_buf).map(|(&a, &p)| (a as u16, p as f32)));
+        self.tree.prior_spans[node as usize] = (from, self.tree.node_priors.len() as u32);
         Ok(())
     }
 
@@ -293,8 +301,60 @@ impl<'p, V: Variant> Worker<'p, V> {
             exploration: self.settings.exploration,
             bounds: &self.bounds,
             prefix: &self.path_prefix[self.path_prefix.len() - m..],
-            priors: (self.priors && self.settings.prior_weight > 0.0).then_some((self.settings.prior_weight, &self.tree.edge_priors[..])),
+            priors: self.prior_weight().map(|w| (w, &self.tree.edge_priors[..])),
         }
+    }
+
+    /// The PUCT weight of the policy's priors: the search's, else the one the policy asks for
+    /// (`None` without priors or with a weight of 0).
+    fn prior_weight(&self) -> Option<f64> {
+        let w = if self.settings.prior_weight > 0.0 { self.settings.prior_weight } else { self.policy_weight.unwrap_or(0.0) };
+        (self.priors && w > 0.0).then_some(w)
+    }
+
+    /// One greedy sequence of the policy from the assembled state (when it ranks removals:
+    /// [`PolicyWorker::greedy`]), offered to the archive and, as a seed, to the local search.
+    /// Deterministic: it draws nothing from the search's random stream.
+    fn greedy_seed(&mut self, policy: &mut dyn PolicyWorker) -> Result<()> {
+        let m = self.m;
+        let root = &self.tree.sets[0];
+        self.sim.reset_with_free(&root.present, &root.free);
+        self.memory.copy_from_slice(self.tree.memory(0));
+        self.sequence.clear();
+        let mut ret = [0.0f64; MAX_OBJECTIVES];
+        let mut rewards = [0.0f64; MAX_OBJECTIVES];
+        let mut actions = Vec::with_capacity(self.n);
+        loop {
+            self.problem.feasible_actions(&mut self.sim, &self.memory, StepKind::Simulation, &mut actions, &mut self.filtered);
+            if actions.is_empty() {
+                break;
+            }
+            let pick = {
+                let mut ctx = PolicyContext { state: &mut self.sim, memory: &self.memory, problem: self.problem };
+                policy.greedy(&mut ctx, &actions)?
+            };
+            let Some(k) = pick else { return Ok(()) };
+            let Some(&p) = actions.get(k) else {
+                return Err(SearchError::plugin("greedy policy", format!("chose action {k} of {}", actions.len())));
+            };
+            self.problem.step(&mut self.sim, &mut self.memory, p, StepKind::Simulation, &mut rewards[..m]);
+            for k in 0..m {
+                ret[k] += rewards[k];
+            }
+            self.sequence.push(p as u16);
+        }
+        if self.sim.is_complete() {
+            self.bounds.update(&ret[..m]);
+            let seq = &self.sequence;
+            if let Some(p) = &mut self.polisher {
+                p.seed(&ret[..m], seq);
+            }
+            if self.archive.insert(&ret[..m], || seq.clone()) {
+                self.archive_changed = true;
+                self.found.push((ret[..m].to_vec(), self.start.elapsed().as_secs_f64(), 0));
+            }
+        }
+        Ok(())
     }
 
     /// The edge the tree policy takes at the end of a search step (to any child that is not
@@ -387,6 +447,14 @@ impl<'p, V: Variant> Worker<'p, V> {
         self.memory.copy_from_slice(self.tree.memory(parent));
         self.untried.clear();
         self.untried.extend(self.tree.sets[parent as usize].untried.iter());
+        if self.priors && self.tree.priors_pending(parent) {
+            // first expansion from the node: nothing expanded yet, so its untried removals are
+            // all its feasible ones
+            let untried = std::mem::take(&mut self.untried);
+            let r = self.record_priors(policy, parent, &untried);
+            self.untried = untried;
+            r?;
+        }
         let untried_priors = if self.priors && self.tree.has_priors(parent) {
             self.untried_priors.clear();
             for &a in &self.untried {
@@ -461,7 +529,7 @@ impl<'p, V: Variant> Worker<'p, V> {
                 self.tree.values.push(V::Value::default());
                 self.tree.memory.extend_from_slice(&self.memory[..w]);
                 if self.priors {
-                    self.record_priors(policy)?;
+                    self.tree.prior_spans.push(PENDING);
                 }
                 id
             };
@@ -691,6 +759,11 @@ impl<'p, V: Variant> Worker<'p, V> {
         };
         if let Err(e) = self.adopt(&mut *policy) {
             return self.fail(e);
+        }
+        if self.stats.iterations == 0 && !self.root_finished() {
+            if let Err(e) = self.greedy_seed(&mut *policy) {
+                return self.fail(e);
+            }
         }
         let mut last = (self.stats.iterations, start.elapsed());
         for k in 0..episodes {

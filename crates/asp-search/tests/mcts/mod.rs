@@ -158,9 +158,9 @@ fn q_guided_expansions_follow_the_priors_and_leave_rollouts_random() {
     let cube = soma(3, 2);
     let maps = maps(&cube, 5);
     let p = problem(&maps, "access");
-    let run = |uses: QUse| {
+    let run_cached = |uses: QUse, cache_bytes: usize| {
         let q = Arc::new(LargestIndex::default());
-        let policy = EpsilonGreedy::new(0.0, vec![q.clone()]).unwrap().using(uses);
+        let policy = EpsilonGreedy::new(0.0, vec![q.clone()]).unwrap().using(uses).cache_bytes(cache_bytes);
         // one episode, one iteration per step: every expansion is its node's first
         let out = Mcts::builder()
             .policy(Arc::new(policy))
@@ -174,6 +174,8 @@ fn q_guided_expansions_follow_the_priors_and_leave_rollouts_random() {
             .unwrap();
         (out, q.0.load(Ordering::Relaxed))
     };
+    // without the cache of values by state, so every evaluation is counted
+    let run = |uses: QUse| run_cached(uses, 0);
     let greedy = |t: &asp_search::Transition| t.action == *t.actions.iter().max().unwrap();
     let (out, calls) = run(QUse::Expansions);
     let expansions: Vec<_> = out.transitions.iter().filter(|t| t.kind == StepKind::Expansion).collect();
@@ -189,10 +191,49 @@ fn q_guided_expansions_follow_the_priors_and_leave_rollouts_random() {
     let rollouts: Vec<_> = out.transitions.iter().filter(|t| t.kind == StepKind::Simulation).collect();
     assert!(rollouts.iter().filter(|t| t.actions.len() > 1).all(|t| greedy(t)));
     assert!(calls >= rollouts.iter().filter(|t| t.actions.len() > 1).count());
+    // the cache of values by state: the same search with fewer evaluations (the greedy rollouts
+    // of consecutive steps pass through the same states)
+    let (cached, cached_calls) = run_cached(QUse::Rollouts, 1 << 20);
+    assert_eq!(cached.solutions, out.solutions);
+    assert_eq!(cached.transitions, out.transitions);
+    assert!(cached_calls < calls, "{cached_calls} evaluations with the cache, {calls} without");
     // both: greedy everywhere
     let (out, _) = run(QUse::Both);
     assert!(out.transitions.iter().filter(|t| t.actions.len() > 1).all(greedy));
     assert!("expansions".parse::<QUse>().unwrap() == QUse::Expansions && "sideways".parse::<QUse>().is_err());
+}
+
+#[test]
+fn q_priors_seed_the_search_with_the_greedy_sequence() {
+    use asp_geom::distmap::MapState;
+    use asp_search::policy::{EpsilonGreedy, QUse};
+    use std::sync::Arc;
+    let cube = soma(3, 2);
+    let maps = maps(&cube, 5);
+    let p = problem(&maps, "access");
+    let run = |uses: QUse| {
+        let policy = EpsilonGreedy::new(0.0, vec![Arc::new(LargestIndex::default())]).unwrap().using(uses);
+        Mcts::builder().policy(Arc::new(policy)).seed(3).episodes(2).budget(2).build().unwrap().solve(&p).unwrap()
+    };
+    // the sequence that removes the largest feasible part index at each step
+    let mut state = MapState::new(p.maps());
+    let mut actions = Vec::new();
+    let mut greedy = Vec::new();
+    loop {
+        state.feasible_actions(&mut actions);
+        let Some(&a) = actions.iter().max() else { break };
+        state.remove(a);
+        greedy.push(a);
+    }
+    assert!(state.is_complete() && greedy.len() >= 5, "{greedy:?}");
+    let (values, _) = p.evaluate(&greedy).unwrap();
+    // with priors the search offers that sequence before its first iteration
+    let out = run(QUse::Priors);
+    assert_eq!(out.trace[0].iterations, 0, "{:?}", out.trace[0]);
+    assert!(close(out.trace[0].value, values[0]), "{:?} vs {values:?}", out.trace[0]);
+    // without, its first sequence comes from an iteration
+    let out = run(QUse::Expansions);
+    assert!(out.trace[0].iterations > 0, "{:?}", out.trace[0]);
 }
 
 /// A random rollout policy whose first choice on each thread waits (up to 20 s) until every

@@ -2,7 +2,8 @@
 
 The package's modules: :mod:`~asp.train.q.network` (the model), :mod:`~asp.train.q.graphs` (graph
 sources and their cache), :mod:`~asp.train.q.replay` (data sets, replay buffer, batching),
-:mod:`~asp.train.q.learner` (deep Q-learning), :mod:`~asp.train.q.evaluate` (ranking quality) and
+:mod:`~asp.train.q.learner` (deep Q-learning), :mod:`~asp.train.q.evaluate` (ranking quality),
+:mod:`~asp.train.q.distill` (a smaller network fitted to a trained one) and
 :mod:`~asp.train.q.export` (ONNX files and weights). Everything is importable from
 ``asp.train.q`` itself.
 
@@ -42,6 +43,7 @@ from ...datasets.transitions import DataError as DataError
 from ...datasets.transitions import Transition as Transition
 from ...datasets.transitions import TransitionAssembly as TransitionAssembly
 from ...datasets.transitions import TransitionDataset as TransitionDataset
+from .distill import DistillConfig, DistillState, distill_q, ranking_kept, sample_states
 from .evaluate import ranking_quality
 from .export import PARITY_PADDING, PARITY_PARTS, export_q, load_q_weights, parity_graphs, save_q_weights
 from .graphs import (
@@ -82,4 +84,9 @@ __all__ = [
     "ReplayBuffer",
     "config_dict",
     "parity_graphs",
+    "DistillConfig",
+    "DistillState",
+    "distill_q",
+    "ranking_kept",
+    "sample_states",
 ]
