@@ -6,6 +6,7 @@ pub mod catalogue;
 pub mod cell;
 pub mod collect;
 pub mod collect_q;
+mod cores;
 pub mod error;
 pub mod pipeline;
 pub mod request;

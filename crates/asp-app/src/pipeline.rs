@@ -389,7 +389,7 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
             return Ok(result);
         }
     }
-    plan_with_world(assembly, settings, progress, budget, units, voxels)
+    plan_with_world(assembly, settings, progress, budget, units, voxels, true)
 }
 
 /// [`plan_assembly`]'s feasibility plan on the collision world, never by the voxel fast path
@@ -399,7 +399,7 @@ pub fn plan_on_world(assembly: Assembly, settings: &PlanSettings, progress: Opti
     let budget = budget(settings)?;
     let units = unit_sets(&assembly, &settings.unit_groups)?;
     let voxels = voxel_model(&assembly, settings, &units);
-    plan_with_world(assembly, settings, progress, budget, units, voxels)
+    plan_with_world(assembly, settings, progress, budget, units, voxels, true)
 }
 
 /// The voxel view the grid planner takes apart, when it may run: it does not keep declared
@@ -408,6 +408,21 @@ fn voxel_model(assembly: &Assembly, settings: &PlanSettings, units: &[PartSet]) 
     (settings.grid && settings.checker_extension.is_none() && units.is_empty()).then(|| VoxelModel::of(assembly)).flatten()
 }
 
+/// A locked core of a plan planned as a model of its own ([`crate::cores`]): `assembly` holds
+/// its parts, its base fixed; the declared units that lie wholly in it are kept. Its own cores
+/// are not planned alone again.
+pub(crate) fn plan_core(assembly: Assembly, settings: &PlanSettings, budget: Budget) -> Result<PlanResult> {
+    let names: Vec<&str> = assembly.parts.iter().map(|p| p.name.as_str()).collect();
+    let groups: Vec<Vec<String>> = settings.unit_groups.iter().filter(|g| g.iter().all(|n| names.contains(&n.as_str()))).cloned().collect();
+    let settings = PlanSettings { unit_groups: groups, ..settings.clone() };
+    let units = unit_sets(&assembly, &settings.unit_groups)?;
+    let voxels = voxel_model(&assembly, &settings, &units);
+    plan_with_world(assembly, &settings, None, budget, units, voxels, false)
+}
+
+/// The feasibility plan on the collision world (after the grid planner on `voxels` when the
+/// model needs its moves); with `cores_alone`, the locked cores of the plan are then planned as
+/// models of their own ([`crate::cores`]).
 fn plan_with_world(
     assembly: Assembly,
     settings: &PlanSettings,
@@ -415,12 +430,14 @@ fn plan_with_world(
     budget: Budget,
     units: Vec<PartSet>,
     voxels: Option<VoxelModel>,
+    cores_alone: bool,
 ) -> Result<PlanResult> {
     let grid_started = Instant::now();
     let probe = voxels.clone().map(|m| GridRun::probe(m, &budget, grid_started));
     let started = Instant::now();
     let checker = checker(assembly, settings)?;
     let world_seconds = started.elapsed().as_secs_f64();
+    let units = with_bearings(units, checker.world());
     let mut grid = None;
     if let (Some(model), true) = (&voxels, probe.as_ref().is_some_and(GridRun::needs_moves)) {
         let run = GridRun::new(model.clone(), &GridConfig::default(), &budget, grid_started);
@@ -483,6 +500,9 @@ fn plan_with_world(
         report.attach_robot(r);
     }
     finish_report(&mut report, world, &outcome, world_seconds);
+    if cores_alone {
+        crate::cores::plan_cores_alone(&mut report, world.assembly(), settings, &budget, grid_started)?;
+    }
     explain_cores(&mut report, world, settings, grid_ran, &units);
     Ok(PlanResult { report, status: outcome.status, search: None })
 }
@@ -543,6 +563,25 @@ pub fn plan_on_voxels(
     Ok(Some(PlanResult { report, status: outcome.status, search: None }))
 }
 
+/// `units` with every rolling bearing `world` found ([`asp_geom::Bearing`]) as one more unit: a
+/// bought unit whose balls never leave their grooves goes in whole. A declared unit that shares
+/// a part with a bearing is merged with it (units are disjoint).
+fn with_bearings(mut units: Vec<PartSet>, world: &asp_geom::World) -> Vec<PartSet> {
+    let n = world.num_parts();
+    for b in world.bearings() {
+        let mut merged = PartSet::from_indices(n + 1, b.parts());
+        units.retain(|u| {
+            let meets = u.intersects(&merged);
+            if meets {
+                merged.union_with(u);
+            }
+            !meets
+        });
+        units.push(merged);
+    }
+    units
+}
+
 /// The declared units ([`PlanSettings::unit_groups`]) as sets of part indices.
 fn unit_sets(assembly: &Assembly, groups: &[Vec<String>]) -> Result<Vec<PartSet>> {
     let n = assembly.len();
@@ -563,6 +602,7 @@ fn unit_sets(assembly: &Assembly, groups: &[Vec<String>]) -> Result<Vec<PartSet>
 fn finish_report(report: &mut PlanReport, world: &asp_geom::World, outcome: &PlanOutcome, world_seconds: f64) {
     report.overlaps = asp_search::report::OverlapsEntry::of(world);
     report.fits = asp_search::report::FitEntry::of(world);
+    report.bearings = asp_search::report::BearingEntry::of(world);
     report.stats.timings =
         Some(Timings { load: 0.0, world: world_seconds, search: outcome.stats.seconds, path_planner: outcome.stats.path_planner_seconds });
 }

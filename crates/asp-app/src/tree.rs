@@ -191,7 +191,7 @@ fn embed(steps: &mut [AssemblyStep], child: &Node, plan: &PlanReport) {
 }
 
 /// Adds a subassembly's search effort to its parent's.
-fn add_effort(report: &mut PlanReport, child: &PlanReport) {
+pub(crate) fn add_effort(report: &mut PlanReport, child: &PlanReport) {
     let (s, c) = (&mut report.stats, &child.stats);
     s.removal_tests += c.removal_tests;
     s.failed_collision += c.failed_collision;
@@ -212,7 +212,7 @@ fn add_effort(report: &mut PlanReport, child: &PlanReport) {
 /// `report` of a level whose part `k` is part `map[k]` of the model, in the model's indices:
 /// every part index of the plan format (`part`, `parts`, `base`, `inner`, `index`, `held`,
 /// `remaining`, `disassembly_sequence`, at any depth) mapped.
-fn remapped(report: &PlanReport, map: &[usize]) -> Result<PlanReport> {
+pub(crate) fn remapped(report: &PlanReport, map: &[usize]) -> Result<PlanReport> {
     let fail = |e: serde_json::Error| AppError::config(format!("cannot map a subassembly's plan to the model: {e}"));
     let mut value = serde_json::to_value(report).map_err(fail)?;
     remap(&mut value, map);

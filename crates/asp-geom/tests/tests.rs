@@ -1,5 +1,6 @@
 //! The one integration test binary of asp-geom.
 
+mod bearings;
 mod distmap;
 mod fastener;
 mod fits;

@@ -18,7 +18,7 @@ pub use parts::{FaceEntry, PartEntry, SurfaceEntry, TessellationEntry};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.11";
+pub const FORMAT_VERSION: &str = "1.12";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -68,6 +68,10 @@ pub struct PlanReport {
     /// Since format 1.10.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub fits: Vec<FitEntry>,
+    /// The rolling bearings found in the model (balls captive between two rings), each planned
+    /// as one unit (feasibility planning; absent when there is none). Since format 1.12.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bearings: Vec<BearingEntry>,
     /// Non-fatal problems found in the model, one line each.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
@@ -282,6 +286,57 @@ impl FitEntry {
                 radii: [len(f.shaft_radius), len(f.hole_radius)],
                 roles: [world.role(f.shaft), world.role(f.hole)],
                 turns: f.turns,
+            })
+            .collect()
+    }
+}
+
+/// A rolling bearing of a plan (format 1.12): balls captive between an inner and an outer ring
+/// (plus a cage, shields), recognised from the geometry and planned as one unit, never taken
+/// apart.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct BearingEntry {
+    /// Every part of the bearing, ascending.
+    pub parts: Vec<usize>,
+    /// The inner ring and the outer ring.
+    pub rings: [usize; 2],
+    /// Their names.
+    pub names: [String; 2],
+    /// The balls.
+    pub balls: Vec<usize>,
+    /// The other parts held with the balls (cage, shields, seals).
+    pub others: Vec<usize>,
+    /// The centre of the balls' centres, model units.
+    pub centre: [f64; 3],
+    /// The bearing's axis (unit; either sign).
+    pub axis: [f64; 3],
+    /// The radius of the circle through the balls' centres, model units.
+    pub pitch_radius: f64,
+    /// The balls' radius, model units.
+    pub ball_radius: f64,
+    /// The rows of balls.
+    pub rows: usize,
+}
+
+impl BearingEntry {
+    /// Every bearing `world` found.
+    pub fn of(world: &asp_geom::World) -> Vec<BearingEntry> {
+        let units = &world.assembly().units;
+        let len = |m: f32| units.from_metres(m as f64);
+        world
+            .bearings()
+            .iter()
+            .map(|b| BearingEntry {
+                parts: b.parts(),
+                rings: b.rings,
+                names: b.rings.map(|p| world.name(p).to_string()),
+                balls: b.balls.clone(),
+                others: b.others.clone(),
+                centre: [b.centre.x, b.centre.y, b.centre.z].map(len),
+                axis: [b.axis.x as f64, b.axis.y as f64, b.axis.z as f64],
+                pitch_radius: len(b.pitch_radius),
+                ball_radius: len(b.ball_radius),
+                rows: b.rows,
             })
             .collect()
     }
@@ -579,6 +634,7 @@ impl PlanReport {
             robot: None,
             grid: None,
             file_subassemblies: Vec::new(),
+            bearings: Vec::new(),
         }
     }
 }

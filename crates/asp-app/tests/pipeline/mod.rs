@@ -406,3 +406,72 @@ fn the_plan_says_which_guidance_ran() {
         assert_eq!(run(Some(q)), Some(want));
     }
 }
+
+/// A rolling bearing in a housing on a shaft: its balls never leave their grooves, so taken part
+/// by part it would stay a locked core with the housing (`partial`); recognised, it goes in as
+/// one unit and the plan is `found`, the shaft through it along the axis.
+#[test]
+fn a_ball_bearing_goes_in_as_one_unit() {
+    use asp_search::report::{PlanStatus, SubassemblyStatus};
+    let settings = PlanSettings { timeout: Some(120.0), ..PlanSettings::default() };
+    let r = plan_assembly(asp_geom::fixtures::ball_bearing(64, 9, true), &settings, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Found, "{json}");
+    assert!(r.report.locked_cores.is_empty(), "{json}");
+    assert_eq!(r.report.bearings.len(), 1, "{json}");
+    let b = &r.report.bearings[0];
+    assert_eq!((b.rings, b.balls.len(), b.rows), ([2, 3], 9, 1), "{json}");
+    assert_eq!(b.names, ["inner ring".to_string(), "outer ring".to_string()]);
+    let steps = &r.report.assembly_sequence;
+    assert_eq!(steps.len(), 2, "the bearing and the shaft: {json}");
+    let unit = steps.iter().find_map(|s| s.subassembly.as_ref()).expect("the bearing's step");
+    assert_eq!((unit.status, unit.parts.len()), (SubassemblyStatus::Unit, 11), "{json}");
+    let mut parts = unit.parts.clone();
+    parts.sort_unstable();
+    assert_eq!(parts, b.parts);
+    // both go in along the axis
+    for s in steps {
+        let d = match &s.motion {
+            asp_search::report::MotionEntry::Linear { direction, .. } | asp_search::report::MotionEntry::Screw { direction, .. } => {
+                *direction
+            }
+            other => panic!("{other:?}"),
+        };
+        assert!(d[2].abs() > 0.999, "{}: {d:?}", s.name);
+    }
+    assert!(json.contains("\"bearings\""));
+    let text = r.report.to_text();
+    assert!(text.contains("rolling bearing: inner ring in outer ring, 9 balls in 1 row"), "{text}");
+    assert!(text.contains("a rolling bearing (balls captive between two rings), one unit, not taken apart"), "{text}");
+}
+
+/// A housing under a fixed roof with a block that must leave along an L, out of the top the roof
+/// covers: the search slides the two out from under the roof as one subassembly, whose own plan
+/// tries straight lines only and cannot open it; planned as a model of its own (its base fixed),
+/// the block comes out along its L, and the plan is `found` with the subassembly built part by
+/// part.
+#[test]
+fn a_core_that_comes_apart_on_its_own_is_planned_as_a_model_of_its_own() {
+    use asp_search::report::{PlanStatus, SubassemblyStatus};
+    let mut a = asp_geom::fixtures::l_path();
+    a.parts[0].fixed = false;
+    let mut roof = asp_geom::fixtures::box_part("roof", [0.0, 0.0, 5.0], [5.0, 3.0, 5.5]);
+    roof.fixed = true;
+    a.parts.push(roof);
+    // without the grid planner (which takes the voxel model apart by moves on its own)
+    let settings = PlanSettings { timeout: Some(120.0), seed: 1, grid: false, ..PlanSettings::default() };
+    let r = plan_assembly(a, &settings, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Found, "{json}");
+    assert!(r.report.locked_cores.is_empty() && r.report.grid.is_none(), "{json}");
+    let steps = &r.report.assembly_sequence;
+    assert_eq!(steps.len(), 1, "the housing and the block, slid in under the roof as one: {json}");
+    let g = steps[0].subassembly.as_ref().expect("a subassembly step");
+    assert_eq!((g.status, steps[0].name.as_str()), (SubassemblyStatus::Found, "housing"), "{json}");
+    assert_eq!(g.assembly_sequence.len(), 1, "{json}");
+    let block = &g.assembly_sequence[0];
+    assert_eq!(block.name, "block");
+    // not one straight line: a path, or a line after moves
+    let straight = matches!(block.motion, asp_search::report::MotionEntry::Linear { .. }) && block.moves.is_empty();
+    assert!(!straight, "the block goes in along its L: {json}");
+}

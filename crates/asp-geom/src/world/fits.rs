@@ -38,8 +38,10 @@ impl World {
                 (p, fits::role(self.name(p), g.surfaces(), g.mesh.vertices()))
             })
             .collect();
+        // a bearing's parts are a bought unit, never a fastener (a ring is no nut)
+        let in_bearing: BTreeSet<usize> = self.bearings.iter().flat_map(|b| b.parts()).collect();
         for (p, r) in roles {
-            self.roles[p] = r;
+            self.roles[p] = if in_bearing.contains(&p) { Role::Other } else { r };
         }
         let found: Vec<((usize, usize), Vec<Fit>)> = pairs
             .par_iter()
@@ -164,6 +166,12 @@ impl World {
     /// Every pair with fits, (low, high), and its fits.
     pub fn all_fits(&self) -> &BTreeMap<(usize, usize), Vec<Fit>> {
         &self.fits
+    }
+
+    /// The rolling bearings among the parts (balls captive between two rings; see
+    /// [`super::Bearing`]), found with the world when fasteners are (`WorldConfig::fasteners`).
+    pub fn bearings(&self) -> &[super::Bearing] {
+        &self.bearings
     }
 
     /// What part `p` is (a nut, a washer, a bolt, a pin; [`Role::Other`] for parts in no mesh

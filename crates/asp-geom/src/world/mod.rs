@@ -13,6 +13,7 @@
 //! contact stability and the collision queries along a motion; this file builds the world
 //! (mesh preparation, contacts and overlap measurement, threads) and answers the blocking rows.
 
+mod bearings;
 mod directions;
 mod fits;
 mod geom;
@@ -20,6 +21,7 @@ mod removal;
 
 pub(crate) use removal::best_free_direction;
 
+pub use bearings::Bearing;
 pub use directions::candidate_directions;
 use geom::{contains_point, nests, Geom};
 
@@ -118,6 +120,8 @@ pub struct World {
     fit_samples: BTreeMap<(usize, usize), OnceLock<Vec<Vec3>>>,
     /// What each part is (nut, washer, bolt, pin, other), from its shape and name.
     roles: Vec<crate::fits::Role>,
+    /// The rolling bearings among the parts ([`Bearing`]), found with the world.
+    bearings: Vec<Bearing>,
     fixed: PartSet,
     rows: Vec<OnceLock<Vec<PartSet>>>,
     warnings: Vec<String>,
@@ -200,6 +204,7 @@ impl World {
             fits: BTreeMap::new(),
             fit_samples: BTreeMap::new(),
             roles: vec![crate::fits::Role::Other; n],
+            bearings: Vec::new(),
             fixed,
             rows,
             warnings,
@@ -207,6 +212,8 @@ impl World {
         };
         world.measure_contacts(config.max_overlap_fraction, config.overlaps)?;
         if config.fasteners {
+            // before the fits: a bearing's rings are no nuts
+            world.bearings = world.find_bearings();
             world.find_fits();
             world.find_threads();
         }
@@ -244,6 +251,7 @@ impl World {
             fits: self.fits.clone(),
             fit_samples: self.fit_samples.keys().map(|&k| (k, OnceLock::new())).collect(),
             roles: self.roles.clone(),
+            bearings: self.bearings.clone(),
             fixed: self.fixed.clone(),
             rows: (0..self.num_parts()).map(|_| OnceLock::new()).collect(),
             warnings: self.warnings.clone(),

@@ -114,6 +114,19 @@ fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
             )?;
         }
     }
+    for b in &r.bearings {
+        writeln!(
+            out,
+            "rolling bearing: {} in {}, {} balls in {} row{} (pitch radius {}, ball radius {}), goes in as one unit",
+            b.names[0],
+            b.names[1],
+            b.balls.len(),
+            b.rows,
+            if b.rows == 1 { "" } else { "s" },
+            sig(b.pitch_radius),
+            sig(b.ball_radius)
+        )?;
+    }
     if !r.assembly_sequence.is_empty() {
         write_steps(out, r, &r.assembly_sequence, width, "")?;
     }
@@ -221,6 +234,9 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
                 SubassemblyStatus::Partial => "built on its base in this order, but not all of it part by part:".to_string(),
                 SubassemblyStatus::NoPlan => "cannot be taken apart (it goes in as one unit):".to_string(),
                 SubassemblyStatus::Unplanned => "not planned".to_string(),
+                SubassemblyStatus::Unit if r.bearings.iter().any(|b| b.parts == sorted(&g.parts)) => {
+                    "a rolling bearing (balls captive between two rings), one unit, not taken apart".to_string()
+                }
                 SubassemblyStatus::Unit => "declared one unit (--unit-group), not taken apart".to_string(),
                 other => format!("{} before its own plan was found; the parts that come off:", other.as_str().replace('_', " ")),
             };
@@ -366,4 +382,11 @@ fn sig(x: f64) -> String {
     }
     let decimals = (2 - x.abs().log10().floor() as i32).max(0) as usize;
     format!("{x:.decimals$}")
+}
+
+/// `parts` ascending.
+fn sorted(parts: &[usize]) -> Vec<usize> {
+    let mut v = parts.to_vec();
+    v.sort_unstable();
+    v
 }

@@ -1,0 +1,57 @@
+//! Rolling bearings recognised from their geometry ([`asp_geom::Bearing`]): balls captive
+//! between two raced rings, whatever the tessellation and the number of balls, in a housing on a
+//! shaft or alone; and nothing taken for one that is not.
+
+use asp_geom::fits::Role;
+use asp_geom::math::Vec3;
+use asp_geom::{fixtures, World, WorldConfig};
+
+fn world(a: asp_geom::Assembly, fasteners: bool) -> World {
+    World::new(a, &WorldConfig { fasteners, ..WorldConfig::default() }).unwrap()
+}
+
+#[test]
+fn a_ball_bearing_in_a_housing_on_a_shaft_is_found_whatever_its_facets_and_balls() {
+    for (facets, balls) in [(32, 7), (64, 9), (128, 12)] {
+        let w = world(fixtures::ball_bearing(facets, balls, true), true);
+        let (inner, outer) = (2, 3);
+        let b = w.bearings();
+        assert_eq!(b.len(), 1, "{facets} facets, {balls} balls: {b:?}");
+        let b = &b[0];
+        assert_eq!(b.rings, [inner, outer], "{facets}/{balls}");
+        assert_eq!(b.balls, (4..4 + balls as usize).collect::<Vec<_>>(), "{facets}/{balls}");
+        assert!(b.others.is_empty(), "the housing and the shaft are not the bearing's: {:?}", b.others);
+        assert_eq!(b.rows, 1);
+        assert!(b.axis.dot(Vec3::Z).abs() > 0.9999, "{:?}", b.axis);
+        assert!((b.pitch_radius - 0.01675).abs() < 2e-5, "{}", b.pitch_radius);
+        assert!((b.ball_radius - 0.003954).abs() < 5e-5, "{}", b.ball_radius);
+        assert!((b.centre - Vec3::new(0.0, 0.0, 0.007)).length() < 1e-5, "{:?}", b.centre);
+        assert_eq!(b.parts(), (2..4 + balls as usize).collect::<Vec<_>>());
+        // the rings are a bearing's, not nuts of a fastener
+        assert_eq!((w.role(inner), w.role(outer)), (Role::Other, Role::Other));
+    }
+}
+
+#[test]
+fn a_bearing_alone_is_found_and_not_when_fasteners_are_off() {
+    let w = world(fixtures::ball_bearing(64, 8, false), true);
+    assert_eq!(w.bearings().len(), 1);
+    assert_eq!(w.bearings()[0].rings, [0, 1]);
+    assert!(world(fixtures::ball_bearing(64, 8, false), false).bearings().is_empty());
+}
+
+#[test]
+fn balls_without_rings_or_off_a_circle_are_no_bearing() {
+    // the balls of a bearing, without its outer ring: they touch one ring only
+    let mut a = fixtures::ball_bearing(64, 8, false);
+    a.parts.remove(1);
+    assert!(world(a, true).bearings().is_empty());
+    // two balls are no row
+    let mut a = fixtures::ball_bearing(64, 8, false);
+    a.parts.truncate(4);
+    assert!(world(a, true).bearings().is_empty());
+    // fasteners and fits without balls
+    for a in [fixtures::bolted_joint([26, 16, 12]), fixtures::pressed_pin([32, 32], 0.0), fixtures::ring_on_locked_post()] {
+        assert!(world(a, true).bearings().is_empty());
+    }
+}
