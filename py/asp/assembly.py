@@ -191,11 +191,13 @@ class Assembly:
 
         The feasibility search (without ``objective``):
 
-        :param order: part ordering: ``given`` (default, the model's order), ``shuffled`` (one
-            order drawn from ``seed`` and kept: the thesis' vanilla AbD), ``random`` (a fresh order
-            in every state), ``bookkeeping`` (``given`` with bookkeeping), ``gnn`` (the learned
-            ordering).
-        :param model: the removability model (ONNX) of ``order="gnn"`` (default: the shipped one).
+        :param order: part ordering: ``auto`` (default: ``given`` on the default checker, ``gnn``
+            with bookkeeping under ``stability="physics"`` or a ``robot``, where a removal test is
+            expensive), ``given`` (the model's order), ``shuffled`` (one order drawn from ``seed``
+            and kept: the thesis' vanilla AbD), ``random`` (a fresh order in every state),
+            ``bookkeeping`` (``given`` with bookkeeping), ``gnn`` (the learned ordering).
+        :param model: the removability model (ONNX) of ``order="gnn"``, and of ``auto`` where it
+            is learned (default: the shipped model of the run's checker).
         :param bookkeeping: skip retesting a part until one of its blockers is gone.
         :param normals: clustered surface-normal directions tried besides the six axes (10).
         :param sphere_directions: extra removal directions sampled evenly on the sphere (0).
@@ -266,7 +268,9 @@ class Assembly:
         :param epsilon: probability of a random removal where ``q`` guides (0.2).
         :param q_use: where ``q`` guides: ``rollouts`` (default, the thesis: one evaluation per
             rollout step), ``expansions`` (the Q-values of every state the search adds order its
-            expansions, rollouts stay random: one evaluation per node) or ``both``.
+            expansions, rollouts stay random: one evaluation per node), ``both``, or ``priors``
+            (the Q-values of every state the search adds are PUCT priors, a greedy sequence on
+            them seeds the local search; rollouts stay random: one evaluation per node).
         :raises ConfigError: a setting is unknown, of the wrong type, out of range or of the
             other search.
         :raises LoadError: the model cannot be planned as given (parts overlapping beyond

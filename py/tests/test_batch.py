@@ -251,7 +251,7 @@ def test_a_batch_joins_a_cluster_by_address(tmp_path, asp_cli):
 
 
 def test_partial_plans_are_counted_apart(tmp_path, crossed_bars):
-    # issue 28: the crossed bars' plan holds a locked core (a partial plan); the summary says so
+    # The crossed bars' plan holds a locked core (a partial plan); the summary says so
     # instead of counting it as planned
     from asp.batch.jobs import LoadSettings
 

@@ -177,7 +177,7 @@ def test_export_error_is_an_asp_error_and_a_runtime_error():
 
 
 def test_files_a_model_names_stay_inside_its_folder(tmp_path):
-    """Issue 25: a glTF whose buffer climbs out of its folder is refused by asp.load (and
+    """A glTF whose buffer climbs out of its folder is refused by asp.load (and
     asp.plan, and batches, which load through it) unless allowed, as on the command line."""
     import json
     import struct

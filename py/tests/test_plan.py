@@ -182,7 +182,7 @@ def test_plan_table_of_a_bad_json_is_an_asp_error():
 
 
 def test_a_plan_with_a_locked_core_is_partial(crossed_bars, asp_cli):
-    # issue 28: with subassemblies (the default) the sequence is complete, but bar and cross go in
+    # With subassemblies (the default) the sequence is complete, but bar and cross go in
     # as one unit its own plan cannot open: the plan is partial, not found, with that core listed,
     # as the CLI says it (exit code 1)
     plan = asp.load(crossed_bars, unit="mm", up="z").plan()
@@ -194,7 +194,7 @@ def test_a_plan_with_a_locked_core_is_partial(crossed_bars, asp_cli):
     assert core["names"] == ["bar", "cross"]
     assert core["status"] == "no_plan" and core["explanation"]
     assert core["base"] in core["parts"]
-    # why it is locked (issue 28 item 2, format 1.9): one overlap, no fit, deeper than any
+    # why it is locked (format 1.9): one overlap, no fit, deeper than any
     # tessellation artefact; the bar blocked by the cross along every direction; no grid;
     # lenient overlaps would free the bar
     why = core["why"]
@@ -216,7 +216,7 @@ def test_a_plan_with_a_locked_core_is_partial(crossed_bars, asp_cli):
     assert table.splitlines()[1] == "planned 2 of 4 parts; 2 stay in 1 locked core: bar, cross"
     assert table.splitlines()[2] == "  why the core on cross (2 parts) is locked:"
     assert "    --overlaps lenient: would free its other part\n" in table
-    # declared one unit on purpose, the same core makes the plan found (issue 28 item 2)
+    # declared one unit on purpose, the same core makes the plan found
     core = plan.locked_cores[0]  # a fresh copy (the one above had its names cleared)
     unit = asp.load(crossed_bars, unit="mm", up="z").plan(unit_group=[core["names"]])
     assert unit.status == "found" and unit.found and unit.locked_cores == []
@@ -225,7 +225,7 @@ def test_a_plan_with_a_locked_core_is_partial(crossed_bars, asp_cli):
     with pytest.raises(asp.ConfigError, match="unit_group: no part is named 'nope'"):
         asp.load(crossed_bars, unit="mm", up="z").plan(unit_group="nope,bar")
     # a plan that takes every part apart has none: the pump, its screws, shaft and ring taken
-    # out along their fits (issue 38), and an IKEA table
+    # out along their fits, and an IKEA table
     pump = asp.load(PUMP, unit="mm", up="z").plan()
     assert pump.status == "found" and pump.found and pump.locked_cores == []
     lack = asp.plan(LACK, up="z")
@@ -273,7 +273,7 @@ def test_steps_are_typed_frozen_views_of_the_sequence(root, crossed_bars):
 
 
 def test_split_bodies_makes_each_body_of_a_mesh_a_part(tmp_path):
-    # issue 38 item 4: a shelf whose mesh also holds two pins stored beside it: named in a
+    # A shelf whose mesh also holds two pins stored beside it: named in a
     # warning and moved as one part, or, with split_bodies, one part per body
     from conftest import _box_stl
 

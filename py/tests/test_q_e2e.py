@@ -1,4 +1,4 @@
-"""Learned Q-functions end to end (issue 12), as a user runs them: generate a 4×4×4 Soma cube,
+"""Learned Q-functions end to end, as a user runs them: generate a 4×4×4 Soma cube,
 collect transitions from asp's own MCTS (``asp collect transitions``), train the Q-function of
 the ``access`` objective by deep Q-learning for a fixed number of steps (``python -m asp.train
 q``), then

@@ -1,4 +1,4 @@
-"""The online settings of thesis 6.5 (issue 12 item 5): a search run episode by episode from Python
+"""The online settings of thesis 6.5: a search run episode by episode from Python
 (``asp.Assembly.search``) whose Q-functions are trained after every episode
 (``python -m asp.train q-online``, :mod:`asp.train.online`), on a generated 4×4×4 Soma cube with
 fixed seeds and a few episodes."""

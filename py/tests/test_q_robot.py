@@ -1,4 +1,4 @@
-"""Q-functions for the robot's objective (issue 24 item 2): ``Assembly.q_graphs`` takes the robot's
+"""Q-functions for the robot's objective: ``Assembly.q_graphs`` takes the robot's
 keywords (what a data set of ``asp collect transitions --robot`` records), builds the robot-path
 problem with its reward range, and gives the same ``asp-q/1`` graphs as without the robot; a Q
 model of another objective is refused by ``Assembly.plan`` under the robot."""

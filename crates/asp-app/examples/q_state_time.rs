@@ -1,4 +1,4 @@
-//! Times a learned Q-function per optimiser state on a real model (issue 24 item 2: "Q inference
+//! Times a learned Q-function per optimiser state on a real model (the goal: "Q inference
 //! per state ≤ 0.2 ms at 30 parts"): the model's robot-path problem as `asp plan --robot panda
 //! --objective robot-path` builds it, then one Q evaluation of every feasible removal (the graph
 //! built from the maps and the forward pass, as a guided rollout step asks it) in each state of

@@ -1,5 +1,5 @@
 //! `asp robot cell MODEL`: which parts the robot cell can take out on their own, before a long
-//! search (issue 24 item 4).
+//! search.
 //!
 //! Each movable part is planned as the robot would take it out if it were the only part left
 //! besides the fixed ones (and the ground): a grasp the arm reaches without collision, the lift

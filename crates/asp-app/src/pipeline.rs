@@ -511,7 +511,7 @@ fn plan_with_world(
 /// (`1 / VOXEL_TIME_SHARE`).
 const VOXEL_TIME_SHARE: u32 = 10;
 
-/// The voxel fast path (issue 27 item 1): when every part is a union of boxes on one lattice
+/// The voxel fast path: when every part is a union of boxes on one lattice
 /// ([`VoxelChecker`]) and the settings ask for nothing it cannot answer (contact stability, no
 /// extension, an ordering that needs no world), the depth-first search runs on the voxel
 /// checker, which answers every removal test as the collision world would, and no world is

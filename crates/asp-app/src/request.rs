@@ -219,10 +219,11 @@ pub struct PlanRequest {
     pub rrt_time: Option<f64>,
 
     // --- the feasibility search ---
-    /// The part ordering, by its catalogue name (`given`, `shuffled`, `random`, `bookkeeping`,
-    /// `gnn`).
+    /// The part ordering, by its catalogue name (`auto`, the default, `given`, `shuffled`,
+    /// `random`, `bookkeeping`, `gnn`).
     pub order: Option<String>,
-    /// The removability model (ONNX) of `order = "gnn"` (default: the shipped one).
+    /// The removability model (ONNX) of `order = "gnn"`, and of `auto` where it is learned
+    /// (default: the shipped model of the run's checker).
     pub model: Option<PathBuf>,
     /// Bookkeeping on top of the ordering.
     pub bookkeeping: Option<bool>,

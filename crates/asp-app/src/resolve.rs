@@ -455,7 +455,7 @@ mod tests {
         );
     }
 
-    /// Issue 28 item 2: unit groups are lists of names (or comma-separated strings), each of at
+    /// Unit groups are lists of names (or comma-separated strings), each of at
     /// least two parts, no part in two, and they need subassemblies.
     #[test]
     fn unit_groups_are_checked() {

@@ -1,5 +1,5 @@
-//! Why each locked core of a feasibility plan is locked (`locked_cores[].why`, plan format 1.9;
-//! issue 28 item 2): the geometry's part comes from the plan's own collision world
+//! Why each locked core of a feasibility plan is locked (`locked_cores[].why`, plan format 1.9):
+//! the geometry's part comes from the plan's own collision world
 //! ([`CoreWhy::of`]); what the pipeline knows is added here — whether the grid planner ran, and
 //! the core's own plan rerun under `--overlaps lenient`.
 

@@ -1,4 +1,4 @@
-//! Stress cases for the planner (issue 28 item 3): small furniture and machine joints that a
+//! Stress cases for the planner: small furniture and machine joints that a
 //! person takes apart without thinking, but that single parts on straight lines cannot.
 //!
 //! - [`StressKind::Chair`]: four legs standing on the floor, a seat on tenons at the legs' tops,

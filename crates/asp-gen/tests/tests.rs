@@ -1,5 +1,5 @@
-//! Integration tests of the generators: the properties the thesis states and the issue asks
-//! for, checked on generated assemblies through the public API.
+//! Integration tests of the generators: the properties the thesis states and the generators promise
+//! (docs/generators.md), checked on generated assemblies through the public API.
 
 use asp_gen::batch::file_name;
 use asp_gen::cuboid::Cuboid;

@@ -1,4 +1,4 @@
-//! Builds a large model from real ones for scale measurements (issue 9, item 7): copies of
+//! Builds a large model from real ones for scale measurements: copies of
 //! several models laid side by side on a grid, written as one GLB.
 //!
 //! ```text

@@ -1,4 +1,4 @@
-//! Times the geometry half of planning for many models in one process (issue 9, item 7): load,
+//! Times the geometry half of planning for many models in one process: load,
 //! world build, and the first (cold) removal test of every part in the full assembly.
 //!
 //! ```text

@@ -10,7 +10,7 @@ use crate::world::World;
 /// How the stability of a state is judged.
 #[derive(Clone, Debug, Default)]
 pub enum StabilityMode {
-    /// Every present part is linked through the contact graph to a fixed part (seed 3.3).
+    /// Every present part is linked through the contact graph to a fixed part (thesis 3.3).
     #[default]
     ContactGraph,
     /// The present parts are simulated under gravity with rapier3d (fixed parts static); the

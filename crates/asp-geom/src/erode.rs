@@ -101,7 +101,7 @@ pub fn eroded_mesh(vertices: &[Vec3], triangles: &[[u32; 3]], amount: f32) -> (V
 }
 
 /// The triangles of [`eroded_mesh`]`(vertices, triangles, amount)` that may reach `region`,
-/// eroded exactly as there, at the cost of the triangles near the region (issue 27 item 3: an
+/// eroded exactly as there, at the cost of the triangles near the region (so an
 /// overlapping pair's trial erosions shrink only the part of a mesh near the other part).
 ///
 /// A vertex moves by at most `3 × amount`, so a triangle whose box, grown by twice that, misses
@@ -312,7 +312,7 @@ mod tests {
         }
     }
 
-    /// Issue 27 item 3: the trial erosions of an overlapping pair shrink only the triangles
+    /// The trial erosions of an overlapping pair shrink only the triangles
     /// near the other part; those triangles are the whole erosion's, bit for bit (saddle splits
     /// included), and every triangle of the whole erosion that reaches the region is among them.
     #[test]

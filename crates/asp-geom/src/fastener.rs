@@ -1,4 +1,4 @@
-//! Fasteners (issue 9 item 5): a part's axis of near rotational symmetry, and *threaded*
+//! Fasteners: a part's axis of near rotational symmetry, and *threaded*
 //! contacts, along whose axis a bolt or nut leaves by screwing.
 //!
 //! **The axis.** A surface of revolution (or a helical surface, a thread) is swept into itself by
@@ -84,7 +84,7 @@ impl SymmetryAxis {
 
 /// Whether `y` lies within `distance` of `mesh`'s surface, as `project_local_point` would say
 /// (the distance to the closest point on a triangle), asking only whether some triangle is that
-/// near (issue 27 item 3): the closest-point search visits the BVH down to the closest triangle
+/// near: the closest-point search visits the BVH down to the closest triangle
 /// even for points far off the surface (most turned samples of a part that is not a fastener),
 /// and among many near triangles (a modelled thread) keeps looking for the closest.
 fn within(mesh: &TriMesh, y: Vec3, distance: f32) -> bool {
@@ -472,7 +472,7 @@ mod tests {
     use crate::fixtures::bolt_and_nut;
     use parry3d::shape::TriMeshFlags;
 
-    /// Issue 27 item 3: whether a point lies within a distance of a surface, asked of the
+    /// Whether a point lies within a distance of a surface, asked of the
     /// triangles that near (the symmetry and thread checks' query), says what the closest
     /// point's distance says, for points on, near and far from a threaded bolt's surface.
     #[test]

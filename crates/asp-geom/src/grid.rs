@@ -1,6 +1,6 @@
 //! Voxel models: an assembly whose parts are sets of cells on ONE common grid ([`VoxelModel::of`]:
 //! from `extras.asp.cells`, or voxelised from a polycube mesh), the geometry the grid planner of
-//! asp-search (`asp_search::grid`) takes apart by moves of parts and groups (issue 9 item 6).
+//! asp-search (`asp_search::grid`) takes apart by moves of parts and groups.
 
 use crate::assembly::Assembly;
 use crate::boxes;

@@ -1,4 +1,4 @@
-//! Interlocking voxel puzzles with known answers (issue 9 item 6), for the grid search's tests
+//! Interlocking voxel puzzles with known answers, for the grid search's tests
 //! and benchmarks: six-piece burrs and a small puzzle that no straight-line or group removal
 //! takes apart. All in 1 cm cells, +Z up, no fixed part; every piece carries its cells
 //! (`extras.asp.voxels`). The piece shapes were found by a seeded search over notched sticks

@@ -33,7 +33,7 @@ pub fn triangle_sweep(a: &[DVec3; 3], dir: DVec3, b: &[DVec3; 3], t_max: f64) ->
 /// separating-axis sweep ([`crossing_sweep`]) never reports them. A solid moving into another
 /// also crosses its side faces, but a part of no thickness (a sheet drawn as a closed surface
 /// of no volume) has none: without this it went through a floor, or a box through it, along
-/// the sheet's normal (issue 28 item 5).
+/// the sheet's normal.
 fn coplanar_passage(a: &[DVec3; 3], dir: DVec3, b: &[DVec3; 3], t_max: f64) -> Option<f64> {
     let na = (a[1] - a[0]).cross(a[2] - a[1]);
     let nb = (b[1] - b[0]).cross(b[2] - b[1]);
@@ -304,7 +304,7 @@ mod tests {
         trimesh(Mesh::cuboid(lo, hi))
     }
 
-    /// Issue 28 item 5: parallel triangles carried through each other's plane meet at the
+    /// Parallel triangles carried through each other's plane meet at the
     /// instant they are coplanar when their interiors overlap there (a sheet of no thickness
     /// has no side faces whose crossing would say so); sliding in the plane, passing beside the
     /// other or only sharing an edge with it in the plane is no hit.

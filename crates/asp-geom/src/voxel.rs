@@ -1,4 +1,4 @@
-//! Voxel models at voxel speed (issue 27 item 1): the removal tests of an assembly whose parts
+//! Voxel models at voxel speed: the removal tests of an assembly whose parts
 //! are unions of axis-aligned boxes on one rectilinear lattice (Soma cubes and their floor,
 //! polycubes, burrs) answered from occupancy with bit operations, with no collision world.
 //!

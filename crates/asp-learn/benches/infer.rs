@@ -101,7 +101,7 @@ fn q_forward(c: &mut Criterion) {
     group.finish();
 }
 
-/// The shipped removability model as `--order gnn` runs it (issue 26 item 4): the Rust forward
+/// The shipped removability model as `--order gnn` runs it: the Rust forward
 /// pass from node and edge encodings cached per graph, per state of 40 and 100 parts with 4 and 5
 /// edges per part (the sizes of `shipped/...` above).
 fn gnn_state(c: &mut Criterion) {

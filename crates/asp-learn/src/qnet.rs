@@ -1,7 +1,7 @@
 //! The forward pass of the trainer's Q network (`py/asp/train/q.py`, `QNetwork`) written out in
-//! Rust, for the Q-function's inner loop (issue 12: one inference per guided rollout step), and
+//! Rust, for the Q-function's inner loop (one inference per guided rollout step), and
 //! of the removability GNN (`py/asp/train/gnn.py`, the same encoder with `log1p` input columns
-//! and a sigmoid head; [`QNet::removability`]) for `--order gnn` (issue 26 item 4).
+//! and a sigmoid head; [`QNet::removability`]) for `--order gnn`.
 //!
 //! Why not tract: the exported graph (docs/learning.md, "Q models") costs about 22 M
 //! multiply-adds per state at 40 parts (81 directions, width 64), and tract runs it near the

@@ -1,4 +1,4 @@
-//! Robot verdicts reused across states (issue 24): what one search thread has learnt of the arm,
+//! Robot verdicts reused across states: what one search thread has learnt of the arm,
 //! kept with the parts that were present when it was learnt.
 //!
 //! A path is checked against the parts present (its obstacles): it stays collision-free among

@@ -217,7 +217,7 @@ type PlanKey = (Vec<u64>, usize, usize, bool);
 /// expansion (`k` plans) learnt and the other way round, and a full plan's verdict is the first
 /// path's ([`RemovalPlanner::removable`]).
 ///
-/// Across states (issue 24): each search thread keeps a [`PathStore`] of the paths and monotone
+/// Across states: each search thread keeps a [`PathStore`] of the paths and monotone
 /// failures it found, each with its state. A rollout step takes a kept path whose state holds
 /// every present part (collision-free there; its length an upper bound) or a kept failure from
 /// a subset of the state before it plans; an expansion plans only for a path shorter than a

@@ -1,5 +1,5 @@
-//! Depth-first Assembly-by-Disassembly (seed 3.3) with backtracking, part orderings and the
-//! bookkeeping heuristic (seed 3.1.1).
+//! Depth-first Assembly-by-Disassembly (thesis 3.3) with backtracking, part orderings and the
+//! bookkeeping heuristic (thesis 3.1.1).
 //!
 //! In each state the parts are tested in the configured order with the fast straight-line test;
 //! the first removal whose remainder is stable is followed. When every single-part removal of a
@@ -53,7 +53,7 @@ impl DfsBuilder {
         self.ordering = factory;
         self
     }
-    /// Bookkeeping (seed 3.1.1) on top of the ordering: a part blocked by collision is retested
+    /// Bookkeeping (thesis 3.1.1) on top of the ordering: a part blocked by collision is retested
     /// only after one of its recorded blockers is gone. Default off.
     pub fn bookkeeping(mut self, on: bool) -> Self {
         self.bookkeeping = on;

@@ -427,8 +427,8 @@ pub enum MotionEntry {
 /// Effort counters.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Default)]
 pub struct StatsEntry {
-    /// What the removal tests ran on: [`CHECKER_COLLISION_WORLD`] (shape casts on the meshes,
-    /// the feasibility planner) or [`CHECKER_DISTANCE_MAPS`] (the optimiser; format 1.2).
+    /// What the removal tests ran on: [`CHECKER_COLLISION_WORLD`] (exact sweeps on the
+    /// collision world, the feasibility planner) or [`CHECKER_DISTANCE_MAPS`] (the optimiser; format 1.2).
     #[serde(default)]
     pub checker: Checker,
     /// Removal tests run.

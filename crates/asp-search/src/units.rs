@@ -1,4 +1,4 @@
-//! Units declared by the user (`--unit-group NAME,NAME...`; issue 28 item 2): a purchased motor,
+//! Units declared by the user (`--unit-group NAME,NAME...`): a purchased motor,
 //! a pressed-in bearing, parts that are one part for assembly. [`UnitChecker`] wraps any
 //! checker so that the planners move each unit as one rigid part, on purpose: its parts never
 //! leave alone, the unit leaves whole (a subassembly step whose `unit` is set, never planned

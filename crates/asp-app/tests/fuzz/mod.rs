@@ -1,4 +1,4 @@
-//! Issue 28 item 5: no panic anywhere on any input. Every planner is driven through the one front
+//! No panic anywhere on any input. Every planner is driven through the one front
 //! door (a [`PlanRequest`], [`asp_app::resolve()`], the pipeline) on generated models: random voxel
 //! models (cells in the metadata, or meshes only; pieces that are polycubes, or disconnected, or
 //! touch along edges), random boxes (axis-aligned and rotated; touching, overlapping, nested,
@@ -693,7 +693,7 @@ fn run(cases: u64) {
     }
 }
 
-/// Issue 28 item 5: every planner, on generated models, ends in a plan with a status or a
+/// Every planner, on generated models, ends in a plan with a status or a
 /// one-line error, and its plans keep the invariants (the module documentation lists them).
 #[test]
 fn issue_28_every_planner_on_generated_models_gives_a_status_or_a_one_line_error() {

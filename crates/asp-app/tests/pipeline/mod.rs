@@ -2,7 +2,7 @@
 
 use asp_app::pipeline::{plan_assembly, PlanSettings};
 
-/// Issue 9 item 6: the pipeline plans interlocking voxel puzzles by grid moves, straight away
+/// The pipeline plans interlocking voxel puzzles by grid moves, straight away
 /// when parts must move in turn before anything can leave, and leaves other voxel models to the
 /// depth-first search.
 #[test]
@@ -34,7 +34,7 @@ fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
     assert!(r.found() && r.report.grid.is_none());
 }
 
-/// Issue 28 item 1: a plan whose only sequence lifts an interlocked group in one piece is not
+/// A plan whose only sequence lifts an interlocked group in one piece is not
 /// `found`: without the grid the burr only lifts off the ground as one subassembly that cannot
 /// be taken apart (straight lines and groups only), so the plan is `partial` and names the core.
 #[test]
@@ -73,7 +73,7 @@ fn issue_28_a_plan_that_lifts_a_locked_core_in_one_piece_is_partial() {
     assert!(r.found() && r.report.locked_cores.is_empty());
 }
 
-/// Issue 28 item 4: on a voxel puzzle the grid planner answers before the path planner, with or
+/// On a voxel puzzle the grid planner answers before the path planner, with or
 /// without a fixed piece (with one fixed, the path planner used to run for half a minute first).
 #[test]
 fn issue_28_voxel_puzzles_with_a_fixed_piece_get_the_grid_before_the_path_planner() {
@@ -99,7 +99,7 @@ fn issue_28_voxel_puzzles_with_a_fixed_piece_get_the_grid_before_the_path_planne
     }
 }
 
-/// Issue 23: an optimiser's `no_plan` is explained like the feasibility search's, by its deepest
+/// An optimiser's `no_plan` is explained like the feasibility search's, by its deepest
 /// dead end on the maps (not an empty explanation over the whole model): the lid comes off, then
 /// the block at the end of the L-shaped channel cannot leave along any straight line.
 #[test]
@@ -191,7 +191,7 @@ fn the_pump_comes_apart_along_its_fits() {
 }
 
 /// Two bars drawn through each other (a halving joint with no notches modelled: an overlap no
-/// shrinking separates) beside issue 9's ring on a locked post (a real interlock of cells): two
+/// shrinking separates) beside a ring on a locked post (a real interlock of cells): two
 /// locked cores, each with its own reason.
 fn crossed_bars_beside_a_locked_post() -> asp_geom::Assembly {
     use asp_geom::fixtures::box_part;
@@ -202,7 +202,7 @@ fn crossed_bars_beside_a_locked_post() -> asp_geom::Assembly {
     a
 }
 
-/// Issue 28 item 2 on a generated case: the crossed bars are locked by a modelling artefact
+/// Locked-core reasons on a generated case: the crossed bars are locked by a modelling artefact
 /// (their overlap is deeper than any fit) that `--overlaps lenient` frees; the ring, post and
 /// base are locked by their shapes (each blocked along every direction, no overlap), which
 /// nothing frees; the model is no voxel model (the bars share cells), but the post's core alone is.
@@ -261,7 +261,7 @@ fn issue_28_an_artefact_and_an_interlock_are_told_apart() {
     );
 }
 
-/// Issue 28 item 2: on a voxel model the grid planner runs on a locked core (and finds no moves
+/// On a voxel model the grid planner runs on a locked core (and finds no moves
 /// that take it apart); with `--no-grid` the core says it was not tried, and why.
 #[test]
 fn issue_28_a_locked_core_says_whether_the_grid_planner_tried_it() {
@@ -280,7 +280,7 @@ fn issue_28_a_locked_core_says_whether_the_grid_planner_tried_it() {
     assert!(r.report.to_text().contains("    grid planner: not tried (--no-grid)\n"));
 }
 
-/// Issue 28 item 2: parts declared one unit (`--unit-group`) are planned as one part on purpose:
+/// Parts declared one unit (`--unit-group`) are planned as one part on purpose:
 /// the locked post's core goes in whole as a `unit` step and the plan is `found`, not `partial`;
 /// a unit with a fixed part is part of the base; an unknown name is an error naming the setting.
 #[test]
@@ -315,7 +315,7 @@ fn issue_28_a_declared_unit_is_planned_as_one_part_and_the_plan_is_found() {
     assert_eq!(e.to_string(), "unit_group: no part is named 'nope'");
 }
 
-/// Issue 28 item 2 on the shared pump: six of its parts declared one unit go in as one `unit`
+/// Unit groups on the shared pump: six of its parts declared one unit go in as one `unit`
 /// step; two parts declared one unit stay whole though their fit would let them part, and the
 /// ring that goes on between them is then locked in a `partial` core.
 #[test]
@@ -347,7 +347,7 @@ fn issue_28_the_pumps_core_declared_one_unit_is_found() {
     assert!(text.contains("\n    grid planner: not tried (units declared with --unit-group)\n"), "{text}");
 }
 
-/// Issue 26 item 1: under `--stability physics` the generated profile assemblies plan, single
+/// Under `--stability physics` the generated profile assemblies plan, single
 /// and double layer, connectors attached or as parts: the simulation holds what the connectors
 /// fasten (without it the frame collapses in its assembled state and nothing can leave). The
 /// plans are `found`: every part gets its own motion (a subassembly's parts in its own plan).

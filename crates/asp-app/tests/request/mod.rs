@@ -81,7 +81,7 @@ fn model_of_checker(dir: &std::path::Path, checker: &str) -> PathBuf {
     path
 }
 
-/// Issue 26 item 2: a model must rank for the checker of the run that uses it; without a file,
+/// A model must rank for the checker of the run that uses it; without a file,
 /// the run's checker picks the shipped model.
 #[test]
 fn a_model_of_another_checker_is_refused_and_the_shipped_one_follows_the_checker() {

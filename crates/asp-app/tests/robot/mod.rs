@@ -289,7 +289,7 @@ fn robot_plan(setup: RobotSetup) -> PlanReport {
     plan_assembly(near_and_far(), &settings, None).unwrap().report
 }
 
-/// Issue 25 item 4, issue 24 item 4: when the robot, not the geometry, keeps a part in, the
+/// When the robot, not the geometry, keeps a part in, the
 /// explanation gives the robot's reason and lists no parts as blockers; a part the geometry
 /// holds (the low far block would leave the top one unsupported) keeps its own reason.
 #[test]
@@ -328,7 +328,7 @@ fn the_explanation_names_the_robot_reason_not_parts_that_do_not_block() {
     assert_eq!(near.robot.as_ref().map(|r| r.reason), Some(RobotReason::NoDropOff), "{near:?}");
 }
 
-/// Issue 24 item 4: `asp robot cell` says which parts the cell can take out on their own before
+/// `asp robot cell` says which parts the cell can take out on their own before
 /// any search: the near block, not the two far ones (out of reach); with the drop-off out of
 /// reach, none (no path). The same request gives the same answer.
 #[test]
@@ -354,7 +354,7 @@ fn the_cell_check_names_the_parts_the_arm_cannot_take_out_alone() {
     assert_eq!(check.parts[0].outcome, "no_path", "{:?}", check.parts[0]);
 }
 
-/// Issue 26 item 6: `asp bench feasible` runs under the robot checker too: with the arm, the
+/// `asp bench feasible` runs under the robot checker too: with the arm, the
 /// blocks out of its reach make every run fail and its refusals count as failed tests; without
 /// it every run finds a plan.
 #[test]
@@ -372,7 +372,7 @@ fn the_feasibility_bench_runs_under_the_robot_checker() {
     assert!(rows.iter().all(|r| r.found == 0 && r.failed_collision.mean > 0.0), "{rows:?}");
 }
 
-/// Issue 26 item 2: `asp collect removability --robot` labels by the robot's checker: the near
+/// `asp collect removability --robot` labels by the robot's checker: the near
 /// block comes out; the far stack's top block is let out by the geometry but the arm reaches
 /// none of its grasps (`arm_no_grasp`); the low one would leave the top one unsupported
 /// (`gravity`). Every non-fixed part of a state is in exactly one list, the index says
@@ -421,7 +421,7 @@ fn resolved(json: &str) -> PlanSettings {
     asp_app::resolve(&asp_app::PlanRequest::from_json(json).unwrap()).unwrap()
 }
 
-/// Issue 24 item 2: `asp collect transitions --robot panda --objective robot-path` records robot
+/// `asp collect transitions --robot panda --objective robot-path` records robot
 /// MCTS with the robot-path rewards, and its index rebuilds the same problem (robot included),
 /// as Python's `Assembly.q_graphs(**maps)` does.
 #[test]
@@ -471,7 +471,7 @@ fn transitions_are_collected_under_the_robot_with_robot_path_rewards() {
     assert_eq!(asp_search::qgraph::QGraphConfig::for_maps(p.maps()).features(), index.features);
 }
 
-/// Issue 24 item 2: the optimiser under the robot guided by a `robot-path` Q model (ε-greedy
+/// The optimiser under the robot guided by a `robot-path` Q model (ε-greedy
 /// rollouts, Q-ordered expansions): a plan whose paths re-check, the same for the same seed, and
 /// not the vanilla search's (greedy rollouts and expansions take other removals).
 #[test]
@@ -489,7 +489,7 @@ fn the_optimiser_under_the_robot_is_guided_by_a_robot_path_q_model() {
     assert_ne!(without_times(&a.report), without_times(&vanilla.report));
 }
 
-/// Issue 24 item 2: a Q model of another objective is refused before the search, naming the file
+/// A Q model of another objective is refused before the search, naming the file
 /// and both objectives; so is the robot-path model for another objective.
 #[test]
 fn a_q_model_of_another_objective_is_refused_under_the_robot() {

@@ -1,4 +1,4 @@
-//! The stepped search (issue 12 item 5): `solve_stepped` and `SteppedSearch` run the same loop as
+//! The stepped search: `solve_stepped` and `SteppedSearch` run the same loop as
 //! `solve` and `asp plan --objective`, episode by episode, and a policy swapped in between two
 //! episodes guides exactly the episodes after it.
 

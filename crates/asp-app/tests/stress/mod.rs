@@ -1,4 +1,4 @@
-//! Issue 28 item 3: the generated stress cases (`asp gen stress`) — chairs with rungs in two
+//! The generated stress cases (`asp gen stress`) — chairs with rungs in two
 //! legs on two or four sides, carcasses of panels joined by dowels (holes modelled or dowels
 //! drawn into solid panels), plates clamped by threaded bolts and nuts — are taken apart
 //! completely (`found`), and every plan passes the independent re-check of

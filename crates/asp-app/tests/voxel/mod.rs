@@ -1,4 +1,4 @@
-//! Issue 27 item 1: the voxel fast path (`asp_geom::voxel::VoxelChecker`, the pipeline's
+//! The voxel fast path (`asp_geom::voxel::VoxelChecker`, the pipeline's
 //! `plan_on_voxels`) answers as the collision world does, so its plans are the world's plans.
 //! Any difference — a blocking row, a contact, a motion's last bit, a counter — fails here.
 

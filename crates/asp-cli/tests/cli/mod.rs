@@ -84,7 +84,7 @@ fn no_plan_exits_1_and_explains() {
     assert_eq!(plan["assembly_sequence"][0]["motion"]["kind"], "path");
     assert_eq!(plan["stats"]["path_planner_calls"], 1);
     // the housing and block are a voxel model: the grid search finds the L (a move along +x,
-    // then out along +z) once straight lines give up, before the path planner (issue 28 item 4),
+    // then out along +z) once straight lines give up, before the path planner,
     // and without it the same
     for flags in [&[][..], &["--no-path-planner"][..]] {
         let mut args = vec!["plan", model.to_str().unwrap(), "--json"];
@@ -108,7 +108,7 @@ fn reach_model(dir: &Path) -> PathBuf {
     fixture_file(dir, &fixtures::assemble("reach", vec![plate, near, far], asp_geom::math::Axis::Z), "reach.glb")
 }
 
-/// Issue 25 item 4, issue 24 item 4: with `--robot`, a part the geometry lets out but the arm
+/// With `--robot`, a part the geometry lets out but the arm
 /// cannot take out is explained by the arm's reason, not "blocked by" parts that do not block
 /// it: a block out of reach of the base `--robot-base` puts (no reachable grasp), and the L's
 /// block, which leaves its housing only along a path: the arm now lifts path motions too (up
@@ -143,7 +143,7 @@ fn issue_25_a_robot_refusal_is_explained_by_the_arms_reason() {
     );
 }
 
-/// Issue 24 item 4: `asp robot cell` names, before any search, the parts the cell cannot take
+/// `asp robot cell` names, before any search, the parts the cell cannot take
 /// out even on their own (exit 1), with the arm's reason; `--json -` prints the check; a bad
 /// robot base is a one-line error naming its flag (exit 2).
 #[test]
@@ -272,7 +272,7 @@ fn physics_stability_takes_the_keystone_before_a_pillar() {
     assert_eq!(order(&["--stability", "physics"])[0], 3);
 }
 
-/// Issue 26 item 3: the default ordering (`auto`) is the learned ordering with bookkeeping under
+/// The default ordering (`auto`) is the learned ordering with bookkeeping under
 /// `--stability physics`, decided from the checker and not from a clock: the same seed gives
 /// the same plan and the same tests, twice, as `--order gnn --bookkeeping` does.
 #[test]
@@ -293,7 +293,7 @@ fn issue_26_the_default_ordering_under_physics_is_gnn_with_bookkeeping_and_repea
     assert_eq!(run(&["--order", "gnn", "--bookkeeping"]), auto);
 }
 
-/// Issue 26: under `--robot` the default ordering is also the learned one with bookkeeping (the
+/// Under `--robot` the default ordering is also the learned one with bookkeeping (the
 /// robot checker's shipped model): the same plan and tests as `--order gnn --bookkeeping`, twice
 /// for a seed, and fewer tests than the file's order, which tries the bottom of a stack first.
 #[test]
@@ -472,9 +472,9 @@ fn issue_9_plans_an_interlocking_burr_by_grid_moves() {
     let mut present: Vec<usize> = (0..6).collect();
     replay_json(&plan["assembly_sequence"], &mut pos, &mut present, 0.01);
     assert!(present.is_empty(), "parts never taken out: {present:?}");
-    // without the grid search (the planner before issue 9 item 6) the burr only lifts off the
+    // without the grid search (the planner before the grid search) the burr only lifts off the
     // ground in one piece: a subassembly of all six pieces that cannot be taken apart
-    // (issue 28: so the plan is partial, exit code 1)
+    // (so the plan is partial, exit code 1)
     let o = asp(&["plan", model.to_str().unwrap(), "--no-grid", "--no-path-planner", "--json"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -484,7 +484,7 @@ fn issue_9_plans_an_interlocking_burr_by_grid_moves() {
     assert!(plan["grid"].is_null());
 }
 
-/// Issue 28 item 1: a plan that lifts a locked core in one piece is `partial`, exit code 1, in
+/// A plan that lifts a locked core in one piece is `partial`, exit code 1, in
 /// the JSON (with the core and why), the table and `--each`'s summary.
 #[test]
 fn issue_28_a_plan_with_a_locked_core_is_partial_with_exit_code_1() {
@@ -566,7 +566,7 @@ fn gen_profiles_attaches_connectors_on_request() {
     assert_eq!(bad.status.code(), Some(2));
 }
 
-/// Issue 28 item 2: `--unit-group` plans the named parts as one part on purpose: the locked
+/// `--unit-group` plans the named parts as one part on purpose: the locked
 /// post's core goes in whole, the plan is `found` (exit 0); a name the model lacks is an error
 /// naming the flag (exit 2).
 #[test]
@@ -627,7 +627,7 @@ fn plan_each_in_parallel_prints_in_model_order() {
     assert_eq!(strip(&table), strip(&tables.join("\n")));
 }
 
-/// Issue 26 item 2: `--model` trained on another checker's labels (its `asp.checker`) is one
+/// `--model` trained on another checker's labels (its `asp.checker`) is one
 /// line naming the file and both checkers, exit status 2, for `asp plan` and `asp bench feasible`.
 #[test]
 fn issue_26_a_model_of_another_checker_exits_2_naming_both() {
@@ -653,7 +653,7 @@ fn issue_26_a_model_of_another_checker_exits_2_naming_both() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
 
-/// Issue 38 item 4: a part whose mesh holds several bodies (pins stored beside a shelf in the
+/// A part whose mesh holds several bodies (pins stored beside a shelf in the
 /// shelf's mesh) is named in a warning and moves as one; `--split-bodies` plans each body as a
 /// part of its own, named `NAME#1`, `NAME#2`, ...
 #[test]

@@ -291,7 +291,7 @@ fn collect_transitions_writes_the_documented_data_set() {
     let o = asp(&["collect", "transitions", models.to_str().unwrap(), "--objective", "access,speed", "--out", bad.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("--objective") && stderr(&o).contains("speed"), "{}", stderr(&o));
-    // the robot flags of `asp plan` (issue 24 item 2): robot-path needs --robot, a robot setting
+    // the robot flags of `asp plan`: robot-path needs --robot, a robot setting
     // needs the robot, and the feasibility search's --grippers is refused; nothing is written
     let m = models.to_str().unwrap();
     for (flags, words) in [
@@ -332,7 +332,7 @@ fn q_models_are_checked_before_the_search() {
     assert!(stderr(&o).contains("--epsilon: must be in [0, 1], got 1.5"), "{}", stderr(&o));
 }
 
-/// Issue 23: a setting of the other search is an error naming the one that applies, before any
+/// A setting of the other search is an error naming the one that applies, before any
 /// work (`--timeout 10` on an MCTS run used to be ignored while the run went on for its whole
 /// episode budget); one line, exit 2, nothing written.
 #[test]

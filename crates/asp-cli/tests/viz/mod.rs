@@ -323,7 +323,7 @@ fn plot_draws_traces_and_rejects_a_plan_without_a_front() {
     assert!(stderr(&o).contains("pareto_front"), "{}", stderr(&o));
 }
 
-/// Issue 25: a part name built to hurt stays text in the viewer: no element it spells is made,
+/// A part name built to hurt stays text in the viewer: no element it spells is made,
 /// no script it carries runs, and the step list shows it verbatim.
 #[test]
 fn a_hostile_part_name_stays_text_in_the_viewer() {

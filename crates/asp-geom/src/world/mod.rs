@@ -866,7 +866,7 @@ mod tests {
     use crate::math::{Axis, Rot};
 
     /// Whether `a` shrunk by `amount` still overlaps `b`, as `Geom::eroded_hits` decided it
-    /// before issue 27 item 3: the whole mesh eroded, as a triangle soup.
+    /// before erosion near the region: the whole mesh eroded, as a triangle soup.
     fn hits_by_whole_erosion(a: &Geom, amount: f32, b: &Geom) -> bool {
         let (v, t) = eroded_mesh(a.mesh.vertices(), a.mesh.indices(), amount);
         sweep::soup_crosses(&v, &t, &b.mesh)
@@ -880,7 +880,7 @@ mod tests {
         depth_search(tol, limit, |extra| !hits_by_whole_erosion(a, tol + extra, b))
     }
 
-    /// Issue 27 item 3: the trial erosions of an overlapping pair shrink only the triangles near
+    /// The trial erosions of an overlapping pair shrink only the triangles near
     /// the other part; every pair's measured depth (shallow, deep, gross, nested, threaded) is
     /// the one the whole erosions give, so the warnings and explanations print the same.
     #[test]

@@ -1,4 +1,4 @@
-//! Threaded fasteners (issue 9 item 5): a bolt with a modelled helical thread in a nut with the
+//! Threaded fasteners: a bolt with a modelled helical thread in a nut with the
 //! matching internal thread leaves by screwing along its axis, only the way its head allows.
 
 use crate::removal::free_axes;

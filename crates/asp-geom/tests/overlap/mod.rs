@@ -1,4 +1,4 @@
-//! Input overlaps (issue 9 item 1): press fits are data, not errors, and under the default
+//! Input overlaps: press fits are data, not errors, and under the default
 //! strict policy an overlapping pair separates only along motions that enter no new material.
 
 use crate::removal::free_axes;
@@ -74,8 +74,8 @@ fn a_dowel_in_two_boards_comes_out_after_the_upper_board_both_upward() {
 
 /// A dowel drawn into a large solid panel (no hole modelled) may not slide sideways through it:
 /// the panel's whole-surface samples are about 2 cm apart on its 2 m² of surface, and the
-/// 8 mm dowel slid between them until the pair's own samples near the dowel came in (issue 28
-/// item 3, the carcasses of `asp gen stress`: the independent replay saw the dowels cut
+/// 8 mm dowel slid between them until the pair's own samples near the dowel came in (the
+/// carcasses of `asp gen stress`: the independent replay saw the dowels cut
 /// through their side panels).
 #[test]
 fn a_dowel_drawn_into_a_large_panel_leaves_along_its_axis_only() {
@@ -117,7 +117,7 @@ fn coincident_parts_are_reported_and_separate() {
     assert_eq!(free_axes(&w, 1, &PartSet::full(2)).len(), 6);
 }
 
-/// Issue 28 item 2: a locked core's lenient rerun tests its pairs in [`World::lenient`], a copy
+/// A locked core's lenient rerun tests its pairs in [`World::lenient`], a copy
 /// of the strict world that measures nothing again; it must test exactly as a world built with
 /// the lenient policy (a small overlap shrunk, a gross one ignored, the rest unchanged).
 #[test]

@@ -125,7 +125,7 @@ fn a_pressed_plug_holds_in_a_ring() {
     assert_eq!(p.stability(&w, &set(3, &[0, 2])), unstable(3, &[2]));
 }
 
-/// Issue 26 item 1: what the model says is fastened holds. A bracket touches a post's side only,
+/// What the model says is fastened holds. A bracket touches a post's side only,
 /// in mid-air: it falls, unless its extras say it is screwed to the post (`fastened_to`), or the
 /// post says it holds the bracket (the connector's `holds`); with the post gone the fastening
 /// goes too. A name that is no part of the model is a load warning, not a bond.

@@ -205,7 +205,7 @@ fn bvh_descent_sweeps_agree_with_the_per_triangle_search() {
     assert!(hits > 20 && misses > 20, "{hits} hits, {misses} misses");
 }
 
-/// Issue 28 item 5 (found by the planners' fuzz test, `asp-app/tests/fuzz`, case 103): a part
+/// Found by the planners' fuzz test (`asp-app/tests/fuzz`, case 103): a part
 /// of zero thickness (a flat box: a sheet drawn as a closed surface with no volume) lying on the
 /// floor left downward through the ground, and a sheet between two boxes left through them: the
 /// tolerance's erosion turned the sheet inside out (its two faces swapped sides), so nothing
@@ -245,7 +245,7 @@ fn issue_28_a_sheet_of_zero_thickness_leaves_neither_through_the_floor_nor_throu
     assert!(!free_axes(&w, 2, &all).contains(&"-z") && !free_axes(&w, 0, &all).contains(&"+z"));
 }
 
-/// Issue 28 item 5 (the planners' fuzz test, `asp-app/tests/fuzz`): a model built in memory with
+/// Found by the planners' fuzz test (`asp-app/tests/fuzz`): a model built in memory with
 /// a part whose triangles all have zero area (collapsed onto a line) was refused with parry's
 /// words ("invalid configuration: cannot build a collision mesh: A triangle mesh must contain
 /// at least one triangle"); it is refused as the loader refuses it, naming the part and saying

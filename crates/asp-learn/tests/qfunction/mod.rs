@@ -240,7 +240,7 @@ fn a_model_the_rust_forward_pass_does_not_know_stays_on_tract() {
     assert_eq!(a, b);
 }
 
-/// Issue 24 item 2: the shipped robot-path Q (`models/q-robot-path.onnx`,
+/// The shipped robot-path Q (`models/q-robot-path.onnx`,
 /// `scripts/train-q-robot-path`) is what `asp plan --robot panda --objective robot-path --q` needs:
 /// the `robot-path` objective, the default maps' features (resolution 9), and the Rust forward pass
 /// (the trainer names its encoder's parameters `encoder.*`), giving tract's values.

@@ -37,7 +37,7 @@ pub struct RemovalConfig {
     /// (false: only the whole arm after inverse kinematics; for comparisons).
     pub gripper_precheck: bool,
     /// Bound a point's displacement by each joint's own lever arm (false: the largest lever arm
-    /// for every joint, as before issue 10's speed-up; for comparisons).
+    /// for every joint, as before the per-joint bound; for comparisons).
     pub per_joint_levers: bool,
     /// Skip edge samples that the clearance bound at an earlier sample proves free (box
     /// distances to the parts and the floor, exact distances between the arm's own shapes):

@@ -31,7 +31,7 @@
 //! overlap in the middle of the joint limits ([`RemovalConfig::self_collision`]). Collisions
 //! between the arm and the part it holds are not checked.
 //!
-//! Speed (issue 10): grasps are examined in increasing order of their lower bound and planned
+//! Speed: grasps are examined in increasing order of their lower bound and planned
 //! at once, so the search stops as soon as no later grasp can beat the best path; each grasp is
 //! rejected by the cheapest test that can (the gripper alone at the grasp and lifted poses needs
 //! no inverse kinematics); shapes are tested against the state's parts only when they meet the

@@ -1,4 +1,4 @@
-//! Grid plans of interlocking voxel puzzles (issue 9 item 6) as plan outcomes.
+//! Grid plans of interlocking voxel puzzles as plan outcomes.
 //!
 //! [`super::solver`] takes a voxel model apart by moves of parts and groups on its grid; here
 //! its answer becomes the steps every report and picture reads: each separation a removal

@@ -1,4 +1,4 @@
-//! Interlocking voxel puzzles by an exact search over grid moves (issue 9 item 6).
+//! Interlocking voxel puzzles by an exact search over grid moves.
 //!
 //! When every part of an assembly is a set of cells on ONE common grid ([`VoxelModel::of`](asp_geom::grid::VoxelModel::of): from
 //! `extras.asp.cells`, or voxelised from a polycube mesh), a BurrTools-style search is exact and
@@ -297,7 +297,7 @@ impl Solver<'_> {
                         let stay_units: Vec<usize> = staying.iter().map(|&i| local.units[i]).collect();
                         let base = self.base(&stay_units);
                         // an index into `local.units` (as `bfs` and the next `Local` read it),
-                        // not a position within `staying` (issue 28: a panic, or a wrong reference)
+                        // not a position within `staying` (else a panic, or a wrong reference)
                         local.reference = staying.iter().copied().find(|&i| local.units[i] == base).unwrap();
                     }
                     let clearance = self.clearance(&local, &offsets, &leaving, &staying, dir);

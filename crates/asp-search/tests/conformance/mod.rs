@@ -107,7 +107,7 @@ fn same_seed_same_plan() {
     assert_eq!(a.stats.counters, b.stats.counters);
 }
 
-/// Issue 8: bookkeeping on top of `--order random` took 18,936 tests where the same ordering
+/// Bookkeeping on top of `--order random` took 18,936 tests where the same ordering
 /// without it took 460 (a double-layer profile assembly), because skipped tests shifted the
 /// random stream and kept skipped parts from the path planner. Bookkeeping must only skip tests
 /// whose answer is known: the same states in the same order, the same plan, never more tests.

@@ -1,4 +1,4 @@
-//! Threaded fasteners (issue 9 item 5) in the planner: a bolt in a nut comes apart by screwing,
+//! Threaded fasteners in the planner: a bolt in a nut comes apart by screwing,
 //! every step re-checked by the independent sweep (the screw steps outside their thread zone).
 
 use crate::verify::verify_plan;

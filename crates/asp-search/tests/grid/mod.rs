@@ -1,4 +1,4 @@
-//! Issue 9 item 6: interlocking voxel puzzles by an exact grid search. Every plan is replayed
+//! Interlocking voxel puzzles by an exact grid search. Every plan is replayed
 //! here on plain cell sets (independently of the solver's pair tables), and the first
 //! separation's move count is checked against a brute-force BFS over every subset of pieces.
 
@@ -283,7 +283,7 @@ fn issue_9_the_state_budget_ends_the_search() {
     assert!(s.complete() || s.plan.status == GridStatus::Budget);
 }
 
-/// Issue 28: with no fixed part, when the larger side of a separation keeps the reference, the
+/// With no fixed part, when the larger side of a separation keeps the reference, the
 /// new reference was stored as a position within the staying side but read as an index into the
 /// units: a panic (`Option::unwrap()` on `None`) or a wrong reference. The key burr with its
 /// pieces reordered (the largest piece not first) panicked on its third separation.
@@ -406,7 +406,7 @@ fn random_puzzle(rng: &mut Rng, n: usize) -> Vec<Vec<Cell>> {
     }
 }
 
-/// Issue 28 item 4: random polycube puzzles (3-12 pieces, random order, with and without a
+/// Random polycube puzzles (3-12 pieces, random order, with and without a
 /// fixed piece, cells given and from meshes only): every plan replays on cells, and the first
 /// separation's move count equals the brute-force BFS over every subset of pieces (the fixed
 /// pieces merged into one, which the brute force never moves relative to the others' frame).
@@ -462,14 +462,14 @@ fn issue_28_random_polycube_puzzles_replay_and_match_the_brute_force() {
     assert!(compared >= 100 && moved >= 5, "too few compared: {compared}, with moves: {moved}");
 }
 
-/// Issue 28 item 4: no panic on 1,000 random puzzles (the 10,000 of the goal in the ignored
+/// No panic on 1,000 random puzzles (the 10,000 of the goal in the ignored
 /// test below); every plan replays on cells.
 #[test]
 fn issue_28_grid_fuzz_1000_random_puzzles() {
     grid_fuzz(1_000, 0x2801);
 }
 
-/// The issue's 10,000 random puzzles (`--ignored`).
+/// The goal of 10,000 random puzzles (`--ignored`).
 #[test]
 #[ignore = "10,000 puzzles: the goal's figure, slower than the suite's 1,000"]
 fn issue_28_grid_fuzz_10000_random_puzzles() {

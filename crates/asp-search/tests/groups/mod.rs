@@ -1,4 +1,4 @@
-//! Subassemblies (issue 9): groups of parts that leave together along a straight line, locked
+//! Subassemblies: groups of parts that leave together along a straight line, locked
 //! cores, and the subassemblies' own plans.
 
 use crate::verify::{verify_plan, verify_removals};
@@ -57,7 +57,7 @@ fn issue_9_with_subassemblies_the_locked_core_leaves_as_one_group_that_cannot_be
     let Status::NoPlan { state, .. } = &inner.status else { panic!("{:?}", inner.status) };
     assert_eq!(state.iter().collect::<Vec<_>>(), [0, 1, 2], "nothing comes off the base");
     // in the plan JSON: one step with its parts, status no_plan and the explanation
-    // (issue 28: base, post and ring never get motions of their own, so the plan is partial,
+    // (base, post and ring never get motions of their own, so the plan is partial,
     // with that group as its one locked core)
     let report = PlanReport::new(w.assembly(), &outcome, w.tolerance(), &[]);
     assert_eq!(report.status, asp_search::report::PlanStatus::Partial);

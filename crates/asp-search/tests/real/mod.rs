@@ -122,7 +122,7 @@ fn pump_without_subassemblies_ends_in_no_plan_with_its_stuck_core_explained_and_
     // the other parts before it gives up (7,979 tests; 200 while both screws were locked in)
     assert!(outcome.stats.counters.removal_tests < 10_000, "{:?}", outcome.stats);
     // the result carries the partial disassembly that reached the stuck core: its removals pass
-    // the independent sweep and leave exactly the core (issue 9: a no_plan is not an empty plan)
+    // the independent sweep and leave exactly the core (a no_plan is not an empty plan)
     assert_eq!(outcome.removals.len(), checker.num_parts() - left.len());
     assert_eq!(verify_removals(w, &outcome.removals), *state);
     let report = asp_search::report::PlanReport::new(w.assembly(), &outcome, w.tolerance(), &[]);
@@ -200,7 +200,7 @@ fn issue_9_the_pumps_lift_their_stuck_core_off_as_one_subassembly_built_on_the_b
 
 #[test]
 fn pump_extension_without_subassemblies_ends_at_its_locked_core() {
-    // before issue 9: 490,539 removal tests in 17 s to the same answer
+    // before subassemblies and the locked-core check: 490,539 removal tests in 17 s to the same answer
     let planner = Dfs::builder().subassemblies(false).path_planner(false).build();
     let (checker, outcome) = plan(world("pump-extension", Some("mm"), OverlapPolicy::Strict).unwrap(), &planner);
     let Status::NoPlan { state, .. } = &outcome.status else { panic!("{:?}", outcome.status) };

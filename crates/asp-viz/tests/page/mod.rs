@@ -61,7 +61,7 @@ fn an_unfinished_plan_shows_its_partial_sequence_and_stuck_parts() {
     assert!(d["explanation"][0]["text"].as_str().unwrap().contains("blocked by receptacle, cap"));
 }
 
-/// Issue 28: a partial plan opens as a complete sequence, its locked core's parts in red and
+/// A partial plan opens as a complete sequence, its locked core's parts in red and
 /// its step labelled as a locked core.
 #[test]
 fn a_partial_plan_highlights_its_locked_core() {
