@@ -16,7 +16,7 @@ use std::path::Path;
 fn models() -> Vec<(String, Assembly)> {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data");
     let z = LoadOptions { up: Some(Axis::Z), ..LoadOptions::default() };
-    let mut out = vec![("tube".to_string(), fixtures::tube())];
+    let mut out = vec![("tube".to_string(), fixtures::tube()), ("ball_bearing".to_string(), fixtures::ball_bearing(64, 9, true))];
     out.push(("beam".into(), load(&data.join("beam/beam.glb"), &z).expect("beam")));
     for name in ["bookcase_billy_0191", "chair_bertil_0148", "table_lack_0825", "desk_hannes_0529"] {
         out.push((name.into(), load(&data.join(format!("ikea/{name}.glb")), &z).expect(name)));
@@ -36,6 +36,7 @@ fn bench(c: &mut Criterion) {
             )
         });
         let world = World::new(assembly.clone(), &WorldConfig::default()).expect("world");
+        c.bench_function(&format!("bearings/{name}"), |b| b.iter(|| black_box(world.find_bearings().len())));
         let n = world.num_parts();
         let full = PartSet::full(n);
         let mut group = c.benchmark_group(format!("removal_test/{name}"));

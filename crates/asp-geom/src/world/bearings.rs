@@ -159,8 +159,9 @@ fn median(mut values: Vec<f32>) -> f32 {
 
 impl World {
     /// Every rolling bearing among the parts (see the module documentation), in the order of
-    /// their first ball. A part belongs to at most one bearing.
-    pub(super) fn find_bearings(&self) -> Vec<Bearing> {
+    /// their first ball; a part belongs to at most one bearing. Found anew: [`World::bearings`]
+    /// holds the ones found with the world.
+    pub fn find_bearings(&self) -> Vec<Bearing> {
         let n = self.num_parts();
         // the balls: parts on a sphere (triangle meshes; unions of boxes are not round)
         let balls: BTreeMap<usize, (Vec3, f32)> = (0..n)

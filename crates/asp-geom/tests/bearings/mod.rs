@@ -55,3 +55,27 @@ fn balls_without_rings_or_off_a_circle_are_no_bearing() {
         assert!(world(a, true).bearings().is_empty());
     }
 }
+
+#[test]
+fn a_bearing_written_to_gltf_and_read_back_is_found() {
+    use asp_geom::io::{load, write_glb, LoadOptions};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bearing.glb");
+    write_glb(&fixtures::ball_bearing(64, 9, true), &path).unwrap();
+    let a = load(&path, &LoadOptions { up: Some(asp_geom::math::Axis::Z), ..LoadOptions::default() }).unwrap();
+    let w = world(a, true);
+    assert_eq!(w.bearings().len(), 1);
+    assert_eq!(w.bearings()[0].balls.len(), 9);
+    assert_eq!(w.name(w.bearings()[0].rings[1]), "outer ring");
+    // the shipped example is this file
+    let shipped = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/bearing/ball_bearing_6204.glb");
+    if std::env::var_os("ASP_WRITE_EXAMPLES").is_some() {
+        std::fs::create_dir_all(shipped.parent().unwrap()).unwrap();
+        std::fs::copy(&path, &shipped).unwrap();
+    }
+    assert_eq!(
+        std::fs::read(&shipped).unwrap(),
+        std::fs::read(&path).unwrap(),
+        "tests/data/bearing is the fixture's glTF (ASP_WRITE_EXAMPLES=1 rewrites it)"
+    );
+}
