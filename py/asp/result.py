@@ -68,6 +68,14 @@ class Plan:
         otherwise."""
         return self._copy("locked_cores", [])
 
+    @property
+    def bearings(self) -> list[dict[str, Any]]:
+        """The rolling bearings found in the model (format 1.12), each planned as one unit:
+        ``parts``, ``rings`` (inner, outer) and their ``names``, ``balls``, ``others`` (cage,
+        shields), ``centre``, ``axis``, ``pitch_radius``, ``ball_radius`` and ``rows``
+        (``docs/plan-format.md``, "Bearings"). Empty when there is none."""
+        return self._copy("bearings", [])
+
     def table(self) -> str:
         """The plan as text, exactly as ``asp plan`` prints it for the same run: the table and,
         for optimising runs, the optimiser's summary."""

@@ -8,7 +8,7 @@ import re
 import pytest
 
 import asp
-from conftest import LACK, PUMP, without_seconds
+from conftest import BEARING, LACK, PUMP, without_seconds
 
 
 @pytest.mark.parametrize(
@@ -296,3 +296,18 @@ def test_split_bodies_makes_each_body_of_a_mesh_a_part(tmp_path):
     assert without_seconds(asp.plan(folder, unit="mm", up="z", split_bodies=True).json) == without_seconds(plan.json)
     with pytest.raises(TypeError, match="split_bodies"):
         whole.plan(split_bodies=True)  # type: ignore[call-arg]
+
+
+def test_a_ball_bearing_is_one_unit(root, asp_cli):
+    # balls captive between two rings: recognised, planned as one unit, listed in the plan
+    plan = asp.load(BEARING, up="z").plan()
+    assert plan.status == "found" and plan.locked_cores == []
+    (bearing,) = plan.bearings
+    assert bearing["names"] == ["inner ring", "outer ring"] and len(bearing["balls"]) == 9 and bearing["rows"] == 1
+    unit = next(s for s in plan.to_dict()["assembly_sequence"] if "subassembly" in s)["subassembly"]
+    assert unit["status"] == "unit" and sorted(unit["parts"]) == bearing["parts"]
+    assert "rolling bearing: inner ring in outer ring, 9 balls in 1 row" in plan.table()
+    code, out, err = asp_cli("plan", BEARING, "--up", "z", "--json")
+    assert code == 0, err
+    assert without_seconds(plan.json) == without_seconds(out)
+    assert asp.load(LACK, up="z").plan().bearings == []
