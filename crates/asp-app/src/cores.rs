@@ -43,13 +43,7 @@ pub(crate) fn plan_cores_alone(
             break;
         }
         let Some(local_base) = core.parts.iter().position(|&p| p == core.base) else { continue };
-        let mut alone = Assembly {
-            parts: core.parts.iter().map(|&p| assembly.parts[p].clone()).collect(),
-            units: assembly.units.clone(),
-            up: assembly.up,
-            source: assembly.source.clone(),
-            warnings: Vec::new(),
-        };
+        let mut alone = assembly.subset(&core.parts);
         alone.parts[local_base].fixed = true;
         let mut plan = plan_core(alone, settings, Budget { timeout: left, ..budget.clone() })?;
         plan.report = remapped(&plan.report, &core.parts)?;

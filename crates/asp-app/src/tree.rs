@@ -104,13 +104,7 @@ fn plan_node(
         .iter()
         .map(|child| plan_node(assembly, child, settings, progress, false, &mut inner))
         .collect::<Result<Vec<PlanResult>>>()?;
-    let mut level = Assembly {
-        parts: node.parts.iter().map(|&i| assembly.parts[i].clone()).collect(),
-        units: assembly.units.clone(),
-        up: assembly.up,
-        source: assembly.source.clone(),
-        warnings: Vec::new(),
-    };
+    let mut level = assembly.subset(&node.parts);
     if !root && !level.parts.iter().any(|p| p.fixed) {
         // a subassembly is built on its largest part, as the search builds the groups it finds
         if let Some(base) = largest(&level) {

@@ -84,14 +84,7 @@ fn core_grid(assembly: &Assembly, settings: &PlanSettings, ran: GridRan, parts: 
     if !settings.unit_groups.is_empty() {
         return not_tried(CoreGridReason::UnitGroups, None);
     }
-    let core = Assembly {
-        parts: parts.iter().filter_map(|&p| assembly.parts.get(p).cloned()).collect(),
-        units: assembly.units.clone(),
-        up: assembly.up,
-        source: assembly.source.clone(),
-        warnings: Vec::new(),
-    };
-    let core_on_grid = Some(VoxelModel::of(&core).is_some());
+    let core_on_grid = Some(VoxelModel::of(&assembly.subset(parts)).is_some());
     if assembly.parts.len() > GRID_MAX_PARTS {
         not_tried(CoreGridReason::TooManyParts, core_on_grid)
     } else {

@@ -122,6 +122,19 @@ impl Assembly {
         self.aabb().map(|b| (b.maxs - b.mins).length()).unwrap_or(0.0)
     }
 
+    /// The model of the parts at `indices` alone (in that order; indices past the end are
+    /// skipped), with this model's unit, up axis and source, and no warnings: a subassembly or a
+    /// core planned on its own.
+    pub fn subset(&self, indices: &[usize]) -> Assembly {
+        Assembly {
+            parts: indices.iter().filter_map(|&i| self.parts.get(i).cloned()).collect(),
+            units: self.units.clone(),
+            up: self.up,
+            source: self.source.clone(),
+            warnings: Vec::new(),
+        }
+    }
+
     /// The index of the part called `name`.
     pub fn part_index(&self, name: &str) -> Option<usize> {
         self.parts.iter().position(|p| p.name == name)
