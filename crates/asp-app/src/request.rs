@@ -226,6 +226,8 @@ pub struct PlanRequest {
     pub model: Option<PathBuf>,
     /// Bookkeeping on top of the ordering.
     pub bookkeeping: Option<bool>,
+    /// Add the precedence graph of a found plan to the plan JSON (format 1.12).
+    pub precedence: Option<bool>,
     /// Seed of every random choice (both searches).
     pub seed: Option<u64>,
     /// Stop after this many removal tests.

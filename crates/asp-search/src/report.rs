@@ -12,13 +12,15 @@ use asp_geom::{Assembly, Motion, PartSet};
 use serde::{Deserialize, Serialize};
 
 mod parts;
+mod precedence;
 pub mod text;
 
 pub use parts::{FaceEntry, PartEntry, SurfaceEntry, TessellationEntry};
+pub use precedence::{PrecedenceEdge, PrecedenceEntry, PrecedenceReason, PrecedenceStability, PrecedenceStep};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.11";
+pub const FORMAT_VERSION: &str = "1.12";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -90,6 +92,10 @@ pub struct PlanReport {
     /// the plan above could put it in as one unit). Since format 1.10.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub file_subassemblies: Vec<SubassemblyEntry>,
+    /// With `precedence` (`asp plan --precedence`), found feasibility plans: the partial order
+    /// of the assembly steps, its levels and critical path. Since format 1.12.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub precedence: Option<PrecedenceEntry>,
 }
 
 /// Parts that go in together as one unit because asp could not take them apart (format 1.8):
@@ -579,6 +585,7 @@ impl PlanReport {
             robot: None,
             grid: None,
             file_subassemblies: Vec::new(),
+            precedence: None,
         }
     }
 }
@@ -708,7 +715,7 @@ fn explain(status: &Status, name: &dyn Fn(usize) -> String, named: &dyn Fn(&Part
 }
 
 /// The insertion that undoes a removal motion, in model units.
-fn insertion(motion: &Motion, u: &dyn Fn(f32) -> f64) -> MotionEntry {
+pub fn insertion(motion: &Motion, u: &dyn Fn(f32) -> f64) -> MotionEntry {
     let v3 = |v: asp_geom::math::Vec3, f: &dyn Fn(f32) -> f64| [f(v.x), f(v.y), f(v.z)];
     let unit = |x: f32| x as f64;
     match motion {
