@@ -492,7 +492,7 @@ mod tests {
     #[test]
     fn keys_are_every_field_and_json_round_trips() {
         let keys = PlanRequest::keys();
-        assert_eq!(keys.len(), 47, "{keys:?}");
+        assert_eq!(keys.len(), 48, "{keys:?}");
         assert!(keys.iter().any(|k| k == "time_limit") && keys.iter().any(|k| k == "robot_base"));
         let r = PlanRequest {
             objective: Some(vec!["access".into()]),

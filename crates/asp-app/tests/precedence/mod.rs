@@ -125,3 +125,26 @@ fn precedence_edges_say_why() {
     let r = plan_assembly(fixtures::arch(), &PlanSettings::default(), None).unwrap();
     assert!(r.report.precedence.is_none());
 }
+
+/// The re-check the extensions pass has teeth: an order the graph forbids (the tube's handle
+/// before its stick, against a blocking edge) is refused by it.
+#[test]
+fn an_order_against_a_blocking_edge_fails_the_re_check() {
+    let settings = PlanSettings { precedence: true, ..PlanSettings::default() };
+    let a = fixtures::tube();
+    let n = a.len();
+    let r = plan_assembly(a.clone(), &settings, None).unwrap();
+    let g = r.report.precedence.unwrap();
+    let step = |name: &str| r.report.assembly_sequence.iter().position(|s| s.name == name).unwrap();
+    let (stick, handle) = (step("stick"), step("handle"));
+    let edge = g.edges.iter().find(|e| e.before == stick && e.after == handle).expect("the handle closes the stick's way");
+    assert!(edge.reasons.contains(&PrecedenceReason::Blocks), "{edge:?}");
+    // the handle first, then the stick along its own motion, then the rest
+    let steps: Vec<Step> = removals(&r.report.assembly_sequence, n).into_iter().rev().collect();
+    let mut order = vec![handle, stick];
+    order.extend((0..steps.len()).filter(|s| *s != handle && *s != stick));
+    let removal: Vec<Step> = order.iter().rev().map(|&i| steps[i].clone()).collect();
+    let world = checker(a, &settings).unwrap();
+    let refused = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| verify_removals(world.world(), &removal)));
+    assert!(refused.is_err(), "the stick went in through the handle");
+}

@@ -126,11 +126,11 @@ impl PrecedenceEntry {
             }
         }
         // a screw step turns on its threaded partner (or a fit it turns on), which it needs in place
-        for c in 0..k {
-            let Motion::Screw { direction, .. } = steps[c].motion else { continue };
-            let p = steps[c].part;
-            for b in 0..c {
-                let partner = parts[b].iter().any(|&q| {
+        for (c, step) in steps.iter().enumerate() {
+            let Motion::Screw { direction, .. } = step.motion else { continue };
+            let p = step.part;
+            for (b, earlier) in parts.iter().enumerate().take(c) {
+                let partner = earlier.iter().any(|&q| {
                     world.thread(p, q).is_some_and(|t| t.axis.direction.dot(direction).abs() > 0.9999)
                         || world.fits(p, q).iter().any(|f| f.turns == Some(p) && f.axis.dot(direction).abs() > 0.9999)
                 });
