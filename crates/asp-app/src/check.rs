@@ -561,17 +561,26 @@ impl Tester<'_> {
     /// Removing `unit` from `state` along any motion the settings allow: straight lines (a
     /// group's together), then the path planner for a single part.
     fn any(&self, parts: &[usize], state: &PartSet) -> Outcome {
-        let outcome = match parts {
-            [p] => self.checker.test_removal(*p, state, MotionKind::Linear),
-            _ => self.checker.test_group_removal(&self.group(parts), state),
-        };
-        if let ([p], true) = (parts, matches!(outcome, Outcome::Collision { .. }) && self.settings.path_planner) {
-            let path = self.checker.test_removal(*p, state, MotionKind::Path { seed: self.settings.seed });
-            if !matches!(path, Outcome::Collision { .. }) {
+        let outcome = self.straight(parts, state);
+        if let ([p], true) = (parts, matches!(outcome, Outcome::Collision { .. })) {
+            if let Some(path) = self.path(*p, state).filter(|o| !matches!(o, Outcome::Collision { .. })) {
                 return path;
             }
         }
         outcome
+    }
+
+    /// Removing `parts` from `state` along a straight line (a group's together).
+    fn straight(&self, parts: &[usize], state: &PartSet) -> Outcome {
+        match parts {
+            [p] => self.checker.test_removal(*p, state, MotionKind::Linear),
+            _ => self.checker.test_group_removal(&self.group(parts), state),
+        }
+    }
+
+    /// Removing part `p` from `state` along a path, when the settings allow the path planner.
+    fn path(&self, p: usize, state: &PartSet) -> Option<Outcome> {
+        self.settings.path_planner.then(|| self.checker.test_removal(p, state, MotionKind::Path { seed: self.settings.seed }))
     }
 
     /// The parts of `state` (and the base) blocking `parts` removed along `dir` (unit).
@@ -807,24 +816,44 @@ fn repair_search(tester: &Tester<'_>, units: &[Unit], full: &PartSet, budget: &B
             if self.dead.contains(state) {
                 return false;
             }
-            for i in (0..left.len()).rev() {
-                if self.budget.exhausted(self.tests, self.started) {
-                    self.exhausted = true;
-                    return false;
-                }
-                let k = left[i];
-                self.tests += 1;
-                let Outcome::Removed(motion) = self.tester.any(&self.units[k].parts, state) else { continue };
-                let next = Tester::rest(state, &self.units[k].parts);
-                left.remove(i);
-                removals.push((k, motion));
-                if self.go(&next, left, removals) {
-                    return true;
-                }
-                removals.pop();
-                left.insert(i, k);
-                if self.exhausted {
-                    return false;
+            // straight lines for every step first (in the given order), then the path planner
+            // for the single parts no straight line freed, as the planner's own search does
+            let mut straight_free = vec![false; self.units.len()];
+            for path in [false, true] {
+                for i in (0..left.len()).rev() {
+                    if self.budget.exhausted(self.tests, self.started) {
+                        self.exhausted = true;
+                        return false;
+                    }
+                    let k = left[i];
+                    let parts = &self.units[k].parts;
+                    let outcome = if !path {
+                        self.tests += 1;
+                        self.tester.straight(parts, state)
+                    } else if parts.len() == 1 && !straight_free[k] {
+                        self.tests += 1;
+                        match self.tester.path(parts[0], state) {
+                            Some(o) => o,
+                            None => continue,
+                        }
+                    } else {
+                        continue;
+                    };
+                    if !path && !matches!(outcome, Outcome::Collision { .. }) {
+                        straight_free[k] = true; // a path would not make it stand
+                    }
+                    let Outcome::Removed(motion) = outcome else { continue };
+                    let next = Tester::rest(state, parts);
+                    left.remove(i);
+                    removals.push((k, motion));
+                    if self.go(&next, left, removals) {
+                        return true;
+                    }
+                    removals.pop();
+                    left.insert(i, k);
+                    if self.exhausted {
+                        return false;
+                    }
                 }
             }
             self.dead.insert(state.clone());
