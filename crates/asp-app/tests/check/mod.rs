@@ -160,3 +160,22 @@ fn check_reads_a_plan_json() {
     let r = check_assembly(fixtures::tube(), &steps, &settings).unwrap();
     assert_eq!(r.status, CheckStatus::Feasible, "{}", r.to_text());
 }
+
+/// A shipped real model: the IKEA Lack table (four legs, a top pushed onto them, Z up). The top
+/// cannot go in before the legs: the first leg after it is blocked by the top in every direction.
+#[test]
+fn check_on_the_shipped_lack_table() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/ikea/table_lack_0825.glb");
+    let settings = PlanSettings { up: Some(asp_geom::math::Axis::Z), ..PlanSettings::default() };
+    let lack = || pipeline::load(&path, &settings).unwrap();
+    let r = check(lack(), "0_part0\n1_part1\n2_part2\n3_part3\n4_part4 -z\n", &settings);
+    assert_eq!(r.status, CheckStatus::Feasible, "{}", r.to_text());
+    let r = check(lack(), "4_part4\n0_part0\n1_part1\n2_part2\n3_part3\n", &settings);
+    assert_eq!(r.first_failure, Some(1), "{}", r.to_text());
+    let Some(Failure::NoPath { blockers, .. }) = &r.steps[1].failure else { panic!("{:?}", r.steps[1].failure) };
+    assert!(blockers.iter().any(|b| b.name == "4_part4"), "{blockers:?}");
+    let repair = r.repair.as_ref().unwrap();
+    assert_eq!((repair.status, repair.moved, repair.kendall_tau), (RepairStatus::Found, 1, 4));
+    assert_eq!(repair.sequence.last().unwrap().parts[0].name, "4_part4");
+    assert!(repair.sequence.last().unwrap().moved);
+}
