@@ -144,6 +144,7 @@ class Assembly:
         order: Order | None = None,
         model: PathLike | None = None,
         bookkeeping: bool | None = None,
+        precedence: bool | None = None,
         seed: int | None = None,
         tolerance: float | None = None,
         contact_distance: float | None = None,
@@ -199,6 +200,9 @@ class Assembly:
         :param model: the removability model (ONNX) of ``order="gnn"``, and of ``auto`` where it
             is learned (default: the shipped model of the run's checker).
         :param bookkeeping: skip retesting a part until one of its blockers is gone.
+        :param precedence: add the precedence graph of a found plan (``plan.json``'s
+            ``precedence``: which steps go in before which, the levels of steps that may go in in
+            parallel, the critical path; docs/plan-format.md).
         :param normals: clustered surface-normal directions tried besides the six axes (10).
         :param sphere_directions: extra removal directions sampled evenly on the sphere (0).
         :param stability: ``contact`` (default: linked through contacts to a base part) or
@@ -283,6 +287,50 @@ class Assembly:
         settings = given({k: v for k, v in locals().items() if k != "self"})
         json, found, trace = self._native.plan(settings)
         return Plan(json, found, trace)
+
+    def check(
+        self,
+        sequence: str | os.PathLike[str] | Sequence[str | Sequence[str]],
+        **settings: Any,
+    ) -> dict[str, Any]:
+        """Checks a given assembly sequence with the removal tests, stability and settings of
+        :meth:`plan` (``asp check``; the report is docs/check-format.md's, as a dict).
+
+        :param sequence: the steps in assembly order: a list whose items are part names (a
+            string may carry an insertion direction after the name, ``"bolt1 -z"`` or
+            ``"bolt1 0,0,-1"``: the part goes in along it and is removed the opposite way) or
+            lists of names (a rigid subassembly, ``["a", "b"]``); or the text of a sequence file
+            (one step per line, ``#`` comments, ``[a, b]`` groups) or of a plan JSON; or the path
+            of such a file.
+        :param settings: the keywords of :meth:`plan`'s feasibility search (``tolerance``,
+            ``stability``, ``path_planner``, ...; ``max_tests`` and ``timeout`` bound the repair).
+        :returns: the report: ``status`` (``"feasible"`` or ``"infeasible"``), ``steps`` (each
+            with its ``motion`` or its ``failure``), ``first_failure`` (a step index or ``None``)
+            and, when infeasible, ``repair`` (the nearest feasible sequence found, its ``moved``
+            steps and ``kendall_tau`` distance).
+        :raises ConfigError: a name that is no part (the message lists the nearest names), a
+            part placed twice or left out, a malformed line, or a bad setting.
+        :raises TypeError: an unknown keyword.
+        """
+        import json as _json
+
+        inspect.signature(Assembly.plan).bind(self, **settings)  # unknown keywords: TypeError
+        if isinstance(sequence, os.PathLike):
+            with open(sequence, encoding="utf-8") as f:
+                text = f.read()
+        elif isinstance(sequence, str):
+            text = sequence
+        else:
+            lines = []
+            for item in sequence:
+                if isinstance(item, str):
+                    lines.append(item)
+                else:
+                    names = [str(n) for n in item]
+                    lines.append("[" + ", ".join(names) + "]")
+            text = "\n".join(lines) + "\n"
+        report, _feasible = self._native.check(text, given(settings))
+        return _json.loads(report)
 
     def search(self, *, record: bool = True, **settings: Any) -> Search:
         """A stepped optimiser run: the search of :meth:`plan` with ``objective``, run episode by

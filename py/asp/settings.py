@@ -45,6 +45,7 @@ class PlanSettings(TypedDict, total=False):
     order: Order
     model: str
     bookkeeping: bool
+    precedence: bool
     seed: int
     max_tests: int
     timeout: float

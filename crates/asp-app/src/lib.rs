@@ -4,6 +4,7 @@ pub mod bench;
 pub mod bench_mcts;
 pub mod catalogue;
 pub mod cell;
+pub mod check;
 pub mod collect;
 pub mod collect_q;
 mod cores;

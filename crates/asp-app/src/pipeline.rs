@@ -25,7 +25,7 @@ use asp_search::grid::GridConfig;
 use asp_search::grid::GridRun;
 use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES};
 use asp_search::report::{
-    Checker as CheckerName, GridEntry, GridReason, OptimisationEntry, OptimisationMethod, ParetoEntry, PlanReport, Timings,
+    Checker as CheckerName, GridEntry, GridReason, OptimisationEntry, OptimisationMethod, ParetoEntry, PlanReport, PrecedenceEntry, Timings,
 };
 use asp_search::units::UnitChecker;
 use asp_search::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
@@ -122,6 +122,8 @@ pub struct PlanSettings {
     pub cancel: Option<StopToken>,
     /// Wraps the depth-first search's checker (e.g. a robot that must also take each part out).
     pub checker_extension: Option<Arc<dyn CheckerExtension>>,
+    /// Add the precedence graph of a found plan to its report ([`PrecedenceEntry`]).
+    pub precedence: bool,
     /// Which checker decides removals (`robot` with a robot in the feasibility search, else
     /// `physics` under the physics stability check, else `default`): the labels `asp collect
     /// removability` records under these settings, and the checker a removability model must
@@ -161,6 +163,7 @@ impl Default for PlanSettings {
             optimise: None,
             cancel: None,
             checker_extension: None,
+            precedence: false,
             checker: asp_learn::Checker::Default,
         }
     }
@@ -384,7 +387,8 @@ pub fn plan_assembly(assembly: Assembly, settings: &PlanSettings, progress: Opti
     let budget = budget(settings)?;
     let units = unit_sets(&assembly, &settings.unit_groups)?;
     let voxels = voxel_model(&assembly, settings, &units);
-    if voxels.is_none() && units.is_empty() {
+    // the voxel fast path builds no world, which the precedence graph tests pairs in
+    if voxels.is_none() && units.is_empty() && !settings.precedence {
         if let Some(result) = plan_on_voxels(&assembly, settings, &budget, progress)? {
             return Ok(result);
         }
@@ -504,6 +508,7 @@ fn plan_with_world(
         crate::cores::plan_cores_alone(&mut report, world.assembly(), settings, &budget, grid_started)?;
     }
     explain_cores(&mut report, world, settings, grid_ran, &units);
+    attach_precedence(&mut report, world, &outcome, settings);
     Ok(PlanResult { report, status: outcome.status, search: None })
 }
 
@@ -607,6 +612,25 @@ fn finish_report(report: &mut PlanReport, world: &asp_geom::World, outcome: &Pla
         Some(Timings { load: 0.0, world: world_seconds, search: outcome.stats.seconds, path_planner: outcome.stats.path_planner_seconds });
 }
 
+/// With [`PlanSettings::precedence`], the precedence graph of a found plan (a warning says why
+/// another plan has none).
+fn attach_precedence(report: &mut PlanReport, world: &World, outcome: &PlanOutcome, settings: &PlanSettings) {
+    if !settings.precedence {
+        return;
+    }
+    let physics = matches!(settings.stability, StabilitySetting::Physics { .. });
+    report.precedence = if outcome.status == Status::Found && report.status == asp_search::report::PlanStatus::Found {
+        PrecedenceEntry::of(world, &outcome.removals, physics)
+    } else {
+        None
+    };
+    if report.precedence.is_none() {
+        report
+            .warnings
+            .push(format!("precedence: no graph for a plan that is {} (found plans only, without grid moves)", report.status.as_str()));
+    }
+}
+
 /// Whether a search ended on its budget (tests, time or a cancel), so that another search
 /// would only spend more of it.
 fn budget_spent(outcome: &PlanOutcome) -> bool {
@@ -651,6 +675,7 @@ fn grid_result(
     });
     finish_report(&mut report, world, &outcome, world_seconds);
     explain_cores(&mut report, world, settings, GridRan::of(&run.solution.plan), &[]);
+    attach_precedence(&mut report, world, &outcome, settings);
     PlanResult { report, status: outcome.status, search: None }
 }
 

@@ -227,6 +227,8 @@ pub struct PlanRequest {
     pub model: Option<PathBuf>,
     /// Bookkeeping on top of the ordering.
     pub bookkeeping: Option<bool>,
+    /// Add the precedence graph of a found plan to the plan JSON (format 1.12).
+    pub precedence: Option<bool>,
     /// Seed of every random choice (both searches).
     pub seed: Option<u64>,
     /// Stop after this many removal tests.
@@ -491,7 +493,7 @@ mod tests {
     #[test]
     fn keys_are_every_field_and_json_round_trips() {
         let keys = PlanRequest::keys();
-        assert_eq!(keys.len(), 47, "{keys:?}");
+        assert_eq!(keys.len(), 48, "{keys:?}");
         assert!(keys.iter().any(|k| k == "time_limit") && keys.iter().any(|k| k == "robot_base"));
         let r = PlanRequest {
             objective: Some(vec!["access".into()]),

@@ -36,6 +36,7 @@ const FEASIBILITY_ONLY: &[(&str, &str)] = &[
     ("order", ""),
     ("model", ""),
     ("bookkeeping", ""),
+    ("precedence", ""),
     ("max_tests", ""),
     ("timeout", "the optimiser's limit is `time_limit`"),
     ("grippers", ""),
@@ -206,6 +207,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         optimise,
         cancel: None,
         checker_extension,
+        precedence: r.precedence.unwrap_or(false),
         checker,
     })
 }
@@ -343,7 +345,7 @@ fn robot_keys(r: &PlanRequest) -> serde_json::Map<String, Value> {
 /// `asp._asp.default_settings()` and the docs show these.
 pub fn defaults() -> serde_json::Map<String, Value> {
     let d = PlanSettings::default();
-    let defaults: [(&str, Value); 47] = [
+    let defaults: [(&str, Value); 48] = [
         ("unit", Value::Null),
         ("up", Value::Null),
         ("fixed", json!([])),
@@ -368,6 +370,7 @@ pub fn defaults() -> serde_json::Map<String, Value> {
         ("order", json!(catalogue::ORDERINGS[0].name)),
         ("model", Value::Null),
         ("bookkeeping", json!(false)),
+        ("precedence", json!(false)),
         ("seed", json!(0)),
         ("max_tests", Value::Null),
         ("timeout", json!(DEFAULT_TIMEOUT)),

@@ -7,9 +7,11 @@ mod fixtures;
 #[allow(dead_code)]
 mod verify;
 
+mod check;
 mod collect;
 mod fuzz;
 mod pipeline;
+mod precedence;
 mod request;
 mod robot;
 mod stepped;

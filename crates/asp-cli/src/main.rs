@@ -3,6 +3,7 @@
 //! The binary is thin: it parses flags, calls the library crates, and formats output.
 
 mod bench_mcts;
+mod check;
 mod flags;
 mod gen;
 mod learn;
@@ -41,6 +42,7 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Plan(args) => output::plan(&args),
+        Command::Check(args) => check::run(&args),
         Command::Gen(args) => gen::run(&args),
         Command::Collect(args) => learn::collect(&args),
         Command::Bench(args) => learn::bench(&args),

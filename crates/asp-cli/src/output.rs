@@ -103,6 +103,9 @@ pub fn plan(args: &PlanArgs) -> anyhow::Result<ExitCode> {
     if many && args.mcap.is_some() {
         bail!("--mcap writes one model's plan: give one model");
     }
+    if many && args.precedence_dot.is_some() {
+        bail!("--precedence-dot writes one model's graph: give one model");
+    }
     if many && args.optimise.trace.is_some() {
         bail!("--trace writes one model's search: give one model");
     }
@@ -248,6 +251,10 @@ fn plan_one(
     }
     if let (Some(path), Some(assembly)) = (&args.mcap, &for_mcap) {
         asp_viz::mcap::write_plan(path, assembly, report)?;
+    }
+    if let (Some(path), Some(graph)) = (&args.precedence_dot, &report.precedence) {
+        asp_geom::io::write_atomic(path, graph.to_dot().as_bytes())
+            .with_context(|| format!("{}: cannot write the precedence graph", path.display()))?;
     }
     let json = report.to_json();
     if let Some(path) = out {

@@ -1,5 +1,6 @@
 //! Integration tests of the `asp` binary (the real executable).
 
+mod check;
 mod cli;
 mod hostile;
 mod optimise;

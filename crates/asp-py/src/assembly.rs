@@ -151,6 +151,21 @@ impl PyAssembly {
         Ok((result.report.to_json(), result.found(), trace))
     }
 
+    /// Checks a given sequence (the text of a sequence file or a plan JSON, docs/check-format.md)
+    /// with the keyword settings of `asp.Assembly.plan` (a dict). Returns `(report_json,
+    /// feasible)`: the check report exactly as `asp check --json` prints it. Releases the GIL;
+    /// Ctrl-C interrupts the repair search.
+    fn check(&self, py: Python<'_>, sequence: &str, settings: &Bound<'_, PyDict>) -> PyResult<(String, bool)> {
+        let settings = settings::plan_settings(settings).map_err(|e| e.into_py(py))?;
+        let steps = asp_app::check::parse_sequence(sequence).map_err(|e| Error::from(e).into_py(py))?;
+        let token = asp_search::StopToken::new();
+        let settings = asp_app::PlanSettings { cancel: Some(token.clone()), ..settings };
+        let assembly = (*self.inner).clone();
+        let result = run::interruptible(py, &token, move || asp_app::check::check_assembly(assembly, &steps, &settings))?;
+        let report = result.map_err(|e| Error::from(e).into_py(py))?;
+        Ok((report.to_json(), report.feasible()))
+    }
+
     /// The graph of the state `present` (part indices) with the keyword settings of
     /// `asp.Assembly.graph` (a dict), as little-endian buffers ([`GraphArrays`]). The model's
     /// graph is built once per settings (without the GIL) and cached.

@@ -12,9 +12,11 @@ use asp_geom::{Assembly, Motion, PartSet};
 use serde::{Deserialize, Serialize};
 
 mod parts;
+mod precedence;
 pub mod text;
 
 pub use parts::{FaceEntry, PartEntry, SurfaceEntry, TessellationEntry};
+pub use precedence::{PrecedenceEdge, PrecedenceEntry, PrecedenceReason, PrecedenceStability, PrecedenceStep};
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
@@ -94,6 +96,10 @@ pub struct PlanReport {
     /// the plan above could put it in as one unit). Since format 1.10.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub file_subassemblies: Vec<SubassemblyEntry>,
+    /// With `precedence` (`asp plan --precedence`), found feasibility plans: the partial order
+    /// of the assembly steps, its levels and critical path. Since format 1.12.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub precedence: Option<PrecedenceEntry>,
 }
 
 /// Parts that go in together as one unit because asp could not take them apart (format 1.8):
@@ -635,6 +641,7 @@ impl PlanReport {
             grid: None,
             file_subassemblies: Vec::new(),
             bearings: Vec::new(),
+            precedence: None,
         }
     }
 }
@@ -764,7 +771,7 @@ fn explain(status: &Status, name: &dyn Fn(usize) -> String, named: &dyn Fn(&Part
 }
 
 /// The insertion that undoes a removal motion, in model units.
-fn insertion(motion: &Motion, u: &dyn Fn(f32) -> f64) -> MotionEntry {
+pub fn insertion(motion: &Motion, u: &dyn Fn(f32) -> f64) -> MotionEntry {
     let v3 = |v: asp_geom::math::Vec3, f: &dyn Fn(f32) -> f64| [f(v.x), f(v.y), f(v.z)];
     let unit = |x: f32| x as f64;
     match motion {

@@ -17,11 +17,13 @@ macro_rules! put {
 }
 pub(crate) use put;
 
+mod check;
 mod learn;
 mod model;
 mod plan;
 mod robot;
 
+pub use check::CheckSeqArgs;
 pub use learn::{BenchArgs, BenchKind, CollectArgs, CollectKind, FeasibleArgs, MctsArgs, TransitionsArgs};
 pub use model::ModelArgs;
 pub use plan::{PlanArgs, PlanRobotArgs};
@@ -45,6 +47,10 @@ pub struct Cli {
 pub enum Command {
     /// Plan a feasible assembly sequence by taking the model apart (Assembly-by-Disassembly).
     Plan(Box<PlanArgs>),
+    /// Check a given assembly sequence: every step with the planner's removal tests, the first
+    /// failing step and why, and the nearest feasible sequence (docs/check-format.md). Exit 0
+    /// feasible, 1 infeasible, 2 bad input.
+    Check(Box<CheckSeqArgs>),
     /// Generate training assemblies (Soma cubes, aluminium profile assemblies).
     Gen(crate::gen::GenArgs),
     /// Collect training data from planning runs (`removability`: labelled states; `transitions`:

@@ -46,6 +46,15 @@ pub struct PlanArgs {
     /// Bookkeeping on top of any ordering (implied by `--order bookkeeping`).
     #[arg(long)]
     pub bookkeeping: bool,
+    /// Add the precedence graph of a found plan to the plan JSON: which steps must go in before
+    /// which (blocking and, conservatively, support), the levels of steps that may go in in
+    /// parallel and the critical path (docs/plan-format.md, "Precedence").
+    #[arg(long)]
+    pub precedence: bool,
+    /// Also write the precedence graph as Graphviz DOT to this file (implies --precedence; one
+    /// model only).
+    #[arg(long, value_name = "FILE")]
+    pub precedence_dot: Option<PathBuf>,
     /// Plan these parts (comma-separated names) as one part, on purpose: a purchased motor, a
     /// pressed-in bearing. The unit goes in whole and the plan is still `found`. Repeat for
     /// several units.
@@ -167,6 +176,9 @@ impl PlanArgs {
         put!(map, self, order, model, seed, max_tests, timeout);
         if self.bookkeeping {
             map.insert("bookkeeping".into(), true.into());
+        }
+        if self.precedence || self.precedence_dot.is_some() {
+            map.insert("precedence".into(), true.into());
         }
         if !self.unit_group.is_empty() {
             map.insert("unit_group".into(), self.unit_group.clone().into());

@@ -1,0 +1,954 @@
+//! Checking a given assembly sequence (`asp check`, `asp.Assembly.check`; docs/check-format.md).
+//!
+//! A sequence names the parts in assembly order, one step per line: a part, or a rigid
+//! subassembly as a bracketed group (`[a, b]`), each with an optional *assembly* (insertion)
+//! direction (`bolt1 -z`, `bolt1 0,0,-1`); the part is then removed along the opposite direction.
+//! A plan JSON (`asp plan --out`) is a sequence too: its `assembly_sequence`, with each linear or
+//! screw step's insertion direction.
+//!
+//! Every step is tested in disassembly order with the planner's own collision world and checker
+//! ([`crate::pipeline::checker`], the request's settings): the state before step `i` is removed
+//! is the base parts plus steps `0..=i`, so each step's test depends only on the sequence, never
+//! on whether another step passed. A step passes when its part (group) leaves that state along
+//! some candidate direction (or along the given one) — the path planner after straight lines when
+//! the settings allow it — and what remains is stable. The first failing step in assembly order
+//! is reported with its reason (blocked: by which parts along which directions; no path; unstable:
+//! which parts would float), and a *repair*: the feasible sequence found by a depth-first search
+//! that at every state tries the given steps in the given order (latest placed first, the given
+//! sequence's own disassembly order), so a feasible sequence is its own repair. The repair's
+//! distance to the given sequence is measured twice, over steps: the steps moved (`n − LCS`, the
+//! length of the longest common subsequence) and the Kendall tau distance (pairs of steps in the
+//! other order). The search is greedy, so the repair is near, not proven nearest.
+
+use crate::error::{AppError, Result};
+use crate::pipeline::{self, PlanSettings};
+use asp_geom::math::Vec3;
+use asp_geom::{Assembly, Checker, FeasibilityChecker, Motion, MotionKind, Outcome, PartSet, Stability, World};
+use asp_search::report::{insertion, MotionEntry, NamedPart};
+use asp_search::Budget;
+use serde::{Deserialize, Serialize};
+use std::collections::HashSet;
+use std::time::Instant;
+
+/// The version of the check report this build writes (docs/check-format.md). Minor bumps add
+/// keys; major bumps change or remove them.
+pub const CHECK_FORMAT_VERSION: &str = "1.0";
+
+/// One step of a given sequence, as written: part names (one, or a group's) and an optional
+/// insertion direction in the model's frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GivenStep {
+    /// The part names (several: a subassembly that goes in as one rigid body).
+    pub names: Vec<String>,
+    /// The assembly (insertion) direction, as given (not normalised).
+    pub direction: Option<[f64; 3]>,
+    /// The line of the sequence file it came from (1-based; the step's number for a plan JSON).
+    pub line: usize,
+    /// For a step read from a plan JSON: the line as its text would read, for messages.
+    pub text: String,
+}
+
+/// Reads a sequence: a plan JSON (text starting with `{`) or the line format of
+/// docs/check-format.md. Errors are [`AppError::Setting`]s of the key `sequence`.
+pub fn parse_sequence(text: &str) -> Result<Vec<GivenStep>> {
+    if text.trim_start().starts_with('{') {
+        return parse_plan_json(text);
+    }
+    let mut steps = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = strip_comment(raw).trim();
+        if line.is_empty() {
+            continue;
+        }
+        let bad = |why: &str| AppError::setting("sequence", format!("line {}: {why}: {line}", i + 1));
+        let (names, rest) = if let Some(inner) = line.strip_prefix('[') {
+            let Some(end) = inner.find(']') else { return Err(bad("a group opened with `[` is not closed")) };
+            let names: Vec<String> = inner[..end].split(',').map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect();
+            if names.is_empty() {
+                return Err(bad("an empty group"));
+            }
+            (names, inner[end + 1..].trim())
+        } else {
+            // the direction is the last word when it reads as one; a name may hold spaces
+            match line.rsplit_once(char::is_whitespace) {
+                Some((name, last)) if parse_direction(last).is_some() => (vec![name.trim().to_string()], last),
+                _ => (vec![line.to_string()], ""),
+            }
+        };
+        let direction = if rest.is_empty() {
+            None
+        } else {
+            Some(
+                parse_direction(rest)
+                    .ok_or_else(|| bad("not a direction (write an axis such as -z or three numbers such as 0,0,-1 after the part)"))?,
+            )
+        };
+        steps.push(GivenStep { names, direction, line: i + 1, text: line.to_string() });
+    }
+    if steps.is_empty() {
+        return Err(AppError::setting("sequence", "names no part (one part per line, in assembly order)"));
+    }
+    Ok(steps)
+}
+
+/// A line without its comment: `#` at the start or after whitespace (a `#` inside a name, as in
+/// `--split-bodies`' `NAME#1`, stays).
+fn strip_comment(line: &str) -> &str {
+    let bytes = line.as_bytes();
+    for (i, &b) in bytes.iter().enumerate() {
+        if b == b'#' && (i == 0 || bytes[i - 1].is_ascii_whitespace()) {
+            return &line[..i];
+        }
+    }
+    line
+}
+
+/// An axis (`x`, `+x`, `-z`, ...) or three comma-separated numbers; `None` for the zero vector.
+pub fn parse_direction(text: &str) -> Option<[f64; 3]> {
+    let t = text.trim().to_ascii_lowercase();
+    let axis = |c: &str| match c {
+        "x" => Some([1.0, 0.0, 0.0]),
+        "y" => Some([0.0, 1.0, 0.0]),
+        "z" => Some([0.0, 0.0, 1.0]),
+        _ => None,
+    };
+    let v = (if let Some(a) = t.strip_prefix('-') {
+        axis(a).map(|v| v.map(|x: f64| -x))
+    } else if let Some(a) = t.strip_prefix('+') {
+        axis(a)
+    } else if let Some(v) = axis(&t) {
+        Some(v)
+    } else {
+        let nums: Vec<f64> = t.split(',').map(|s| s.trim().parse::<f64>()).collect::<std::result::Result<_, _>>().ok()?;
+        (nums.len() == 3 && nums.iter().all(|x| x.is_finite())).then(|| [nums[0], nums[1], nums[2]])
+    })?;
+    (v.iter().map(|x| x * x).sum::<f64>() > 1e-18).then_some(v)
+}
+
+/// The `assembly_sequence` of a plan JSON as given steps: each step's part (a subassembly's
+/// parts) by name, with the insertion direction of a linear or screw motion.
+fn parse_plan_json(text: &str) -> Result<Vec<GivenStep>> {
+    let bad = |why: String| AppError::setting("sequence", format!("plan JSON: {why}"));
+    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(format!("not JSON: {e}")))?;
+    let names: Vec<String> =
+        v["parts"].as_array().map(|ps| ps.iter().map(|p| p["name"].as_str().unwrap_or_default().to_string()).collect()).unwrap_or_default();
+    let Some(seq) = v["assembly_sequence"].as_array().filter(|s| !s.is_empty()) else {
+        return Err(bad(format!("no assembly_sequence (status {})", v["status"])));
+    };
+    let name_of = |i: &serde_json::Value| -> Result<String> {
+        i.as_u64().and_then(|i| names.get(i as usize)).cloned().ok_or_else(|| bad(format!("part {i} is not in its `parts`")))
+    };
+    let mut steps = Vec::new();
+    for (k, s) in seq.iter().enumerate() {
+        let group = s["subassembly"]["parts"].as_array();
+        let names: Vec<String> = match group {
+            Some(ps) => ps.iter().map(&name_of).collect::<Result<_>>()?,
+            None => vec![s["name"].as_str().map(str::to_string).map_or_else(|| name_of(&s["part"]), Ok)?],
+        };
+        let direction = match s["motion"]["kind"].as_str() {
+            Some("linear" | "screw") => s["motion"]["direction"]
+                .as_array()
+                .and_then(|d| (d.len() == 3).then(|| [d[0].as_f64(), d[1].as_f64(), d[2].as_f64()]))
+                .and_then(|[x, y, z]| Some([x?, y?, z?])),
+            _ => None,
+        };
+        let text = if names.len() == 1 { names[0].clone() } else { format!("[{}]", names.join(", ")) };
+        steps.push(GivenStep { names, direction, line: k + 1, text });
+    }
+    Ok(steps)
+}
+
+/// The edit (Levenshtein) distance of two strings, by characters.
+pub fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+/// The (at most three) part names nearest to `name` by edit distance (case-insensitive), nearest
+/// first.
+pub fn nearest_names<'a>(name: &str, names: impl Iterator<Item = &'a str>) -> Vec<String> {
+    let lower = name.to_lowercase();
+    let mut scored: Vec<(usize, &str)> = names.map(|n| (edit_distance(&lower, &n.to_lowercase()), n)).collect();
+    scored.sort();
+    scored.into_iter().take(3).map(|(_, n)| n.to_string()).collect()
+}
+
+/// A step of the sequence resolved on the model: its parts (the first is the one the report
+/// names a subassembly by) and its unit insertion direction.
+#[derive(Clone, Debug)]
+struct Unit {
+    parts: Vec<usize>,
+    direction: Option<Vec3>,
+}
+
+/// The steps' names as part indices, the base parts listed dropped (with a note). Unknown names,
+/// a part named twice and parts left out are errors (one line: the unknown names with their
+/// nearest names).
+fn resolve_units(assembly: &Assembly, steps: &[GivenStep], notes: &mut Vec<String>) -> Result<Vec<Unit>> {
+    let index = |name: &str| assembly.part_index(name);
+    // a one-name step whose "direction" is part of a name with spaces (`bolt x`)
+    let mut steps = steps.to_vec();
+    for s in &mut steps {
+        if s.names.len() == 1 && index(&s.names[0]).is_none() && index(&s.text).is_some() {
+            s.names = vec![s.text.clone()];
+            s.direction = None;
+        }
+    }
+    let unknown: Vec<&str> = steps.iter().flat_map(|s| &s.names).map(String::as_str).filter(|&n| index(n).is_none()).collect();
+    if !unknown.is_empty() {
+        let names = || assembly.parts.iter().map(|p| p.name.as_str());
+        let listed: Vec<String> = unknown.iter().map(|n| format!("'{n}' (nearest: {})", nearest_names(n, names()).join(", "))).collect();
+        return Err(AppError::setting("sequence", format!("no part is named {}", listed.join("; "))));
+    }
+    let mut seen = vec![false; assembly.len()];
+    let mut units = Vec::new();
+    for s in &steps {
+        let mut parts = Vec::new();
+        for n in &s.names {
+            let p = index(n).expect("names checked");
+            if std::mem::replace(&mut seen[p], true) {
+                return Err(AppError::setting("sequence", format!("line {}: part '{n}' is placed twice", s.line)));
+            }
+            if assembly.parts[p].fixed {
+                notes.push(format!("'{n}' is a base part: it is in place from the start, not a step"));
+            } else {
+                parts.push(p);
+            }
+        }
+        if parts.is_empty() {
+            continue;
+        }
+        let direction = s.direction.map(|d| {
+            let v = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
+            v / v.length()
+        });
+        units.push(Unit { parts, direction });
+    }
+    let missing: Vec<&str> =
+        assembly.parts.iter().enumerate().filter(|(p, part)| !part.fixed && !seen[*p]).map(|(_, part)| part.name.as_str()).collect();
+    if !missing.is_empty() {
+        return Err(AppError::setting(
+            "sequence",
+            format!("leaves out {}: {} (every part that is not a base part goes in once)", missing.len(), missing.join(", ")),
+        ));
+    }
+    Ok(units)
+}
+
+/// Whether the check found the sequence feasible.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CheckStatus {
+    /// Every step goes in.
+    Feasible,
+    /// Some step does not.
+    Infeasible,
+}
+
+/// The check report (docs/check-format.md).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CheckReport {
+    /// [`CHECK_FORMAT_VERSION`].
+    pub format_version: String,
+    /// The model file or folder, as given.
+    pub model: String,
+    /// The model's unit; lengths below are in it.
+    pub units: String,
+    /// The up axis.
+    pub up: String,
+    /// `feasible` or `infeasible`.
+    pub status: CheckStatus,
+    /// The base parts: in place before the first step (the ground too when no part is fixed).
+    pub base: Vec<NamedPart>,
+    /// Every step in assembly order, tested.
+    pub steps: Vec<CheckStep>,
+    /// The first failing step's index in `steps` (assembly order), when infeasible.
+    pub first_failure: Option<usize>,
+    /// When infeasible: the nearest feasible sequence found.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repair: Option<Repair>,
+    /// Remarks about the input (base parts listed as steps).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+    /// Warnings about the model (as the plan's).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+    /// Effort.
+    pub stats: CheckStats,
+}
+
+/// One tested step.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CheckStep {
+    /// Its index in assembly order (0 goes in first).
+    pub step: usize,
+    /// Its parts (several: a rigid subassembly, built beforehand).
+    pub parts: Vec<NamedPart>,
+    /// The insertion direction given with it (unit, model frame).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub given_direction: Option<[f64; 3]>,
+    /// Whether it goes in.
+    pub feasible: bool,
+    /// How it goes in (the insertion motion, as the plan JSON's), when feasible.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<MotionEntry>,
+    /// Why it does not, when infeasible.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failure: Option<Failure>,
+}
+
+/// Why a step fails.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(tag = "reason", rename_all = "snake_case")]
+pub enum Failure {
+    /// Every straight motion tried collides (along the given direction, when one was given).
+    Blocked {
+        /// Whether only the given direction was tried.
+        along_given: bool,
+        /// Per insertion direction tried, the parts already in place it collides with.
+        directions: Vec<DirectionBlockers>,
+        /// Every blocker of every direction.
+        blockers: Vec<NamedPart>,
+        /// With a given direction: the candidate insertion directions that are free instead.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        free_directions: Vec<[f64; 3]>,
+    },
+    /// Every straight motion collides and the path planner found no path either.
+    NoPath {
+        /// Per insertion direction, the parts it collides with.
+        directions: Vec<DirectionBlockers>,
+        /// Every blocker of every direction.
+        blockers: Vec<NamedPart>,
+    },
+    /// The step goes in along `motion`, but the state before it does not stand: `floating` parts
+    /// are not supported without it (in disassembly terms: removing it leaves them unsupported).
+    Unstable {
+        /// The parts left without support.
+        floating: Vec<NamedPart>,
+        /// The free insertion motion.
+        motion: MotionEntry,
+    },
+}
+
+impl Failure {
+    /// The reason's name (`blocked`, `no_path`, `unstable`).
+    pub fn reason(&self) -> &'static str {
+        match self {
+            Failure::Blocked { .. } => "blocked",
+            Failure::NoPath { .. } => "no_path",
+            Failure::Unstable { .. } => "unstable",
+        }
+    }
+}
+
+/// The blockers of one insertion direction.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct DirectionBlockers {
+    /// Unit insertion direction, model frame.
+    pub direction: [f64; 3],
+    /// The parts in place that it collides with (a motion along it pushes into them).
+    pub blockers: Vec<NamedPart>,
+}
+
+/// How the repair search ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RepairStatus {
+    /// A feasible sequence of the given steps.
+    Found,
+    /// No order of the given steps is feasible (with these settings).
+    None,
+    /// The budget (`max_tests`, `timeout`) ran out first.
+    BudgetExhausted,
+}
+
+/// The nearest feasible sequence found.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Repair {
+    /// How the search ended.
+    pub status: RepairStatus,
+    /// The feasible sequence in assembly order (empty unless `found`).
+    pub sequence: Vec<RepairStep>,
+    /// Steps moved: the number of steps minus the longest common subsequence of the two orders.
+    pub moved: usize,
+    /// The Kendall tau distance: pairs of steps the repair puts in the other order.
+    pub kendall_tau: usize,
+    /// Removal tests the search ran.
+    pub removal_tests: u64,
+}
+
+/// One step of the repair.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RepairStep {
+    /// Its parts.
+    pub parts: Vec<NamedPart>,
+    /// Its index in the given sequence.
+    pub given_step: usize,
+    /// Whether it is one of the moved steps (not in the longest common subsequence).
+    pub moved: bool,
+    /// How it goes in.
+    pub motion: MotionEntry,
+}
+
+/// Effort.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Default)]
+pub struct CheckStats {
+    /// Removal tests of the check and the repair.
+    pub removal_tests: u64,
+    /// Wall time, seconds (loading and the world included).
+    pub seconds: f64,
+}
+
+impl CheckReport {
+    /// The report as JSON: pretty-printed, with a final newline.
+    pub fn to_json(&self) -> String {
+        let mut s = serde_json::to_string_pretty(self).expect("check reports serialise");
+        s.push('\n');
+        s
+    }
+
+    /// Whether the sequence is feasible.
+    pub fn feasible(&self) -> bool {
+        self.status == CheckStatus::Feasible
+    }
+
+    /// The report as text: a line per step, the first failure with its reason, the repair with
+    /// its moved steps marked `*`.
+    pub fn to_text(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::new();
+        let names = |ps: &[NamedPart]| ps.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ");
+        let label = |ps: &[NamedPart]| if ps.len() == 1 { ps[0].name.clone() } else { format!("[{}]", names(ps)) };
+        let _ = writeln!(s, "model: {} ({} steps onto {})", self.model, self.steps.len(), names(&self.base));
+        for st in &self.steps {
+            let what = match (&st.motion, &st.failure) {
+                (Some(m), _) => format!("ok, in {}", motion_text(m, &self.units)),
+                (None, Some(f)) => failure_text(f),
+                _ => String::new(),
+            };
+            let _ = writeln!(s, "  {:>3}. {:<24} {what}", st.step + 1, label(&st.parts));
+        }
+        match self.first_failure {
+            None => {
+                let _ = writeln!(s, "feasible: every step goes in");
+            }
+            Some(k) => {
+                let st = &self.steps[k];
+                let why = st.failure.as_ref().map(failure_text).unwrap_or_default();
+                let _ = writeln!(s, "infeasible: step {} ({}) fails: {why}", k + 1, label(&st.parts));
+            }
+        }
+        if let Some(r) = &self.repair {
+            match r.status {
+                RepairStatus::Found => {
+                    let _ = writeln!(
+                        s,
+                        "nearest feasible sequence ({} step{} moved, Kendall tau distance {}; * marks a moved step):",
+                        r.moved,
+                        if r.moved == 1 { "" } else { "s" },
+                        r.kendall_tau
+                    );
+                    for (i, st) in r.sequence.iter().enumerate() {
+                        let mark = if st.moved { "*" } else { " " };
+                        let _ = writeln!(
+                            s,
+                            "  {mark}{:>3}. {:<24} in {} (given as step {})",
+                            i + 1,
+                            label(&st.parts),
+                            motion_text(&st.motion, &self.units),
+                            st.given_step + 1
+                        );
+                    }
+                }
+                RepairStatus::None => {
+                    let _ = writeln!(s, "no order of these steps is feasible");
+                }
+                RepairStatus::BudgetExhausted => {
+                    let _ = writeln!(s, "no feasible order found within the budget");
+                }
+            }
+        }
+        for n in &self.notes {
+            let _ = writeln!(s, "note: {n}");
+        }
+        s
+    }
+}
+
+/// A direction as `+z` when it is an axis, else its three components.
+fn direction_text(d: &[f64; 3]) -> String {
+    for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+        if (d[i].abs() - 1.0).abs() < 1e-6 {
+            return format!("{}{axis}", if d[i] > 0.0 { "+" } else { "-" });
+        }
+    }
+    format!("({:.3}, {:.3}, {:.3})", d[0], d[1], d[2])
+}
+
+fn motion_text(m: &MotionEntry, units: &str) -> String {
+    match m {
+        MotionEntry::Linear { direction, distance } => format!("along {} ({distance:.4} {units})", direction_text(direction)),
+        MotionEntry::Screw { direction, distance, .. } => format!("screwed along {} ({distance:.4} {units})", direction_text(direction)),
+        MotionEntry::Path { poses, .. } => format!("along a path of {} poses", poses.len()),
+    }
+}
+
+fn failure_text(f: &Failure) -> String {
+    let names = |ps: &[NamedPart]| ps.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ");
+    let per_dir = |ds: &[DirectionBlockers]| {
+        let shown: Vec<String> = ds
+            .iter()
+            .filter(|d| !d.blockers.is_empty())
+            .take(6)
+            .map(|d| format!("{} by {}", direction_text(&d.direction), names(&d.blockers)))
+            .collect();
+        let more = ds.iter().filter(|d| !d.blockers.is_empty()).count().saturating_sub(shown.len());
+        let tail = if more > 0 { format!("; {more} more directions") } else { String::new() };
+        format!("{}{tail}", shown.join("; "))
+    };
+    match f {
+        Failure::Blocked { along_given: true, directions, free_directions, .. } => {
+            let free = if free_directions.is_empty() {
+                String::new()
+            } else {
+                format!(" (free instead: {})", free_directions.iter().map(direction_text).collect::<Vec<_>>().join(", "))
+            };
+            format!("blocked along the given direction: {}{free}", per_dir(directions))
+        }
+        Failure::Blocked { blockers, directions, .. } => {
+            format!("blocked by {} (insertion {})", names(blockers), per_dir(directions))
+        }
+        Failure::NoPath { blockers, directions } => {
+            format!("blocked by {} along every straight line (insertion {}) and no path found", names(blockers), per_dir(directions))
+        }
+        Failure::Unstable { floating, .. } => format!("unstable: {}, placed before it, would not be supported without it", names(floating)),
+    }
+}
+
+/// The tests of one unit in one state, on the planner's checker.
+struct Tester<'a> {
+    checker: &'a Checker,
+    settings: &'a PlanSettings,
+}
+
+impl Tester<'_> {
+    fn world(&self) -> &World {
+        self.checker.world()
+    }
+
+    fn group(&self, parts: &[usize]) -> PartSet {
+        PartSet::from_indices(self.world().num_parts() + 1, parts.iter().copied())
+    }
+
+    fn rest(state: &PartSet, parts: &[usize]) -> PartSet {
+        let mut rest = state.clone();
+        for &p in parts {
+            rest.remove(p);
+        }
+        rest
+    }
+
+    /// Removing `unit` from `state` along any motion the settings allow: straight lines (a
+    /// group's together), then the path planner for a single part.
+    fn any(&self, parts: &[usize], state: &PartSet) -> Outcome {
+        let outcome = self.straight(parts, state);
+        if let ([p], true) = (parts, matches!(outcome, Outcome::Collision { .. })) {
+            if let Some(path) = self.path(*p, state).filter(|o| !matches!(o, Outcome::Collision { .. })) {
+                return path;
+            }
+        }
+        outcome
+    }
+
+    /// Removing `parts` from `state` along a straight line (a group's together).
+    fn straight(&self, parts: &[usize], state: &PartSet) -> Outcome {
+        match parts {
+            [p] => self.checker.test_removal(*p, state, MotionKind::Linear),
+            _ => self.checker.test_group_removal(&self.group(parts), state),
+        }
+    }
+
+    /// Removing part `p` from `state` along a path, when the settings allow the path planner.
+    fn path(&self, p: usize, state: &PartSet) -> Option<Outcome> {
+        self.settings.path_planner.then(|| self.checker.test_removal(p, state, MotionKind::Path { seed: self.settings.seed }))
+    }
+
+    /// The parts of `state` (and the base) blocking `parts` removed along `dir` (unit).
+    fn blockers_along(&self, parts: &[usize], state: &PartSet, dir: Vec3) -> PartSet {
+        let world = self.world();
+        let present = world.with_fixed(state);
+        let group = self.group(parts);
+        if let Some(k) = world.directions().iter().position(|d| d.dot(dir) > 0.99999) {
+            return world.group_blockers(&group, k, &present);
+        }
+        let mut blockers = PartSet::empty(world.num_parts() + 1);
+        for &p in parts {
+            for q in present.iter().filter(|q| !group.contains(*q)) {
+                if world.pair_blocks(p, q, dir) {
+                    blockers.insert(q);
+                }
+            }
+        }
+        blockers
+    }
+
+    /// Removing `parts` from `state` along `dir` only (unit removal direction).
+    fn along(&self, parts: &[usize], state: &PartSet, dir: Vec3) -> std::result::Result<Outcome, PartSet> {
+        let world = self.world();
+        let blockers = self.blockers_along(parts, state, dir);
+        if !blockers.is_empty() {
+            return Err(blockers);
+        }
+        let group = self.group(parts);
+        let distance = match parts {
+            [p] => world.clearance(*p, state, dir),
+            _ => world.group_clearance(&group, state, dir),
+        };
+        let motion = match parts {
+            [p] => {
+                let partner = world.with_fixed(state).iter().filter(|&q| q != *p).find_map(|q| world.thread(*p, q));
+                match partner.filter(|t| t.axis.direction.dot(dir).abs() > 0.9999) {
+                    Some(t) => Motion::Screw { axis_point: t.axis.point, direction: dir, distance },
+                    None => Motion::Linear { direction: dir, distance },
+                }
+            }
+            _ => Motion::Linear { direction: dir, distance },
+        };
+        Ok(match self.checker.stability(&Self::rest(state, parts)) {
+            Stability::Stable => Outcome::Removed(motion),
+            Stability::Unstable { floating } => Outcome::Unstable { floating, motion },
+        })
+    }
+
+    /// Per candidate direction, the blockers of `parts` in `state` (removal directions).
+    fn per_direction(&self, parts: &[usize], state: &PartSet) -> Vec<(Vec3, PartSet)> {
+        let world = self.world();
+        let present = world.with_fixed(state);
+        let group = self.group(parts);
+        world.directions().iter().enumerate().map(|(k, d)| (*d, world.group_blockers(&group, k, &present))).collect()
+    }
+}
+
+/// Checks `steps` on the model at `path` with `settings` (the request's, as `asp plan` resolves
+/// them).
+pub fn check_file(path: &std::path::Path, steps: &[GivenStep], settings: &PlanSettings) -> Result<CheckReport> {
+    let started = Instant::now();
+    let assembly = pipeline::load(path, settings)?;
+    let mut report = check_assembly(assembly, steps, settings)?;
+    report.stats.seconds = started.elapsed().as_secs_f64();
+    Ok(report)
+}
+
+/// Checks `steps` on `assembly` with `settings`: every step's removal in disassembly order on
+/// the planner's checker, the first failure, and a repair when one fails.
+pub fn check_assembly(assembly: Assembly, steps: &[GivenStep], settings: &PlanSettings) -> Result<CheckReport> {
+    let started = Instant::now();
+    if settings.optimise.is_some() {
+        return Err(AppError::setting("objective", "does not apply to checking a sequence (the check tests feasibility)"));
+    }
+    if settings.checker_extension.is_some() {
+        return Err(AppError::setting("robot", "does not apply to checking a sequence yet"));
+    }
+    let mut notes = Vec::new();
+    let units = resolve_units(&assembly, steps, &mut notes)?;
+    let budget = pipeline::budget(settings)?;
+    let checker = pipeline::checker(assembly, settings)?;
+    let world = checker.world();
+    let assembly = world.assembly();
+    let n = world.num_parts();
+    let u = |m: f32| assembly.units.from_metres(m as f64);
+    let named = |s: &mut dyn Iterator<Item = usize>| -> Vec<NamedPart> {
+        s.map(|p| NamedPart { part: p, name: world.name(p).to_string() }).collect()
+    };
+    let v3 = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
+    let full = PartSet::full(n);
+    let tester = Tester { checker: &checker, settings };
+    // the state before step i is removed: the base and steps 0..=i
+    let mut base = PartSet::from_indices(n, (0..n).filter(|&p| world.fixed().contains(p)));
+    let mut states = Vec::with_capacity(units.len());
+    for unit in &units {
+        for &p in &unit.parts {
+            base.insert(p);
+        }
+        states.push(base.clone());
+    }
+    let mut checked = Vec::with_capacity(units.len());
+    for (i, unit) in units.iter().enumerate() {
+        let state = &states[i];
+        let outcome = match unit.direction {
+            Some(d) => tester.along(&unit.parts, state, -d),
+            None => Ok(tester.any(&unit.parts, state)),
+        };
+        let (motion, failure) = match outcome {
+            Ok(Outcome::Removed(m)) => (Some(insertion(&m, &u)), None),
+            Ok(Outcome::Unstable { floating, motion }) => {
+                (None, Some(Failure::Unstable { floating: named(&mut floating.iter()), motion: insertion(&motion, &u) }))
+            }
+            Ok(Outcome::Collision { .. }) => {
+                let dirs = tester.per_direction(&unit.parts, state);
+                let mut all = PartSet::empty(n + 1);
+                for (_, b) in &dirs {
+                    all.union_with(b);
+                }
+                let directions =
+                    dirs.iter().map(|(d, b)| DirectionBlockers { direction: v3(-*d), blockers: named(&mut b.iter()) }).collect();
+                let blockers = named(&mut all.iter());
+                let tried_path = settings.path_planner && unit.parts.len() == 1;
+                (
+                    None,
+                    Some(if tried_path {
+                        Failure::NoPath { directions, blockers }
+                    } else {
+                        Failure::Blocked { along_given: false, directions, blockers, free_directions: Vec::new() }
+                    }),
+                )
+            }
+            Err(blockers) => {
+                let d = unit.direction.expect("a direction was given");
+                let free_directions =
+                    tester.per_direction(&unit.parts, state).into_iter().filter(|(_, b)| b.is_empty()).map(|(d, _)| v3(-d)).collect();
+                let names = named(&mut blockers.iter());
+                (
+                    None,
+                    Some(Failure::Blocked {
+                        along_given: true,
+                        directions: vec![DirectionBlockers { direction: v3(d), blockers: names.clone() }],
+                        blockers: names,
+                        free_directions,
+                    }),
+                )
+            }
+        };
+        checked.push(CheckStep {
+            step: i,
+            parts: named(&mut unit.parts.iter().copied()),
+            given_direction: unit.direction.map(v3),
+            feasible: failure.is_none(),
+            motion,
+            failure,
+        });
+    }
+    let first_failure = checked.iter().position(|s| !s.feasible);
+    let repair = first_failure.map(|_| {
+        let found = repair_search(&tester, &units, &full, &budget);
+        match found.sequence {
+            Some(seq) => {
+                let order: Vec<usize> = seq.iter().map(|(k, _)| *k).collect();
+                let (moved, kept) = moved_steps(&order);
+                Repair {
+                    status: RepairStatus::Found,
+                    sequence: seq
+                        .iter()
+                        .zip(kept)
+                        .map(|((k, m), kept)| RepairStep {
+                            parts: named(&mut units[*k].parts.iter().copied()),
+                            given_step: *k,
+                            moved: !kept,
+                            motion: insertion(m, &u),
+                        })
+                        .collect(),
+                    moved,
+                    kendall_tau: kendall_tau(&order),
+                    removal_tests: found.tests,
+                }
+            }
+            None => Repair {
+                status: if found.exhausted { RepairStatus::BudgetExhausted } else { RepairStatus::None },
+                sequence: Vec::new(),
+                moved: 0,
+                kendall_tau: 0,
+                removal_tests: found.tests,
+            },
+        }
+    });
+    let base_parts = named(&mut world.fixed().iter());
+    Ok(CheckReport {
+        format_version: CHECK_FORMAT_VERSION.into(),
+        model: assembly.source.display().to_string(),
+        units: assembly.units.name.clone(),
+        up: assembly.up.to_string(),
+        status: if first_failure.is_none() { CheckStatus::Feasible } else { CheckStatus::Infeasible },
+        base: base_parts,
+        steps: checked,
+        first_failure,
+        repair,
+        notes,
+        warnings: world.warnings().to_vec(),
+        stats: CheckStats { removal_tests: checker.counters().removal_tests, seconds: started.elapsed().as_secs_f64() },
+    })
+}
+
+/// What the repair search found: the units in assembly order with their removal motions.
+struct Found {
+    sequence: Option<Vec<(usize, Motion)>>,
+    tests: u64,
+    exhausted: bool,
+}
+
+/// The depth-first search of the repair: from the assembled state, at every state the present
+/// units in the given sequence's disassembly order (the latest placed first), dead states
+/// remembered; within the settings' budget.
+fn repair_search(tester: &Tester<'_>, units: &[Unit], full: &PartSet, budget: &Budget) -> Found {
+    struct Search<'s, 'a> {
+        tester: &'s Tester<'a>,
+        units: &'s [Unit],
+        budget: &'s Budget,
+        started: Instant,
+        tests: u64,
+        dead: HashSet<PartSet>,
+        exhausted: bool,
+    }
+    impl Search<'_, '_> {
+        fn go(&mut self, state: &PartSet, left: &mut Vec<usize>, removals: &mut Vec<(usize, Motion)>) -> bool {
+            if left.is_empty() {
+                return true;
+            }
+            if self.dead.contains(state) {
+                return false;
+            }
+            // straight lines for every step first (in the given order), then the path planner
+            // for the single parts no straight line freed, as the planner's own search does
+            let mut straight_free = vec![false; self.units.len()];
+            for path in [false, true] {
+                for i in (0..left.len()).rev() {
+                    if self.budget.exhausted(self.tests, self.started) {
+                        self.exhausted = true;
+                        return false;
+                    }
+                    let k = left[i];
+                    let parts = &self.units[k].parts;
+                    let outcome = if !path {
+                        self.tests += 1;
+                        self.tester.straight(parts, state)
+                    } else if parts.len() == 1 && !straight_free[k] {
+                        self.tests += 1;
+                        match self.tester.path(parts[0], state) {
+                            Some(o) => o,
+                            None => continue,
+                        }
+                    } else {
+                        continue;
+                    };
+                    if !path && !matches!(outcome, Outcome::Collision { .. }) {
+                        straight_free[k] = true; // a path would not make it stand
+                    }
+                    let Outcome::Removed(motion) = outcome else { continue };
+                    let next = Tester::rest(state, parts);
+                    left.remove(i);
+                    removals.push((k, motion));
+                    if self.go(&next, left, removals) {
+                        return true;
+                    }
+                    removals.pop();
+                    left.insert(i, k);
+                    if self.exhausted {
+                        return false;
+                    }
+                }
+            }
+            self.dead.insert(state.clone());
+            false
+        }
+    }
+    let mut search = Search { tester, units, budget, started: Instant::now(), tests: 0, dead: HashSet::new(), exhausted: false };
+    let mut left: Vec<usize> = (0..units.len()).collect();
+    let mut removals = Vec::new();
+    let found = search.go(full, &mut left, &mut removals);
+    removals.reverse();
+    Found { sequence: found.then_some(removals), tests: search.tests, exhausted: search.exhausted }
+}
+
+/// For an order of the given steps (`order[j]` = the given index of the `j`-th step), the number
+/// of moved steps (`n` − the longest increasing subsequence, i.e. the longest common subsequence
+/// with the given order) and, per position, whether it is in that subsequence (kept in place).
+pub fn moved_steps(order: &[usize]) -> (usize, Vec<bool>) {
+    let n = order.len();
+    // O(n²) longest increasing subsequence with predecessors
+    let mut len = vec![1usize; n];
+    let mut prev = vec![usize::MAX; n];
+    for j in 0..n {
+        for i in 0..j {
+            if order[i] < order[j] && len[i] + 1 > len[j] {
+                len[j] = len[i] + 1;
+                prev[j] = i;
+            }
+        }
+    }
+    let mut kept = vec![false; n];
+    if let Some(mut j) = (0..n).max_by_key(|&j| (len[j], std::cmp::Reverse(j))) {
+        let best = len[j];
+        loop {
+            kept[j] = true;
+            if prev[j] == usize::MAX {
+                break;
+            }
+            j = prev[j];
+        }
+        (n - best, kept)
+    } else {
+        (0, kept)
+    }
+}
+
+/// The Kendall tau distance of an order of the given steps to the given order: pairs in the
+/// other order.
+pub fn kendall_tau(order: &[usize]) -> usize {
+    let mut count = 0;
+    for j in 0..order.len() {
+        for i in 0..j {
+            count += usize::from(order[i] > order[j]);
+        }
+    }
+    count
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_groups_directions_and_comments_parse() {
+        let steps = parse_sequence("# base first\nbase\n[a, b] -z  # a pair\nbolt 1 0,0,-1\nnut#1\n  \nwasher +x\n").unwrap();
+        assert_eq!(steps.len(), 5);
+        assert_eq!(steps[1].names, vec!["a", "b"]);
+        assert_eq!(steps[1].direction, Some([0.0, 0.0, -1.0]));
+        assert_eq!(steps[2].names, vec!["bolt 1"]);
+        assert_eq!(steps[2].direction, Some([0.0, 0.0, -1.0]));
+        assert_eq!(steps[3].names, vec!["nut#1"]);
+        assert_eq!(steps[4].direction, Some([1.0, 0.0, 0.0]));
+        assert!(parse_sequence("[a, b\n").is_err());
+        assert!(parse_sequence("[a] sideways\n").is_err());
+        assert!(parse_sequence("# nothing\n").is_err());
+    }
+
+    #[test]
+    fn distances_count_moved_steps_and_swapped_pairs() {
+        assert_eq!(moved_steps(&[0, 1, 2, 3]).0, 0);
+        assert_eq!(kendall_tau(&[0, 1, 2, 3]), 0);
+        let (moved, kept) = moved_steps(&[0, 2, 1, 3]);
+        assert_eq!(moved, 1);
+        assert_eq!(kept.iter().filter(|k| !**k).count(), 1);
+        assert_eq!(kendall_tau(&[0, 2, 1, 3]), 1);
+        assert_eq!(moved_steps(&[3, 2, 1, 0]).0, 3);
+        assert_eq!(kendall_tau(&[3, 2, 1, 0]), 6);
+        assert_eq!(moved_steps(&[1, 2, 3, 0]).0, 1);
+        assert_eq!(kendall_tau(&[1, 2, 3, 0]), 3);
+    }
+
+    #[test]
+    fn edit_distance_and_nearest_names() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(nearest_names("stik", ["receptacle", "stick", "handle", "cap"].into_iter())[0], "stick");
+    }
+}
