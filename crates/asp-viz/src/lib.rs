@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 pub mod error;
+pub mod instructions;
 pub mod mcap;
 pub mod plot;
 pub mod render;

@@ -175,10 +175,15 @@ impl Browser {
 
     /// Opens `page` (a file) and waits until the viewer says it is ready.
     pub fn open(&mut self, page: &Path) {
+        self.open_until(page, "window.aspViewer !== undefined && window.aspViewer.ready === true");
+    }
+
+    /// Opens `page` (a file) and waits until `ready` (a script expression) is true.
+    pub fn open_until(&mut self, page: &Path, ready: &str) {
         let url = format!("file://{}", page.canonicalize().unwrap().display());
         let s = self.session.clone();
         self.call(Some(&s), "Page.navigate", json!({ "url": url }));
-        self.wait_for("window.aspViewer !== undefined && window.aspViewer.ready === true", 60.0);
+        self.wait_for(ready, 60.0);
     }
 
     /// The value of a script expression (promises awaited).

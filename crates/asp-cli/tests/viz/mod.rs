@@ -345,3 +345,108 @@ fn a_hostile_part_name_stays_text_in_the_viewer() {
     assert!(steps.as_str().is_some_and(|t| t.contains(hostile)), "the step list does not show the name as text: {steps}");
     browser.assert_no_errors();
 }
+
+/// `asp render instructions`: the bookcase planned with its precedence graph, balanced into
+/// three stations (every step at one station, no step before a predecessor's station, about
+/// equal parts each), the pages open in the headless browser with their pictures loaded; a
+/// times file moves the balance; a plan without a sequence, zero stations and a bad times file
+/// are one-line errors.
+#[test]
+fn work_instructions_per_station_open_in_a_headless_browser() {
+    let dir = tempfile::tempdir().unwrap();
+    let plan = dir.path().join("grevback.json");
+    let model = data("ikea/bookcase_grevback_0484.glb");
+    let o = asp(&["plan", &model, "--up", "z", "--precedence", "--quiet", "--out", plan.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let line = dir.path().join("line");
+    let o = asp(&["render", "instructions", plan.to_str().unwrap(), "--stations", "3", "--out", line.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("3 stations") && stderr(&o).contains("on the precedence graph"), "{}", stderr(&o));
+    for f in ["index.html", "station-01.html", "station-01.png", "station-02.html", "station-03.png"] {
+        assert!(line.join(f).is_file(), "{f} missing");
+    }
+    assert!(!line.join("station-04.html").exists());
+    // the stations against the plan's graph
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&plan).unwrap()).unwrap();
+    let steps = report["assembly_sequence"].as_array().unwrap().len();
+    let pages: Vec<String> = (1..=3).map(|i| std::fs::read_to_string(line.join(format!("station-{i:02}.html"))).unwrap()).collect();
+    let station_of = |k: usize| -> usize {
+        let name = report["assembly_sequence"][k]["name"].as_str().unwrap();
+        let cell = format!("<tr><td>{}</td><td>{name}", k + 1);
+        let at: Vec<usize> = (0..3).filter(|&i| pages[i].contains(&cell)).collect();
+        assert_eq!(at.len(), 1, "step {} is at one station: {at:?}", k + 1);
+        at[0]
+    };
+    let stations: Vec<usize> = (0..steps).map(station_of).collect();
+    for e in report["precedence"]["edges"].as_array().unwrap() {
+        let (a, b) = (e["before"].as_u64().unwrap() as usize, e["after"].as_u64().unwrap() as usize);
+        assert!(stations[a] <= stations[b], "step {} before step {} but at a later station", a + 1, b + 1);
+    }
+    let per: Vec<usize> = (0..3).map(|i| stations.iter().filter(|&&s| s == i).count()).collect();
+    assert!(per.iter().all(|&c| c >= 1 && c <= steps.div_ceil(3) + 1), "{per:?}");
+    // the pages in a browser: no errors, the pictures loaded
+    if let Some(mut browser) = Browser::launch() {
+        let loaded = "document.readyState === 'complete' && document.images.length > 0 && Array.from(document.images).every(i => i.complete && i.naturalWidth > 0)";
+        browser.open_until(&line.join("station-01.html"), loaded);
+        assert!(browser.eval("document.querySelectorAll('tr').length").as_u64().unwrap() >= 2);
+        let shot = browser.screenshot();
+        assert!(model_pixels(&shot, 0) > 500, "the station's pictures show the model");
+        browser.open_until(&line.join("index.html"), "document.readyState === 'complete'");
+        assert_eq!(browser.eval("document.querySelectorAll('a[href^=\"station-\"]').length").as_u64(), Some(3));
+        browser.assert_no_errors();
+    }
+    // a time per part: the heaviest part alone fills a station
+    let first = report["assembly_sequence"][0]["name"].as_str().unwrap().to_string();
+    let times = dir.path().join("times.csv");
+    std::fs::write(&times, format!("# seconds per part\n{first},100\n")).unwrap();
+    let timed = dir.path().join("timed");
+    let o = asp(&[
+        "render",
+        "instructions",
+        plan.to_str().unwrap(),
+        "--stations",
+        "2",
+        "--times",
+        times.to_str().unwrap(),
+        "--out",
+        timed.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("cycle 100.0 s"), "{}", stderr(&o));
+    // errors: one line each, naming the cause
+    std::fs::write(&times, "nope,1\n").unwrap();
+    let o = asp(&[
+        "render",
+        "instructions",
+        plan.to_str().unwrap(),
+        "--stations",
+        "2",
+        "--times",
+        times.to_str().unwrap(),
+        "--out",
+        timed.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("'nope', which is no part of the plan"), "{}", stderr(&o));
+    std::fs::write(&times, "x;1\n").unwrap();
+    let o = asp(&[
+        "render",
+        "instructions",
+        plan.to_str().unwrap(),
+        "--stations",
+        "2",
+        "--times",
+        times.to_str().unwrap(),
+        "--out",
+        timed.to_str().unwrap(),
+    ]);
+    assert!(o.status.code() == Some(2) && stderr(&o).contains("times.csv:1: no comma"), "{}", stderr(&o));
+    let o = asp(&["render", "instructions", plan.to_str().unwrap(), "--stations", "0", "--out", timed.to_str().unwrap()]);
+    assert!(o.status.code() == Some(2) && stderr(&o).contains("--stations must be at least 1"), "{}", stderr(&o));
+    let o = asp(&["render", "instructions", pump_plan().to_str().unwrap(), "--stations", "2", "--out", timed.to_str().unwrap()]);
+    assert!(o.status.code() == Some(2) && stderr(&o).contains("instructions need an assembly sequence"), "{}", stderr(&o));
+    // the storyboard is still `asp render PLAN --out FILE`
+    let png = dir.path().join("board.png");
+    let o = asp(&["render", plan.to_str().unwrap(), "--out", png.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
