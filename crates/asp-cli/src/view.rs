@@ -116,8 +116,13 @@ fn instructions(args: &InstructionArgs) -> anyhow::Result<ExitCode> {
     let scene = Scene::from_plan_file(&args.plan, args.model.as_deref())?;
     let options = InstructionOptions { stations: args.stations, times, default_time: args.default_time, panel: args.panel };
     let made = asp_viz::instructions::write(&args.out, &scene, &options)?;
+    let fewer = if made.stations.len() < args.stations {
+        format!(" ({} asked: more would not shorten the cycle, which no step can be split below)", args.stations)
+    } else {
+        String::new()
+    };
     eprintln!(
-        "{} stations, cycle {:.1} s ({}); wrote {}",
+        "{} stations{fewer}, cycle {:.1} s ({}); wrote {}",
         made.stations.len(),
         made.cycle,
         if made.from_precedence { "on the precedence graph" } else { "in the plan's order: plan with --precedence to balance better" },
