@@ -295,6 +295,36 @@ for (const e of data.explanation) {
   li.textContent = e.text;
   explanation.appendChild(li);
 }
+// the precedence graph, when the plan has one: the steps by level (a level's steps may go in
+// side by side, once every earlier level is in), the critical path in bold; a click on a step
+// shows the model up to it
+const precedence = document.getElementById('asp-precedence');
+if (data.precedence) {
+  const p = data.precedence;
+  const critical = new Set(p.critical_path);
+  const head = document.createElement('div');
+  head.textContent = `Precedence: ${p.levels.length} levels, critical path ${p.critical_path.length} steps` +
+    (p.conservative ? ' (support edges conservative)' : '');
+  precedence.appendChild(head);
+  const levels = document.createElement('ol');
+  p.levels.forEach((level) => {
+    const li = document.createElement('li');
+    li.className = 'asp-level';
+    level.forEach((k, j) => {
+      const a = document.createElement('span');
+      a.className = critical.has(k) ? 'asp-step critical' : 'asp-step';
+      if (critical.has(k)) a.style.fontWeight = 'bold';
+      a.style.cursor = 'pointer';
+      a.textContent = `${k + 1}. ${steps[k] ? steps[k].name : '?'}`;
+      a.addEventListener('click', () => { pause(); goto(k + 1); });
+      li.appendChild(a);
+      if (j + 1 < level.length) li.appendChild(document.createTextNode(' | '));
+    });
+    levels.appendChild(li);
+  });
+  precedence.appendChild(levels);
+  precedence.hidden = false;
+}
 const counter = document.getElementById('asp-counter');
 const playButton = document.getElementById('asp-play');
 function updatePanel(cur) {

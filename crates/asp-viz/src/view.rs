@@ -136,6 +136,15 @@ fn page_data(scene: &Scene) -> Value {
             json!({ "part": e.part, "name": e.name, "reason": e.reason, "text": text })
         })
         .collect();
+    // the precedence graph (`asp plan --precedence`): which steps may go in side by side
+    let precedence = r.precedence.as_ref().map(|p| {
+        json!({
+            "levels": p.levels,
+            "critical_path": p.critical_path,
+            "edges": p.edges.iter().map(|e| [e.before, e.after]).collect::<Vec<_>>(),
+            "conservative": p.stability.conservative,
+        })
+    });
     let up = asp_geom::math::Axis::parse(&r.up).map(|a| a.vector()).unwrap_or(asp_geom::math::Vec3::Z);
     json!({
         "title": r.model,
@@ -148,6 +157,7 @@ fn page_data(scene: &Scene) -> Value {
         "stuck": scene.stuck,
         "steps": steps,
         "explanation": explanation,
+        "precedence": precedence,
     })
 }
 

@@ -450,3 +450,35 @@ fn work_instructions_per_station_open_in_a_headless_browser() {
     let o = asp(&["render", plan.to_str().unwrap(), "--out", png.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
+
+/// The viewer shows a plan's precedence graph (`asp plan --precedence`): its levels, the
+/// critical path in bold, a click on a step shows the model up to it; without the graph the
+/// section stays hidden.
+#[test]
+fn the_viewer_shows_the_precedence_levels() {
+    let Some(mut browser) = Browser::launch() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let plan = dir.path().join("grevback.json");
+    let o =
+        asp(&["plan", &data("ikea/bookcase_grevback_0484.glb"), "--up", "z", "--precedence", "--quiet", "--out", plan.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&plan).unwrap()).unwrap();
+    let levels = report["precedence"]["levels"].as_array().unwrap().len();
+    let page = dir.path().join("grevback.html");
+    let o = asp(&["view", plan.to_str().unwrap(), "--out", page.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    browser.open(&page);
+    assert_eq!(browser.eval("document.getElementById('asp-precedence').hidden"), serde_json::json!(false));
+    assert_eq!(browser.eval("document.querySelectorAll('#asp-precedence li.asp-level').length").as_u64(), Some(levels as u64));
+    let critical = report["precedence"]["critical_path"].as_array().unwrap().len() as u64;
+    assert_eq!(browser.eval("document.querySelectorAll('#asp-precedence .asp-step.critical').length").as_u64(), Some(critical));
+    // a click on the first step of the last level shows the model up to that step
+    let k = report["precedence"]["levels"][levels - 1][0].as_u64().unwrap();
+    browser.eval("document.querySelector('#asp-precedence li.asp-level:last-child .asp-step').click(); true");
+    let state: serde_json::Value = serde_json::from_str(browser.eval("JSON.stringify(aspViewer.state())").as_str().unwrap()).unwrap();
+    assert_eq!(state["shown"].as_u64(), Some(k + 1), "{state}");
+    browser.assert_no_errors();
+    // a plan without the graph: no section
+    browser.open(&view(lack_plan(), "lack-no-precedence.html"));
+    assert_eq!(browser.eval("document.getElementById('asp-precedence').hidden"), serde_json::json!(true));
+}
