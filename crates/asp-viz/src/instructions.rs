@@ -43,7 +43,7 @@ pub struct Station {
     pub time: f64,
 }
 
-/// What [`write`] made.
+/// What [`write()`] made.
 #[derive(Clone, Debug)]
 pub struct Instructions {
     /// The stations, first to last.
