@@ -471,18 +471,25 @@ fn request(rng: &mut ChaCha8Rng, diagonal: f64) -> (PlanRequest, String) {
 // Checks
 
 /// The report's plan as removals (disassembly order, world frame, metres): the insertions
-/// reversed. Only for models in metres.
+/// reversed. For models in metres ([`removals_scaled`] for others).
 pub(crate) fn removals(steps: &[AssemblyStep], n: usize) -> Vec<Step> {
+    removals_scaled(steps, n, 1.0)
+}
+
+/// [`removals`] of a plan in model units of `metres` each.
+pub(crate) fn removals_scaled(steps: &[AssemblyStep], n: usize, metres: f64) -> Vec<Step> {
     let f = |v: [f64; 3]| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32);
+    let m = |v: [f64; 3]| f(v.map(|c| c * metres));
+    let len = |d: f64| (d * metres) as f32;
     steps
         .iter()
         .rev()
         .map(|s| {
             assert!(s.moves.is_empty(), "a plan of the depth-first search has no grid moves");
             let motion = match &s.motion {
-                MotionEntry::Linear { direction, distance } => Motion::Linear { direction: -f(*direction), distance: *distance as f32 },
+                MotionEntry::Linear { direction, distance } => Motion::Linear { direction: -f(*direction), distance: len(*distance) },
                 MotionEntry::Screw { direction, distance, axis_point } => {
-                    Motion::Screw { direction: -f(*direction), distance: *distance as f32, axis_point: f(*axis_point) }
+                    Motion::Screw { direction: -f(*direction), distance: len(*distance), axis_point: m(*axis_point) }
                 }
                 MotionEntry::Path { poses, pivot } => Motion::Path {
                     poses: poses
@@ -490,10 +497,10 @@ pub(crate) fn removals(steps: &[AssemblyStep], n: usize) -> Vec<Step> {
                         .rev()
                         .map(|p| {
                             let q = Rot::from_xyzw(p[3] as f32, p[4] as f32, p[5] as f32, p[6] as f32);
-                            Pose::from_parts(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32), q)
+                            Pose::from_parts(m([p[0], p[1], p[2]]), q)
                         })
                         .collect(),
-                    pivot: f(*pivot),
+                    pivot: m(*pivot),
                 },
             };
             let group = s.subassembly.as_ref().map(|g| {
@@ -506,7 +513,7 @@ pub(crate) fn removals(steps: &[AssemblyStep], n: usize) -> Vec<Step> {
                     parts: PartSet::from_indices(n + 1, g.parts.iter().copied()),
                     plan: status.map(|status| PlanOutcome {
                         status,
-                        removals: removals(&g.assembly_sequence, n),
+                        removals: removals_scaled(&g.assembly_sequence, n, metres),
                         stats: Default::default(),
                     }),
                     unit: g.status == SubassemblyStatus::Unit,

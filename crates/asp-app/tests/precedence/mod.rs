@@ -2,7 +2,7 @@
 //! feasible with the plan's own motions (the graph's travel per step), by the independent
 //! re-check of `asp-search/tests/verify`.
 
-use crate::fuzz::removals;
+use crate::fuzz::{removals, removals_scaled};
 use crate::verify::verify_removals;
 use asp_app::pipeline::{checker, plan_assembly, PlanSettings};
 use asp_gen::batch::{generate_item, Generator};
@@ -42,6 +42,11 @@ fn linear_extension(g: &PrecedenceEntry, rng: &mut impl RngExt) -> Vec<usize> {
 /// Plans `assembly` with the precedence graph and re-checks `SAMPLES` random linear extensions;
 /// returns the graph and how many distinct orders were drawn.
 fn extensions_are_feasible(what: &str, assembly: Assembly, seed: u64) -> (PrecedenceEntry, usize) {
+    sampled_extensions_are_feasible(what, assembly, seed, SAMPLES)
+}
+
+/// [`extensions_are_feasible`] with `samples` extensions.
+fn sampled_extensions_are_feasible(what: &str, assembly: Assembly, seed: u64, samples: usize) -> (PrecedenceEntry, usize) {
     let settings = PlanSettings { precedence: true, ..PlanSettings::default() };
     let n = assembly.len();
     let metres = assembly.units.metres as f32;
@@ -61,7 +66,7 @@ fn extensions_are_feasible(what: &str, assembly: Assembly, seed: u64) -> (Preced
     }
     assert_eq!(g.levels.iter().map(Vec::len).sum::<usize>(), k);
     // each assembly step as a removal, with the graph's travel
-    let mut steps: Vec<Step> = removals(&r.report.assembly_sequence, n).into_iter().rev().collect();
+    let mut steps: Vec<Step> = removals_scaled(&r.report.assembly_sequence, n, metres as f64).into_iter().rev().collect();
     for (s, entry) in steps.iter_mut().zip(&g.steps) {
         if let (Motion::Linear { distance, .. } | Motion::Screw { distance, .. }, Some(d)) = (&mut s.motion, entry.distance) {
             *distance = d as f32 * metres;
@@ -71,8 +76,11 @@ fn extensions_are_feasible(what: &str, assembly: Assembly, seed: u64) -> (Preced
     let world = world.world();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let mut seen = std::collections::HashSet::new();
-    for _ in 0..SAMPLES {
+    for _ in 0..samples {
         let order = linear_extension(&g, &mut rng);
+        if seen.contains(&order) {
+            continue; // re-checked already
+        }
         let removal: Vec<Step> = order.iter().rev().map(|&i| steps[i].clone()).collect();
         let left = verify_removals(world, &removal);
         assert!(left.iter().all(|p| world.fixed().contains(p)), "{what}: {order:?} leaves parts");
@@ -147,4 +155,47 @@ fn an_order_against_a_blocking_edge_fails_the_re_check() {
     let world = checker(a, &settings).unwrap();
     let refused = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| verify_removals(world.world(), &removal)));
     assert!(refused.is_err(), "the stick went in through the handle");
+}
+
+/// The shipped real models (`tests/data`): their plans' graphs, every sampled extension
+/// re-checked (each distinct order once). By default 5 orders per model and the two large pumps
+/// left out (a re-check of one of their orders takes 1-2 s); `ASP_EXTENSIONS=N` samples N per
+/// model on every model (the benchmark in `docs/benchmarks.md`).
+#[test]
+fn the_shipped_models_precedence_graphs_hold_for_every_sampled_order() {
+    use asp_geom::io::{load, LoadOptions};
+    use asp_geom::math::Axis;
+    let asked: Option<usize> = std::env::var("ASP_EXTENSIONS").ok().and_then(|v| v.parse().ok());
+    let samples = asked.unwrap_or(5);
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data");
+    let z = LoadOptions { up: Some(Axis::Z), ..LoadOptions::default() };
+    let mm = LoadOptions { unit: asp_geom::Units::parse("mm"), up: Some(Axis::Z), ..LoadOptions::default() };
+    let mut models: Vec<(String, Assembly)> = Vec::new();
+    let folders: &[&str] =
+        if asked.is_some() { &["pump", "pump-extension", "pump-threaded", "cube20", "cube81"] } else { &["pump", "cube20", "cube81"] };
+    for &m in folders {
+        models.push((m.into(), load(&data.join(m), &mm).unwrap()));
+    }
+    let mut glb: Vec<std::path::PathBuf> = ["beam", "ikea", "step", "bearing"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(data.join(d)).unwrap().map(|e| e.unwrap().path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "glb"))
+        .collect();
+    glb.sort();
+    for p in glb {
+        models.push((p.file_name().unwrap().to_string_lossy().into_owned(), load(&p, &z).unwrap()));
+    }
+    let started = std::time::Instant::now();
+    for (i, (what, a)) in models.iter().enumerate() {
+        let t = std::time::Instant::now();
+        let (g, distinct) = sampled_extensions_are_feasible(what, a.clone(), 100 + i as u64, samples);
+        eprintln!(
+            "{what}: {} steps, {} edges, {} levels, {distinct} distinct of {samples} orders re-checked in {:.2} s",
+            g.steps.len(),
+            g.edges.len(),
+            g.levels.len(),
+            t.elapsed().as_secs_f64()
+        );
+    }
+    eprintln!("{} models in {:.1} s", models.len(), started.elapsed().as_secs_f64());
 }
