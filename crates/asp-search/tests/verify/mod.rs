@@ -382,7 +382,7 @@ pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: 
                 Some(_) => assert!(
                     threads.iter().any(|t| t.axis.direction.dot(direction).abs() > 0.9999
                         && t.axis.radial(axis_point) < 1e-3 * t.axis.radius.max(1e-9) + 1e-6),
-                    "step {k}: '{}' screws off the axis of every threaded partner present",
+                    "step {k}: '{}' screws off its axis (the axis of every threaded partner present)",
                     world.name(step.part)
                 ),
                 None => assert!(
