@@ -61,9 +61,8 @@ pub(crate) fn plan_cores_alone(
     if changed {
         // the core's why is of the core that stayed locked; a core opened by its own plan
         // has none
-        let kept: Vec<LockedCore> = report.locked_cores.clone();
+        known.append(&mut report.locked_cores);
         report.status = asp_search::report::PlanStatus::Found;
-        known.extend(kept);
         report.settle(&known);
     }
     Ok(())

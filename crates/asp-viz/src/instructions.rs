@@ -105,10 +105,11 @@ pub fn balance(times: &[f64], edges: &[(usize, usize)], stations: usize) -> Vec<
         out
     };
     let (mut lo, mut hi) = ((total / stations as f64).max(longest), total.max(longest));
-    let mut best = assign(hi);
-    if assign(lo).len() <= stations {
-        return assign(lo);
+    let tightest = assign(lo);
+    if tightest.len() <= stations {
+        return tightest;
     }
+    let mut best = assign(hi);
     for _ in 0..60 {
         let mid = 0.5 * (lo + hi);
         let a = assign(mid);

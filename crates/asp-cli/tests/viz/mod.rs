@@ -400,46 +400,30 @@ fn work_instructions_per_station_open_in_a_headless_browser() {
     let times = dir.path().join("times.csv");
     std::fs::write(&times, format!("# seconds per part\n{first},100\n")).unwrap();
     let timed = dir.path().join("timed");
-    let o = asp(&[
-        "render",
-        "instructions",
-        plan.to_str().unwrap(),
-        "--stations",
-        "2",
-        "--times",
-        times.to_str().unwrap(),
-        "--out",
-        timed.to_str().unwrap(),
-    ]);
+    // two stations with the times file as it stands
+    let timed_run = || {
+        asp(&[
+            "render",
+            "instructions",
+            plan.to_str().unwrap(),
+            "--stations",
+            "2",
+            "--times",
+            times.to_str().unwrap(),
+            "--out",
+            timed.to_str().unwrap(),
+        ])
+    };
+    let o = timed_run();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(stderr(&o).contains("cycle 100.0 s"), "{}", stderr(&o));
     // errors: one line each, naming the cause
     std::fs::write(&times, "nope,1\n").unwrap();
-    let o = asp(&[
-        "render",
-        "instructions",
-        plan.to_str().unwrap(),
-        "--stations",
-        "2",
-        "--times",
-        times.to_str().unwrap(),
-        "--out",
-        timed.to_str().unwrap(),
-    ]);
+    let o = timed_run();
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("'nope', which is no part of the plan"), "{}", stderr(&o));
     std::fs::write(&times, "x;1\n").unwrap();
-    let o = asp(&[
-        "render",
-        "instructions",
-        plan.to_str().unwrap(),
-        "--stations",
-        "2",
-        "--times",
-        times.to_str().unwrap(),
-        "--out",
-        timed.to_str().unwrap(),
-    ]);
+    let o = timed_run();
     assert!(o.status.code() == Some(2) && stderr(&o).contains("times.csv:1: no comma"), "{}", stderr(&o));
     let o = asp(&["render", "instructions", plan.to_str().unwrap(), "--stations", "0", "--out", timed.to_str().unwrap()]);
     assert!(o.status.code() == Some(2) && stderr(&o).contains("--stations must be at least 1"), "{}", stderr(&o));
