@@ -303,7 +303,9 @@ class Assembly:
             (one step per line, ``#`` comments, ``[a, b]`` groups) or of a plan JSON; or the path
             of such a file.
         :param settings: the keywords of :meth:`plan`'s feasibility search (``tolerance``,
-            ``stability``, ``path_planner``, ...; ``max_tests`` and ``timeout`` bound the repair).
+            ``stability``, ``path_planner``, ...; ``max_tests`` and ``timeout`` bound the repair;
+            with ``robot`` the arm must also carry every step out, and each step then carries its
+            grasp and path, with ``grippers`` the parts held).
         :returns: the report: ``status`` (``"feasible"`` or ``"infeasible"``), ``steps`` (each
             with its ``motion`` or its ``failure``), ``first_failure`` (a step index or ``None``)
             and, when infeasible, ``repair`` (the nearest feasible sequence found, its ``moved``

@@ -24,15 +24,15 @@ use crate::error::{AppError, Result};
 use crate::pipeline::{self, PlanSettings};
 use asp_geom::math::Vec3;
 use asp_geom::{Assembly, Checker, FeasibilityChecker, Motion, MotionKind, Outcome, PartSet, Stability, World};
-use asp_search::report::{insertion, MotionEntry, NamedPart};
-use asp_search::Budget;
+use asp_search::report::{insertion, MotionEntry, NamedPart, RobotEntry, RobotStepEntry};
+use asp_search::{Budget, PlanOutcome, Stats, Status, Step, Subassembly};
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
 use std::time::Instant;
 
 /// The version of the check report this build writes (docs/check-format.md). Minor bumps add
 /// keys; major bumps change or remove them.
-pub const CHECK_FORMAT_VERSION: &str = "1.0";
+pub const CHECK_FORMAT_VERSION: &str = "1.1";
 
 /// One step of a given sequence, as written: part names (one, or a group's) and an optional
 /// insertion direction in the model's frame.
@@ -277,6 +277,9 @@ pub struct CheckReport {
     /// When infeasible: the nearest feasible sequence found.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub repair: Option<Repair>,
+    /// The robot the steps were checked for (`--robot`), as the plan JSON's. Since 1.1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot: Option<RobotEntry>,
     /// Remarks about the input (base parts listed as steps).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
@@ -305,6 +308,14 @@ pub struct CheckStep {
     /// Why it does not, when infeasible.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub failure: Option<Failure>,
+    /// How the robot takes it out (`--robot`), when every step is feasible: grasp, gripper path,
+    /// joint trajectory, as the plan JSON's step `robot`. Since 1.1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot: Option<RobotStepEntry>,
+    /// The parts held in place while the rest stands without it (`--grippers N`), when every
+    /// step is feasible. Since 1.1.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub held: Vec<NamedPart>,
 }
 
 /// Why a step fails.
@@ -338,6 +349,15 @@ pub enum Failure {
         /// The free insertion motion.
         motion: MotionEntry,
     },
+    /// The parts are free to go in along `motion`, but the robot cannot carry the step out (in
+    /// disassembly terms): `robot_reason` says why (`no reachable grasp`, `no path`, `blocked`:
+    /// the arm would hit a part; a group: the robot carries one part at a time). Since 1.1.
+    Robot {
+        /// The robot's reason.
+        robot_reason: String,
+        /// The parts' own free insertion motion.
+        motion: MotionEntry,
+    },
 }
 
 impl Failure {
@@ -347,6 +367,7 @@ impl Failure {
             Failure::Blocked { .. } => "blocked",
             Failure::NoPath { .. } => "no_path",
             Failure::Unstable { .. } => "unstable",
+            Failure::Robot { .. } => "robot",
         }
     }
 }
@@ -398,6 +419,12 @@ pub struct RepairStep {
     pub moved: bool,
     /// How it goes in.
     pub motion: MotionEntry,
+    /// How the robot takes it out (`--robot`). Since 1.1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot: Option<RobotStepEntry>,
+    /// The parts held in place (`--grippers N`). Since 1.1.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub held: Vec<NamedPart>,
 }
 
 /// Effort.
@@ -430,9 +457,12 @@ impl CheckReport {
         let names = |ps: &[NamedPart]| ps.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ");
         let label = |ps: &[NamedPart]| if ps.len() == 1 { ps[0].name.clone() } else { format!("[{}]", names(ps)) };
         let _ = writeln!(s, "model: {} ({} steps onto {})", self.model, self.steps.len(), names(&self.base));
+        if let Some(r) = &self.robot {
+            let _ = writeln!(s, "robot: {} (every step carried out by the arm; path lengths below are the arm's, in disassembly)", r.name);
+        }
         for st in &self.steps {
             let what = match (&st.motion, &st.failure) {
-                (Some(m), _) => format!("ok, in {}", motion_text(m, &self.units)),
+                (Some(m), _) => format!("ok, in {}{}", motion_text(m, &self.units), robot_text(st.robot.as_ref(), &st.held, &self.units)),
                 (None, Some(f)) => failure_text(f),
                 _ => String::new(),
             };
@@ -462,10 +492,11 @@ impl CheckReport {
                         let mark = if st.moved { "*" } else { " " };
                         let _ = writeln!(
                             s,
-                            "  {mark}{:>3}. {:<24} in {} (given as step {})",
+                            "  {mark}{:>3}. {:<24} in {}{} (given as step {})",
                             i + 1,
                             label(&st.parts),
                             motion_text(&st.motion, &self.units),
+                            robot_text(st.robot.as_ref(), &st.held, &self.units),
                             st.given_step + 1
                         );
                     }
@@ -503,6 +534,22 @@ fn motion_text(m: &MotionEntry, units: &str) -> String {
     }
 }
 
+/// `, robot path 0.412 m` (and the held parts) for a step the robot carries out.
+fn robot_text(robot: Option<&RobotStepEntry>, held: &[NamedPart], units: &str) -> String {
+    let mut s = robot.map(|r| format!(", robot path {:.3} {units}", r.path_length)).unwrap_or_default();
+    if !held.is_empty() {
+        s += &format!(", holding {}", held.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", "));
+    }
+    s
+}
+
+fn motion_dir_text(m: &MotionEntry) -> String {
+    match m {
+        MotionEntry::Linear { direction, .. } | MotionEntry::Screw { direction, .. } => direction_text(direction),
+        MotionEntry::Path { poses, .. } => format!("a path of {} poses", poses.len()),
+    }
+}
+
 fn failure_text(f: &Failure) -> String {
     let names = |ps: &[NamedPart]| ps.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ");
     let per_dir = |ds: &[DirectionBlockers]| {
@@ -532,18 +579,25 @@ fn failure_text(f: &Failure) -> String {
             format!("blocked by {} along every straight line (insertion {}) and no path found", names(blockers), per_dir(directions))
         }
         Failure::Unstable { floating, .. } => format!("unstable: {}, placed before it, would not be supported without it", names(floating)),
+        Failure::Robot { robot_reason, motion } => {
+            format!("the parts go in along {}, but the robot cannot: {robot_reason}", motion_dir_text(motion))
+        }
     }
 }
 
-/// The tests of one unit in one state, on the planner's checker.
+/// The tests of one unit in one state, on the planner's checker: `checker` answers (the
+/// collision world's, or the robot's decorating it), `mesh` names blockers and motions.
 struct Tester<'a> {
-    checker: &'a Checker,
+    mesh: &'a Checker,
+    checker: &'a dyn FeasibilityChecker,
+    /// Whether `checker` decorates `mesh` (a robot, held parts).
+    decorated: bool,
     settings: &'a PlanSettings,
 }
 
 impl Tester<'_> {
     fn world(&self) -> &World {
-        self.checker.world()
+        self.mesh.world()
     }
 
     fn group(&self, parts: &[usize]) -> PartSet {
@@ -572,15 +626,36 @@ impl Tester<'_> {
 
     /// Removing `parts` from `state` along a straight line (a group's together).
     fn straight(&self, parts: &[usize], state: &PartSet) -> Outcome {
+        Self::straight_on(self.checker, &self.group(parts), parts, state)
+    }
+
+    fn straight_on(checker: &dyn FeasibilityChecker, group: &PartSet, parts: &[usize], state: &PartSet) -> Outcome {
         match parts {
-            [p] => self.checker.test_removal(*p, state, MotionKind::Linear),
-            _ => self.checker.test_group_removal(&self.group(parts), state),
+            [p] => checker.test_removal(*p, state, MotionKind::Linear),
+            _ => checker.test_group_removal(group, state),
         }
     }
 
     /// Removing part `p` from `state` along a path, when the settings allow the path planner.
     fn path(&self, p: usize, state: &PartSet) -> Option<Outcome> {
         self.settings.path_planner.then(|| self.checker.test_removal(p, state, MotionKind::Path { seed: self.settings.seed }))
+    }
+
+    /// When the decorating checker refused what the collision world admits: the world's free
+    /// removal motion and the decorator's reason.
+    fn refusal(&self, parts: &[usize], state: &PartSet) -> Option<(Motion, String)> {
+        if !self.decorated {
+            return None;
+        }
+        let motion = match Self::straight_on(self.mesh, &self.group(parts), parts, state) {
+            Outcome::Removed(m) | Outcome::Unstable { motion: m, .. } => m,
+            Outcome::Collision { .. } => return None,
+        };
+        let reason = match parts {
+            [p] => self.checker.refusal_reason(*p, state).unwrap_or("refused").to_string(),
+            _ => "a group: the robot carries one part at a time".to_string(),
+        };
+        Some((motion, reason))
     }
 
     /// The parts of `state` (and the base) blocking `parts` removed along `dir` (unit).
@@ -602,7 +677,9 @@ impl Tester<'_> {
         blockers
     }
 
-    /// Removing `parts` from `state` along `dir` only (unit removal direction).
+    /// Removing `parts` from `state` along `dir` only (unit removal direction). With a robot
+    /// (or held parts), the decorating checker's verdict on the step follows: the arm plans its
+    /// own lift, as in `asp plan`, and a refusal or the held parts' stability is its answer.
     fn along(&self, parts: &[usize], state: &PartSet, dir: Vec3) -> std::result::Result<Outcome, PartSet> {
         let world = self.world();
         let blockers = self.blockers_along(parts, state, dir);
@@ -624,6 +701,16 @@ impl Tester<'_> {
             }
             _ => Motion::Linear { direction: dir, distance },
         };
+        if self.decorated {
+            match self.straight(parts, state) {
+                Outcome::Removed(_) => return Ok(Outcome::Removed(motion)),
+                Outcome::Unstable { floating, .. } => return Ok(Outcome::Unstable { floating, motion }),
+                // refused (the caller asks why), or no candidate direction is free although
+                // the given one is: the collision world's stability below
+                Outcome::Collision { blockers } if self.refusal(parts, state).is_some() => return Ok(Outcome::Collision { blockers }),
+                Outcome::Collision { .. } => {}
+            }
+        }
         Ok(match self.checker.stability(&Self::rest(state, parts)) {
             Stability::Stable => Outcome::Removed(motion),
             Stability::Unstable { floating } => Outcome::Unstable { floating, motion },
@@ -649,21 +736,88 @@ pub fn check_file(path: &std::path::Path, steps: &[GivenStep], settings: &PlanSe
     Ok(report)
 }
 
+/// What the check of every step and the repair found, before the robot's annotations.
+struct Checked {
+    steps: Vec<CheckStep>,
+    first_failure: Option<usize>,
+    repair: Option<Repair>,
+    /// The feasible sequence (the given one, or the repair) in disassembly order, for the
+    /// decorating checker to describe.
+    removals: Vec<Step>,
+}
+
 /// Checks `steps` on `assembly` with `settings`: every step's removal in disassembly order on
-/// the planner's checker, the first failure, and a repair when one fails.
+/// the planner's checker (with a robot, the robot's decorating it), the first failure, and a
+/// repair when one fails.
 pub fn check_assembly(assembly: Assembly, steps: &[GivenStep], settings: &PlanSettings) -> Result<CheckReport> {
     let started = Instant::now();
     if settings.optimise.is_some() {
         return Err(AppError::setting("objective", "does not apply to checking a sequence (the check tests feasibility)"));
-    }
-    if settings.checker_extension.is_some() {
-        return Err(AppError::setting("robot", "does not apply to checking a sequence yet"));
     }
     let mut notes = Vec::new();
     let units = resolve_units(&assembly, steps, &mut notes)?;
     let budget = pipeline::budget(settings)?;
     let checker = pipeline::checker(assembly, settings)?;
     let world = checker.world();
+    let assembly = world.assembly();
+    let named = |s: &mut dyn Iterator<Item = usize>| -> Vec<NamedPart> {
+        s.map(|p| NamedPart { part: p, name: world.name(p).to_string() }).collect()
+    };
+    let mut checked = None;
+    let mut run = |c: &dyn FeasibilityChecker| -> PlanOutcome {
+        let tester = Tester { mesh: &checker, checker: c, decorated: settings.checker_extension.is_some(), settings };
+        let found = check_units(&tester, &units, &budget);
+        let status = if found.removals.is_empty() { Status::BudgetExhausted } else { Status::Found };
+        let outcome = PlanOutcome { status, removals: found.removals.clone(), stats: Stats::default() };
+        checked = Some(found);
+        outcome
+    };
+    let robot = match &settings.checker_extension {
+        Some(e) => e.solve(&checker, settings.seed, &mut run)?.1,
+        None => {
+            run(&checker);
+            None
+        }
+    };
+    let mut found = checked.expect("the check ran");
+    if let Some(r) = &robot {
+        // the decorator describes the feasible sequence's removals, in disassembly order
+        // (`steps` is empty without a robot, `held` may be shorter than the removals)
+        let robot_step = |k: usize| r.steps.get(k).cloned().flatten();
+        let held = |k: usize| named(&mut r.held.get(k).into_iter().flatten().copied());
+        let m = found.removals.len();
+        if found.first_failure.is_none() {
+            for (i, s) in found.steps.iter_mut().enumerate() {
+                (s.robot, s.held) = (robot_step(m - 1 - i), held(m - 1 - i));
+            }
+        } else if let Some(rep) = found.repair.as_mut() {
+            for (i, s) in rep.sequence.iter_mut().enumerate() {
+                (s.robot, s.held) = (robot_step(m - 1 - i), held(m - 1 - i));
+            }
+        }
+    }
+    let base_parts = named(&mut world.fixed().iter());
+    Ok(CheckReport {
+        format_version: CHECK_FORMAT_VERSION.into(),
+        model: assembly.source.display().to_string(),
+        units: assembly.units.name.clone(),
+        up: assembly.up.to_string(),
+        status: if found.first_failure.is_none() { CheckStatus::Feasible } else { CheckStatus::Infeasible },
+        base: base_parts,
+        steps: found.steps,
+        first_failure: found.first_failure,
+        repair: found.repair,
+        robot: robot.and_then(|r| r.entry),
+        notes,
+        warnings: world.warnings().to_vec(),
+        stats: CheckStats { removal_tests: checker.counters().removal_tests, seconds: started.elapsed().as_secs_f64() },
+    })
+}
+
+/// Every unit's test in its state, the first failure, the repair, and the feasible sequence as
+/// removals.
+fn check_units(tester: &Tester<'_>, units: &[Unit], budget: &Budget) -> Checked {
+    let world = tester.world();
     let assembly = world.assembly();
     let n = world.num_parts();
     let u = |m: f32| assembly.units.from_metres(m as f64);
@@ -672,17 +826,28 @@ pub fn check_assembly(assembly: Assembly, steps: &[GivenStep], settings: &PlanSe
     };
     let v3 = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
     let full = PartSet::full(n);
-    let tester = Tester { checker: &checker, settings };
     // the state before step i is removed: the base and steps 0..=i
     let mut base = PartSet::from_indices(n, (0..n).filter(|&p| world.fixed().contains(p)));
     let mut states = Vec::with_capacity(units.len());
-    for unit in &units {
+    for unit in units {
         for &p in &unit.parts {
             base.insert(p);
         }
         states.push(base.clone());
     }
+    let step_of = |unit: &Unit, motion: Motion| -> Step {
+        match unit.parts.as_slice() {
+            [p] => Step::single(*p, motion),
+            parts => Step {
+                part: parts[0],
+                motion,
+                group: Some(Box::new(Subassembly { parts: PartSet::from_indices(n + 1, parts.iter().copied()), plan: None, unit: false })),
+                moves: Vec::new(),
+            },
+        }
+    };
     let mut checked = Vec::with_capacity(units.len());
+    let mut removals = Vec::with_capacity(units.len());
     for (i, unit) in units.iter().enumerate() {
         let state = &states[i];
         let outcome = match unit.direction {
@@ -690,29 +855,36 @@ pub fn check_assembly(assembly: Assembly, steps: &[GivenStep], settings: &PlanSe
             None => Ok(tester.any(&unit.parts, state)),
         };
         let (motion, failure) = match outcome {
-            Ok(Outcome::Removed(m)) => (Some(insertion(&m, &u)), None),
+            Ok(Outcome::Removed(m)) => {
+                let entry = insertion(&m, &u);
+                removals.push(step_of(unit, m));
+                (Some(entry), None)
+            }
             Ok(Outcome::Unstable { floating, motion }) => {
                 (None, Some(Failure::Unstable { floating: named(&mut floating.iter()), motion: insertion(&motion, &u) }))
             }
-            Ok(Outcome::Collision { .. }) => {
-                let dirs = tester.per_direction(&unit.parts, state);
-                let mut all = PartSet::empty(n + 1);
-                for (_, b) in &dirs {
-                    all.union_with(b);
+            Ok(Outcome::Collision { .. }) => match tester.refusal(&unit.parts, state) {
+                Some((m, robot_reason)) => (None, Some(Failure::Robot { robot_reason, motion: insertion(&m, &u) })),
+                None => {
+                    let dirs = tester.per_direction(&unit.parts, state);
+                    let mut all = PartSet::empty(n + 1);
+                    for (_, b) in &dirs {
+                        all.union_with(b);
+                    }
+                    let directions =
+                        dirs.iter().map(|(d, b)| DirectionBlockers { direction: v3(-*d), blockers: named(&mut b.iter()) }).collect();
+                    let blockers = named(&mut all.iter());
+                    let tried_path = tester.settings.path_planner && unit.parts.len() == 1;
+                    (
+                        None,
+                        Some(if tried_path {
+                            Failure::NoPath { directions, blockers }
+                        } else {
+                            Failure::Blocked { along_given: false, directions, blockers, free_directions: Vec::new() }
+                        }),
+                    )
                 }
-                let directions =
-                    dirs.iter().map(|(d, b)| DirectionBlockers { direction: v3(-*d), blockers: named(&mut b.iter()) }).collect();
-                let blockers = named(&mut all.iter());
-                let tried_path = settings.path_planner && unit.parts.len() == 1;
-                (
-                    None,
-                    Some(if tried_path {
-                        Failure::NoPath { directions, blockers }
-                    } else {
-                        Failure::Blocked { along_given: false, directions, blockers, free_directions: Vec::new() }
-                    }),
-                )
-            }
+            },
             Err(blockers) => {
                 let d = unit.direction.expect("a direction was given");
                 let free_directions =
@@ -736,15 +908,22 @@ pub fn check_assembly(assembly: Assembly, steps: &[GivenStep], settings: &PlanSe
             feasible: failure.is_none(),
             motion,
             failure,
+            robot: None,
+            held: Vec::new(),
         });
     }
     let first_failure = checked.iter().position(|s| !s.feasible);
+    removals.reverse();
+    if first_failure.is_some() {
+        removals.clear();
+    }
     let repair = first_failure.map(|_| {
-        let found = repair_search(&tester, &units, &full, &budget);
+        let found = repair_search(tester, units, &full, budget);
         match found.sequence {
             Some(seq) => {
                 let order: Vec<usize> = seq.iter().map(|(k, _)| *k).collect();
                 let (moved, kept) = moved_steps(&order);
+                removals = seq.iter().rev().map(|(k, m)| step_of(&units[*k], m.clone())).collect();
                 Repair {
                     status: RepairStatus::Found,
                     sequence: seq
@@ -755,6 +934,8 @@ pub fn check_assembly(assembly: Assembly, steps: &[GivenStep], settings: &PlanSe
                             given_step: *k,
                             moved: !kept,
                             motion: insertion(m, &u),
+                            robot: None,
+                            held: Vec::new(),
                         })
                         .collect(),
                     moved,
@@ -771,21 +952,7 @@ pub fn check_assembly(assembly: Assembly, steps: &[GivenStep], settings: &PlanSe
             },
         }
     });
-    let base_parts = named(&mut world.fixed().iter());
-    Ok(CheckReport {
-        format_version: CHECK_FORMAT_VERSION.into(),
-        model: assembly.source.display().to_string(),
-        units: assembly.units.name.clone(),
-        up: assembly.up.to_string(),
-        status: if first_failure.is_none() { CheckStatus::Feasible } else { CheckStatus::Infeasible },
-        base: base_parts,
-        steps: checked,
-        first_failure,
-        repair,
-        notes,
-        warnings: world.warnings().to_vec(),
-        stats: CheckStats { removal_tests: checker.counters().removal_tests, seconds: started.elapsed().as_secs_f64() },
-    })
+    Checked { steps: checked, first_failure, repair, removals }
 }
 
 /// What the repair search found: the units in assembly order with their removal motions.

@@ -501,3 +501,96 @@ fn a_q_model_of_another_objective_is_refused_under_the_robot() {
         assert!(e.contains(&format!("estimates objective '{estimates}'")) && e.contains(&format!("that of '{objective}'")), "{e}");
     }
 }
+
+/// `asp check --robot`: a sequence the arm can carry out is feasible with every step's grasp and
+/// path, each re-checked on the exact geometry; a cube too wide for the gripper, free to go in,
+/// fails with the robot's reason, and no order of the same steps is feasible.
+#[test]
+fn check_with_the_robot_carries_out_every_step_or_says_why_not() {
+    use asp_app::check::{check_assembly, parse_sequence, CheckStatus, Failure, RepairStatus};
+    let setup = RobotSetup::panda();
+    let settings = PlanSettings {
+        checker_extension: Some(Arc::new(CellSetup { robot: Some(setup.clone()), grippers: 1 })),
+        seed: 3,
+        ..PlanSettings::default()
+    };
+    let r = check_assembly(blocks(), &parse_sequence("a\nb\na_top\nb_top\n").unwrap(), &settings).unwrap();
+    assert_eq!(r.status, CheckStatus::Feasible, "{}", r.to_text());
+    assert_eq!(r.robot.as_ref().map(|e| e.name.as_str()), Some(setup.robot.name.as_str()));
+    assert!(r.to_text().contains("robot path"), "{}", r.to_text());
+    // each step's arm path, in disassembly order, against the parts present before it
+    let world = World::new(blocks(), &WorldConfig::default()).unwrap();
+    let cell: RobotCell = setup.cell(&blocks());
+    let mut state = PartSet::full(world.num_parts());
+    for s in r.steps.iter().rev() {
+        let part = s.parts[0].part;
+        let e = s.robot.as_ref().unwrap_or_else(|| panic!("step {} has no robot path", s.step));
+        let g = e.grasp;
+        let removal = RobotRemoval {
+            grasp: Grasp {
+                position: Vec3::new(g[0] as f32, g[1] as f32, g[2] as f32),
+                orientation: Rot::from_xyzw(g[3] as f32, g[4] as f32, g[5] as f32, g[6] as f32),
+                width: e.grasp_width as f32,
+            },
+            grasp_index: 0,
+            direction: Vec3::Z,
+            joints: e.joint_trajectory.clone(),
+            gripper_path: Vec::new(),
+            length: e.path_length,
+            reachable_grasps: 0,
+        };
+        recheck(&world, &cell, part, &state, &removal, 0.003).unwrap_or_else(|err| panic!("step {}: {err}", s.step));
+        state.remove(part);
+    }
+    // without the robot the same check has no robot entries
+    let plain = check_assembly(blocks(), &parse_sequence("a\nb\na_top\nb_top\n").unwrap(), &PlanSettings::default()).unwrap();
+    assert!(plain.robot.is_none() && plain.steps.iter().all(|s| s.robot.is_none()));
+
+    // a 15 cm cube: nothing stops it going in from above, but no grasp fits the gripper
+    let mut parts = blocks().parts;
+    parts.push(box_part("crate", [0.18, -0.075, 0.0], [0.33, 0.075, 0.15]));
+    let wide = assemble("wide", parts, Axis::Z);
+    let text = "a\nb\ncrate -z\na_top\nb_top\n";
+    let geometry = check_assembly(wide.clone(), &parse_sequence(text).unwrap(), &PlanSettings::default()).unwrap();
+    assert_eq!(geometry.status, CheckStatus::Feasible, "{}", geometry.to_text());
+    let r = check_assembly(wide, &parse_sequence(text).unwrap(), &settings).unwrap();
+    assert_eq!(r.status, CheckStatus::Infeasible, "{}", r.to_text());
+    let k = r.first_failure.unwrap();
+    assert_eq!(r.steps[k].parts[0].name, "crate", "{}", r.to_text());
+    let Some(Failure::Robot { robot_reason, .. }) = &r.steps[k].failure else { panic!("{:?}", r.steps[k].failure) };
+    assert_eq!(robot_reason, "no reachable grasp");
+    assert!(r.to_text().contains("but the robot cannot: no reachable grasp"), "{}", r.to_text());
+    assert_eq!(r.repair.as_ref().unwrap().status, RepairStatus::None, "no order lets the arm carry the crate");
+}
+
+/// `asp check --grippers 2`: bar, block, then the post under them stands only while the bar is
+/// held; with one gripper the block's step is the first that does not stand.
+#[test]
+fn check_with_two_grippers_names_the_held_part() {
+    use asp_app::check::{check_assembly, parse_sequence, CheckStatus, Failure};
+    let mut plate = box_part("plate", [-0.3, -0.3, -0.02], [0.3, 0.3, 0.0]);
+    plate.fixed = true;
+    let model = || {
+        assemble(
+            "held",
+            vec![
+                plate.clone(),
+                box_part("post", [0.0, -0.02, 0.0], [0.04, 0.02, 0.1]),
+                box_part("bar", [-0.1, -0.02, 0.1], [0.14, 0.02, 0.12]),
+                box_part("block", [0.0, -0.02, 0.12], [0.04, 0.02, 0.16]),
+            ],
+            Axis::Z,
+        )
+    };
+    let text = "bar\nblock\npost\n";
+    let one = check_assembly(model(), &parse_sequence(text).unwrap(), &PlanSettings::default()).unwrap();
+    assert_eq!(one.status, CheckStatus::Infeasible);
+    assert_eq!(one.first_failure, Some(1), "{}", one.to_text());
+    assert!(matches!(one.steps[1].failure, Some(Failure::Unstable { .. })), "{}", one.to_text());
+    let settings = PlanSettings { checker_extension: Some(Arc::new(CellSetup { robot: None, grippers: 2 })), ..PlanSettings::default() };
+    let two = check_assembly(model(), &parse_sequence(text).unwrap(), &settings).unwrap();
+    assert_eq!(two.status, CheckStatus::Feasible, "{}", two.to_text());
+    let held: Vec<&str> = two.steps[2].held.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(held, ["bar"], "{}", two.to_text());
+    assert!(two.to_text().contains("holding bar"), "{}", two.to_text());
+}

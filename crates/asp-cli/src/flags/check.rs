@@ -30,7 +30,7 @@ pub struct CheckSeqArgs {
     /// Loading and testing.
     #[command(flatten)]
     pub load: ModelArgs,
-    /// Seed of the path planner.
+    /// Seed of the path planner (and the robot's).
     #[arg(long)]
     pub seed: Option<u64>,
     /// Stop the repair search after this many removal tests.
@@ -42,6 +42,9 @@ pub struct CheckSeqArgs {
     /// No warnings.
     #[arg(long, short)]
     pub quiet: bool,
+    /// The robot that must carry every step out (as `asp plan --robot`).
+    #[command(flatten)]
+    pub robot: super::PlanRobotArgs,
 }
 
 impl CheckSeqArgs {
@@ -49,5 +52,6 @@ impl CheckSeqArgs {
     pub fn put(&self, map: &mut Map) {
         self.load.put(map);
         super::put!(map, self, seed, max_tests, timeout);
+        self.robot.put(map);
     }
 }

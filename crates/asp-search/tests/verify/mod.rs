@@ -308,125 +308,163 @@ pub fn verify_removals(world: &World, removals: &[asp_search::Step]) -> PartSet 
 /// Re-checks `removals` from `state` on the `base` parts: each step's parts (one part, or a
 /// rigid subassembly's) swept together against the others, bounds cleared at the end, the rest
 /// stable on the base; a subassembly's own plan re-checked the same way on its base part.
-pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: &[asp_search::Step]) -> PartSet {
-    let mut cache = HashMap::new();
-    let mut samples = HashMap::new();
-    for (k, step) in removals.iter().enumerate() {
-        let movers = step.parts();
-        assert!(movers.contains(&step.part), "step {k}: its part is one of its movers");
-        for &p in &movers {
-            assert!(state.contains(p) && !base.contains(p), "step {k}: part {p} not removable");
-        }
-        let mut others = state.clone();
-        others.union_with(base);
-        for &p in &movers {
-            others.remove(p);
-        }
-        let bounds = movers
-            .iter()
-            .map(|&p| *world.aabb(p))
-            .reduce(|a, b| parry3d::bounding_volume::Aabb::new(a.mins.min(b.mins), a.maxs.max(b.maxs)))
-            .unwrap();
-        // steps of a quarter of the thinnest moving part
-        let thinnest = movers.iter().map(|&p| (world.aabb(p).maxs - world.aabb(p).mins).min_element()).fold(f32::INFINITY, f32::min);
-        let h = (thinnest / 4.0).max(world.tolerance());
-        let poses: Vec<Pose> = match &step.motion {
-            Motion::Linear { direction, distance } | Motion::Screw { direction, distance, .. } => {
-                assert!((direction.length() - 1.0).abs() < 1e-4);
-                let count = ((distance / h).ceil() as usize).clamp(8, 400);
-                // and steps of the tolerance over the first 20 tolerances (strict overlaps)
-                let tol = world.tolerance();
-                let first = (1..=20).map(|i| i as f32 * tol).filter(|&t| t < *distance);
-                let mut ts: Vec<f32> = (0..=count).map(|i| distance * i as f32 / count as f32).chain(first).collect();
-                ts.sort_by(f32::total_cmp);
-                ts.into_iter().map(|t| Pose::from_translation(*direction * t)).collect()
-            }
-            // every segment, at least 20 samples, and at most `h` apart along its pivot's travel
-            Motion::Path { poses, pivot } => poses
-                .windows(2)
-                .flat_map(|w| {
-                    let travel = (w[1].transform_point(*pivot) - w[0].transform_point(*pivot)).length();
-                    let count = ((travel / h).ceil() as usize).clamp(20, 400);
-                    (0..count).map(move |i| interpolate_about(*pivot, &w[0], &w[1], i as f32 / count as f32))
-                })
-                .chain(poses.last().copied())
-                .collect(),
-        };
-        let screw = match step.motion {
-            Motion::Screw { direction, .. } => Some(direction),
-            _ => None,
-        };
-        // straight motions: the pairs that carry a coaxial fit along them, found here
-        let dir = match step.motion {
-            Motion::Linear { direction, .. } | Motion::Screw { direction, .. } => Some(direction),
-            Motion::Path { .. } => None,
-        };
-        let mut fits = HashMap::new();
-        if let Some(d) = dir {
+pub fn verify_from(world: &World, state: PartSet, base: &PartSet, removals: &[asp_search::Step]) -> PartSet {
+    Verifier::default().verify_from(world, state, base, removals)
+}
+
+/// The re-check with what it learns kept across calls: shrunk meshes and surface samples of
+/// each part, and every (step, other part) pair already swept clear. Every test of the sweep is
+/// a test of one moving part against one present part, so a step whose motion was swept clear
+/// of part `q` once is clear of it in any other order too; re-checking many orders of one plan
+/// (the precedence graph's linear extensions) then sweeps each pair once. The bounds at the end
+/// and the stability of each state are tested every time.
+#[derive(Default)]
+pub struct Verifier {
+    cache: HashMap<(usize, u32), TriMesh>,
+    samples: HashMap<usize, Vec<Vec3>>,
+    /// (the step's movers and motion, the other part) swept clear.
+    clear: std::collections::HashSet<(String, usize)>,
+}
+
+impl Verifier {
+    /// [`verify_removals`] with this verifier's caches.
+    #[allow(dead_code)] // asp-app's precedence tests re-check many orders with one verifier
+    pub fn verify_removals(&mut self, world: &World, removals: &[asp_search::Step]) -> PartSet {
+        self.verify_from(world, PartSet::full(world.num_parts()), world.fixed(), removals)
+    }
+
+    /// [`verify_from`] with this verifier's caches.
+    pub fn verify_from(&mut self, world: &World, mut state: PartSet, base: &PartSet, removals: &[asp_search::Step]) -> PartSet {
+        for (k, step) in removals.iter().enumerate() {
+            let movers = step.parts();
+            assert!(movers.contains(&step.part), "step {k}: its part is one of its movers");
             for &p in &movers {
-                for q in others.iter().filter(|&q| q < world.num_parts() && world.contacts(p).contains(q)) {
-                    if let Some(b) = fit_band(world, p, q, d, &mut samples).or_else(|| reported_band(world, p, q, d)) {
-                        fits.insert((p, q), b);
+                assert!(state.contains(p) && !base.contains(p), "step {k}: part {p} not removable");
+            }
+            let mut others = state.clone();
+            others.union_with(base);
+            for &p in &movers {
+                others.remove(p);
+            }
+            let bounds = movers
+                .iter()
+                .map(|&p| *world.aabb(p))
+                .reduce(|a, b| parry3d::bounding_volume::Aabb::new(a.mins.min(b.mins), a.maxs.max(b.maxs)))
+                .unwrap();
+            // steps of a quarter of the thinnest moving part
+            let thinnest = movers.iter().map(|&p| (world.aabb(p).maxs - world.aabb(p).mins).min_element()).fold(f32::INFINITY, f32::min);
+            let h = (thinnest / 4.0).max(world.tolerance());
+            let poses: Vec<Pose> = match &step.motion {
+                Motion::Linear { direction, distance } | Motion::Screw { direction, distance, .. } => {
+                    assert!((direction.length() - 1.0).abs() < 1e-4);
+                    let count = ((distance / h).ceil() as usize).clamp(8, 400);
+                    // and steps of the tolerance over the first 20 tolerances (strict overlaps)
+                    let tol = world.tolerance();
+                    let first = (1..=20).map(|i| i as f32 * tol).filter(|&t| t < *distance);
+                    let mut ts: Vec<f32> = (0..=count).map(|i| distance * i as f32 / count as f32).chain(first).collect();
+                    ts.sort_by(f32::total_cmp);
+                    ts.into_iter().map(|t| Pose::from_translation(*direction * t)).collect()
+                }
+                // every segment, at least 20 samples, and at most `h` apart along its pivot's travel
+                Motion::Path { poses, pivot } => poses
+                    .windows(2)
+                    .flat_map(|w| {
+                        let travel = (w[1].transform_point(*pivot) - w[0].transform_point(*pivot)).length();
+                        let count = ((travel / h).ceil() as usize).clamp(20, 400);
+                        (0..count).map(move |i| interpolate_about(*pivot, &w[0], &w[1], i as f32 / count as f32))
+                    })
+                    .chain(poses.last().copied())
+                    .collect(),
+            };
+            let screw = match step.motion {
+                Motion::Screw { direction, .. } => Some(direction),
+                _ => None,
+            };
+            // straight motions: the pairs that carry a coaxial fit along them, found here
+            let dir = match step.motion {
+                Motion::Linear { direction, .. } | Motion::Screw { direction, .. } => Some(direction),
+                Motion::Path { .. } => None,
+            };
+            // the pairs this step's motion was not yet swept clear of
+            let key = format!("{movers:?} {:?}", step.motion);
+            let mut unknown = others.clone();
+            for q in others.iter() {
+                if self.clear.contains(&(key.clone(), q)) {
+                    unknown.remove(q);
+                }
+            }
+            let mut fits = HashMap::new();
+            if let Some(d) = dir {
+                for &p in &movers {
+                    for q in unknown.iter().filter(|&q| q < world.num_parts() && world.contacts(p).contains(q)) {
+                        if let Some(b) = fit_band(world, p, q, d, &mut self.samples).or_else(|| reported_band(world, p, q, d)) {
+                            fits.insert((p, q), b);
+                        }
                     }
                 }
             }
-        }
-        if let Motion::Screw { axis_point, direction, .. } = step.motion {
-            // a screw step's part has a threaded partner present, and turns about that axis:
-            // a modelled thread, or a coaxial fit along the motion (a nut on its bolt as CAD
-            // draws it)
-            // any threaded partner present will do (in another order than the plan's, another
-            // of them may be the one present; each has its own fitted axis)
-            let threads: Vec<_> = others.iter().filter_map(|q| world.thread(step.part, q)).collect();
-            match threads.first() {
-                Some(_) => assert!(
-                    threads.iter().any(|t| t.axis.direction.dot(direction).abs() > 0.9999
-                        && t.axis.radial(axis_point) < 1e-3 * t.axis.radius.max(1e-9) + 1e-6),
-                    "step {k}: '{}' screws off its axis (the axis of every threaded partner present)",
-                    world.name(step.part)
-                ),
-                None => assert!(
-                    others.iter().any(|q| world
-                        .fits(step.part, q)
-                        .iter()
-                        .any(|f| f.turns == Some(step.part) && f.axis.dot(direction).abs() > 0.9999)),
-                    "step {k}: '{}' screws with no threaded partner and no fit it turns on along its motion",
-                    world.name(step.part)
-                ),
+            if let Motion::Screw { axis_point, direction, .. } = step.motion {
+                // a screw step's part has a threaded partner present, and turns about that axis:
+                // a modelled thread, or a coaxial fit along the motion (a nut on its bolt as CAD
+                // draws it)
+                // any threaded partner present will do (in another order than the plan's, another
+                // of them may be the one present; each has its own fitted axis)
+                let threads: Vec<_> = others.iter().filter_map(|q| world.thread(step.part, q)).collect();
+                match threads.first() {
+                    Some(_) => assert!(
+                        threads.iter().any(|t| t.axis.direction.dot(direction).abs() > 0.9999
+                            && t.axis.radial(axis_point) < 1e-3 * t.axis.radius.max(1e-9) + 1e-6),
+                        "step {k}: '{}' screws off its axis (the axis of every threaded partner present)",
+                        world.name(step.part)
+                    ),
+                    None => assert!(
+                        others.iter().any(|q| world
+                            .fits(step.part, q)
+                            .iter()
+                            .any(|f| f.turns == Some(step.part) && f.axis.dot(direction).abs() > 0.9999)),
+                        "step {k}: '{}' screws with no threaded partner and no fit it turns on along its motion",
+                        world.name(step.part)
+                    ),
+                }
             }
-        }
-        check_strict(world, k, &movers, &others, &poses, &mut samples, screw, &fits, dir);
-        for pose in &poses {
+            check_strict(world, k, &movers, &unknown, &poses, &mut self.samples, screw, &fits, dir);
+            for pose in &poses {
+                for &p in &movers {
+                    if let Some(q) =
+                        penetrates(world, p, pose, &unknown, &mut self.cache, matches!(step.motion, Motion::Screw { .. }), &fits)
+                    {
+                        panic!("step {k}: part '{}' hits '{}' at {pose:?}", world.name(p), world.name(q));
+                    }
+                }
+            }
+            for q in unknown.iter() {
+                self.clear.insert((key.clone(), q));
+            }
+            // at the end, the movers' bounds are clear of the other present real parts' bounds
+            let end = bounds.transform_by(poses.last().unwrap());
+            for q in state.iter().filter(|q| !movers.contains(q)) {
+                let b = world.aabb(q);
+                let overlap = (0..3).all(|i| end.mins[i] < b.maxs[i] - 1e-6 && b.mins[i] < end.maxs[i] - 1e-6);
+                assert!(!overlap, "step {k}: part '{}' still inside the bounds of '{}'", world.name(step.part), world.name(q));
+            }
             for &p in &movers {
-                if let Some(q) = penetrates(world, p, pose, &others, &mut cache, matches!(step.motion, Motion::Screw { .. }), &fits) {
-                    panic!("step {k}: part '{}' hits '{}' at {pose:?}", world.name(p), world.name(q));
+                state.remove(p);
+            }
+            let mut present = state.clone();
+            present.union_with(base);
+            assert_eq!(world.contact_stability_among(&present, base), Stability::Stable, "step {k}: remainder unstable");
+            if let Some(plan) = step.group.as_ref().and_then(|g| g.plan.as_ref()) {
+                let group = step.group.as_ref().unwrap();
+                let sub_base = PartSet::from_indices(world.num_parts() + 1, [step.part]);
+                let mut inner = group.parts.clone();
+                inner.remove(step.part);
+                let left = self.verify_from(world, inner, &sub_base, &plan.removals);
+                if plan.status == Status::Found {
+                    assert!(left.is_empty(), "step {k}: its subassembly's plan leaves parts on the base");
                 }
             }
         }
-        // at the end, the movers' bounds are clear of the other present real parts' bounds
-        let end = bounds.transform_by(poses.last().unwrap());
-        for q in state.iter().filter(|q| !movers.contains(q)) {
-            let b = world.aabb(q);
-            let overlap = (0..3).all(|i| end.mins[i] < b.maxs[i] - 1e-6 && b.mins[i] < end.maxs[i] - 1e-6);
-            assert!(!overlap, "step {k}: part '{}' still inside the bounds of '{}'", world.name(step.part), world.name(q));
-        }
-        for &p in &movers {
-            state.remove(p);
-        }
-        let mut present = state.clone();
-        present.union_with(base);
-        assert_eq!(world.contact_stability_among(&present, base), Stability::Stable, "step {k}: remainder unstable");
-        if let Some(plan) = step.group.as_ref().and_then(|g| g.plan.as_ref()) {
-            let group = step.group.as_ref().unwrap();
-            let sub_base = PartSet::from_indices(world.num_parts() + 1, [step.part]);
-            let mut inner = group.parts.clone();
-            inner.remove(step.part);
-            let left = verify_from(world, inner, &sub_base, &plan.removals);
-            if plan.status == Status::Found {
-                assert!(left.is_empty(), "step {k}: its subassembly's plan leaves parts on the base");
-            }
-        }
+        let _ = Vec3::ZERO;
+        state
     }
-    let _ = Vec3::ZERO;
-    state
 }
