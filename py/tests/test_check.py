@@ -81,3 +81,14 @@ def test_plan_precedence_keyword(stack):
     assert "supports" in graph["edges"][0]["reasons"]
     assert graph["critical_path"] == [0, 1]
     assert "precedence" not in json.loads(stack.plan(path_planner=False).json)
+
+
+def test_check_with_the_robot_names_its_reason(stack):
+    # metre boxes: nothing blocks them, but no grasp of the arm's gripper fits them
+    report = stack.check(["lower", "top -z"], path_planner=False, robot="panda")
+    assert report["status"] == "infeasible"
+    assert report["robot"]["name"]
+    failure = report["steps"][report["first_failure"]]["failure"]
+    assert failure["reason"] == "robot"
+    assert failure["robot_reason"] == "no reachable grasp"
+    assert report["repair"]["status"] == "none"
