@@ -8,6 +8,42 @@ use crate::surface::PartFaces;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+/// How finely OpenCASCADE tessellates a STEP file's B-rep (the STEP reader), kept on each part
+/// it tessellated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tessellation {
+    /// The chord tolerance of every edge and face relative to its own size (OpenCASCADE's
+    /// relative deflection): a small screw is tessellated as finely, for its size, as a housing.
+    pub relative: f64,
+    /// The largest angle between neighbouring facets' normals along a curved face, radians.
+    pub angular: f64,
+}
+
+/// The default relative chord tolerance ([`Tessellation::relative`]).
+pub const DEFAULT_RELATIVE: f64 = 0.001;
+/// The default angular deflection, radians ([`Tessellation::angular`]): about 25 facets
+/// around a full circle.
+pub const DEFAULT_ANGULAR: f64 = 0.25;
+
+impl Default for Tessellation {
+    fn default() -> Self {
+        Tessellation { relative: DEFAULT_RELATIVE, angular: DEFAULT_ANGULAR }
+    }
+}
+
+impl Tessellation {
+    /// Checks that both tolerances are positive and finite (the angle below a half turn).
+    pub fn validate(&self) -> std::result::Result<(), String> {
+        if !(self.relative.is_finite() && self.relative > 0.0 && self.relative < 1.0) {
+            return Err(format!("the relative tessellation tolerance must lie between 0 and 1, got {}", self.relative));
+        }
+        if !(self.angular.is_finite() && self.angular > 0.0 && self.angular < std::f64::consts::PI) {
+            return Err(format!("the angular tessellation tolerance must lie between 0 and pi, got {}", self.angular));
+        }
+        Ok(())
+    }
+}
+
 /// One part of an assembly, its mesh baked in its assembled pose (world frame, metres).
 #[derive(Clone, Debug)]
 pub struct Part {
@@ -32,7 +68,7 @@ pub struct Part {
     pub path: Vec<String>,
     /// How the part's B-rep was tessellated into `mesh` when asp did it (STEP); `None` for
     /// parts that came as triangles.
-    pub tessellation: Option<crate::io::Tessellation>,
+    pub tessellation: Option<Tessellation>,
 }
 
 impl Part {

@@ -22,6 +22,7 @@ use tract_onnx::pb::{self, tensor_shape_proto::dimension, type_proto};
 use tract_onnx::prelude::*;
 
 use crate::error::{one_line, LearnError, Result};
+use crate::qnet::{OnnxWeights, QNet};
 
 /// The value of the `asp.kind` metadata property of a removability model.
 pub const KIND: &str = "removability";
@@ -168,7 +169,7 @@ pub struct GraphModel {
     bool_initializers: Vec<(String, Vec<bool>)>,
     /// The Rust forward pass of a removability model (`qnet.rs`), built on first use; `None`
     /// when the file is not the trainer's architecture (tract then runs every state).
-    fast: std::sync::OnceLock<Option<Arc<crate::qnet::QNet>>>,
+    fast: std::sync::OnceLock<Option<Arc<QNet>>>,
 }
 
 /// A removability model (the graph model of `--order gnn`).
@@ -467,31 +468,16 @@ impl GraphModel {
         Ok(plan)
     }
 
-    /// The float32 initialiser `name`: its shape and values.
-    pub(crate) fn initializer(&self, name: &str) -> Option<(&[usize], &[f32])> {
-        self.initializers.iter().find(|(n, _, _)| n == name).map(|(_, s, v)| (s.as_slice(), v.as_slice()))
-    }
-
-    /// The boolean initialiser `name`, flattened.
-    pub(crate) fn bool_initializer(&self, name: &str) -> Option<&[bool]> {
-        self.bool_initializers.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_slice())
-    }
-
-    /// The Rust forward pass of this removability model ([`QNet::removability`](crate::qnet::QNet::removability)),
+    /// The Rust forward pass of this removability model ([`QNet::removability`]),
     /// built and checked against tract on first use; `None` when the file is not the trainer's
     /// architecture or is a Q model.
-    pub fn fast_net(&self) -> Option<&Arc<crate::qnet::QNet>> {
+    pub fn fast_net(&self) -> Option<&Arc<QNet>> {
         self.fast
             .get_or_init(|| match self.kind {
-                ModelKind::Removability => crate::qnet::QNet::removability(self).ok().map(Arc::new),
+                ModelKind::Removability => QNet::removability(self).ok().map(Arc::new),
                 ModelKind::Q => None,
             })
             .as_ref()
-    }
-
-    /// The values of the float32 initialisers of rank 0, in file order.
-    pub(crate) fn scalar_initializers(&self) -> Vec<f32> {
-        self.initializers.iter().filter(|(_, s, _)| s.is_empty()).map(|(_, _, v)| v[0]).collect()
     }
 
     /// How many padded-size plans are cached (for tests and benchmarks).
@@ -801,5 +787,42 @@ mod tests {
         let err = RemovabilityModel::from_bytes(b"\x08\x07garbage", "models/x.onnx").unwrap_err().to_string();
         assert!(err.starts_with("models/x.onnx: "), "{err}");
         assert!(!err.contains('\n'), "{err}");
+    }
+}
+
+impl OnnxWeights for GraphModel {
+    fn node_dim(&self) -> usize {
+        self.node_dim
+    }
+
+    fn edge_dim(&self) -> usize {
+        self.edge_dim
+    }
+
+    fn metadata_value(&self, key: &str) -> Option<&str> {
+        self.metadata.get(key).map(String::as_str)
+    }
+
+    fn initializer(&self, name: &str) -> Option<(&[usize], &[f32])> {
+        self.initializers.iter().find(|(n, _, _)| n == name).map(|(_, s, v)| (s.as_slice(), v.as_slice()))
+    }
+
+    fn bool_initializer(&self, name: &str) -> Option<&[bool]> {
+        self.bool_initializers.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_slice())
+    }
+
+    fn scalar_initializers(&self) -> Vec<f32> {
+        self.initializers.iter().filter(|(_, s, _)| s.is_empty()).map(|(_, _, v)| v[0]).collect()
+    }
+
+    fn reference_scores(
+        &self,
+        x: &[f32],
+        n: usize,
+        edge_index: &[i64],
+        e: usize,
+        edge_attr: &[f32],
+    ) -> std::result::Result<Vec<f32>, String> {
+        self.score(x, n, edge_index, e, edge_attr).map_err(|err| err.to_string())
     }
 }

@@ -58,7 +58,7 @@ impl OnnxQ {
             .get("asp.objective")
             .cloned()
             .ok_or_else(|| mismatch("no metadata property 'asp.objective' (the objective the model estimates)".into()))?;
-        let net = QNet::from_model(&model).map(Arc::new);
+        let net = QNet::from_model(model.as_ref()).map(Arc::new);
         Ok(OnnxQ { model, config, objective, net })
     }
 

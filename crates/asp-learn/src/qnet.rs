@@ -27,8 +27,35 @@
 //! graph: a model that is not this architecture (or a future trainer's) falls back to tract
 //! instead of giving other values.
 
-use crate::model::GraphModel;
 use pulp::Simd;
+
+/// What the Rust forward pass reads from a loaded ONNX graph model: its feature sizes, its
+/// metadata, its initialisers by name, and the reference forward pass (tract) it checks itself
+/// against. The model loader implements it, so this module depends on no loader.
+pub trait OnnxWeights {
+    /// Floats per node attribute.
+    fn node_dim(&self) -> usize;
+    /// Floats per edge attribute.
+    fn edge_dim(&self) -> usize;
+    /// The metadata property `key`.
+    fn metadata_value(&self, key: &str) -> Option<&str>;
+    /// The float32 initialiser `name`: its shape and values.
+    fn initializer(&self, name: &str) -> Option<(&[usize], &[f32])>;
+    /// The boolean initialiser `name`, flattened.
+    fn bool_initializer(&self, name: &str) -> Option<&[bool]>;
+    /// The values of the float32 initialisers of rank 0, in file order.
+    fn scalar_initializers(&self) -> Vec<f32>;
+    /// The reference forward pass: one score per node of the graph (`x` `[n, node_dim]`,
+    /// `edge_index` `[2, e]`, `edge_attr` `[e, edge_dim]`).
+    fn reference_scores(
+        &self,
+        x: &[f32],
+        n: usize,
+        edge_index: &[i64],
+        e: usize,
+        edge_attr: &[f32],
+    ) -> std::result::Result<Vec<f32>, String>;
+}
 
 /// The constant added to messages (`asp.train.gnn.EPS`).
 const EPS: f32 = 1e-7;
@@ -253,7 +280,7 @@ impl QNet {
     /// The network of a loaded Q model, if its file holds the trainer's architecture and the
     /// forward pass agrees with tract on a generated graph; `Err` says why not (the caller then
     /// keeps tract).
-    pub fn from_model(model: &GraphModel) -> std::result::Result<Self, String> {
+    pub fn from_model(model: &(impl OnnxWeights + ?Sized)) -> std::result::Result<Self, String> {
         let net = Self::read(model, false)?;
         net.self_check(model)?;
         Ok(net)
@@ -263,17 +290,17 @@ impl QNet {
     /// the same encoder with `log1p` input columns and a linear head with a sigmoid), if its
     /// file holds that architecture and agrees with tract on a generated graph (see
     /// [`from_model`](Self::from_model)). [`forward`](Self::forward) then gives removabilities.
-    pub fn removability(model: &GraphModel) -> std::result::Result<Self, String> {
+    pub fn removability(model: &(impl OnnxWeights + ?Sized)) -> std::result::Result<Self, String> {
         let net = Self::read(model, true)?;
         net.self_check(model)?;
         Ok(net)
     }
 
-    fn read(model: &GraphModel, removability: bool) -> std::result::Result<Self, String> {
+    fn read(model: &(impl OnnxWeights + ?Sized), removability: bool) -> std::result::Result<Self, String> {
         const ENCODER_PREFIX: &str = "encoder.";
         let (node_dim, edge_dim) = (model.node_dim(), model.edge_dim());
         let meta = |key: &str| -> std::result::Result<usize, String> {
-            model.metadata().get(key).and_then(|v| v.parse().ok()).ok_or_else(|| format!("no integer metadata '{key}'"))
+            model.metadata_value(key).and_then(|v| v.parse().ok()).ok_or_else(|| format!("no integer metadata '{key}'"))
         };
         let (width, layers) = (meta("asp.width")?, meta("asp.layers")?);
         if width == 0 || layers == 0 {
@@ -360,7 +387,7 @@ impl QNet {
 
     /// Compares [`forward_graph`](Self::forward_graph) with tract on a generated graph of 13
     /// parts (values in the features' ranges, nearest-neighbour-like edges, a context node).
-    fn self_check(&self, model: &GraphModel) -> std::result::Result<(), String> {
+    fn self_check(&self, model: &(impl OnnxWeights + ?Sized)) -> std::result::Result<(), String> {
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
         let mut uniform = move || {
             seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
@@ -384,7 +411,7 @@ impl QNet {
         let e = sources.len();
         let attr: Vec<f32> = (0..e * self.edge_dim).map(|_| uniform()).collect();
         let index = [sources, targets].concat();
-        let want = model.score(&x, n, &index, e, &attr).map_err(|err| err.to_string())?;
+        let want = model.reference_scores(&x, n, &index, e, &attr)?;
         let nodes: Vec<usize> = (0..n).collect();
         let mut got = vec![0.0; n];
         self.forward_graph(&x, n, &index, &attr, &nodes, &mut got, &mut Scratch::default());

@@ -28,40 +28,7 @@ pub const PYTHON_VAR: &str = "ASP_PYTHON";
 /// The command that installs what reading STEP needs (named in the error when it is missing).
 pub const INSTALL: &str = "pip install cascadio";
 
-/// How finely OpenCASCADE tessellates a STEP file's B-rep.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Tessellation {
-    /// The chord tolerance of every edge and face relative to its own size (OpenCASCADE's
-    /// relative deflection): a small screw is tessellated as finely, for its size, as a housing.
-    pub relative: f64,
-    /// The largest angle between neighbouring facets' normals along a curved face, radians.
-    pub angular: f64,
-}
-
-/// The default relative chord tolerance ([`Tessellation::relative`]).
-pub const DEFAULT_RELATIVE: f64 = 0.001;
-/// The default angular deflection, radians ([`Tessellation::angular`]): about 25 facets
-/// around a full circle.
-pub const DEFAULT_ANGULAR: f64 = 0.25;
-
-impl Default for Tessellation {
-    fn default() -> Self {
-        Tessellation { relative: DEFAULT_RELATIVE, angular: DEFAULT_ANGULAR }
-    }
-}
-
-impl Tessellation {
-    /// Checks that both tolerances are positive and finite (the angle below a half turn).
-    pub fn validate(&self) -> std::result::Result<(), String> {
-        if !(self.relative.is_finite() && self.relative > 0.0 && self.relative < 1.0) {
-            return Err(format!("the relative tessellation tolerance must lie between 0 and 1, got {}", self.relative));
-        }
-        if !(self.angular.is_finite() && self.angular > 0.0 && self.angular < std::f64::consts::PI) {
-            return Err(format!("the angular tessellation tolerance must lie between 0 and pi, got {}", self.angular));
-        }
-        Ok(())
-    }
-}
+pub use crate::assembly::{Tessellation, DEFAULT_ANGULAR, DEFAULT_RELATIVE};
 
 /// Whether `path` names a STEP file by its extension.
 pub fn is_step(path: &Path) -> bool {
