@@ -821,7 +821,7 @@ fn repair_search(tester: &Tester<'_>, units: &[Unit], full: &PartSet, budget: &B
             let mut straight_free = vec![false; self.units.len()];
             for path in [false, true] {
                 for i in (0..left.len()).rev() {
-                    if self.budget.exhausted(self.tests, self.started) {
+                    if self.budget.exhausted(asp_search::Spent::tests(self.tests), self.started) {
                         self.exhausted = true;
                         return false;
                     }

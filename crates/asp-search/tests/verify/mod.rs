@@ -305,10 +305,22 @@ pub fn verify_removals(world: &World, removals: &[asp_search::Step]) -> PartSet 
     verify_from(world, PartSet::full(world.num_parts()), world.fixed(), removals)
 }
 
+/// Re-checks removals from the full assembly as [`verify_removals`] does, but not the
+/// remainder's stability: the contract of a planner that takes a model apart in the hand (the
+/// grid planner tests no gravity).
+pub fn verify_removals_in_hand(world: &World, removals: &[asp_search::Step]) -> PartSet {
+    verify_steps(world, PartSet::full(world.num_parts()), world.fixed(), removals, false)
+}
+
 /// Re-checks `removals` from `state` on the `base` parts: each step's parts (one part, or a
 /// rigid subassembly's) swept together against the others, bounds cleared at the end, the rest
 /// stable on the base; a subassembly's own plan re-checked the same way on its base part.
-pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: &[asp_search::Step]) -> PartSet {
+pub fn verify_from(world: &World, state: PartSet, base: &PartSet, removals: &[asp_search::Step]) -> PartSet {
+    verify_steps(world, state, base, removals, true)
+}
+
+/// [`verify_from`], the remainder's stability checked only with `gravity`.
+fn verify_steps(world: &World, mut state: PartSet, base: &PartSet, removals: &[asp_search::Step], gravity: bool) -> PartSet {
     let mut cache = HashMap::new();
     let mut samples = HashMap::new();
     for (k, step) in removals.iter().enumerate() {
@@ -415,13 +427,15 @@ pub fn verify_from(world: &World, mut state: PartSet, base: &PartSet, removals: 
         }
         let mut present = state.clone();
         present.union_with(base);
-        assert_eq!(world.contact_stability_among(&present, base), Stability::Stable, "step {k}: remainder unstable");
+        if gravity {
+            assert_eq!(world.contact_stability_among(&present, base), Stability::Stable, "step {k}: remainder unstable");
+        }
         if let Some(plan) = step.group.as_ref().and_then(|g| g.plan.as_ref()) {
             let group = step.group.as_ref().unwrap();
             let sub_base = PartSet::from_indices(world.num_parts() + 1, [step.part]);
             let mut inner = group.parts.clone();
             inner.remove(step.part);
-            let left = verify_from(world, inner, &sub_base, &plan.removals);
+            let left = verify_steps(world, inner, &sub_base, &plan.removals, gravity);
             if plan.status == Status::Found {
                 assert!(left.is_empty(), "step {k}: its subassembly's plan leaves parts on the base");
             }
