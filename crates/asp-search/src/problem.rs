@@ -365,3 +365,68 @@ impl PlanOutcome {
         PlanOutcome { status: Status::BudgetExhausted, removals: Vec::new(), stats: Stats { stopped_by: Some(reason), ..Stats::default() } }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_budget_names_the_limit_that_is_spent_a_cancel_first() {
+        let started = Instant::now();
+        let token = StopToken::new();
+        let budget = Budget {
+            max_tests: Some(10),
+            timeout: Some(Duration::from_secs(3600)),
+            max_episodes: Some(5),
+            max_states: Some(7),
+            cancel: Some(token.clone()),
+        };
+        let spent = |tests, episodes, states| Spent { tests, episodes, states };
+        assert_eq!(budget.stop_reason(spent(9, 4, 6), started), None);
+        assert_eq!(budget.stop_reason(spent(10, 4, 6), started), Some(StopReason::MaxTests));
+        assert_eq!(budget.stop_reason(spent(9, 5, 6), started), Some(StopReason::MaxEpisodes));
+        assert_eq!(budget.stop_reason(spent(9, 4, 7), started), Some(StopReason::MaxStates));
+        assert_eq!(budget.stop_reason(spent(10, 5, 7), started), Some(StopReason::MaxTests));
+        token.stop();
+        assert_eq!(budget.stop_reason(spent(10, 5, 7), started), Some(StopReason::Interrupted));
+        assert!(budget.cancelled());
+        let no_time = Budget { timeout: Some(Duration::ZERO), ..Budget::default() };
+        assert_eq!(no_time.stop_reason(Spent::default(), started), Some(StopReason::Timeout));
+        assert_eq!(Budget::default().stop_reason(spent(u64::MAX, u64::MAX, u64::MAX), started), None);
+    }
+
+    #[test]
+    fn the_remaining_budget_subtracts_what_was_spent_and_keeps_the_token() {
+        let token = StopToken::new();
+        let budget =
+            Budget { max_tests: Some(10), max_episodes: Some(5), max_states: Some(7), cancel: Some(token.clone()), ..Budget::default() };
+        let left = budget.remaining(Spent { tests: 4, episodes: 6, states: 2 }, Instant::now());
+        assert_eq!((left.max_tests, left.max_episodes, left.max_states, left.timeout), (Some(6), Some(0), Some(5), None));
+        token.stop();
+        assert!(left.cancelled(), "the remaining budget shares the token");
+    }
+
+    #[test]
+    fn effort_adds_up_but_not_the_reason_to_stop() {
+        let counters = |t| CounterSnapshot { removal_tests: t, failed_collision: t, failed_gravity: 1, path_planner_calls: 2 };
+        let mut later = Stats { counters: counters(3), seconds: 1.0, states_expanded: 4, path_planner_seconds: 0.5, stopped_by: None };
+        let earlier = Stats {
+            counters: counters(5),
+            seconds: 2.0,
+            states_expanded: 6,
+            path_planner_seconds: 1.0,
+            stopped_by: Some(StopReason::Timeout),
+        };
+        later.add_effort(&earlier);
+        assert_eq!(
+            later,
+            Stats {
+                counters: CounterSnapshot { removal_tests: 8, failed_collision: 8, failed_gravity: 2, path_planner_calls: 4 },
+                seconds: 3.0,
+                states_expanded: 10,
+                path_planner_seconds: 1.5,
+                stopped_by: None,
+            }
+        );
+    }
+}

@@ -173,6 +173,28 @@ fn a_small_budget_is_kept_by_every_planner() {
     let grid = GridPlanner::of(&burr, GridConfig::default()).expect("a voxel puzzle");
     let o = grid.solve(&Problem::full(&checker), &Budget { max_states: Some(3), ..Budget::default() }).unwrap();
     assert_eq!((o.status, o.stats.stopped_by), (Status::BudgetExhausted, Some(StopReason::MaxStates)));
+    // a token stopped while the grid search runs (it looks every 1,024 states): the search
+    // itself ends `interrupted` on a closed box whose five loose cubes slide around a 3 × 4
+    // cavity (95,040 states to visit before it is stuck)
+    let mut frame = Vec::new();
+    for x in 0..5 {
+        for y in 0..3 {
+            for z in 0..6 {
+                if !(y == 1 && (1..4).contains(&x) && (1..5).contains(&z)) {
+                    frame.push([x, y, z]);
+                }
+            }
+        }
+    }
+    let mut pieces = vec![frame];
+    pieces.extend([[1, 1, 1], [2, 1, 1], [3, 1, 1], [1, 1, 2], [2, 1, 2]].map(|c| vec![c]));
+    let boxed = asp_geom::puzzles::voxel_puzzle("closed box", &pieces);
+    let grid = GridPlanner::of(&boxed, GridConfig::default()).expect("a voxel puzzle");
+    let cancelled = StopToken::new();
+    cancelled.stop();
+    let run = grid.run(&Budget { cancel: Some(cancelled), ..Budget::default() }, std::time::Instant::now());
+    let o = run.outcome(&boxed);
+    assert_eq!((o.status, o.stats.stopped_by), (Status::BudgetExhausted, Some(StopReason::Interrupted)), "{} states", run.solution.states);
 }
 
 /// The same planner on the same problem gives the same outcome, effort included (the time
