@@ -197,6 +197,52 @@ fn a_small_budget_is_kept_by_every_planner() {
     assert_eq!((o.status, o.stats.stopped_by), (Status::BudgetExhausted, Some(StopReason::Interrupted)), "{} states", run.solution.states);
 }
 
+/// Keeps one part in forever (so no sequence exists) and stops a token at its first check.
+#[derive(Debug)]
+struct StopsAndHolds {
+    token: StopToken,
+    held: usize,
+}
+
+impl asp_search::ActionFilter for StopsAndHolds {
+    fn name(&self) -> &str {
+        "stops"
+    }
+    fn reasons(&self) -> Vec<String> {
+        vec!["held".into()]
+    }
+    fn check(&self, step: &mut asp_search::StepContext<'_, '_>, _memory: &[u64]) -> asp_search::Verdict {
+        self.token.stop();
+        if step.part() == self.held {
+            asp_search::Verdict::Infeasible { reason: 0 }
+        } else {
+            asp_search::Verdict::Feasible
+        }
+    }
+}
+
+/// A tree search that a budget ends while it runs, before any complete sequence, says which
+/// limit: its episodes, or the token (stopped by a filter during the first expansion) — on a
+/// tree of the classic Soma cube with one piece held in, far from explored when it stops.
+#[test]
+fn a_tree_search_ended_by_its_budget_while_it_runs_says_which_limit() {
+    let soma = crate::fixtures::classic_soma();
+    let checker = asp_geom::voxel::VoxelChecker::new(&soma, &WorldConfig::default()).expect("a voxel model");
+    let held = (0..soma.len()).find(|&p| !soma.parts[p].fixed).unwrap();
+    let token = StopToken::new();
+    let filter = Arc::new(StopsAndHolds { token: token.clone(), held });
+    let mdp = crate::fixtures::problem(&crate::fixtures::maps(&soma, 3), "access").with_filter(filter);
+    let mcts = Mcts::builder().episodes(1000).seed(2).transpositions(false).build().unwrap();
+    let planner = MapPlanner::new(mcts, &mdp);
+    let problem = Problem::full(&checker);
+    let o = planner.solve(&problem, &Budget { cancel: Some(token.clone()), ..Budget::default() }).unwrap();
+    assert!(token.is_stopped(), "the filter was asked");
+    assert_eq!((o.status, o.stats.stopped_by), (Status::BudgetExhausted, Some(StopReason::Interrupted)));
+    // the filter's token is stopped now, but no budget holds it
+    let o = planner.solve(&problem, &Budget { max_episodes: Some(3), ..Budget::default() }).unwrap();
+    assert_eq!((o.status, o.stats.stopped_by), (Status::BudgetExhausted, Some(StopReason::MaxEpisodes)));
+}
+
 /// The same planner on the same problem gives the same outcome, effort included (the time
 /// aside).
 #[test]
