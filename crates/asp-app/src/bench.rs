@@ -11,7 +11,7 @@ use crate::pipeline::{self, PlanSettings};
 use asp_geom::Checker;
 use asp_search::OrderingSource;
 use asp_search::Problem;
-use asp_search::{Planner, Status};
+use asp_search::Status;
 use serde::Serialize;
 use std::path::Path;
 use std::sync::Arc;
@@ -142,7 +142,7 @@ pub fn bench_model(path: &Path, name: &str, settings: &PlanSettings, methods: &[
             // with a robot (or held parts) the search runs on the extension's checker, whose
             // refusals count as failed tests, as in `asp plan`
             let outcome = match &settings.checker_extension {
-                Some(ext) => ext.solve(&checker, m.seed, &mut |c| dfs.solve(&Problem::full(c), &budget))?.0,
+                Some(ext) => ext.solve(&checker, m.seed, &mut |c| Ok(dfs.solve(&Problem::full(c), &budget)))?.0,
                 None => dfs.solve(&Problem::full(&checker), &budget),
             };
             secs.push(started.elapsed().as_secs_f64());

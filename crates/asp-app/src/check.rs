@@ -764,18 +764,18 @@ pub fn check_assembly(assembly: Assembly, steps: &[GivenStep], settings: &PlanSe
         s.map(|p| NamedPart { part: p, name: world.name(p).to_string() }).collect()
     };
     let mut checked = None;
-    let mut run = |c: &dyn FeasibilityChecker| -> PlanOutcome {
+    let mut run = |c: &dyn FeasibilityChecker| -> asp_search::Result<PlanOutcome> {
         let tester = Tester { mesh: &checker, checker: c, decorated: settings.checker_extension.is_some(), settings };
         let found = check_units(&tester, &units, &budget);
         let status = if found.removals.is_empty() { Status::BudgetExhausted } else { Status::Found };
         let outcome = PlanOutcome { status, removals: found.removals.clone(), stats: Stats::default() };
         checked = Some(found);
-        outcome
+        Ok(outcome)
     };
     let robot = match &settings.checker_extension {
         Some(e) => e.solve(&checker, settings.seed, &mut run)?.1,
         None => {
-            run(&checker);
+            run(&checker)?;
             None
         }
     };
@@ -988,7 +988,7 @@ fn repair_search(tester: &Tester<'_>, units: &[Unit], full: &PartSet, budget: &B
             let mut straight_free = vec![false; self.units.len()];
             for path in [false, true] {
                 for i in (0..left.len()).rev() {
-                    if self.budget.exhausted(self.tests, self.started) {
+                    if self.budget.exhausted(asp_search::Spent::tests(self.tests), self.started) {
                         self.exhausted = true;
                         return false;
                     }

@@ -338,7 +338,7 @@ pub fn collect_model(item: &ModelItem, out: &Path, settings: &CollectSettings) -
     let world = checker.world();
     let graph = AssemblyGraph::build(world, &settings.graph)?;
     let n = world.num_parts();
-    let budget = Budget { max_tests: settings.max_tests, timeout: settings.timeout.map(Duration::from_secs_f64), cancel: None };
+    let budget = Budget { max_tests: settings.max_tests, timeout: settings.timeout.map(Duration::from_secs_f64), ..Budget::default() };
     let robot = match label_checker(&settings.plan)? {
         asp_learn::Checker::Robot => settings.plan.checker_extension.as_ref(),
         _ => None,
@@ -356,17 +356,17 @@ pub fn collect_model(item: &ModelItem, out: &Path, settings: &CollectSettings) -
             .seed(seed)
             .build();
         let mut lines = Vec::new();
-        let mut search = |c: &dyn FeasibilityChecker| {
+        let mut search = |c: &dyn FeasibilityChecker| -> asp_search::Result<asp_search::PlanOutcome> {
             let mut states = Vec::new();
             let mut visit = |s: &PartSet| states.push(s.clone());
             let outcome = dfs.solve_visiting(&Problem::full(c), &budget, Some(&mut visit));
             let plain: Option<&dyn FeasibilityChecker> = robot.map(|_| &checker as &dyn FeasibilityChecker);
             lines = states.iter().enumerate().map(|(step, state)| StateLine { run: r, step, ..label_state(c, plain, state) }).collect();
-            outcome
+            Ok(outcome)
         };
         let outcome = match robot {
             Some(ext) => ext.solve(&checker, seed, &mut search)?.0,
-            None => search(&checker),
+            None => search(&checker)?,
         };
         Ok((lines, outcome.status == asp_search::Status::Found))
     };

@@ -16,23 +16,19 @@ use asp_geom::math::Axis;
 use asp_geom::physics::PhysicsConfig;
 use asp_geom::rrt::RrtConfig;
 use asp_geom::voxel::VoxelChecker;
-use asp_geom::{
-    Assembly, Checker, CheckerConfig, CounterSnapshot, Motion, OverlapPolicy, PartSet, StabilityMode, Units, World, WorldConfig,
-};
-use asp_search::dead_end::deepest_dead_end;
+use asp_geom::{Assembly, Checker, CheckerConfig, FeasibilityChecker, OverlapPolicy, PartSet, StabilityMode, Units, World, WorldConfig};
 use asp_search::extension::resolve_objectives;
-use asp_search::grid::GridConfig;
-use asp_search::grid::GridRun;
+use asp_search::grid::{GridConfig, GridPlanner, GridRun};
 use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES};
 use asp_search::report::{
     Checker as CheckerName, GridEntry, GridReason, OptimisationEntry, OptimisationMethod, ParetoEntry, PlanReport, PrecedenceEntry, Timings,
 };
 use asp_search::units::UnitChecker;
-use asp_search::{Budget, PlanOutcome, Problem, Progress, Stats, Status, Step, StuckReason};
+use asp_search::{Budget, PlanOutcome, Problem, Progress, Status, StuckReason};
 use asp_search::{BuiltinOrder, OrderingSource};
 use asp_search::{CheckerExtension, MdpExtension, ModelContext};
 use asp_search::{Dfs, Mcts, Mdp, ParetoMcts, Planner};
-use asp_search::{EpisodeHook, SearchOutcome, SearchStatus, StopToken};
+use asp_search::{EpisodeHook, SearchOutcome, StopToken};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -359,6 +355,7 @@ pub fn budget(settings: &PlanSettings) -> Result<Budget> {
         max_tests: settings.max_tests,
         timeout: settings.timeout.map(|t| positive("the timeout", t).map(Duration::from_secs_f64)).transpose()?,
         cancel: settings.cancel.clone(),
+        ..Budget::default()
     })
 }
 
@@ -442,9 +439,10 @@ fn plan_with_world(
     let checker = checker(assembly, settings)?;
     let world_seconds = started.elapsed().as_secs_f64();
     let units = with_bearings(units, checker.world());
+    let grid_planner = voxels.map(|m| GridPlanner::new(checker.world().assembly(), m, GridConfig::default()));
     let mut grid = None;
-    if let (Some(model), true) = (&voxels, probe.as_ref().is_some_and(GridRun::needs_moves)) {
-        let run = GridRun::new(model.clone(), &GridConfig::default(), &budget, grid_started);
+    if let (Some(planner), true) = (&grid_planner, probe.as_ref().is_some_and(GridRun::needs_moves)) {
+        let run = planner.run(&budget, grid_started);
         if run.found() {
             return Ok(grid_result(&checker, settings, &run, GridReason::NeedsMoves, None, world_seconds));
         }
@@ -453,24 +451,13 @@ fn plan_with_world(
     // on a voxel model the grid's moves are the exact answer to what the path planner samples
     // for: the depth-first search tries straight lines (and groups) first, then the grid, and
     // only then the path planner (a piece that must turn to come out)
-    let grid_first = voxels.is_some() && settings.path_planner;
+    let grid_first = grid_planner.is_some() && settings.path_planner;
     let run_dfs = |path_planner: bool| -> Result<(PlanOutcome, Option<asp_search::report::RobotReport>)> {
         let dfs = planner(&PlanSettings { path_planner, ..settings.clone() }, checker.world())?;
-        let mut search = |c: &dyn asp_geom::FeasibilityChecker| {
-            let with_units;
-            let c: &dyn asp_geom::FeasibilityChecker = if units.is_empty() {
-                c
-            } else {
-                with_units = UnitChecker::new(c, units.clone());
-                &with_units
-            };
-            let mut problem = Problem::full(c);
-            problem.progress = progress;
-            dfs.solve(&problem, &budget)
-        };
+        let mut run = |c: &dyn FeasibilityChecker| search(&dfs, c, &units, progress, &budget);
         Ok(match &settings.checker_extension {
-            Some(e) => e.solve(&checker, settings.seed, &mut search)?,
-            None => (search(&checker as &dyn asp_geom::FeasibilityChecker), None),
+            Some(e) => e.solve(&checker, settings.seed, &mut run)?,
+            None => (run(&checker as &dyn FeasibilityChecker)?, None),
         })
     };
     let (mut outcome, mut robot) = run_dfs(settings.path_planner && !grid_first)?;
@@ -485,9 +472,9 @@ fn plan_with_world(
     };
     let mut grid_ran = GridRan::No;
     if wants_grid(&outcome) {
-        if let Some(model) = voxels {
+        if let Some(planner) = &grid_planner {
             let found = outcome.status == Status::Found;
-            let run = grid.unwrap_or_else(|| GridRun::new(model, &GridConfig::default(), &budget, Instant::now()));
+            let run = grid.unwrap_or_else(|| planner.run(&budget, Instant::now()));
             if (!found && run.found()) || run.solution.complete() {
                 return Ok(grid_result(&checker, settings, &run, GridReason::Fallback, Some(&outcome), world_seconds));
             }
@@ -553,9 +540,7 @@ pub fn plan_on_voxels(
             report(p);
         }
     };
-    let mut problem = Problem::full(&checker);
-    problem.progress = Some(&watch);
-    let outcome = dfs(settings, factory).solve(&problem, &share);
+    let outcome = search(&dfs(settings, factory), &checker, &[], Some(&watch), &share)?;
     if checker.needs_world() || outcome.status != Status::Found {
         return Ok(None);
     }
@@ -563,9 +548,36 @@ pub fn plan_on_voxels(
     if !report.locked_cores.is_empty() {
         return Ok(None);
     }
-    report.stats.timings =
-        Some(Timings { load: 0.0, world: world_seconds, search: outcome.stats.seconds, path_planner: outcome.stats.path_planner_seconds });
+    report.stats.timings = Some(timings(&outcome, world_seconds));
     Ok(Some(PlanResult { report, status: outcome.status, search: None }))
+}
+
+/// Runs `planner` through [`Planner`] on `checker` from the assembled state, the declared
+/// `units` kept together and `progress` reported: the one feasibility search of every plan,
+/// whichever planner and checker (the collision world's, the voxel fast path's, a robot's on
+/// either).
+fn search(
+    planner: &dyn Planner,
+    checker: &dyn FeasibilityChecker,
+    units: &[PartSet],
+    progress: Option<&(dyn Fn(&Progress) + Sync)>,
+    budget: &Budget,
+) -> asp_search::Result<PlanOutcome> {
+    let with_units;
+    let checker: &dyn FeasibilityChecker = if units.is_empty() {
+        checker
+    } else {
+        with_units = UnitChecker::new(checker, units.to_vec());
+        &with_units
+    };
+    let mut problem = Problem::full(checker);
+    problem.progress = progress;
+    planner.solve(&problem, budget)
+}
+
+/// Where a feasibility plan's wall time went (loading is timed by the caller).
+fn timings(outcome: &PlanOutcome, world_seconds: f64) -> Timings {
+    Timings { load: 0.0, world: world_seconds, search: outcome.stats.seconds, path_planner: outcome.stats.path_planner_seconds }
 }
 
 /// `units` with every rolling bearing `world` found ([`asp_geom::Bearing`]) as one more unit: a
@@ -608,8 +620,7 @@ fn finish_report(report: &mut PlanReport, world: &asp_geom::World, outcome: &Pla
     report.overlaps = asp_search::report::OverlapsEntry::of(world);
     report.fits = asp_search::report::FitEntry::of(world);
     report.bearings = asp_search::report::BearingEntry::of(world);
-    report.stats.timings =
-        Some(Timings { load: 0.0, world: world_seconds, search: outcome.stats.seconds, path_planner: outcome.stats.path_planner_seconds });
+    report.stats.timings = Some(timings(outcome, world_seconds));
 }
 
 /// With [`PlanSettings::precedence`], the precedence graph of a found plan (a warning says why
@@ -659,9 +670,7 @@ fn grid_result(
     let assembly = world.assembly();
     let mut outcome = run.outcome(assembly);
     if let Some(b) = before {
-        outcome.stats.counters = b.stats.counters;
-        outcome.stats.seconds += b.stats.seconds;
-        outcome.stats.path_planner_seconds = b.stats.path_planner_seconds;
+        outcome.stats.add_effort(&b.stats);
     }
     let mut report = PlanReport::new(assembly, &outcome, world.tolerance(), world.warnings());
     let u = |x: f32| assembly.units.from_metres(x as f64);
@@ -792,18 +801,22 @@ pub fn optimise_problem(
         (true, Some(h)) => configure!(ParetoMcts::builder()).solve_stepped(&mdp, h)?,
         (false, Some(h)) => configure!(Mcts::builder()).solve_stepped(&mdp, h)?,
     };
-    let (plan, rejected) = adapt(&mdp, &outcome);
+    let plan = &outcome.plan;
     let mut warnings = assembly.warnings.clone();
     for w in maps.warnings() {
         if !warnings.contains(w) {
             warnings.push(w.clone());
         }
     }
-    for (part, why) in rejected {
-        warnings.push(format!("part '{}' {why} in the deepest dead end", assembly.parts[part].name));
+    for (part, why) in &outcome.rejected {
+        warnings.push(format!("part '{}' {why} in the deepest dead end", assembly.parts[*part].name));
     }
-    let mut report = PlanReport::new(&assembly, &plan, maps.tolerance(), &warnings);
+    let mut report = PlanReport::new(&assembly, plan, maps.tolerance(), &warnings);
     report.stats.checker = CheckerName::DistanceMaps;
+    // the optimiser's budget is its episodes and time limit, reported in `optimisation`
+    // (`exhaustive`, `episodes`); `stats.stopped_by` belongs to the feasibility search's
+    // budget (plan format: `--timeout`, `--max-tests`, Ctrl-C), so it stays out
+    report.stats.stopped_by = None;
     if let Some(best) = outcome.best() {
         for e in &o.extensions {
             if let Some(r) = e.describe(&model, &best.sequence)? {
@@ -837,62 +850,5 @@ pub fn optimise_problem(
         search_seconds: s.seconds,
         guidance: o.policy.as_ref().and_then(|p| p.guidance()),
     });
-    Ok(PlanResult { report, status: plan.status, search: Some(outcome) })
+    Ok(PlanResult { report, status: plan.status.clone(), search: Some(outcome) })
 }
-
-/// The optimiser's outcome as a plan outcome: motions get the maps' contact margin (the plan
-/// format's removal ends that far beyond the remaining bounds). When the whole tree holds no
-/// complete sequence, the explanation is its deepest dead end on the maps
-/// ([`asp_search::dead_end`]); the second value lists the parts there that the maps let out but
-/// a feasibility filter rejected, with the filter's words.
-fn adapt(mdp: &Mdp, outcome: &SearchOutcome) -> (PlanOutcome, Vec<(usize, String)>) {
-    let maps = mdp.maps();
-    let margin = maps.contact_distance();
-    let with_margin = |part: usize, m: &Motion| {
-        Step::single(
-            part,
-            match m {
-                Motion::Linear { direction, distance } => Motion::Linear { direction: *direction, distance: distance + margin },
-                other => other.clone(),
-            },
-        )
-    };
-    let mut removals: Vec<Step> =
-        outcome.best().map(|s| s.sequence.iter().zip(&s.motions).map(|(&part, m)| with_margin(part, m)).collect()).unwrap_or_default();
-    let mut rejected = Vec::new();
-    let status = match outcome.status {
-        SearchStatus::Found => Status::Found,
-        SearchStatus::NoPlan => match deepest_dead_end(mdp, DEAD_END_STATES) {
-            Some(end) => {
-                removals = end.removals.iter().map(|(part, m)| with_margin(*part, m)).collect();
-                rejected = end.rejected;
-                Status::NoPlan { stuck: end.stuck, state: end.state }
-            }
-            // the tree search saw no complete sequence where the dead-end search finds one
-            // within its bound (it cannot: both walk the same removals): nothing to explain
-            None => Status::NoPlan { stuck: Vec::new(), state: asp_geom::PartSet::full(maps.num_parts()) },
-        },
-        SearchStatus::BudgetExhausted => Status::BudgetExhausted,
-    };
-    let s = &outcome.stats;
-    let plan = PlanOutcome {
-        status,
-        removals,
-        stats: Stats {
-            counters: CounterSnapshot {
-                removal_tests: s.removal_tests,
-                failed_collision: s.failed_collision,
-                failed_gravity: s.failed_gravity,
-                // the optimiser moves parts along straight lines only
-                path_planner_calls: 0,
-            },
-            seconds: s.seconds,
-            ..Stats::default()
-        },
-    };
-    (plan, rejected)
-}
-
-/// States the dead-end search of an optimiser's `no_plan` visits at most (a tree the optimiser
-/// exhausted is far smaller).
-const DEAD_END_STATES: usize = 200_000;

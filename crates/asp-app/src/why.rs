@@ -6,10 +6,10 @@
 use crate::pipeline::{checker_config, planner, PlanSettings};
 use asp_geom::grid::VoxelModel;
 use asp_geom::{Assembly, Checker, FeasibilityChecker, PartSet, World};
-use asp_search::grid::solver::{GridPlan, GridStatus};
+use asp_search::grid::solver::GridPlan;
 use asp_search::report::{CoreGrid, CoreGridReason, CoreLenient, CoreWhy, LenientStatus, PlanReport};
 use asp_search::units::UnitChecker;
-use asp_search::{Budget, Planner, Problem};
+use asp_search::{Budget, Problem, Status};
 use std::time::{Duration, Instant};
 
 /// The longest the lenient reruns of a plan's cores may take together, seconds (less when the
@@ -34,7 +34,7 @@ impl GridRan {
     /// How a grid search that ended in `plan` ran.
     pub(crate) fn of(plan: &GridPlan) -> GridRan {
         fn budget(p: &GridPlan) -> bool {
-            p.status == GridStatus::Budget || p.steps.iter().any(|s| s.plan.as_deref().is_some_and(budget))
+            p.status == Status::BudgetExhausted || p.steps.iter().any(|s| s.plan.as_deref().is_some_and(budget))
         }
         if budget(plan) {
             GridRan::Budget
@@ -111,7 +111,7 @@ fn rerun(checker: &Checker, settings: &PlanSettings, base: usize, parts: &[usize
         return unknown; // the base is the largest part of the group, and so of its core
     }
     let left = deadline.saturating_duration_since(Instant::now());
-    let budget = Budget { max_tests: settings.max_tests, timeout: Some(left), cancel: settings.cancel.clone() };
+    let budget = Budget { max_tests: settings.max_tests, timeout: Some(left), cancel: settings.cancel.clone(), ..Budget::default() };
     let plan = dfs.solve(&Problem { checker: &*sub, start, progress: None }, &budget);
     CoreLenient::of(&plan, parts.len())
 }

@@ -520,7 +520,7 @@ fn plans_to_completion(path: &std::path::Path) -> std::result::Result<(), String
 }
 
 fn plans_to_completion_with(path: &std::path::Path, config: &WorldConfig) -> std::result::Result<(), String> {
-    use asp_search::{Budget, Dfs, Planner, Problem, Status};
+    use asp_search::{Budget, Dfs, Problem, Status};
     let assembly = asp_geom::io::load(path, &Default::default()).map_err(|e| e.to_string())?;
     let world = World::new(assembly, config).map_err(|e| e.to_string())?;
     let checker = Checker::new(world, CheckerConfig::default());

@@ -117,7 +117,7 @@ impl CheckerExtension for CellSetup {
         &self,
         checker: &Checker,
         seed: u64,
-        search: &mut dyn FnMut(&dyn FeasibilityChecker) -> PlanOutcome,
+        search: &mut dyn FnMut(&dyn FeasibilityChecker) -> asp_search::Result<PlanOutcome>,
     ) -> asp_search::Result<(PlanOutcome, Option<RobotReport>)> {
         let world = checker.world();
         let holding = (self.grippers >= 2).then(|| HoldingChecker::new(checker, self.grippers));
@@ -131,8 +131,8 @@ impl CheckerExtension for CellSetup {
             (cell, RobotChecker::new(base, planner, seed, r.config.replans))
         });
         let mut outcome = match &robot {
-            Some((_, rc)) => search(rc),
-            None => search(base),
+            Some((_, rc)) => search(rc)?,
+            None => search(base)?,
         };
         if let Some((_, rc)) = &robot {
             explain_refusals(&mut outcome, rc, world.assembly());

@@ -12,12 +12,13 @@ use asp_geom::Checker;
 /// checker on the collision-world checker, lets the search run on it, and describes the
 /// outcome's steps (a robot's grasps and paths).
 pub trait CheckerExtension: Send + Sync + std::fmt::Debug {
-    /// Builds the decorated checker on `checker`, calls `search` with it, and returns the
-    /// search's outcome with the extension's report (or `None`).
+    /// Builds the decorated checker on `checker`, calls `search` with it (any [`crate::Planner`]
+    /// on a problem of that checker), and returns the search's outcome with the extension's
+    /// report (or `None`); an error of the search is returned as it is.
     fn solve(
         &self,
         checker: &Checker,
         seed: u64,
-        search: &mut dyn FnMut(&dyn asp_geom::FeasibilityChecker) -> PlanOutcome,
+        search: &mut dyn FnMut(&dyn asp_geom::FeasibilityChecker) -> Result<PlanOutcome>,
     ) -> Result<(PlanOutcome, Option<RobotReport>)>;
 }

@@ -9,6 +9,10 @@ use asp_geom::distmap::MapState;
 use asp_geom::{Motion, PartSet, Stability};
 use std::collections::HashSet;
 
+/// States the dead-end search of a tree search's `NoPlan` visits at most (a tree the search
+/// exhausted is far smaller).
+pub const DEAD_END_STATES: usize = 200_000;
+
 /// The deepest dead end found: the removals that reach it (disassembly order, with their
 /// motions), the parts present there and why each non-fixed one cannot leave.
 #[derive(Clone, Debug, PartialEq)]

@@ -12,7 +12,9 @@
 //! Subassemblies of the result are then planned on their own base, recursively.
 
 use crate::ordering::{state_seed, BuiltinOrder, OrderingFactory, PartOrdering, WithBookkeeping};
-use crate::problem::{Budget, PlanOutcome, Planner, Problem, Progress, Stats, Status, Step, StopReason, Stuck, StuckReason, Subassembly};
+use crate::problem::{
+    Budget, PlanOutcome, Planner, Problem, Progress, Spent, Stats, Status, Step, StopReason, Stuck, StuckReason, Subassembly,
+};
 use asp_geom::{MotionKind, Outcome, PartSet};
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
@@ -135,7 +137,8 @@ impl Search<'_, '_, '_> {
 
     fn out_of_budget(&mut self) -> bool {
         if !self.exhausted {
-            if let Some(reason) = self.budget.stop_reason(self.tests(), self.started) {
+            let spent = Spent { tests: self.tests(), states: self.expanded, ..Spent::default() };
+            if let Some(reason) = self.budget.stop_reason(spent, self.started) {
                 self.exhausted = true;
                 self.stopped_by = Some(reason);
             }
@@ -359,13 +362,22 @@ impl Planner for Dfs {
         "dfs"
     }
 
-    fn solve(&self, problem: &Problem, budget: &Budget) -> PlanOutcome {
-        self.solve_visiting(problem, budget, None)
+    /// [`Dfs::solve`] (the depth-first search has no error to report).
+    fn solve(&self, problem: &Problem, budget: &Budget) -> crate::Result<PlanOutcome> {
+        Ok(Dfs::solve(self, problem, budget))
     }
 }
 
 impl Dfs {
-    /// [`Planner::solve`], calling `visit` with every state the search expands (in order; each
+    /// [`Planner::solve`] without its `Result`: the depth-first search cannot fail (its settings
+    /// are all valid, its checker answers every test), so its callers need not unwrap. It
+    /// counts removal tests ([`Budget::max_tests`]), expanded states ([`Budget::max_states`]),
+    /// wall time and the cancel token.
+    pub fn solve(&self, problem: &Problem, budget: &Budget) -> PlanOutcome {
+        self.solve_visiting(problem, budget, None)
+    }
+
+    /// [`Dfs::solve`], calling `visit` with every state the search expands (in order; each
     /// state once). Data collection records these states.
     pub fn solve_visiting(&self, problem: &Problem, budget: &Budget, visit: Option<&mut dyn FnMut(&PartSet)>) -> PlanOutcome {
         let started = Instant::now();
@@ -430,8 +442,9 @@ impl Dfs {
                 continue; // declared one unit: not taken apart
             }
             let stats = &outcome.stats;
-            let left = budget.remaining(stats.counters.removal_tests, started);
-            if left.exhausted(0, Instant::now()) {
+            let left =
+                budget.remaining(Spent { tests: stats.counters.removal_tests, states: stats.states_expanded, ..Spent::default() }, started);
+            if left.exhausted(Spent::default(), Instant::now()) {
                 continue;
             }
             let sub = Problem { checker: &*checker, start: group.parts.clone(), progress: problem.progress };

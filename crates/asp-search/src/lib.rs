@@ -26,12 +26,13 @@ pub use checker_extension::CheckerExtension;
 pub use dfs::Dfs;
 pub use error::{Result, SearchError};
 pub use extension::{MdpExtension, ModelContext};
-pub use mcts::{EpisodeEnd, EpisodeHook, Mcts, Next, ParetoMcts, SearchOutcome, SearchStats, SearchStatus, Solution, Transition};
+pub use mcts::{EpisodeEnd, EpisodeHook, MapPlanner, Mcts, Next, ParetoMcts, SearchOutcome, SearchStats, Solution, Transition};
 pub use mdp::{ActionFilter, FilterCount, Mdp, Verdict};
 pub use objective::{Accessibility, DirHistory, DirectionChanges, Objective, PathLength};
 pub use ordering::{Bookkeeping, BuiltinOrder, OrderingFactory, OrderingSource, PartOrdering, WithBookkeeping};
 pub use policy::{EpsilonGreedy, Policy, PolicyContext, PolicyWorker, QFunction, QUse, QWorker, RandomPolicy};
 pub use problem::{
-    Budget, GroupMove, PlanOutcome, Planner, Problem, Progress, Stats, Status, Step, StopReason, StopToken, Stuck, StuckReason, Subassembly,
+    Budget, GroupMove, PlanOutcome, Planner, Problem, Progress, Spent, Stats, Status, Step, StopReason, StopToken, Stuck, StuckReason,
+    Subassembly,
 };
 pub use step::{StepContext, StepKind};

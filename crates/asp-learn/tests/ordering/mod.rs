@@ -6,7 +6,7 @@ use std::sync::Arc;
 use asp_geom::graph::{AssemblyGraph, GraphConfig};
 use asp_geom::{fixtures, Checker, CheckerConfig, PartSet, World, WorldConfig};
 use asp_learn::{GnnFactory, GnnOrdering, GnnSource, RemovabilityModel};
-use asp_search::{Budget, Dfs, OrderingSource, PartOrdering, Planner, Problem, Status};
+use asp_search::{Budget, Dfs, OrderingSource, PartOrdering, Problem, Status};
 
 fn model() -> Arc<RemovabilityModel> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/random_gnn.onnx");

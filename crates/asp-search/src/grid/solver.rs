@@ -20,7 +20,9 @@
 //! Gravity is not checked: the puzzle is taken apart in the hand, as a subassembly is planned on
 //! its base (no ground plane, no stability test).
 
+use crate::problem::{Status, Stuck, StuckReason};
 use asp_geom::grid::{Cell, VoxelModel};
+use asp_geom::PartSet;
 use std::collections::HashSet;
 use std::time::Instant;
 
@@ -38,7 +40,7 @@ pub struct GridConfig {
     /// The most groups tried per state and direction (closures of single parts always; unions
     /// of them up to this count).
     pub max_groups: usize,
-    /// Stop after the model's first separation (its plan then ends `Budget` with one step):
+    /// Stop after the model's first separation (its plan then ends `BudgetExhausted` with one step):
     /// a cheap probe of whether parts must move before anything can leave.
     pub first_only: bool,
 }
@@ -81,20 +83,36 @@ pub struct GridPlan {
     /// The separations in disassembly order.
     pub steps: Vec<GridStep>,
     /// The reference parts that stay (the fixed parts, or the base) and, when not
-    /// [`GridStatus::Found`], the parts that could not be separated.
+    /// [`Status::Found`], the parts that could not be separated.
     pub remaining: Vec<usize>,
-    /// How the search ended.
-    pub status: GridStatus,
+    /// How the search ended, in every planner's vocabulary: `Found` (taken apart down to the
+    /// reference), `NoPlan` (every reachable state was visited and none separates `remaining`:
+    /// each of them blocked by the others) or `BudgetExhausted` (the state budget or the stop
+    /// condition ended it).
+    pub status: Status,
 }
 
-/// How a grid search ended.
+impl GridPlan {
+    /// A plan of a model of `n` parts that ended `how`, with `remaining` left.
+    fn ended(steps: Vec<GridStep>, remaining: Vec<usize>, n: usize, how: Ended) -> GridPlan {
+        let status = match how {
+            Ended::Found => Status::Found,
+            Ended::Budget => Status::BudgetExhausted,
+            Ended::Stuck => {
+                let state = PartSet::from_indices(n, remaining.iter().copied());
+                let stuck = remaining.iter().map(|&p| Stuck { part: p, reason: StuckReason::Blocked(state.without(p)) }).collect();
+                Status::NoPlan { stuck, state }
+            }
+        };
+        GridPlan { steps, remaining, status }
+    }
+}
+
+/// How a (sub)assembly's search ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum GridStatus {
-    /// Taken apart down to the reference.
+enum Ended {
     Found,
-    /// Every reachable state was visited and none separates `remaining`.
     Stuck,
-    /// The state budget or the stop condition ended it.
     Budget,
 }
 
@@ -115,7 +133,7 @@ impl GridSolution {
     /// Whether the whole model was taken apart (every subassembly included).
     pub fn complete(&self) -> bool {
         fn ok(p: &GridPlan) -> bool {
-            p.status == GridStatus::Found && p.steps.iter().all(|s| s.plan.as_ref().is_none_or(|q| ok(q)))
+            p.status == Status::Found && p.steps.iter().all(|s| s.plan.as_ref().is_none_or(|q| ok(q)))
         }
         ok(&self.plan)
     }
@@ -210,6 +228,8 @@ struct Solver<'a> {
     stop: &'a dyn Fn() -> bool,
     states: u64,
     expanded: u64,
+    /// The model's part count.
+    parts: usize,
 }
 
 /// A search's local view: the units of the (sub)assembly, their offsets, its reference.
@@ -250,11 +270,11 @@ pub fn solve(model: &VoxelModel, config: &GridConfig, stop: &dyn Fn() -> bool) -
         .collect();
     let table: i64 = spans.iter().flat_map(|a| spans.iter().map(move |b| (0..3).map(|k| a[k] + b[k]).product::<i64>())).sum();
     if table > MAX_PAIR_TABLE as i64 {
-        let plan = GridPlan { steps: Vec::new(), remaining: (0..model.len()).collect(), status: GridStatus::Budget };
+        let plan = GridPlan::ended(Vec::new(), (0..model.len()).collect(), model.len(), Ended::Budget);
         return GridSolution { plan, states: 0, first_separation_moves: None, seconds: started.elapsed().as_secs_f64() };
     }
     let pairs = (0..units.len()).map(|p| (0..units.len()).map(|q| Pair::new(&cells[p], &cells[q])).collect()).collect();
-    let mut solver = Solver { units, cells, pairs, config: *config, stop, states: 0, expanded: 0 };
+    let mut solver = Solver { units, cells, pairs, config: *config, stop, states: 0, expanded: 0, parts: model.len() };
     let n = solver.units.len();
     let reference = if fixed.is_empty() { solver.base(&(0..n).collect::<Vec<_>>()) } else { 0 };
     let local = Local { units: (0..n).collect(), offsets: vec![[0; 3]; n], reference, free: fixed.is_empty() };
@@ -322,7 +342,7 @@ impl Solver<'_> {
                         plan: sub,
                     });
                     if self.config.first_only {
-                        return GridPlan { steps, remaining: self.parts_of(local.units.iter().copied()), status: GridStatus::Budget };
+                        return GridPlan::ended(steps, self.parts_of(local.units.iter().copied()), self.parts, Ended::Budget);
                     }
                     let reference_unit = local.units[local.reference];
                     local = Local {
@@ -333,14 +353,14 @@ impl Solver<'_> {
                     };
                 }
                 Bfs::Stuck => {
-                    return GridPlan { steps, remaining: self.parts_of(local.units.iter().copied()), status: GridStatus::Stuck };
+                    return GridPlan::ended(steps, self.parts_of(local.units.iter().copied()), self.parts, Ended::Stuck);
                 }
                 Bfs::Budget => {
-                    return GridPlan { steps, remaining: self.parts_of(local.units.iter().copied()), status: GridStatus::Budget };
+                    return GridPlan::ended(steps, self.parts_of(local.units.iter().copied()), self.parts, Ended::Budget);
                 }
             }
         }
-        GridPlan { steps, remaining: self.parts_of(local.units.iter().copied()), status: GridStatus::Found }
+        GridPlan::ended(steps, self.parts_of(local.units.iter().copied()), self.parts, Ended::Found)
     }
 
     /// Cells the leaving units travel along `dir` until their bounds clear the staying ones'.

@@ -59,7 +59,9 @@
 //! with an error; a panic in one is reported as an error too, not re-raised.
 //!
 //! # Files
-//! [`settings`] (the builder), [`outcome`] (what a search gives back), `graph` (nodes, edges,
+//! [`settings`] (the builder), [`outcome`] (what a search gives back; its
+//! [`SearchOutcome::plan`] in every planner's vocabulary), `planner` (the searches behind
+//! [`crate::Planner`], [`MapPlanner`]), `graph` (nodes, edges,
 //! the variants' seam), `worker` (one thread's search: select, expand, rollout, backup),
 //! `record` (recording transitions), `run` (threads and the merged answer); the variants in
 //! [`uct`] and [`pareto`].
@@ -67,14 +69,16 @@
 mod graph;
 pub mod outcome;
 pub mod pareto;
+mod planner;
 mod record;
 mod run;
 pub mod settings;
 pub mod uct;
 mod worker;
 
-pub use outcome::{EpisodeEnd, EpisodeHook, Next, SearchOutcome, SearchStats, SearchStatus, Solution, TracePoint, Transition};
+pub use outcome::{EpisodeEnd, EpisodeHook, Next, SearchOutcome, SearchStats, Solution, TracePoint, Transition};
 pub use pareto::{ParetoMcts, ParetoMctsBuilder};
+pub use planner::{MapPlanner, TreeSearch};
 pub use settings::{
     SearchBuilder, SearchSettings, DEFAULT_BUDGET, DEFAULT_EPISODES, DEFAULT_EXPLORATION, DEFAULT_MAX_NODES, DEFAULT_POLISH,
     DEFAULT_RECORD_LIMIT,

@@ -5,21 +5,10 @@
 use crate::error::Result;
 use crate::mdp::FilterCount;
 use crate::policy::Policy;
+use crate::problem::{PlanOutcome, Status};
 use crate::step::StepKind;
 use asp_geom::{Motion, PartSet};
 use std::sync::Arc;
-
-/// How a search ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SearchStatus {
-    /// At least one complete feasible sequence was found.
-    Found,
-    /// The whole tree was explored: no complete feasible sequence exists.
-    NoPlan,
-    /// The budget ran out before any complete sequence was found.
-    BudgetExhausted,
-}
 
 /// One answer: a complete feasible disassembly sequence, its objective vector and its motions.
 #[derive(Clone, Debug, PartialEq)]
@@ -101,8 +90,20 @@ pub struct SearchStats {
 /// The result of a search.
 #[derive(Clone, Debug)]
 pub struct SearchOutcome {
-    /// How the search ended.
-    pub status: SearchStatus,
+    /// The answer in every planner's vocabulary ([`crate::Planner`]; the outcome of
+    /// [`MapPlanner`](crate::mcts::MapPlanner)): how the search ended — `Found` (at least one
+    /// complete feasible sequence), `NoPlan` (the whole tree was explored and holds none; the
+    /// deepest dead end on the maps says what holds each part, [`crate::dead_end`]) or
+    /// `BudgetExhausted` (the episodes, the time or a stop ended it first) — the best
+    /// sequence's removals (for `NoPlan` those to the dead end), each motion carried the maps'
+    /// contact distance further (a plan's removal ends that far beyond the remaining bounds),
+    /// and the effort (the maps' test counters, the time, which limit stopped it). See
+    /// [`SearchOutcome::status`].
+    pub plan: PlanOutcome,
+    /// The parts of a `NoPlan`'s dead end that the maps let out but a feasibility filter of the
+    /// problem rejected, each with the filter's words ("is rejected by robot: ..."); empty
+    /// otherwise.
+    pub rejected: Vec<(usize, String)>,
     /// The objectives' names.
     pub objectives: Vec<String>,
     /// The answers: the best sequence (single objective) or the Pareto front, sorted by the first
@@ -200,6 +201,11 @@ pub enum Next {
 pub type EpisodeHook<'h> = dyn FnMut(EpisodeEnd) -> Result<Next> + Send + 'h;
 
 impl SearchOutcome {
+    /// How the search ended ([`SearchOutcome::plan`]'s status).
+    pub fn status(&self) -> &Status {
+        &self.plan.status
+    }
+
     /// The first solution (the best one for a single objective).
     pub fn best(&self) -> Option<&Solution> {
         self.solutions.first()
@@ -212,5 +218,12 @@ impl SearchOutcome {
             writeln!(w, "{},{},{:.6},{},{}", t.episode, t.iterations, t.seconds, t.value, t.front_size)?;
         }
         Ok(())
+    }
+}
+
+impl From<SearchOutcome> for PlanOutcome {
+    /// The search's answer in every planner's vocabulary ([`SearchOutcome::plan`]).
+    fn from(outcome: SearchOutcome) -> PlanOutcome {
+        outcome.plan
     }
 }

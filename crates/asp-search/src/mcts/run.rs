@@ -1,21 +1,23 @@
 //! A whole search: the threads' workers, each on its share of the episodes, and their answers
 //! merged in thread order into a [`SearchOutcome`].
 
-use super::graph::{Status, Variant};
-use super::outcome::{EpisodeHook, SearchOutcome, SearchStats, SearchStatus, Solution, TracePoint};
+use super::graph::{Status as NodeStatus, Variant};
+use super::outcome::{EpisodeHook, SearchOutcome, SearchStats, Solution, TracePoint};
 use super::record::Recorder;
 use super::settings::SearchSettings;
 use super::worker::{front_value, share_of, Shared, Worker};
+use crate::dead_end::{deepest_dead_end, DEAD_END_STATES};
 use crate::error::{Result, SearchError};
 use crate::hypervolume::ParetoFront;
 use crate::mdp::{FilterCounts, Mdp};
-use crate::problem::StopToken;
+use crate::problem::{PlanOutcome, Stats, Status, Step, StopReason, StopToken};
+use asp_geom::{CounterSnapshot, Motion, PartSet};
 use std::sync::Mutex;
 use std::time::Instant;
 
 /// What one worker hands back: its archive, statistics, filter counts, root status and
 /// recording.
-type WorkerResult = Result<(ParetoFront<Vec<u16>>, SearchStats, FilterCounts, Status, Option<Recorder>)>;
+type WorkerResult = Result<(ParetoFront<Vec<u16>>, SearchStats, FilterCounts, NodeStatus, Option<Recorder>)>;
 
 /// The message of a panic payload.
 fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
@@ -116,7 +118,7 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings, hook: Op
         stats.exhausted |= s.exhausted;
         stats.stopped |= s.stopped;
         filtered.add(f);
-        dead &= *status == Status::Dead;
+        dead &= *status == NodeStatus::Dead;
     }
     stats.filtered = problem.report_filtered(&filtered);
     stats.filter_checks = filtered.checks();
@@ -152,15 +154,17 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings, hook: Op
         front_size: merged.len(),
     };
     shared.trace.push(last);
-    let status = if !solutions.is_empty() {
-        SearchStatus::Found
-    } else if dead {
-        SearchStatus::NoPlan
-    } else {
-        SearchStatus::BudgetExhausted
+    // what ended a search without an answer: a stop (the token, else the time limit) or its
+    // episodes
+    let stopped_by = match (stats.stopped, settings.stop.as_ref().is_some_and(StopToken::is_stopped)) {
+        (true, true) => StopReason::Interrupted,
+        (true, false) => StopReason::Timeout,
+        (false, _) => StopReason::MaxEpisodes,
     };
+    let (plan, rejected) = plan_outcome(problem, &solutions, dead, &stats, stopped_by);
     Ok(SearchOutcome {
-        status,
+        plan,
+        rejected,
         objectives: problem.objective_names(),
         solutions,
         reference,
@@ -170,4 +174,62 @@ pub(crate) fn run<V: Variant>(problem: &Mdp, settings: &SearchSettings, hook: Op
         transitions,
         transitions_capped,
     })
+}
+
+/// The search's answer in every planner's vocabulary, and the dead end's parts a filter
+/// rejected ([`SearchOutcome::plan`], [`SearchOutcome::rejected`]): `Found` with the best
+/// solution's removals when there is one; else `NoPlan` when every root was dead, explained by
+/// the deepest dead end on the maps; else `BudgetExhausted`, stopped by `stopped_by`. Motions
+/// are carried the maps' contact distance further (the plan format's removal ends that far
+/// beyond the remaining bounds).
+fn plan_outcome(
+    problem: &Mdp,
+    solutions: &[Solution],
+    dead: bool,
+    stats: &SearchStats,
+    stopped_by: StopReason,
+) -> (PlanOutcome, Vec<(usize, String)>) {
+    let maps = problem.maps();
+    let margin = maps.contact_distance();
+    let with_margin = |part: usize, m: &Motion| {
+        Step::single(
+            part,
+            match m {
+                Motion::Linear { direction, distance } => Motion::Linear { direction: *direction, distance: distance + margin },
+                other => other.clone(),
+            },
+        )
+    };
+    let mut removals: Vec<Step> =
+        solutions.first().map(|s| s.sequence.iter().zip(&s.motions).map(|(&part, m)| with_margin(part, m)).collect()).unwrap_or_default();
+    let mut rejected = Vec::new();
+    let status = if !solutions.is_empty() {
+        Status::Found
+    } else if dead {
+        match deepest_dead_end(problem, DEAD_END_STATES) {
+            Some(end) => {
+                removals = end.removals.iter().map(|(part, m)| with_margin(*part, m)).collect();
+                rejected = end.rejected;
+                Status::NoPlan { stuck: end.stuck, state: end.state }
+            }
+            // the tree search saw no complete sequence where the dead-end search finds one
+            // within its bound (it cannot: both walk the same removals): nothing to explain
+            None => Status::NoPlan { stuck: Vec::new(), state: PartSet::full(maps.num_parts()) },
+        }
+    } else {
+        Status::BudgetExhausted
+    };
+    let effort = Stats {
+        counters: CounterSnapshot {
+            removal_tests: stats.removal_tests,
+            failed_collision: stats.failed_collision,
+            failed_gravity: stats.failed_gravity,
+            // the tree searches move parts along straight lines only
+            path_planner_calls: 0,
+        },
+        seconds: stats.seconds,
+        stopped_by: (status == Status::BudgetExhausted).then_some(stopped_by),
+        ..Stats::default()
+    };
+    (PlanOutcome { status, removals, stats: effort }, rejected)
 }

@@ -1,9 +1,281 @@
-//! Every planner configuration (the depth-first search and the optimisers) on every fixture with a
-//! known answer; every found plan is re-checked by the independent sweep.
+//! Every planner behind the [`Planner`] trait — the depth-first search in four configurations,
+//! MCTS, Pareto-MCTS and the grid planner — on shared small problems, held to the trait's
+//! contract: a found plan re-checks step by step on the geometry (the independent sweep), a
+//! spent budget ends the search with the budget status and says which limit (a cancelled token:
+//! `interrupted`), a seed gives one answer. Then the depth-first search's own properties.
 
-use crate::verify::verify_plan;
+use crate::verify::{verify_plan, verify_removals, verify_removals_in_hand};
+use asp_geom::distmap::{DistanceMaps, MapConfig};
 use asp_geom::{fixtures, Assembly, Checker, CheckerConfig, FeasibilityChecker, World, WorldConfig};
-use asp_search::{Budget, BuiltinOrder, Dfs, PlanOutcome, Planner, Problem, Status};
+use asp_search::grid::{GridConfig, GridPlanner};
+use asp_search::objective::parse_objectives;
+use asp_search::{
+    Budget, BuiltinOrder, Dfs, MapPlanner, Mcts, Mdp, ParetoMcts, PlanOutcome, Planner, Problem, Status, StopReason, StopToken,
+};
+use std::sync::Arc;
+use std::time::Duration;
+
+/// One shared problem: an assembly, its collision world's checker (the problem every planner
+/// is given, and the geometry its plans are re-checked on) and the MDPs the tree searches are
+/// made on.
+struct Case {
+    assembly: Assembly,
+    checker: Checker,
+    /// One objective per MDP (`access`, `dirchange`, `pathlen`), for MCTS.
+    single: Vec<Mdp>,
+    /// `access,dirchange`, for Pareto-MCTS.
+    front: Mdp,
+}
+
+impl Case {
+    fn new(assembly: Assembly) -> Case {
+        let config = MapConfig::builder().resolution(5).build().unwrap();
+        let world = World::new(assembly.clone(), &config.world_config(&assembly)).unwrap();
+        let checker = Checker::new(world, CheckerConfig::default());
+        let maps = Arc::new(DistanceMaps::build(&assembly, &config).unwrap());
+        let mdp = |objectives: &str| Mdp::new(maps.clone(), parse_objectives(objectives).unwrap()).unwrap();
+        let single = ["access", "dirchange", "pathlen"].into_iter().map(mdp).collect();
+        Case { front: mdp("access,dirchange"), single, checker, assembly }
+    }
+
+    fn label(&self) -> String {
+        self.assembly.source.display().to_string()
+    }
+
+    /// Every planner that can plan this assembly, with whether its plans keep the remainder
+    /// stable (the grid planner takes puzzles apart in the hand and tests no gravity).
+    fn planners(&self) -> Vec<(String, Box<dyn Planner + '_>, bool)> {
+        let mut out: Vec<(String, Box<dyn Planner + '_>, bool)> = Vec::new();
+        for (label, dfs) in planners() {
+            out.push((format!("dfs {label}"), Box::new(dfs), true));
+        }
+        for (mdp, objective) in self.single.iter().zip(["access", "dirchange", "pathlen"]) {
+            let mcts = Mcts::builder().episodes(60).seed(2).build().unwrap();
+            out.push((format!("mcts {objective}"), Box::new(MapPlanner::new(mcts, mdp)), true));
+        }
+        let pareto = ParetoMcts::builder().episodes(60).seed(2).build().unwrap();
+        out.push(("pareto_mcts".into(), Box::new(MapPlanner::new(pareto, &self.front)), true));
+        if let Some(grid) = GridPlanner::of(&self.assembly, GridConfig::default()) {
+            out.push(("grid".into(), Box::new(grid), false));
+        }
+        out
+    }
+
+    fn solve(&self, planner: &dyn Planner, budget: &Budget) -> PlanOutcome {
+        planner.solve(&Problem::full(&self.checker), budget).unwrap_or_else(|e| panic!("{} on {}: {e}", planner.name(), self.label()))
+    }
+}
+
+/// The shared problems: the fixtures a straight line takes apart, and the thesis' figure 6.2
+/// in voxels (which the grid planner takes too).
+fn straight_cases() -> Vec<Case> {
+    [fixtures::stacked_boxes(), fixtures::peg_in_hole(), fixtures::tube(), fixtures::arch(), fixtures::figure_6_2(1.0)]
+        .into_iter()
+        .map(Case::new)
+        .collect()
+}
+
+/// Re-checks a found plan on the case's world: with the stability check when the planner keeps
+/// the remainder stable.
+fn recheck(case: &Case, label: &str, outcome: &PlanOutcome, gravity: bool) {
+    assert_eq!(outcome.status, Status::Found, "{label} on {}", case.label());
+    assert!(outcome.removals.iter().all(|s| s.moves.is_empty()), "{label}: the re-check replays no grid moves");
+    let world = case.checker.world();
+    let rest = if gravity { verify_removals(world, &outcome.removals) } else { verify_removals_in_hand(world, &outcome.removals) };
+    assert!(rest.iter().all(|p| world.fixed().contains(p)), "{label} on {}: parts left: {rest:?}", case.label());
+}
+
+#[test]
+fn every_planner_through_the_trait_takes_every_shared_problem_apart_and_every_step_rechecks() {
+    let mut grids = 0;
+    for case in straight_cases() {
+        for (label, planner, gravity) in case.planners() {
+            let outcome = case.solve(&*planner, &Budget::default());
+            recheck(&case, &label, &outcome, gravity);
+            grids += usize::from(planner.name() == "grid");
+        }
+    }
+    assert!(grids > 0, "the grid planner planned none of the shared problems");
+}
+
+/// The L-shaped channel needs a path no straight line gives: the depth-first search finds it
+/// with its path planner, the grid planner only by moves before the removal, and the tree
+/// searches (straight lines only) may not claim a plan.
+#[test]
+fn only_a_planner_with_a_path_planner_takes_the_l_path_apart() {
+    let case = Case::new(fixtures::l_path());
+    for (label, planner, gravity) in case.planners() {
+        let outcome = case.solve(&*planner, &Budget::default());
+        match planner.name() {
+            "dfs" => recheck(&case, &label, &outcome, gravity),
+            "grid" => assert!(
+                outcome.status != Status::Found || outcome.removals.iter().any(|s| !s.moves.is_empty()),
+                "{label}: claims a straight-line plan"
+            ),
+            _ => assert_ne!(outcome.status, Status::Found, "{label}: claims a straight-line plan"),
+        }
+    }
+}
+
+/// A budget spent before the start ends every planner at once with the budget status and the
+/// limit that was spent: a cancelled token (`interrupted`), no time left, and a zero limit of
+/// any count (a planner that does not keep a count has spent none of it, and zero is spent).
+#[test]
+fn a_spent_budget_ends_every_planner_with_the_budget_status_and_says_which() {
+    let case = Case::new(fixtures::tube());
+    let cancelled = StopToken::new();
+    cancelled.stop();
+    let budgets = [
+        (Budget { cancel: Some(cancelled), ..Budget::default() }, StopReason::Interrupted),
+        (Budget { timeout: Some(Duration::ZERO), ..Budget::default() }, StopReason::Timeout),
+        (Budget { max_tests: Some(0), ..Budget::default() }, StopReason::MaxTests),
+        (Budget { max_episodes: Some(0), ..Budget::default() }, StopReason::MaxEpisodes),
+        (Budget { max_states: Some(0), ..Budget::default() }, StopReason::MaxStates),
+    ];
+    for (label, planner, _) in case.planners() {
+        for (budget, reason) in &budgets {
+            let outcome = case.solve(&*planner, budget);
+            assert_eq!(outcome.status, Status::BudgetExhausted, "{label} with {budget:?}");
+            assert_eq!(outcome.stats.stopped_by, Some(*reason), "{label} with {budget:?}");
+            assert!(outcome.removals.is_empty(), "{label} with {budget:?}: removed parts");
+        }
+    }
+}
+
+/// A small budget of what a planner counts ends it with the budget status when it ends it
+/// first, and is kept: the depth-first search runs no more tests than allowed, a tree search no
+/// more episodes, the grid search stops at its state limit.
+#[test]
+fn a_small_budget_is_kept_by_every_planner() {
+    let case = Case::new(fixtures::tube());
+    let dfs = Dfs::builder().build();
+    let o = case.solve(&dfs, &Budget { max_tests: Some(2), ..Budget::default() });
+    assert_eq!((o.status, o.stats.stopped_by, o.stats.counters.removal_tests), (Status::BudgetExhausted, Some(StopReason::MaxTests), 2));
+    let o = case.solve(&dfs, &Budget { max_states: Some(1), ..Budget::default() });
+    assert_eq!((o.status, o.stats.stopped_by, o.stats.states_expanded), (Status::BudgetExhausted, Some(StopReason::MaxStates), 1));
+    // a tree (no transpositions) over the classic Soma cube's 7! orders: far from explored
+    // after a few episodes
+    let soma = crate::fixtures::classic_soma();
+    let soma_checker = asp_geom::voxel::VoxelChecker::new(&soma, &WorldConfig::default()).expect("a voxel model");
+    let mdp = crate::fixtures::problem(&crate::fixtures::maps(&soma, 3), "access");
+    for threads in [1, 2] {
+        let mcts = Mcts::builder().episodes(60).seed(2).threads(threads).transpositions(false).build().unwrap();
+        let planner = MapPlanner::new(mcts, &mdp);
+        let full = planner.search(&Budget::default()).unwrap();
+        assert_eq!(full.stats.episodes, 60, "{threads} threads");
+        let out = planner.search(&Budget { max_episodes: Some(3), ..Budget::default() }).unwrap();
+        assert_eq!(out.stats.episodes, 3, "{threads} threads");
+        let plan = planner.solve(&Problem::full(&soma_checker), &Budget { max_episodes: Some(3), ..Budget::default() }).unwrap();
+        assert!(plan.status == Status::Found || plan.stats.stopped_by == Some(StopReason::MaxEpisodes), "{:?}", plan.status);
+    }
+    let burr = asp_geom::puzzles::burr_level();
+    let checker = asp_geom::voxel::VoxelChecker::new(&burr, &WorldConfig::default()).expect("a voxel puzzle");
+    let grid = GridPlanner::of(&burr, GridConfig::default()).expect("a voxel puzzle");
+    let o = grid.solve(&Problem::full(&checker), &Budget { max_states: Some(3), ..Budget::default() }).unwrap();
+    assert_eq!((o.status, o.stats.stopped_by), (Status::BudgetExhausted, Some(StopReason::MaxStates)));
+    // a token stopped while the grid search runs (it looks every 1,024 states): the search
+    // itself ends `interrupted` on a closed box whose five loose cubes slide around a 3 × 4
+    // cavity (95,040 states to visit before it is stuck)
+    let mut frame = Vec::new();
+    for x in 0..5 {
+        for y in 0..3 {
+            for z in 0..6 {
+                if !(y == 1 && (1..4).contains(&x) && (1..5).contains(&z)) {
+                    frame.push([x, y, z]);
+                }
+            }
+        }
+    }
+    let mut pieces = vec![frame];
+    pieces.extend([[1, 1, 1], [2, 1, 1], [3, 1, 1], [1, 1, 2], [2, 1, 2]].map(|c| vec![c]));
+    let boxed = asp_geom::puzzles::voxel_puzzle("closed box", &pieces);
+    let grid = GridPlanner::of(&boxed, GridConfig::default()).expect("a voxel puzzle");
+    let cancelled = StopToken::new();
+    cancelled.stop();
+    let run = grid.run(&Budget { cancel: Some(cancelled), ..Budget::default() }, std::time::Instant::now());
+    let o = run.outcome(&boxed);
+    assert_eq!((o.status, o.stats.stopped_by), (Status::BudgetExhausted, Some(StopReason::Interrupted)), "{} states", run.solution.states);
+}
+
+/// Keeps one part in forever (so no sequence exists) and stops a token at its first check.
+#[derive(Debug)]
+struct StopsAndHolds {
+    token: StopToken,
+    held: usize,
+}
+
+impl asp_search::ActionFilter for StopsAndHolds {
+    fn name(&self) -> &str {
+        "stops"
+    }
+    fn reasons(&self) -> Vec<String> {
+        vec!["held".into()]
+    }
+    fn check(&self, step: &mut asp_search::StepContext<'_, '_>, _memory: &[u64]) -> asp_search::Verdict {
+        self.token.stop();
+        if step.part() == self.held {
+            asp_search::Verdict::Infeasible { reason: 0 }
+        } else {
+            asp_search::Verdict::Feasible
+        }
+    }
+}
+
+/// A tree search that a budget ends while it runs, before any complete sequence, says which
+/// limit: its episodes, or the token (stopped by a filter during the first expansion) — on a
+/// tree of the classic Soma cube with one piece held in, far from explored when it stops.
+#[test]
+fn a_tree_search_ended_by_its_budget_while_it_runs_says_which_limit() {
+    let soma = crate::fixtures::classic_soma();
+    let checker = asp_geom::voxel::VoxelChecker::new(&soma, &WorldConfig::default()).expect("a voxel model");
+    let held = (0..soma.len()).find(|&p| !soma.parts[p].fixed).unwrap();
+    let token = StopToken::new();
+    let filter = Arc::new(StopsAndHolds { token: token.clone(), held });
+    let mdp = crate::fixtures::problem(&crate::fixtures::maps(&soma, 3), "access").with_filter(filter);
+    let mcts = Mcts::builder().episodes(1000).seed(2).transpositions(false).build().unwrap();
+    let planner = MapPlanner::new(mcts, &mdp);
+    let problem = Problem::full(&checker);
+    let o = planner.solve(&problem, &Budget { cancel: Some(token.clone()), ..Budget::default() }).unwrap();
+    assert!(token.is_stopped(), "the filter was asked");
+    assert_eq!((o.status, o.stats.stopped_by), (Status::BudgetExhausted, Some(StopReason::Interrupted)));
+    // the filter's token is stopped now, but no budget holds it
+    let o = planner.solve(&problem, &Budget { max_episodes: Some(3), ..Budget::default() }).unwrap();
+    assert_eq!((o.status, o.stats.stopped_by), (Status::BudgetExhausted, Some(StopReason::MaxEpisodes)));
+}
+
+/// The same planner on the same problem gives the same outcome, effort included (the time
+/// aside).
+#[test]
+fn a_seed_gives_every_planner_one_answer() {
+    for case in [Case::new(fixtures::tube()), Case::new(fixtures::figure_6_2(1.0))] {
+        for (label, planner, _) in case.planners() {
+            let (mut a, mut b) = (case.solve(&*planner, &Budget::default()), case.solve(&*planner, &Budget::default()));
+            a.stats.seconds = 0.0;
+            b.stats.seconds = 0.0;
+            a.stats.path_planner_seconds = 0.0;
+            b.stats.path_planner_seconds = 0.0;
+            assert_eq!(a, b, "{label} on {}", case.label());
+        }
+    }
+}
+
+/// A planner made on a model of its own takes only that model's whole assembly apart: another
+/// problem is an error, not an outcome.
+#[test]
+fn a_planner_made_on_its_own_model_refuses_another_problem() {
+    let case = Case::new(fixtures::figure_6_2(1.0));
+    let other = Case::new(fixtures::tube());
+    for (label, planner, _) in case.planners() {
+        let part = Problem { start: asp_geom::PartSet::from_indices(3, [0, 1]), ..Problem::full(&case.checker) };
+        let elsewhere = planner.solve(&Problem::full(&other.checker), &Budget::default());
+        if label.starts_with("dfs") {
+            assert!(elsewhere.is_ok() && planner.solve(&part, &Budget::default()).is_ok(), "{label}");
+        } else {
+            assert!(elsewhere.is_err(), "{label}: planned another assembly than its model's");
+            assert!(planner.solve(&part, &Budget::default()).is_err(), "{label}: planned part of its model");
+        }
+    }
+}
 
 fn planners() -> Vec<(&'static str, Dfs)> {
     vec![
@@ -162,12 +434,10 @@ fn shuffled_orders_are_reproducible_per_seed() {
 /// L-shaped path needs a path no straight removal gives: no optimiser may claim it.
 #[test]
 fn the_optimisers_solve_every_straight_line_fixture_and_every_answer_rechecks() {
-    use asp_geom::distmap::{DistanceMaps, MapConfig};
-    use asp_search::{Mdp, SearchOutcome, SearchStatus, Step};
-    use std::sync::Arc;
+    use asp_search::{SearchOutcome, Step};
 
-    fn recheck(label: &str, world: &World, out: &SearchOutcome) {
-        assert_eq!(out.status, SearchStatus::Found, "{label}");
+    fn recheck_front(label: &str, world: &World, out: &SearchOutcome) {
+        assert_eq!(*out.status(), Status::Found, "{label}");
         assert!(!out.solutions.is_empty(), "{label}");
         for s in &out.solutions {
             let removals: Vec<Step> = s
@@ -188,7 +458,7 @@ fn the_optimisers_solve_every_straight_line_fixture_and_every_answer_rechecks() 
         let maps = Arc::new(DistanceMaps::build(&assembly, &config).unwrap());
         let straight = !source.contains("l_path");
         for objectives in ["access", "dirchange", "pathlen", "access,dirchange"] {
-            let mdp = Mdp::new(maps.clone(), asp_search::objective::parse_objectives(objectives).unwrap()).unwrap();
+            let mdp = Mdp::new(maps.clone(), parse_objectives(objectives).unwrap()).unwrap();
             let out = if objectives.contains(',') {
                 asp_search::ParetoMcts::builder().episodes(60).seed(2).build().unwrap().solve(&mdp).unwrap()
             } else {
@@ -196,9 +466,9 @@ fn the_optimisers_solve_every_straight_line_fixture_and_every_answer_rechecks() 
             };
             let label = format!("{objectives} on {source}");
             if straight {
-                recheck(&label, &world, &out);
+                recheck_front(&label, &world, &out);
             } else {
-                assert_ne!(out.status, SearchStatus::Found, "{label}: claims a straight-line plan");
+                assert_ne!(*out.status(), Status::Found, "{label}: claims a straight-line plan");
             }
         }
     }

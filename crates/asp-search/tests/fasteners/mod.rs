@@ -3,7 +3,7 @@
 
 use crate::verify::verify_plan;
 use asp_geom::{fixtures, Checker, CheckerConfig, Motion, World, WorldConfig};
-use asp_search::{Budget, Dfs, Planner, Problem, Status};
+use asp_search::{Budget, Dfs, Problem, Status};
 
 #[test]
 fn issue_9_a_bolt_in_a_nut_on_a_plate_comes_apart_by_screwing_and_every_step_rechecks() {

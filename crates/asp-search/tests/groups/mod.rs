@@ -5,7 +5,7 @@ use crate::verify::{verify_plan, verify_removals};
 use asp_geom::fixtures::ring_on_locked_post;
 use asp_geom::{Checker, CheckerConfig, FeasibilityChecker, World, WorldConfig};
 use asp_search::report::PlanReport;
-use asp_search::{Budget, Dfs, PlanOutcome, Planner, Problem, Status, StuckReason};
+use asp_search::{Budget, Dfs, PlanOutcome, Problem, Status, StuckReason};
 
 fn plan(planner: &Dfs) -> (Checker, PlanOutcome) {
     let world = World::new(ring_on_locked_post(), &WorldConfig::default()).unwrap();

@@ -3,7 +3,7 @@
 
 use crate::fixtures::{close, exact_instances, figure_6_2, maps, problem, soma};
 use asp_search::exact::exact_front;
-use asp_search::SearchStatus;
+use asp_search::Status;
 use asp_search::{Mcts, SearchError};
 
 #[test]
@@ -11,7 +11,7 @@ fn finds_the_optimum_of_figure_6_2() {
     let maps = maps(&figure_6_2(), 3);
     let p = problem(&maps, "access");
     let out = Mcts::builder().seed(3).build().unwrap().solve(&p).unwrap();
-    assert_eq!(out.status, SearchStatus::Found);
+    assert_eq!(*out.status(), Status::Found);
     let best = out.best().unwrap();
     assert_eq!(best.sequence, vec![2, 1, 0]);
     assert!(out.stats.exhausted, "two sequences: the tree is fully explored");
@@ -26,7 +26,7 @@ fn finds_the_exact_optimum_on_instances_with_exact_references() {
             let exact = exact_front(&p, 2_000_000).unwrap();
             let out = Mcts::builder().seed(k as u64).build().unwrap().solve(&p).unwrap();
             if exact.solutions.is_empty() {
-                assert_ne!(out.status, SearchStatus::Found, "{name}");
+                assert_ne!(*out.status(), Status::Found, "{name}");
                 continue;
             }
             let best = out.best().expect("a sequence exists");

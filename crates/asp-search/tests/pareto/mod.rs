@@ -5,14 +5,14 @@ use crate::fixtures::{close, exact_instances, figure_6_2, maps, problem, soma};
 use asp_search::exact::exact_front;
 use asp_search::hypervolume::dominates;
 use asp_search::ParetoMcts;
-use asp_search::SearchStatus;
+use asp_search::Status;
 
 #[test]
 fn figure_6_2_front() {
     let maps = maps(&figure_6_2(), 3);
     let p = problem(&maps, "access,dirchange");
     let out = ParetoMcts::builder().seed(1).build().unwrap().solve(&p).unwrap();
-    assert_eq!(out.status, SearchStatus::Found);
+    assert_eq!(*out.status(), Status::Found);
     assert_eq!(out.solutions.len(), 1);
     assert_eq!(out.solutions[0].sequence, vec![2, 1, 0]);
     assert_eq!(out.solutions[0].values[1], 3.0);

@@ -5,7 +5,7 @@ use crate::verify::{verify_plan, verify_removals};
 use asp_geom::io::{load, LoadOptions};
 use asp_geom::math::Axis;
 use asp_geom::{Checker, CheckerConfig, FeasibilityChecker, OverlapPolicy, PartSet, Units, World, WorldConfig};
-use asp_search::{Budget, Dfs, PlanOutcome, Planner, Problem, Status, StuckReason};
+use asp_search::{Budget, Dfs, PlanOutcome, Problem, Status, StuckReason};
 
 fn data(rel: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data").join(rel)

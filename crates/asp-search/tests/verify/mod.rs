@@ -305,6 +305,13 @@ pub fn verify_removals(world: &World, removals: &[asp_search::Step]) -> PartSet 
     verify_from(world, PartSet::full(world.num_parts()), world.fixed(), removals)
 }
 
+/// Re-checks removals from the full assembly as [`verify_removals`] does, but not the
+/// remainder's stability: the contract of a planner that takes a model apart in the hand (the
+/// grid planner tests no gravity).
+pub fn verify_removals_in_hand(world: &World, removals: &[asp_search::Step]) -> PartSet {
+    Verifier { in_hand: true, ..Verifier::default() }.verify_from(world, PartSet::full(world.num_parts()), world.fixed(), removals)
+}
+
 /// Re-checks `removals` from `state` on the `base` parts: each step's parts (one part, or a
 /// rigid subassembly's) swept together against the others, bounds cleared at the end, the rest
 /// stable on the base; a subassembly's own plan re-checked the same way on its base part.
@@ -324,6 +331,8 @@ pub struct Verifier {
     samples: HashMap<usize, Vec<Vec3>>,
     /// (the step's movers and motion, the other part) swept clear.
     clear: std::collections::HashSet<(String, usize)>,
+    /// Whether the remainders' stability is left out (a plan made in the hand).
+    in_hand: bool,
 }
 
 impl Verifier {
@@ -452,7 +461,9 @@ impl Verifier {
             }
             let mut present = state.clone();
             present.union_with(base);
-            assert_eq!(world.contact_stability_among(&present, base), Stability::Stable, "step {k}: remainder unstable");
+            if !self.in_hand {
+                assert_eq!(world.contact_stability_among(&present, base), Stability::Stable, "step {k}: remainder unstable");
+            }
             if let Some(plan) = step.group.as_ref().and_then(|g| g.plan.as_ref()) {
                 let group = step.group.as_ref().unwrap();
                 let sub_base = PartSet::from_indices(world.num_parts() + 1, [step.part]);

@@ -2,7 +2,7 @@
 
 use asp_geom::{fixtures, Assembly, Checker, CheckerConfig, World, WorldConfig};
 use asp_search::report::{Explanation, NamedPart, PlanReport};
-use asp_search::{Budget, Dfs, Planner, Problem};
+use asp_search::{Budget, Dfs, Problem};
 use asp_viz::Scene;
 use std::path::Path;
 
