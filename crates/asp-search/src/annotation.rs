@@ -3,6 +3,7 @@
 //! in place. These are plan-format types (`docs/plan-format.md`; [`crate::report`] re-exports
 //! them); they live apart from the report so that the extension seam does not depend on it.
 
+use crate::vocabulary::vocabulary;
 use serde::{Deserialize, Serialize};
 
 /// The robot a plan was made for. Since format 1.5.
@@ -52,4 +53,48 @@ pub struct RobotReport {
     /// One per removal, in removal order: the parts held in place while the rest stands
     /// without the removed part (empty: none); may be shorter than the removals.
     pub held: Vec<Vec<usize>>,
+}
+
+/// Why a robot cannot take out a part that the geometry lets out (`explanation[].robot`,
+/// format 1.9).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RobotRefusal {
+    /// The robot's reason.
+    pub reason: RobotReason,
+    /// What the robot found, one line in words (grasps out of reach, colliding, ...).
+    pub detail: String,
+}
+
+vocabulary! {
+    /// Why a robot cannot take out a part the geometry lets out (`explanation[].robot.reason`;
+    /// format 1.9).
+    RobotReason {
+        /// Lifting the part along its removal direction hits a part.
+        BlockedLift => "blocked_lift",
+        /// The part leaves only along a path of several moves; the robot lifts along a straight
+        /// line.
+        NoStraightLift => "no_straight_lift",
+        /// No grasp of the part is reachable without collision (out of the arm's reach, or the
+        /// gripper or arm collides there).
+        NoReachableGrasp => "no_reachable_grasp",
+        /// Grasps are reachable, but with none of them can the part be put down at the
+        /// drop-off (its pose there is out of reach or collides).
+        NoDropOff => "no_drop_off",
+        /// Grasps are reachable and the part can be put down at the drop-off, but no
+        /// collision-free joint path to it was found.
+        NoPath => "no_path",
+    }
+}
+
+impl RobotReason {
+    /// The reason in words, for the text table and the viewer.
+    pub fn words(self) -> &'static str {
+        match self {
+            RobotReason::BlockedLift => "blocked lift",
+            RobotReason::NoStraightLift => "no straight lift",
+            RobotReason::NoReachableGrasp => "no reachable grasp",
+            RobotReason::NoDropOff => "cannot put it down at the drop-off",
+            RobotReason::NoPath => "no path to the drop-off",
+        }
+    }
 }

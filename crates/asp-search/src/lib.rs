@@ -21,6 +21,7 @@ pub mod qgraph;
 pub mod report;
 pub mod step;
 pub mod units;
+mod vocabulary;
 
 pub use checker_extension::CheckerExtension;
 pub use dfs::Dfs;

@@ -1,6 +1,6 @@
 //! What every planner gets (a [`Problem`] and a [`Budget`]) and gives back (a [`PlanOutcome`]).
 
-use crate::report::RobotRefusal;
+use crate::annotation::RobotRefusal;
 use asp_geom::{CounterSnapshot, FeasibilityChecker, Motion, PartSet};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;

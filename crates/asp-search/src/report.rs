@@ -4,8 +4,9 @@
 //! frame; `assembly_sequence` runs in assembly order (the removal order reversed, each motion
 //! reversed into an insertion).
 
-pub use crate::annotation::{RobotEntry, RobotReport, RobotStepEntry};
+pub use crate::annotation::{RobotEntry, RobotReason, RobotRefusal, RobotReport, RobotStepEntry};
 use crate::problem::{PlanOutcome, Status, Step, StopReason, StuckReason};
+use crate::vocabulary::vocabulary;
 use asp_geom::math::Pose;
 use asp_geom::overlap::{OverlapHandling, OverlapPolicy};
 use asp_geom::{Assembly, Motion, PartSet};
@@ -492,16 +493,6 @@ pub struct Explanation {
     pub robot: Option<RobotRefusal>,
 }
 
-/// Why a robot cannot take out a part that the geometry lets out (`explanation[].robot`,
-/// format 1.9).
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct RobotRefusal {
-    /// The robot's reason.
-    pub reason: RobotReason,
-    /// What the robot found, one line in words (grasps out of reach, colliding, ...).
-    pub detail: String,
-}
-
 /// A part reference with its name (`ground` for the virtual ground plane).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct NamedPart {
@@ -794,34 +785,6 @@ pub fn insertion(motion: &Motion, u: &dyn Fn(f32) -> f64) -> MotionEntry {
     }
 }
 
-/// Declares a closed set of names in the plan JSON: a serde enum written by its snake-case name,
-/// with `as_str` giving that name.
-macro_rules! vocabulary {
-    ($(#[$meta:meta])* $name:ident { $($(#[$vmeta:meta])* $variant:ident => $text:literal,)+ }) => {
-        $(#[$meta])*
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-        #[serde(rename_all = "snake_case")]
-        pub enum $name {
-            $($(#[$vmeta])* $variant,)+
-        }
-
-        impl $name {
-            /// The name in the plan JSON.
-            pub fn as_str(self) -> &'static str {
-                match self {
-                    $($name::$variant => $text,)+
-                }
-            }
-        }
-
-        impl std::fmt::Display for $name {
-            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-                f.write_str(self.as_str())
-            }
-        }
-    };
-}
-
 vocabulary! {
     /// How a plan's search ended (`status`).
     PlanStatus {
@@ -917,40 +880,6 @@ vocabulary! {
         Unsupported => "unsupported",
         /// It can leave, but nothing after that works.
         DeadEnd => "dead_end",
-    }
-}
-
-vocabulary! {
-    /// Why a robot cannot take out a part the geometry lets out (`explanation[].robot.reason`;
-    /// format 1.9).
-    RobotReason {
-        /// Lifting the part along its removal direction hits a part.
-        BlockedLift => "blocked_lift",
-        /// The part leaves only along a path of several moves; the robot lifts along a straight
-        /// line.
-        NoStraightLift => "no_straight_lift",
-        /// No grasp of the part is reachable without collision (out of the arm's reach, or the
-        /// gripper or arm collides there).
-        NoReachableGrasp => "no_reachable_grasp",
-        /// Grasps are reachable, but with none of them can the part be put down at the
-        /// drop-off (its pose there is out of reach or collides).
-        NoDropOff => "no_drop_off",
-        /// Grasps are reachable and the part can be put down at the drop-off, but no
-        /// collision-free joint path to it was found.
-        NoPath => "no_path",
-    }
-}
-
-impl RobotReason {
-    /// The reason in words, for the text table and the viewer.
-    pub fn words(self) -> &'static str {
-        match self {
-            RobotReason::BlockedLift => "blocked lift",
-            RobotReason::NoStraightLift => "no straight lift",
-            RobotReason::NoReachableGrasp => "no reachable grasp",
-            RobotReason::NoDropOff => "cannot put it down at the drop-off",
-            RobotReason::NoPath => "no path to the drop-off",
-        }
     }
 }
 
