@@ -148,8 +148,8 @@ pub struct OverlapNote {
     /// The measured depth in metres. For pairs some shrinking separates: the least shrinking of
     /// one part (tolerance included) after which they no longer cross. For `gross` pairs: how
     /// deep the surface of each part lies inside the other, measured in the overlap region
-    /// ([`overlap_region`]; the largest shrinking tried when no sample of either surface lies
-    /// inside the other).
+    /// ([`overlap_region`]; exact on two unions of boxes; the largest shrinking tried, and
+    /// `bound` true, when no sample of either surface lies inside the other).
     pub depth: f32,
     /// No shrinking up to the limit separates them.
     pub gross: bool,

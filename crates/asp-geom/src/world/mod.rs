@@ -289,7 +289,9 @@ impl World {
             self.geoms[k].eroded(self.tolerance);
         });
         let limit_of = |k: usize| max_overlap_fraction * (self.geoms[k].aabb.maxs - self.geoms[k].aabb.mins).min_element();
-        type Found = (usize, usize, bool, Option<f32>, Option<f32>, Option<overlap::OverlapRegion>);
+        // (pair, touching, extra erosions, a gross pair's depth: exact on boxes, else measured
+        // in its overlap region)
+        type Found = (usize, usize, bool, Option<f32>, Option<f32>, Option<f32>, Option<overlap::OverlapRegion>);
         let found: Vec<Found> = pairs
             .par_iter()
             .map(|&(i, j)| {
@@ -300,7 +302,7 @@ impl World {
                     let gap = pairs().map(|(a, b)| boxes::box_distance(a, b, Vec3::ONE)).fold(f32::INFINITY, f32::min);
                     let extra = (depth - self.tolerance).max(0.0);
                     let within = |k: usize| (extra <= limit_of(k)).then_some(extra);
-                    return (i, j, gap <= self.contact_distance, within(i), within(j), None);
+                    return (i, j, gap <= self.contact_distance, within(i), within(j), Some(depth), None);
                 }
                 let (a, b) = (&*self.geoms[i].mesh, &*self.geoms[j].mesh);
                 let id = Pose::IDENTITY;
@@ -311,14 +313,15 @@ impl World {
                     overlapping || !matches!(query::closest_points(&id, a, &id, b, self.contact_distance), Ok(ClosestPoints::Disjoint));
                 // no shrinking separates them: how deep they overlap is measured where they do
                 let region = (e_ij.is_none() && e_ji.is_none()).then(|| overlap::overlap_region(a, b, overlap::REGION_SAMPLES));
-                (i, j, touching, e_ij, e_ji, region)
+                let measured = region.as_ref().and_then(|r| r.depth());
+                (i, j, touching, e_ij, e_ji, measured, region)
             })
             .collect();
         self.contacts = vec![PartSet::empty(count); count];
         let units = self.assembly.units.clone();
         let len = |m: f32| format!("{} {}", significant(units.from_metres(m as f64), 3), units.name);
         let mut regions = Regions::new();
-        for (i, j, touching, e_ij, e_ji, region) in found {
+        for (i, j, touching, e_ij, e_ji, measured, region) in found {
             if touching {
                 self.contacts[i].insert(j);
                 self.contacts[j].insert(i);
@@ -346,7 +349,7 @@ impl World {
                 }
                 // the erosion bound overstates thin-walled and detailed parts (a panel 2 mm into
                 // another is no shallower for being large): the overlap region says how deep
-                None => match region.as_ref().and_then(|r| r.depth()) {
+                None => match measured.filter(|d| d.is_finite() && *d > 0.0) {
                     Some(d) => (d.max(self.tolerance), true, false),
                     None => (self.tolerance + limit, true, true),
                 },
