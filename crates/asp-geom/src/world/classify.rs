@@ -54,15 +54,6 @@ impl World {
             return (OverlapClass::Fit, None);
         }
         let common = self.common_box(i, j);
-        let sagitta: f32 = [i, j]
-            .iter()
-            .map(|&k| {
-                self.geoms[k].surfaces().cylinders.iter().filter(|c| cylinder_meets(c, &common)).map(|c| c.tolerance).fold(0.0, f32::max)
-            })
-            .sum();
-        if !note.bound && note.depth <= sagitta + 2.0 * self.tolerance {
-            return (OverlapClass::Tessellation, None);
-        }
         let measured;
         let region = match region {
             Some(r) => r,
@@ -71,6 +62,30 @@ impl World {
                 &measured
             }
         };
+        // two faceted round faces of one surface, one of each part, that the overlap lies on:
+        // coaxial, of one radius within their sagittas; their sagittas together
+        let points: Vec<Vec3> = region.points().collect();
+        let tol = self.tolerance;
+        let on = |c: &Cylinder| {
+            cylinder_meets(c, &common)
+                && points.iter().any(|&x| (crate::surface::radial(x, c.point, c.axis) - c.radius).abs() <= c.tolerance + 2.0 * tol)
+        };
+        let faces = |k: usize| -> Vec<&Cylinder> { self.geoms[k].surfaces().cylinders.iter().filter(|c| on(c)).collect() };
+        let (ci, cj) = (faces(i), faces(j));
+        let parallel = 1.5f32.to_radians().cos();
+        let sagitta = ci
+            .iter()
+            .flat_map(|a| cj.iter().map(move |b| (a, b)))
+            .filter(|(a, b)| {
+                a.axis.dot(b.axis).abs() >= parallel
+                    && crate::surface::radial(b.point, a.point, a.axis) <= 0.1 * a.radius.min(b.radius)
+                    && (a.radius - b.radius).abs() <= a.tolerance + b.tolerance + 2.0 * tol
+            })
+            .map(|(a, b)| a.tolerance + b.tolerance)
+            .fold(0.0, f32::max);
+        if !note.bound && note.depth <= sagitta + 2.0 * tol {
+            return (OverlapClass::Tessellation, None);
+        }
         let depth = region.depth().unwrap_or(note.depth);
         match self.slab_normal(i, j, region, depth, &common) {
             Some(n) => (OverlapClass::PlanarSlab, Some(n)),
