@@ -106,7 +106,8 @@ pub enum OverlapClass {
     /// A coaxial fit that is not a clearance fit (a press fit, a thread drawn without its helix,
     /// one nominal radius): the plan's `fits` list it ([`crate::fits`]).
     Fit,
-    /// No deeper than the facets' sagittas (and twice the tolerance): two tessellations of one
+    /// No deeper than the sagittas (and twice the tolerance) of two coaxial faceted round faces
+    /// of one radius, one of each part, that the overlap lies on: two tessellations of one
     /// surface, not material of one part in the other.
     Tessellation,
     /// A thin slab between parallel planar faces of the two parts, one facing the other: a panel

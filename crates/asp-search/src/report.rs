@@ -224,7 +224,7 @@ pub struct OverlapPair {
     /// `ignored`.
     pub handling: OverlapHandling,
     /// What the pair is by the shape of its overlap: `fit` (a coaxial fit, listed in `fits`),
-    /// `tessellation` (no deeper than the facets' sagittas), `planar_slab` (a panel sunk into
+    /// `tessellation` (two faceted round faces of one surface, no deeper than their sagittas), `planar_slab` (a panel sunk into
     /// another between parallel planar faces) or `interpenetration`. Since 1.13.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub class: Option<OverlapClass>,
