@@ -59,8 +59,9 @@ class Plan:
         ``base``, ``parts``, ``names``, ``status`` (why: ``"no_plan"``, ``"budget_exhausted"``
         or ``"unplanned"``), ``explanation`` (what holds each part) and ``why`` (format 1.9): a
         dict with ``overlaps`` (the core's overlapping pairs: ``parts``, ``names``, ``depth``,
-        ``gross``, ``artefact``, the last true when deeper than ``artefact_depth``, a modelling
-        artefact rather than a fit), ``directions`` (the candidate directions), ``blocks`` (per
+        ``gross``, ``class`` (format 1.13: ``"fit"``, ``"tessellation"``, ``"planar_slab"`` or
+        ``"interpenetration"``), ``artefact``, the last true when deeper than ``artefact_depth``,
+        a modelling artefact rather than a fit), ``directions`` (the candidate directions), ``blocks`` (per
         part but the base: ``free`` directions and ``by``, the parts that block it with their
         ``directions`` and ``only`` counts), ``grid`` (``tried``, ``reason``, ``core_on_grid``)
         and ``lenient`` (``status`` and ``frees``: the parts the core's own plan frees under

@@ -8,7 +8,7 @@ pub use crate::annotation::{RobotEntry, RobotReason, RobotRefusal, RobotReport, 
 use crate::problem::{PlanOutcome, Status, Step, StopReason, StuckReason};
 use crate::vocabulary::vocabulary;
 use asp_geom::math::Pose;
-use asp_geom::overlap::{OverlapHandling, OverlapPolicy};
+use asp_geom::overlap::{OverlapClass, OverlapHandling, OverlapPolicy};
 use asp_geom::{Assembly, Motion, PartSet};
 use serde::{Deserialize, Serialize};
 
@@ -21,7 +21,7 @@ pub use precedence::{PrecedenceEdge, PrecedenceEntry, PrecedenceReason, Preceden
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.12";
+pub const FORMAT_VERSION: &str = "1.13";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -211,13 +211,28 @@ pub struct OverlapPair {
     /// For `nested`: the part that lies inside the other.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inner: Option<usize>,
-    /// The measured depth in model units (for `gross` pairs a lower bound).
+    /// The measured depth in model units: the least shrinking that separates them, or for
+    /// `gross` pairs how deep each surface lies inside the other where they overlap (since 1.13;
+    /// before, the largest shrinking tried; still that, a lower bound, when `depth_bound`).
     pub depth: f64,
+    /// `depth` is a lower bound: a gross pair whose overlap no surface sample found. Since 1.13,
+    /// only when true.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub depth_bound: bool,
     /// No shrinking of either part up to 40 % of its thickness separates them.
     pub gross: bool,
     /// `strict` (they separate only along motions that enter no new material), `shrunk` or
     /// `ignored`.
     pub handling: OverlapHandling,
+    /// What the pair is by the shape of its overlap: `fit` (a coaxial fit, listed in `fits`),
+    /// `tessellation` (two faceted round faces of one surface, no deeper than their sagittas), `planar_slab` (a panel sunk into
+    /// another between parallel planar faces) or `interpenetration`. Since 1.13.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub class: Option<OverlapClass>,
+    /// For a `planar_slab`: its unit normal, the outward normal of the first part's face (the
+    /// second part lifts off the first along it). Since 1.13.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
 }
 
 impl OverlapsEntry {
@@ -243,8 +258,11 @@ impl OverlapsEntry {
                     _ => None,
                 },
                 depth: units.from_metres(n.depth as f64),
+                depth_bound: n.bound,
                 gross: n.gross,
                 handling: n.handling,
+                class: Some(n.class),
+                normal: n.normal.map(|v| [v.x as f64, v.y as f64, v.z as f64]),
             })
             .collect();
         Some(OverlapsEntry { policy: world.overlap_policy(), pairs })

@@ -245,7 +245,9 @@ fn issue_28_an_artefact_and_an_interlock_are_told_apart() {
     assert_eq!((post.lenient.status, post.lenient.frees), (LenientStatus::Unchanged, 0), "{json}");
     assert!(!post.grid.tried && post.grid.core_on_grid == Some(true), "the post's core alone is on one grid: {json}");
     let text = r.report.to_text();
-    assert!(text.contains("    overlap bar / cross: more than "), "{text}");
+    // the bars' exact boxes say how deep they cross (10 mm: the shorter push out of the cross,
+    // the smallest over the axes), and what they are
+    assert!(text.contains("    overlap bar / cross (interpenetration): 0.01000 deep"), "{text}");
     assert!(text.contains(": a modelling artefact, not an interlock\n"), "{text}");
     assert!(text.contains("    --overlaps lenient: would free its other part\n"), "{text}");
     assert!(text.contains("    --overlaps lenient: changes nothing (no two of its parts overlap)\n"), "{text}");
@@ -474,4 +476,45 @@ fn a_core_that_comes_apart_on_its_own_is_planned_as_a_model_of_its_own() {
     // not one straight line: a path, or a line after moves
     let straight = matches!(block.motion, asp_search::report::MotionEntry::Linear { .. }) && block.moves.is_empty();
     assert!(!straight, "the block goes in along its L: {json}");
+}
+
+/// Issue 38, end to end: two holed boards sunk 1.5 mm into each other, off the axes, at coarse
+/// and fine tessellation, plan `found` with the upper board lifted along the slab's normal; the
+/// plan lists the pair as a `planar_slab` 1.5 mm deep with its normal (the table says so too),
+/// and a board stabbed 8 mm into another as `interpenetration`.
+#[test]
+fn issue_38_boards_sunk_into_each_other_plan_found_lifted_along_the_slab_normal() {
+    use asp_geom::overlap::OverlapClass;
+    let turn = asp_geom::math::Rot::from_axis_angle(asp_geom::math::Vec3::new(1.0, 2.0, 0.5).normalize(), 0.3);
+    let settings = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
+    for facets in [16, 96] {
+        let r = plan_assembly(asp_geom::fixtures::sunk_boards(facets, 0.003, turn), &settings, None).unwrap();
+        let json = r.report.to_json();
+        assert!(r.found(), "{facets}: {json}");
+        let pair = &r.report.overlaps.as_ref().expect("the boards overlap").pairs[0];
+        assert_eq!(pair.class, Some(OverlapClass::PlanarSlab), "{json}");
+        assert!((pair.depth - 0.0015).abs() <= 0.00015 && !pair.depth_bound, "{json}");
+        let n = pair.normal.expect("a slab's normal");
+        let up = turn * asp_geom::math::Vec3::Z;
+        assert!(n[0] * up.x as f64 + n[1] * up.y as f64 + n[2] * up.z as f64 > 0.99999, "{json}");
+        assert!(json.contains("\"class\": \"planar_slab\""), "{json}");
+        assert_eq!(r.report.assembly_sequence.len(), 1, "{json}");
+        let step = &r.report.assembly_sequence[0];
+        assert_eq!(step.part, 1);
+        match &step.motion {
+            // in assembly order: the board goes in down along the normal
+            asp_search::report::MotionEntry::Linear { direction, .. } => {
+                let d: f64 = direction.iter().zip(n).map(|(a, b)| a * b).sum();
+                assert!(d < -0.9999, "{json}");
+            }
+            m => panic!("{m:?}"),
+        }
+        let mut table = Vec::new();
+        r.report.write_text(&mut table).unwrap();
+        let table = String::from_utf8(table).unwrap();
+        assert!(table.contains("a planar slab (normal"), "{table}");
+    }
+    let r = plan_assembly(asp_geom::fixtures::stabbed_board(16, turn), &settings, None).unwrap();
+    let pair = &r.report.overlaps.as_ref().expect("the boards overlap").pairs[0];
+    assert_eq!((pair.class, pair.normal), (Some(OverlapClass::Interpenetration), None), "{}", r.report.to_json());
 }

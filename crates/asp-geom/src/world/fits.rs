@@ -6,7 +6,7 @@ use crate::fits::{self, Fit, Role};
 
 /// A direction is a fit's axis when their cosine exceeds this (0.1°): the exact axis joins the
 /// candidates unless one lies this close.
-const AXIS_ALIGNED: f32 = 0.999_998_5;
+pub(super) const AXIS_ALIGNED: f32 = 0.999_998_5;
 /// The most directions the pairs' planar contacts add to the candidates.
 const MAX_CONTACT_DIRECTIONS: usize = 48;
 
@@ -208,7 +208,7 @@ impl World {
                 .collect()
         };
         let (sp, sq) = (outside(self.fit_pair_samples(p, q)), outside(self.fit_pair_samples(q, p)));
-        overlap::strict_entry(&sp, &self.geoms[p].mesh, &sq, &self.geoms[q].mesh, Vec3::ZERO, dir, t_max, true).is_some()
+        overlap::strict_entry(&sp, &self.geoms[p].mesh, &sq, &self.geoms[q].mesh, Vec3::ZERO, dir, t_max, true, self.tolerance).is_some()
     }
 
     /// Part `p`'s samples for its fit tests with `q`: its whole-surface samples and dense ones

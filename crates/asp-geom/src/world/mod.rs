@@ -14,6 +14,7 @@
 //! (mesh preparation, contacts and overlap measurement, threads) and answers the blocking rows.
 
 mod bearings;
+mod classify;
 mod directions;
 mod fits;
 mod geom;
@@ -22,6 +23,7 @@ mod removal;
 pub(crate) use removal::best_free_direction;
 
 pub use bearings::Bearing;
+use classify::Regions;
 pub use directions::candidate_directions;
 use geom::{contains_point, nests, Geom};
 
@@ -32,7 +34,7 @@ use crate::fastener::{self, SymmetryAxis, Thread};
 use crate::feasibility::{Motion, Stability};
 use crate::math::{aabb_of, sweep_overlap, Aabb, Pose, Vec3};
 use crate::mesh::{Mesh, Topology};
-use crate::overlap::{self, OverlapHandling, OverlapKind, OverlapNote, OverlapPolicy};
+use crate::overlap::{self, OverlapClass, OverlapHandling, OverlapKind, OverlapNote, OverlapPolicy};
 use crate::partset::PartSet;
 use crate::sweep;
 use parry3d::query::{self, ClosestPoints, NonlinearRigidMotion, PointQuery};
@@ -210,13 +212,15 @@ impl World {
             warnings,
             config: WorldConfig { tolerance: Some(tolerance), contact_distance: Some(contact_distance), ..config.clone() },
         };
-        world.measure_contacts(config.max_overlap_fraction, config.overlaps)?;
+        let regions = world.measure_contacts(config.max_overlap_fraction, config.overlaps)?;
         if config.fasteners {
             // before the fits: a bearing's rings are no nuts
             world.bearings = world.find_bearings();
             world.find_fits();
             world.find_threads();
         }
+        // after the fits: a pair with a fit is one
+        world.classify_overlaps(regions);
         world.prepare_pair_shapes();
         Ok(world)
     }
@@ -260,7 +264,8 @@ impl World {
     }
 
     /// Finds contacts (parts within the contact distance) and input overlaps between parts.
-    fn measure_contacts(&mut self, max_overlap_fraction: f32, policy: OverlapPolicy) -> Result<()> {
+    /// Returns the overlap regions it measured (gross mesh pairs), for the classification.
+    fn measure_contacts(&mut self, max_overlap_fraction: f32, policy: OverlapPolicy) -> Result<Regions> {
         let count = self.geoms.len();
         let pairs: Vec<(usize, usize)> = (0..count)
             .flat_map(|i| ((i + 1)..count).map(move |j| (i, j)))
@@ -284,7 +289,9 @@ impl World {
             self.geoms[k].eroded(self.tolerance);
         });
         let limit_of = |k: usize| max_overlap_fraction * (self.geoms[k].aabb.maxs - self.geoms[k].aabb.mins).min_element();
-        type Found = (usize, usize, bool, Option<f32>, Option<f32>);
+        // (pair, touching, extra erosions, a gross pair's depth: exact on boxes, else measured
+        // in its overlap region)
+        type Found = (usize, usize, bool, Option<f32>, Option<f32>, Option<f32>, Option<overlap::OverlapRegion>);
         let found: Vec<Found> = pairs
             .par_iter()
             .map(|&(i, j)| {
@@ -295,7 +302,7 @@ impl World {
                     let gap = pairs().map(|(a, b)| boxes::box_distance(a, b, Vec3::ONE)).fold(f32::INFINITY, f32::min);
                     let extra = (depth - self.tolerance).max(0.0);
                     let within = |k: usize| (extra <= limit_of(k)).then_some(extra);
-                    return (i, j, gap <= self.contact_distance, within(i), within(j));
+                    return (i, j, gap <= self.contact_distance, within(i), within(j), Some(depth), None);
                 }
                 let (a, b) = (&*self.geoms[i].mesh, &*self.geoms[j].mesh);
                 let id = Pose::IDENTITY;
@@ -304,13 +311,17 @@ impl World {
                 let overlapping = e_ij != Some(0.0) || e_ji != Some(0.0);
                 let touching =
                     overlapping || !matches!(query::closest_points(&id, a, &id, b, self.contact_distance), Ok(ClosestPoints::Disjoint));
-                (i, j, touching, e_ij, e_ji)
+                // no shrinking separates them: how deep they overlap is measured where they do
+                let region = (e_ij.is_none() && e_ji.is_none()).then(|| overlap::overlap_region(a, b, overlap::REGION_SAMPLES));
+                let measured = region.as_ref().and_then(|r| r.depth());
+                (i, j, touching, e_ij, e_ji, measured, region)
             })
             .collect();
         self.contacts = vec![PartSet::empty(count); count];
         let units = self.assembly.units.clone();
         let len = |m: f32| format!("{} {}", significant(units.from_metres(m as f64), 3), units.name);
-        for (i, j, touching, e_ij, e_ji) in found {
+        let mut regions = Regions::new();
+        for (i, j, touching, e_ij, e_ji, measured, region) in found {
             if touching {
                 self.contacts[i].insert(j);
                 self.contacts[j].insert(i);
@@ -325,7 +336,7 @@ impl World {
                 (None, None) => None,
             };
             let limit = limit_of(i).max(limit_of(j));
-            let (depth, gross) = match eroder {
+            let (depth, gross, bound) = match eroder {
                 _ if e_ij == Some(0.0) && e_ji == Some(0.0) => continue,
                 Some((k, 0.0)) => {
                     // only the other part, shrunk by the tolerance, still crosses: shrink this one
@@ -334,19 +345,35 @@ impl World {
                 }
                 Some((k, extra)) => {
                     self.overlaps.insert((i, j), (k, extra));
-                    (self.tolerance + extra, false)
+                    (self.tolerance + extra, false, false)
                 }
-                None => (self.tolerance + limit, true),
+                // the erosion bound overstates thin-walled and detailed parts (a panel 2 mm into
+                // another is no shallower for being large): the overlap region says how deep
+                None => match measured.filter(|d| d.is_finite() && *d > 0.0) {
+                    Some(d) => (d.max(self.tolerance), true, false),
+                    None => (self.tolerance + limit, true, true),
+                },
             };
             let kind = self.overlap_kind(i, j);
+            // coincident parts are as deep as they are thick, which no sample measures
+            let (depth, bound) = if gross && kind == OverlapKind::Coincident { (self.tolerance + limit, true) } else { (depth, bound) };
+            if let Some(r) = region {
+                regions.insert((i, j), r);
+            }
             let what = match kind {
                 OverlapKind::Crossing => "overlap".to_string(),
                 OverlapKind::Nested { inner } => format!("overlap ('{}' lies inside the other)", self.name(inner)),
                 OverlapKind::Coincident => "overlap (they occupy the same space)".to_string(),
             };
-            let measured = if gross {
+            let measured = if bound {
                 format!(
                     "by more than {} (shrinking either by {:.0}% of its thickness does not separate them)",
+                    len(depth),
+                    max_overlap_fraction * 100.0
+                )
+            } else if gross {
+                format!(
+                    "by about {} (measured where they overlap; shrinking either by {:.0}% of its thickness does not separate them)",
                     len(depth),
                     max_overlap_fraction * 100.0
                 )
@@ -390,9 +417,11 @@ impl World {
             };
             self.warnings
                 .push(format!("parts '{a}' and '{b}' {what} in the input {measured} (tolerance {}); {consequence}", len(self.tolerance)));
-            self.notes.push(OverlapNote { parts: (i, j), kind, depth, gross, handling });
+            // classified with the fits ([`World::classify_overlaps`])
+            let class = OverlapClass::Interpenetration;
+            self.notes.push(OverlapNote { parts: (i, j), kind, depth, gross, bound, handling, class, normal: None });
         }
-        Ok(())
+        Ok(regions)
     }
 
     /// Builds, in parallel, the shrunk meshes the removal tests will ask for: each part by the
@@ -536,7 +565,7 @@ impl World {
             return None;
         }
         let (sp, sq) = (self.strict_pair_samples(p, q), self.strict_pair_samples(q, p));
-        overlap::strict_entry(sp, &self.geoms[p].mesh, sq, &self.geoms[q].mesh, from, dir, t_max, first_only)
+        overlap::strict_entry(sp, &self.geoms[p].mesh, sq, &self.geoms[q].mesh, from, dir, t_max, first_only, self.tolerance)
     }
 
     /// Part `p`'s samples for its strict test with `q`: its whole-surface samples (about
@@ -622,7 +651,7 @@ impl World {
     fn screw_blocks(&self, p: usize, q: usize, thread: &Thread, dir: Vec3, t_max: f32) -> bool {
         let outside = |s: &[Vec3]| -> Vec<Vec3> { s.iter().copied().filter(|&x| thread.axis.radial(x) > thread.radius).collect() };
         let (sp, sq) = (outside(self.strict_samples(p)), outside(self.strict_samples(q)));
-        overlap::strict_entry(&sp, &self.geoms[p].mesh, &sq, &self.geoms[q].mesh, Vec3::ZERO, dir, t_max, true).is_some()
+        overlap::strict_entry(&sp, &self.geoms[p].mesh, &sq, &self.geoms[q].mesh, Vec3::ZERO, dir, t_max, true, self.tolerance).is_some()
     }
 
     /// Whether collisions between `p` and `q` are ignored by the shrunk tests (a pair no

@@ -89,8 +89,13 @@ fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
     if let Some(o) = &r.overlaps {
         writeln!(out, "overlapping in the input ({} pairs, policy {}):", o.pairs.len(), o.policy.name())?;
         for p in &o.pairs {
-            let bound = if p.gross { "more than " } else { "" };
-            writeln!(out, "  {} / {}: {}, {bound}{} deep, {}", p.names[0], p.names[1], p.kind, sig(p.depth), p.handling.name())?;
+            let bound = if p.depth_bound { "more than " } else { "" };
+            let class = match (p.class, p.normal) {
+                (Some(c), Some(n)) => format!(", {} (normal {:.3}, {:.3}, {:.3})", c.describe(), n[0], n[1], n[2]),
+                (Some(c), None) => format!(", {}", c.describe()),
+                (None, _) => String::new(),
+            };
+            writeln!(out, "  {} / {}: {}, {bound}{} deep{class}, {}", p.names[0], p.names[1], p.kind, sig(p.depth), p.handling.name())?;
         }
     }
     if !r.fits.is_empty() {
@@ -309,13 +314,14 @@ fn write_why(out: &mut impl Write, r: &PlanReport, core: &LockedCore, why: &Core
     let mut overlaps: Vec<_> = why.overlaps.iter().collect();
     overlaps.sort_by(|a, b| b.gross.cmp(&a.gross).then(b.depth.total_cmp(&a.depth)));
     for o in overlaps.into_iter().take(WHY_ITEMS) {
-        let bound = if o.gross { "more than " } else { "" };
+        let bound = if o.depth_bound { "more than " } else { "" };
+        let class = o.class.map_or(String::new(), |c| format!(" ({})", c.describe()));
         let verdict = if o.artefact {
             format!("deeper than {}: a modelling artefact, not an interlock", sig(why.artefact_depth))
         } else {
             format!("within {}: a fit, not an artefact", sig(why.artefact_depth))
         };
-        writeln!(out, "    overlap {} / {}: {bound}{} deep, {verdict}", o.names[0], o.names[1], sig(o.depth))?;
+        writeln!(out, "    overlap {} / {}{class}: {bound}{} deep, {verdict}", o.names[0], o.names[1], sig(o.depth))?;
     }
     if why.overlaps.len() > WHY_ITEMS {
         writeln!(out, "    ... and {} more overlapping pairs", why.overlaps.len() - WHY_ITEMS)?;

@@ -44,10 +44,16 @@ pub struct CoreOverlap {
     pub parts: [usize; 2],
     /// Their names.
     pub names: [String; 2],
-    /// The measured depth in model units (a lower bound when `gross`).
+    /// The measured depth in model units (as the top-level `overlaps`).
     pub depth: f64,
+    /// `depth` is a lower bound (as the top-level `overlaps`). Only when true.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub depth_bound: bool,
     /// No shrinking of either part up to 40 % of its thickness separates them.
     pub gross: bool,
+    /// What the pair is by the shape of its overlap (as the top-level `overlaps`). Since 1.13.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub class: Option<asp_geom::overlap::OverlapClass>,
     /// A modelling artefact, not an interlock or a fit: `gross`, or deeper than
     /// `artefact_depth`.
     pub artefact: bool,
@@ -148,7 +154,9 @@ impl CoreWhy {
                     parts: [o.parts.0, o.parts.1],
                     names: [world.name(o.parts.0).to_string(), world.name(o.parts.1).to_string()],
                     depth,
+                    depth_bound: o.bound,
                     gross: o.gross,
+                    class: Some(o.class),
                     artefact: o.gross || depth > artefact_depth,
                 }
             })
