@@ -501,3 +501,38 @@ fn a_q_model_of_another_objective_is_refused_under_the_robot() {
         assert!(e.contains(&format!("estimates objective '{estimates}'")) && e.contains(&format!("that of '{objective}'")), "{e}");
     }
 }
+
+/// Held-out double-layer assembly 17 of `asp gen profiles --preset double-layer --count 20
+/// --seed 900 --connectors attached` (its seed from that run's manifest). Its profiles' metadata
+/// grasps close across the four long sides only; with those alone the robot refused removals
+/// the geometry allows and the search ran out of its time (at 60 s, `budget_exhausted`). With
+/// grasps on every pair of parallel faces (the connectors' faces, the profile with its
+/// connector's wall) it plans, every path re-checked, and some steps hold a part by faces its
+/// metadata has no grasp on.
+#[test]
+fn a_double_layer_assembly_plans_with_grasps_on_faces_its_metadata_lacks() {
+    let params = asp_gen::ProfileParams { connectors: asp_gen::ConnectorMode::Attached, ..asp_gen::ProfileParams::double_layer() };
+    let assembly = asp_gen::ProfileAssembly::generate(&params, 242_557_999_537_143_880).unwrap().to_assembly("profiles_017");
+    let setup = RobotSetup::panda();
+    let settings = PlanSettings {
+        checker_extension: Some(Arc::new(CellSetup { robot: Some(setup.clone()), grippers: 1 })),
+        timeout: Some(30.0),
+        ..PlanSettings::default()
+    };
+    let plan = plan_assembly(assembly.clone(), &settings, None).unwrap();
+    assert!(plan.found(), "{:?} {:?}", plan.report.status, plan.report.explanation);
+    recheck_report(&assembly, &plan.report, &setup);
+    // steps whose grasp is none of the part's metadata grasps
+    let off_metadata = plan
+        .report
+        .assembly_sequence
+        .iter()
+        .filter(|s| {
+            let g = s.robot.as_ref().unwrap().grasp;
+            let at = Vec3::new(g[0] as f32, g[1] as f32, g[2] as f32);
+            let rot = Rot::from_xyzw(g[3] as f32, g[4] as f32, g[5] as f32, g[6] as f32);
+            !assembly.parts[s.part].meta.grasps.iter().any(|m| (m.position - at).length() < 1e-4 && m.orientation.angle_between(rot) < 1e-3)
+        })
+        .count();
+    assert!(off_metadata > 0, "every step held its part by a metadata grasp");
+}
