@@ -536,3 +536,33 @@ fn a_double_layer_assembly_plans_with_grasps_on_faces_its_metadata_lacks() {
         .count();
     assert!(off_metadata > 0, "every step held its part by a metadata grasp");
 }
+
+/// A block walled in by fixed walls 5 mm away: the geometry lets it out (up), the robot finds
+/// no grasp. The dead end's explanation names what the gripper meets (the walls, by name),
+/// and says a second gripper would not change it.
+#[test]
+fn a_refused_part_explanation_names_the_parts_its_grasps_meet() {
+    use asp_search::report::RobotReason;
+    let mut parts = vec![
+        box_part("plate", [-0.2, -0.2, -0.02], [0.3, 0.2, 0.0]),
+        box_part("block", [0.08, -0.02, 0.0], [0.12, 0.02, 0.04]),
+        box_part("wall_xm", [0.06, -0.05, 0.0], [0.075, 0.05, 0.04]),
+        box_part("wall_xp", [0.125, -0.05, 0.0], [0.14, 0.05, 0.04]),
+        box_part("wall_ym", [0.075, -0.05, 0.0], [0.125, -0.025, 0.04]),
+        box_part("wall_yp", [0.075, 0.025, 0.0], [0.125, 0.05, 0.04]),
+    ];
+    for (i, p) in parts.iter_mut().enumerate() {
+        p.fixed = i != 1;
+    }
+    let walled = assemble("walled", parts, Axis::Z);
+    let setup = RobotSetup { base: Some(Vec3::new(-0.35, 0.0, -0.02)), ..RobotSetup::panda() };
+    let settings =
+        PlanSettings { checker_extension: Some(Arc::new(CellSetup { robot: Some(setup), grippers: 1 })), ..PlanSettings::default() };
+    let report = plan_assembly(walled, &settings, None).unwrap().report;
+    let block = report.explanation.iter().find(|e| e.name == "block").unwrap_or_else(|| panic!("{:?}", report.explanation));
+    let robot = block.robot.as_ref().expect("the robot's reason");
+    assert_eq!(robot.reason, RobotReason::NoReachableGrasp);
+    assert!(robot.detail.contains("the gripper alone collides at") && robot.detail.contains("'wall_"), "{}", robot.detail);
+    assert!(robot.detail.contains("--grippers 2"), "{}", robot.detail);
+    assert!(!robot.detail.contains("'block'"), "{}", robot.detail);
+}

@@ -446,13 +446,12 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         self.shapes_collide(&placed, self.gripper_first, obstacles)
     }
 
-    /// The parts the gripper alone collides with at each grasp of part `p` in `present`,
-    /// lifted along `direction` (the robot's first test of a grasp, at the grasp pose and the
-    /// lifted one): per grasp of [`RemovalPlanner::grasps`], the colliding parts in increasing
-    /// order, empty when the gripper alone is free. The floor is not a part: a gripper that
-    /// only goes below the floor gets an empty list too, so an empty list does not promise the
-    /// grasp passes. What a dead end's explanation says about its grasps.
-    pub fn grasp_blockers(&self, p: usize, present: &PartSet, direction: Vec3) -> Vec<Vec<usize>> {
+    /// What the gripper alone meets at each grasp of part `p` in `present`, lifted along
+    /// `direction` (the robot's first test of a grasp, at the grasp pose and the lifted one),
+    /// per grasp of [`RemovalPlanner::grasps`]: `None` when it is free there, else the parts it
+    /// collides with in increasing order (empty when only the floor or the ground is in the
+    /// way). What a dead end's explanation says about a part's grasps.
+    pub fn grasp_blockers(&self, p: usize, present: &PartSet, direction: Vec3) -> Vec<Option<Vec<usize>>> {
         let lift = Pose::from_translation(direction * self.config.lift);
         let all = self.obstacles(present, p);
         let world = self.world();
@@ -471,14 +470,16 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
                 let tool = Pose::from_parts(g.position, g.orientation);
                 let lifted = lift * tool;
                 if !(self.gripper_collides(&tool, g.width, &all) || self.gripper_collides(&lifted, g.width, &all)) {
-                    return Vec::new();
+                    return None;
                 }
-                all.ids
-                    .iter()
-                    .zip(&one)
-                    .filter(|(_, obs)| self.gripper_collides(&tool, g.width, obs) || self.gripper_collides(&lifted, g.width, obs))
-                    .map(|(&o, _)| o)
-                    .collect()
+                Some(
+                    all.ids
+                        .iter()
+                        .zip(&one)
+                        .filter(|(_, obs)| self.gripper_collides(&tool, g.width, obs) || self.gripper_collides(&lifted, g.width, obs))
+                        .map(|(&o, _)| o)
+                        .collect(),
+                )
             })
             .collect()
     }
