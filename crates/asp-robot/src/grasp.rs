@@ -36,7 +36,8 @@ pub struct GraspConfig {
     /// Seed of the surface sampling.
     pub seed: u64,
     /// [`face_pair_grasps`]: the spacing of the grasp centres on each pair of parallel faces,
-    /// metres.
+    /// metres (4 cm: a face shorter than that gets one centre; at 2 cm `asp plan --robot` on
+    /// held-out single-layer assemblies took up to 2.4× the CPU time, all found either way).
     pub face_spacing: f32,
 }
 
@@ -52,7 +53,7 @@ impl Default for GraspConfig {
             min_spacing: 0.01,
             max_grasps: 64,
             seed: 0,
-            face_spacing: 0.02,
+            face_spacing: 0.04,
         }
     }
 }
@@ -375,7 +376,7 @@ mod tests {
     /// 7 × 4 × 3 cm box is held across each of its three pairs (the 7 cm one is the pair the
     /// random sampler rarely hits, the pair of end faces, and metadata of a profile lacks), a 20 × 4 × 3 cm box across the two
     /// narrow pairs only; every grasp's fingers lie on the two faces, its approach across the
-    /// closing axis; the lattice covers a pair evenly (grasp centres every 2 cm).
+    /// closing axis; the lattice covers a pair evenly (grasp centres every 4 cm).
     #[test]
     fn face_pairs_are_enumerated_within_the_opening() {
         let cfg = GraspConfig::default();
@@ -393,8 +394,8 @@ mod tests {
                 *widths.entry((g.width * 1000.0).round() as i32).or_insert(0) += 1;
             }
             assert_eq!(widths.keys().copied().collect::<Vec<_>>(), expected, "{hi:?}");
-            // across the 3 cm sides of the long box: centres every 2 cm along its 20 cm and
-            // 4 cm (10 × 2)
+            // across the 3 cm sides of the long box: centres every 4 cm along its 20 cm and
+            // one across its 4 cm (5 × 1)
             if hi.x > 0.1 {
                 let mut centres: Vec<[i32; 3]> = grasps
                     .iter()
@@ -403,8 +404,8 @@ mod tests {
                     .collect();
                 centres.sort();
                 centres.dedup();
-                assert_eq!(centres.len(), 10 * 2, "{centres:?}");
-                assert!(centres.iter().all(|c| c[0] % 20 == 10 && c[1] % 20 == 10 && c[2] == 15), "{centres:?}");
+                assert_eq!(centres.len(), 5, "{centres:?}");
+                assert!(centres.iter().all(|c| c[0] % 40 == 20 && c[1] == 20 && c[2] == 15), "{centres:?}");
             }
         }
     }
