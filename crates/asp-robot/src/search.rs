@@ -169,9 +169,66 @@ fn explain_refusals(outcome: &mut PlanOutcome, robot: &RobotChecker<'_>, assembl
             continue;
         }
         if let Some(f) = robot.refusal(s.part, state) {
-            s.reason = StuckReason::Refused(f.refusal(assembly));
+            let mut refusal = f.refusal(assembly);
+            if matches!(f, RobotFailure::NoReachableGrasp { grasps: 1.., .. }) {
+                if let Some(more) = grasp_detail(robot, s.part, state, assembly) {
+                    refusal.detail.push_str(&more);
+                }
+            }
+            s.reason = StuckReason::Refused(refusal);
         }
     }
+}
+
+/// More words for a part refused for want of a reachable grasp, lifted up (`None` when the
+/// lift up is blocked: the refusal lifted along another direction): which present parts the
+/// gripper alone collides with at how many of its grasps (the most first, three by name),
+/// how many grasps one part alone blocks (taken out first, it frees them), how many the gripper
+/// alone fits at (the arm then does not reach them or collides on the way), and that a second
+/// gripper does not change it (`--grippers 2` holds parts in place; it moves none, and the
+/// arm's grasps stay where they are).
+fn grasp_detail(robot: &RobotChecker<'_>, part: usize, state: &PartSet, assembly: &Assembly) -> Option<String> {
+    let planner = robot.planner();
+    let up = planner.lift_direction(part, state, None).ok()?;
+    let blockers = planner.grasp_blockers(part, state, up);
+    let name = |p: usize| assembly.parts.get(p).map_or_else(|| format!("part {p}"), |p| format!("'{}'", p.name));
+    let mut by: Vec<(usize, usize, usize)> = Vec::new(); // part, grasps it meets, grasps it alone blocks
+    for b in blockers.iter().flatten() {
+        for &o in b {
+            match by.iter_mut().find(|e| e.0 == o) {
+                Some(e) => e.1 += 1,
+                None => by.push((o, 1, 0)),
+            }
+        }
+        if let [only] = b[..] {
+            if let Some(e) = by.iter_mut().find(|e| e.0 == only) {
+                e.2 += 1;
+            }
+        }
+    }
+    by.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    let colliding = blockers.iter().filter(|b| b.is_some()).count();
+    let fits = blockers.len() - colliding;
+    let mut out = String::new();
+    if colliding > 0 {
+        let named: Vec<String> = by.iter().take(3).map(|&(o, n, _)| format!("{} at {n}", name(o))).collect();
+        out.push_str(&format!("; lifted up, the gripper alone collides at {colliding} of {} grasps", blockers.len()));
+        if !named.is_empty() {
+            out.push_str(&format!(": with {}", named.join(", ")));
+            if by.len() > 3 {
+                out.push_str(&format!(" and {} more parts", by.len() - 3));
+            }
+        }
+        let alone: Vec<String> = by.iter().filter(|e| e.2 > 0).take(3).map(|&(o, _, k)| format!("{} alone blocks {k}", name(o))).collect();
+        if !alone.is_empty() {
+            out.push_str(&format!(" ({}: taken out first, it frees them)", alone.join(", ")));
+        }
+    }
+    if fits > 0 {
+        out.push_str(&format!("; at {fits} the gripper alone fits and the arm does not reach it or collides on the way"));
+    }
+    out.push_str("; a second gripper (--grippers 2) does not change this: it holds parts in place and moves none");
+    Some(out)
 }
 
 impl RobotFailure {

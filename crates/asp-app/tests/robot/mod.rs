@@ -594,3 +594,68 @@ fn check_with_two_grippers_names_the_held_part() {
     assert_eq!(held, ["bar"], "{}", two.to_text());
     assert!(two.to_text().contains("holding bar"), "{}", two.to_text());
 }
+
+/// Held-out double-layer assembly 17 of `asp gen profiles --preset double-layer --count 20
+/// --seed 900 --connectors attached` (its seed from that run's manifest). Its profiles' metadata
+/// grasps close across the four long sides only; with those alone the robot refused removals
+/// the geometry allows and the search ran out of its time (at 60 s, `budget_exhausted`). With
+/// grasps on every pair of parallel faces (the connectors' faces, the profile with its
+/// connector's wall) it plans, every path re-checked, and some steps hold a part by faces its
+/// metadata has no grasp on.
+#[test]
+fn a_double_layer_assembly_plans_with_grasps_on_faces_its_metadata_lacks() {
+    let params = asp_gen::ProfileParams { connectors: asp_gen::ConnectorMode::Attached, ..asp_gen::ProfileParams::double_layer() };
+    let assembly = asp_gen::ProfileAssembly::generate(&params, 242_557_999_537_143_880).unwrap().to_assembly("profiles_017");
+    let setup = RobotSetup::panda();
+    let settings = PlanSettings {
+        checker_extension: Some(Arc::new(CellSetup { robot: Some(setup.clone()), grippers: 1 })),
+        timeout: Some(30.0),
+        ..PlanSettings::default()
+    };
+    let plan = plan_assembly(assembly.clone(), &settings, None).unwrap();
+    assert!(plan.found(), "{:?} {:?}", plan.report.status, plan.report.explanation);
+    recheck_report(&assembly, &plan.report, &setup);
+    // steps whose grasp is none of the part's metadata grasps
+    let off_metadata = plan
+        .report
+        .assembly_sequence
+        .iter()
+        .filter(|s| {
+            let g = s.robot.as_ref().unwrap().grasp;
+            let at = Vec3::new(g[0] as f32, g[1] as f32, g[2] as f32);
+            let rot = Rot::from_xyzw(g[3] as f32, g[4] as f32, g[5] as f32, g[6] as f32);
+            !assembly.parts[s.part].meta.grasps.iter().any(|m| (m.position - at).length() < 1e-4 && m.orientation.angle_between(rot) < 1e-3)
+        })
+        .count();
+    assert!(off_metadata > 0, "every step held its part by a metadata grasp");
+}
+
+/// A block walled in by fixed walls 5 mm away: the geometry lets it out (up), the robot finds
+/// no grasp. The dead end's explanation names what the gripper meets (the walls, by name),
+/// and says a second gripper would not change it.
+#[test]
+fn a_refused_part_explanation_names_the_parts_its_grasps_meet() {
+    use asp_search::report::RobotReason;
+    let mut parts = vec![
+        box_part("plate", [-0.2, -0.2, -0.02], [0.3, 0.2, 0.0]),
+        box_part("block", [0.08, -0.02, 0.0], [0.12, 0.02, 0.04]),
+        box_part("wall_xm", [0.06, -0.05, 0.0], [0.075, 0.05, 0.04]),
+        box_part("wall_xp", [0.125, -0.05, 0.0], [0.14, 0.05, 0.04]),
+        box_part("wall_ym", [0.075, -0.05, 0.0], [0.125, -0.025, 0.04]),
+        box_part("wall_yp", [0.075, 0.025, 0.0], [0.125, 0.05, 0.04]),
+    ];
+    for (i, p) in parts.iter_mut().enumerate() {
+        p.fixed = i != 1;
+    }
+    let walled = assemble("walled", parts, Axis::Z);
+    let setup = RobotSetup { base: Some(Vec3::new(-0.35, 0.0, -0.02)), ..RobotSetup::panda() };
+    let settings =
+        PlanSettings { checker_extension: Some(Arc::new(CellSetup { robot: Some(setup), grippers: 1 })), ..PlanSettings::default() };
+    let report = plan_assembly(walled, &settings, None).unwrap().report;
+    let block = report.explanation.iter().find(|e| e.name == "block").unwrap_or_else(|| panic!("{:?}", report.explanation));
+    let robot = block.robot.as_ref().expect("the robot's reason");
+    assert_eq!(robot.reason, RobotReason::NoReachableGrasp);
+    assert!(robot.detail.contains("the gripper alone collides at") && robot.detail.contains("'wall_"), "{}", robot.detail);
+    assert!(robot.detail.contains("--grippers 2"), "{}", robot.detail);
+    assert!(!robot.detail.contains("'block'"), "{}", robot.detail);
+}

@@ -97,6 +97,9 @@ struct Obstacles {
     bounds: Option<Aabb>,
     /// Their distances, filled as the sphere check asks (`ids` as bits).
     field: Field,
+    /// Whether the floor counts ([`RemovalPlanner::shapes_collide`]; off only to name the
+    /// parts a gripper meets, [`RemovalPlanner::grasp_blockers`]).
+    floor: bool,
 }
 
 /// The arm's configurations for one grasp and lift direction ([`RemovalPlanner::grasp_ik`]).
@@ -326,7 +329,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         for &o in ids.iter().filter(|&&o| o < world.num_parts()) {
             bits[o / 64] |= 1 << (o % 64);
         }
-        Obstacles { ids, ground, bounds, field: Field::new(bits) }
+        Obstacles { ids, ground, bounds, field: Field::new(bits), floor: true }
     }
 
     /// Whether robot shapes `first..first + placed.len()` (in [`Robot::collision_shapes`]
@@ -341,7 +344,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
             let prepared = &self.arm[k];
             let on_base = k < self.base_shapes;
             if !on_base {
-                if lowest(&bb, up) <= self.cell.floor && prepared.meets(&pose, &self.floor.0, &*self.floor.1) {
+                if obstacles.floor && lowest(&bb, up) <= self.cell.floor && prepared.meets(&pose, &self.floor.0, &*self.floor.1) {
                     // the box may reach below the floor: exact test against the half-space
                     return true;
                 }
@@ -441,6 +444,44 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         let poses: Vec<Pose> = self.cell.robot.gripper_shapes(tool, opening).into_iter().map(|(p, _)| p).collect();
         let placed = world_shapes(&self.arm[self.gripper_first..], &poses);
         self.shapes_collide(&placed, self.gripper_first, obstacles)
+    }
+
+    /// What the gripper alone meets at each grasp of part `p` in `present`, lifted along
+    /// `direction` (the robot's first test of a grasp, at the grasp pose and the lifted one),
+    /// per grasp of [`RemovalPlanner::grasps`]: `None` when it is free there, else the parts it
+    /// collides with in increasing order (empty when only the floor or the ground is in the
+    /// way). What a dead end's explanation says about a part's grasps.
+    pub fn grasp_blockers(&self, p: usize, present: &PartSet, direction: Vec3) -> Vec<Option<Vec<usize>>> {
+        let lift = Pose::from_translation(direction * self.config.lift);
+        let all = self.obstacles(present, p);
+        let world = self.world();
+        let one: Vec<Obstacles> = all
+            .ids
+            .iter()
+            .map(|&o| {
+                let mut bits = vec![0u64; world.num_parts().div_ceil(64).max(1)];
+                bits[o / 64] |= 1 << (o % 64);
+                Obstacles { ids: vec![o], ground: None, bounds: Some(*world.aabb(o)), field: Field::new(bits), floor: false }
+            })
+            .collect();
+        self.grasps(p)
+            .iter()
+            .map(|g| {
+                let tool = Pose::from_parts(g.position, g.orientation);
+                let lifted = lift * tool;
+                if !(self.gripper_collides(&tool, g.width, &all) || self.gripper_collides(&lifted, g.width, &all)) {
+                    return None;
+                }
+                Some(
+                    all.ids
+                        .iter()
+                        .zip(&one)
+                        .filter(|(_, obs)| self.gripper_collides(&tool, g.width, obs) || self.gripper_collides(&lifted, g.width, obs))
+                        .map(|(&o, _)| o)
+                        .collect(),
+                )
+            })
+            .collect()
     }
 
     /// Whether part `p` shrunk (`shrunk`), displaced by `pose` from its assembled pose, crosses

@@ -81,7 +81,9 @@ pub fn recheck(world: &World, cell: &RobotCell, part: usize, present: &PartSet, 
         let n = (max_step / 5e-4).ceil().max(1.0) as usize;
         for i in 0..=n {
             let t = i as f64 / n as f64;
-            let q: Vec<f64> = a.iter().zip(b).map(|(x, y)| x + (y - x) * t).collect();
+            // on the segment: rounding may not carry a sample past an end (a waypoint exactly
+            // at a joint limit, as inverse kinematics leaves one, stays within it)
+            let q: Vec<f64> = a.iter().zip(b).map(|(x, y)| (x + (y - x) * t).clamp(x.min(*y), x.max(*y))).collect();
             if !robot.within_limits(&q) {
                 return Err(format!("segment {w} sample {i}: outside the joint limits"));
             }

@@ -101,6 +101,12 @@ fn a_walled_in_block_has_no_reachable_grasp() {
         }
         other => panic!("expected no reachable grasp, got {other:?}"),
     }
+    // what the gripper alone meets, grasp by grasp (what the dead end's explanation names):
+    // the walls and the plate, never the block itself; at least one grasp by a wall
+    let blockers = planner.grasp_blockers(1, &state, Vec3::Z);
+    assert_eq!(blockers.len(), planner.grasps(1).len());
+    assert!(blockers.iter().flatten().all(|b| b.iter().all(|&o| o != 1)), "{blockers:?}");
+    assert!(blockers.iter().flatten().any(|b| b.iter().any(|&o| (2..6).contains(&o))), "{blockers:?}");
     // the arm lifts up when it can (thesis 5.3), whatever the removal direction: sideways the
     // lift would hit a wall, up it is free (and the grasps still collide)
     assert_eq!(planner.lift_direction(1, &state, Some(Vec3::X)), Ok(Vec3::Z));
@@ -134,6 +140,8 @@ fn a_walled_in_block_has_no_reachable_grasp() {
     let state = PartSet::full(world.num_parts());
     let r = planner.plan(1, &state, Vec3::Z, 3, 1).expect("a free block is removable");
     recheck(&world, planner.cell(), 1, &state, &r, 0.003).unwrap();
+    // and the grasp it took is one the gripper alone fits at
+    assert_eq!(planner.grasp_blockers(1, &state, Vec3::Z)[r.grasp_index], None);
 }
 
 /// The drop-off lies inside a closed fixed box: the block is reachable, but no path puts it down.
