@@ -660,6 +660,43 @@ fn expect_rank(what: &str, shape: &Option<Vec<Dim>>, rank: usize, layout: &str) 
     }
 }
 
+impl OnnxWeights for GraphModel {
+    fn node_dim(&self) -> usize {
+        self.node_dim
+    }
+
+    fn edge_dim(&self) -> usize {
+        self.edge_dim
+    }
+
+    fn metadata_value(&self, key: &str) -> Option<&str> {
+        self.metadata.get(key).map(String::as_str)
+    }
+
+    fn initializer(&self, name: &str) -> Option<(&[usize], &[f32])> {
+        self.initializers.iter().find(|(n, _, _)| n == name).map(|(_, s, v)| (s.as_slice(), v.as_slice()))
+    }
+
+    fn bool_initializer(&self, name: &str) -> Option<&[bool]> {
+        self.bool_initializers.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_slice())
+    }
+
+    fn scalar_initializers(&self) -> Vec<f32> {
+        self.initializers.iter().filter(|(_, s, _)| s.is_empty()).map(|(_, _, v)| v[0]).collect()
+    }
+
+    fn reference_scores(
+        &self,
+        x: &[f32],
+        n: usize,
+        edge_index: &[i64],
+        e: usize,
+        edge_attr: &[f32],
+    ) -> std::result::Result<Vec<f32>, String> {
+        self.score(x, n, edge_index, e, edge_attr).map_err(|err| err.to_string())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -787,42 +824,5 @@ mod tests {
         let err = RemovabilityModel::from_bytes(b"\x08\x07garbage", "models/x.onnx").unwrap_err().to_string();
         assert!(err.starts_with("models/x.onnx: "), "{err}");
         assert!(!err.contains('\n'), "{err}");
-    }
-}
-
-impl OnnxWeights for GraphModel {
-    fn node_dim(&self) -> usize {
-        self.node_dim
-    }
-
-    fn edge_dim(&self) -> usize {
-        self.edge_dim
-    }
-
-    fn metadata_value(&self, key: &str) -> Option<&str> {
-        self.metadata.get(key).map(String::as_str)
-    }
-
-    fn initializer(&self, name: &str) -> Option<(&[usize], &[f32])> {
-        self.initializers.iter().find(|(n, _, _)| n == name).map(|(_, s, v)| (s.as_slice(), v.as_slice()))
-    }
-
-    fn bool_initializer(&self, name: &str) -> Option<&[bool]> {
-        self.bool_initializers.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_slice())
-    }
-
-    fn scalar_initializers(&self) -> Vec<f32> {
-        self.initializers.iter().filter(|(_, s, _)| s.is_empty()).map(|(_, _, v)| v[0]).collect()
-    }
-
-    fn reference_scores(
-        &self,
-        x: &[f32],
-        n: usize,
-        edge_index: &[i64],
-        e: usize,
-        edge_attr: &[f32],
-    ) -> std::result::Result<Vec<f32>, String> {
-        self.score(x, n, edge_index, e, edge_attr).map_err(|err| err.to_string())
     }
 }
