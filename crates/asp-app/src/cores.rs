@@ -7,7 +7,7 @@
 //! valid plan of the subassembly: the core built first, then the parts the subassembly's own
 //! plan did place.
 
-use crate::pipeline::{plan_core, PlanSettings};
+use crate::setup::{PlanResult, PlanSettings};
 use crate::tree::{add_effort, remapped};
 use crate::Result;
 use asp_geom::Assembly;
@@ -20,13 +20,15 @@ use std::time::Instant;
 /// report's status and cores ([`PlanReport::settle`]). Cores holding a fixed part of the model
 /// stay as they are, and so do cores of subassemblies stopped by the budget and the cores of
 /// robot plans. `started` and
-/// `budget` are the run's: the cores share what is left of its time.
+/// `budget` are the run's: the cores share what is left of its time. `plan_core` plans one core
+/// as a model of its own (the pipeline's).
 pub(crate) fn plan_cores_alone(
     report: &mut PlanReport,
     assembly: &Assembly,
     settings: &PlanSettings,
     budget: &Budget,
     started: Instant,
+    plan_core: &dyn Fn(Assembly, &PlanSettings, Budget) -> Result<PlanResult>,
 ) -> Result<()> {
     // a robot plans in its cell, with the whole model: a core alone is no cell
     if report.locked_cores.is_empty() || settings.checker_extension.is_some() {

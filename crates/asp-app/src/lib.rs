@@ -12,6 +12,7 @@ pub mod error;
 pub mod pipeline;
 pub mod request;
 pub mod resolve;
+mod setup;
 pub mod stepped;
 pub mod tree;
 pub mod why;

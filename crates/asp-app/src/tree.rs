@@ -5,12 +5,16 @@
 //! model. The result is one hierarchical plan in the plan JSON's subassembly step format: each
 //! unit's step carries its subassembly's own plan and its name in the tree.
 //!
-//! Every level is planned by the pipeline's [`crate::pipeline::plan_assembly`] on the level's
+//! Every level is planned by the pipeline's `plan_assembly` (handed in as [`PlanLevel`]) on the level's
 //! parts; the contact tolerance and distance are the whole model's, so that a bolt and its nut
 //! are tested alike in their subassembly and in the model.
 
 use crate::error::{AppError, Result};
-use crate::pipeline::{self, PlanResult, PlanSettings};
+use crate::setup::{PlanResult, PlanSettings};
+
+/// How one level of the tree is planned (the pipeline's `plan_assembly`): the level's parts, its
+/// settings (its subassemblies as units), the progress callback.
+pub type PlanLevel<'a> = &'a dyn Fn(Assembly, &PlanSettings, Option<&(dyn Fn(&Progress) + Sync)>) -> Result<PlanResult>;
 use asp_geom::world::{DEFAULT_RELATIVE_CONTACT, DEFAULT_RELATIVE_TOLERANCE};
 use asp_geom::Assembly;
 use asp_search::report::{AssemblyStep, LockedCore, PlanReport, SubassemblyEntry, SubassemblyStatus};
@@ -64,8 +68,13 @@ fn node(assembly: &Assembly, name: String, depth: usize, parts: Vec<usize>) -> N
 }
 
 /// Plans `assembly` level by level along its product tree (see the module documentation).
-/// `settings` are the run's, with [`PlanSettings::from_file`] set.
-pub fn plan(assembly: Assembly, settings: &PlanSettings, progress: Option<&(dyn Fn(&Progress) + Sync)>) -> Result<PlanResult> {
+/// `settings` are the run's, with [`PlanSettings::from_file`] set; `plan_level` plans each level.
+pub fn plan(
+    assembly: Assembly,
+    settings: &PlanSettings,
+    progress: Option<&(dyn Fn(&Progress) + Sync)>,
+    plan_level: PlanLevel<'_>,
+) -> Result<PlanResult> {
     let root = tree(&assembly);
     let metres = assembly.units.metres;
     let diagonal = assembly.diagonal() as f64 / metres;
@@ -77,7 +86,7 @@ pub fn plan(assembly: Assembly, settings: &PlanSettings, progress: Option<&(dyn 
         ..settings.clone()
     };
     let mut entries = Vec::new();
-    let mut result = plan_node(&assembly, &root, &level, progress, true, &mut entries)?;
+    let mut result = plan_node(&assembly, &root, &level, progress, plan_level, true, &mut entries)?;
     result.report.file_subassemblies = entries;
     if root.children.is_empty() {
         result
@@ -95,6 +104,7 @@ fn plan_node(
     node: &Node,
     settings: &PlanSettings,
     progress: Option<&(dyn Fn(&Progress) + Sync)>,
+    plan_level: PlanLevel<'_>,
     root: bool,
     entries: &mut Vec<SubassemblyEntry>,
 ) -> Result<PlanResult> {
@@ -102,7 +112,7 @@ fn plan_node(
     let children = node
         .children
         .iter()
-        .map(|child| plan_node(assembly, child, settings, progress, false, &mut inner))
+        .map(|child| plan_node(assembly, child, settings, progress, plan_level, false, &mut inner))
         .collect::<Result<Vec<PlanResult>>>()?;
     let mut level = assembly.subset(&node.parts);
     if !root && !level.parts.iter().any(|p| p.fixed) {
@@ -113,7 +123,7 @@ fn plan_node(
     }
     let units = node.children.iter().map(|c| c.parts.iter().map(|&i| assembly.parts[i].name.clone()).collect()).collect();
     let level_settings = PlanSettings { unit_groups: units, ..settings.clone() };
-    let mut result = pipeline::plan_assembly(level, &level_settings, progress)?;
+    let mut result = plan_level(level, &level_settings, progress)?;
     if !root {
         result.report = remapped(&result.report, &node.parts)?;
     }

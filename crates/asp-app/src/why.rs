@@ -3,7 +3,7 @@
 //! ([`CoreWhy::of`]); what the pipeline knows is added here — whether the grid planner ran, and
 //! the core's own plan rerun under `--overlaps lenient`.
 
-use crate::pipeline::{checker_config, planner, PlanSettings};
+use crate::setup::{checker_config, planner, PlanSettings};
 use asp_geom::grid::VoxelModel;
 use asp_geom::{Assembly, Checker, FeasibilityChecker, PartSet, World};
 use asp_search::grid::solver::GridPlan;
