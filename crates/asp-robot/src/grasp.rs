@@ -80,6 +80,23 @@ pub fn part_grasps(part: &Part, cfg: &GraspConfig) -> Vec<Grasp> {
     grasps
 }
 
+/// The hand orientations of a grasp closing along `y` at `centre` (`cfg.approaches` of them
+/// evenly around `y`, z the approach) for which the hand, coming from -z, finds the part's
+/// surface within finger reach behind the centre.
+fn approaches<'a>(tris: &'a [[Vec3; 3]], centre: Vec3, y: Vec3, cfg: &'a GraspConfig) -> impl Iterator<Item = Rot> + 'a {
+    let u0 = perpendicular(y);
+    let v0 = y.cross(u0);
+    let count = cfg.approaches.max(1);
+    (0..count).filter_map(move |k| {
+        let th = std::f32::consts::TAU * k as f32 / count as f32;
+        let z = u0 * th.cos() + v0 * th.sin();
+        match first_hit(tris, centre, -z, 0.0) {
+            Some((d, _)) if d <= cfg.finger_depth => Some(Rot::from_mat3(&Mat3::from_cols(y.cross(z), y, z)).normalize()),
+            _ => None,
+        }
+    })
+}
+
 /// Distance along the ray `o + t d` (t > `t_min`) to the first triangle of `tris` it crosses, with that
 /// triangle's index (Möller-Trumbore, both sides).
 fn first_hit(tris: &[[Vec3; 3]], o: Vec3, d: Vec3, t_min: f32) -> Option<(f32, usize)> {
@@ -167,19 +184,7 @@ pub fn antipodal_grasps(mesh: &Mesh, cfg: &GraspConfig) -> Vec<Grasp> {
             continue;
         }
         let centre = p - n * (0.5 * width);
-        let y = n;
-        let u0 = perpendicular(y);
-        let v0 = y.cross(u0);
-        for k in 0..cfg.approaches.max(1) {
-            let th = std::f32::consts::TAU * k as f32 / cfg.approaches.max(1) as f32;
-            let z = u0 * th.cos() + v0 * th.sin();
-            // the hand comes from -z: the part's surface must be within finger reach behind the centre
-            match first_hit(&tris, centre, -z, 0.0) {
-                Some((d, _)) if d <= cfg.finger_depth => {}
-                _ => continue,
-            }
-            let x = y.cross(z);
-            let orientation = Rot::from_mat3(&Mat3::from_cols(x, y, z)).normalize();
+        for orientation in approaches(&tris, centre, n, cfg) {
             let duplicate =
                 out.iter().any(|g| (g.position - centre).length() < cfg.min_spacing && g.orientation.angle_between(orientation) < 0.3);
             if !duplicate {
@@ -315,18 +320,7 @@ pub fn face_pair_grasps(mesh: &Mesh, cfg: &GraspConfig, known: &[Grasp]) -> Vec<
                     continue;
                 }
                 let centre = p - a.normal * (0.5 * w);
-                let y = a.normal;
-                let u0 = perpendicular(y);
-                let v0 = y.cross(u0);
-                for k in 0..cfg.approaches.max(1) {
-                    let th = std::f32::consts::TAU * k as f32 / cfg.approaches.max(1) as f32;
-                    let z = u0 * th.cos() + v0 * th.sin();
-                    match first_hit(&tris, centre, -z, 0.0) {
-                        Some((d, _)) if d <= cfg.finger_depth => {}
-                        _ => continue,
-                    }
-                    let x = y.cross(z);
-                    let orientation = Rot::from_mat3(&Mat3::from_cols(x, y, z)).normalize();
+                for orientation in approaches(&tris, centre, a.normal, cfg) {
                     let near =
                         |g: &Grasp| (g.position - centre).length() < cfg.min_spacing && g.orientation.angle_between(orientation) < 0.3;
                     if !(pair.iter().any(near) || out.iter().any(near) || known.iter().any(near)) {

@@ -128,25 +128,28 @@ fn the_optimiser_minimises_the_robot_path_and_repeats_itself() {
     }
 }
 
+/// A post on a fixed plate carries a bar, the bar a block (metres).
+fn post_bar_block() -> Assembly {
+    let mut plate = box_part("plate", [-0.3, -0.3, -0.02], [0.3, 0.3, 0.0]);
+    plate.fixed = true;
+    assemble(
+        "held",
+        vec![
+            plate,
+            box_part("post", [0.0, -0.02, 0.0], [0.04, 0.02, 0.1]),
+            box_part("bar", [-0.1, -0.02, 0.1], [0.14, 0.02, 0.12]),
+            box_part("block", [0.0, -0.02, 0.12], [0.04, 0.02, 0.16]),
+        ],
+        Axis::Z,
+    )
+}
+
 /// A post on a fixed plate carries a bar, the bar a block. Taken in the given order (post
 /// first), the post's removal leaves bar and block unsupported: refused with one gripper,
 /// admitted with two when the bar is held (the block rests on it), and the plan says so.
 #[test]
 fn a_second_gripper_holds_the_bar_while_the_post_goes_in() {
-    let mut plate = box_part("plate", [-0.3, -0.3, -0.02], [0.3, 0.3, 0.0]);
-    plate.fixed = true;
-    let model = || {
-        assemble(
-            "held",
-            vec![
-                plate.clone(),
-                box_part("post", [0.0, -0.02, 0.0], [0.04, 0.02, 0.1]),
-                box_part("bar", [-0.1, -0.02, 0.1], [0.14, 0.02, 0.12]),
-                box_part("block", [0.0, -0.02, 0.12], [0.04, 0.02, 0.16]),
-            ],
-            Axis::Z,
-        )
-    };
+    let model = post_bar_block;
     let one = plan_assembly(model(), &PlanSettings::default(), None).unwrap();
     assert!(one.found());
     assert_ne!(one.report.disassembly_sequence[0], 1, "the post cannot go first without holding");
@@ -568,20 +571,7 @@ fn check_with_the_robot_carries_out_every_step_or_says_why_not() {
 #[test]
 fn check_with_two_grippers_names_the_held_part() {
     use asp_app::check::{check_assembly, parse_sequence, CheckStatus, Failure};
-    let mut plate = box_part("plate", [-0.3, -0.3, -0.02], [0.3, 0.3, 0.0]);
-    plate.fixed = true;
-    let model = || {
-        assemble(
-            "held",
-            vec![
-                plate.clone(),
-                box_part("post", [0.0, -0.02, 0.0], [0.04, 0.02, 0.1]),
-                box_part("bar", [-0.1, -0.02, 0.1], [0.14, 0.02, 0.12]),
-                box_part("block", [0.0, -0.02, 0.12], [0.04, 0.02, 0.16]),
-            ],
-            Axis::Z,
-        )
-    };
+    let model = post_bar_block;
     let text = "bar\nblock\npost\n";
     let one = check_assembly(model(), &parse_sequence(text).unwrap(), &PlanSettings::default()).unwrap();
     assert_eq!(one.status, CheckStatus::Infeasible);
@@ -636,18 +626,7 @@ fn a_double_layer_assembly_plans_with_grasps_on_faces_its_metadata_lacks() {
 #[test]
 fn a_refused_part_explanation_names_the_parts_its_grasps_meet() {
     use asp_search::report::RobotReason;
-    let mut parts = vec![
-        box_part("plate", [-0.2, -0.2, -0.02], [0.3, 0.2, 0.0]),
-        box_part("block", [0.08, -0.02, 0.0], [0.12, 0.02, 0.04]),
-        box_part("wall_xm", [0.06, -0.05, 0.0], [0.075, 0.05, 0.04]),
-        box_part("wall_xp", [0.125, -0.05, 0.0], [0.14, 0.05, 0.04]),
-        box_part("wall_ym", [0.075, -0.05, 0.0], [0.125, -0.025, 0.04]),
-        box_part("wall_yp", [0.075, 0.025, 0.0], [0.125, 0.05, 0.04]),
-    ];
-    for (i, p) in parts.iter_mut().enumerate() {
-        p.fixed = i != 1;
-    }
-    let walled = assemble("walled", parts, Axis::Z);
+    let walled = asp_geom::fixtures::walled_block();
     let setup = RobotSetup { base: Some(Vec3::new(-0.35, 0.0, -0.02)), ..RobotSetup::panda() };
     let settings =
         PlanSettings { checker_extension: Some(Arc::new(CellSetup { robot: Some(setup), grippers: 1 })), ..PlanSettings::default() };

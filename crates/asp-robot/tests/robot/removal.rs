@@ -78,18 +78,7 @@ fn same_seed_same_removal() {
 /// the block: it can be lifted, but every grasp puts a finger into a wall.
 #[test]
 fn a_walled_in_block_has_no_reachable_grasp() {
-    let mut parts = vec![
-        box_part("plate", [-0.2, -0.2, -0.02], [0.3, 0.2, 0.0]),
-        box_part("block", [0.08, -0.02, 0.0], [0.12, 0.02, 0.04]),
-        box_part("wall_xm", [0.06, -0.05, 0.0], [0.075, 0.05, 0.04]),
-        box_part("wall_xp", [0.125, -0.05, 0.0], [0.14, 0.05, 0.04]),
-        box_part("wall_ym", [0.075, -0.05, 0.0], [0.125, -0.025, 0.04]),
-        box_part("wall_yp", [0.075, 0.025, 0.0], [0.125, 0.05, 0.04]),
-    ];
-    for (i, p) in parts.iter_mut().enumerate() {
-        p.fixed = i != 1;
-    }
-    let world = World::new(assemble("walled", parts, Axis::Z), &WorldConfig::default()).unwrap();
+    let world = World::new(asp_geom::fixtures::walled_block(), &WorldConfig::default()).unwrap();
     let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), Some(Vec3::new(-0.35, 0.0, -0.02)), None);
     let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
     let state = PartSet::full(world.num_parts());
