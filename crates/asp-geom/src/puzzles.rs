@@ -38,6 +38,25 @@ pub fn burr_sticks() -> [Vec<Cell>; 6] {
     ]
 }
 
+/// A closed box (5 × 3 × 6 cells) whose five loose unit cubes slide around a 3 × 4 cavity
+/// without ever getting out: the frame first, then the cubes. A grid search visits all 95,040
+/// states before it is stuck.
+pub fn closed_box_cells() -> Vec<Vec<Cell>> {
+    let mut frame = Vec::new();
+    for x in 0..5 {
+        for y in 0..3 {
+            for z in 0..6 {
+                if !(y == 1 && (1..4).contains(&x) && (1..5).contains(&z)) {
+                    frame.push([x, y, z]);
+                }
+            }
+        }
+    }
+    let mut pieces = vec![frame];
+    pieces.extend([[1, 1, 1], [2, 1, 1], [3, 1, 1], [1, 1, 2], [2, 1, 2]].map(|c| vec![c]));
+    pieces
+}
+
 /// An assembly of voxel pieces named `piece0`, `piece1`, ... in [`CELL`] cells.
 pub fn voxel_puzzle(name: &str, pieces: &[Vec<Cell>]) -> Assembly {
     assemble(name, pieces.iter().enumerate().map(|(i, c)| voxel_part(&format!("piece{i}"), c, CELL)).collect(), Axis::Z)

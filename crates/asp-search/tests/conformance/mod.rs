@@ -176,18 +176,7 @@ fn a_small_budget_is_kept_by_every_planner() {
     // a token stopped while the grid search runs (it looks every 1,024 states): the search
     // itself ends `interrupted` on a closed box whose five loose cubes slide around a 3 × 4
     // cavity (95,040 states to visit before it is stuck)
-    let mut frame = Vec::new();
-    for x in 0..5 {
-        for y in 0..3 {
-            for z in 0..6 {
-                if !(y == 1 && (1..4).contains(&x) && (1..5).contains(&z)) {
-                    frame.push([x, y, z]);
-                }
-            }
-        }
-    }
-    let mut pieces = vec![frame];
-    pieces.extend([[1, 1, 1], [2, 1, 1], [3, 1, 1], [1, 1, 2], [2, 1, 2]].map(|c| vec![c]));
+    let pieces = asp_geom::puzzles::closed_box_cells();
     let boxed = asp_geom::puzzles::voxel_puzzle("closed box", &pieces);
     let grid = GridPlanner::of(&boxed, GridConfig::default()).expect("a voxel puzzle");
     let cancelled = StopToken::new();

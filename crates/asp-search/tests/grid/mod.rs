@@ -646,18 +646,7 @@ fn issue_9_write_puzzle_glbs() {
 #[test]
 #[ignore = "a benchmark, not a test: figures in docs/benchmarks.md"]
 fn issue_9_bench_grid() {
-    let mut frame = Vec::new();
-    for x in 0..5 {
-        for y in 0..3 {
-            for z in 0..6 {
-                if !(y == 1 && (1..4).contains(&x) && (1..5).contains(&z)) {
-                    frame.push([x, y, z]);
-                }
-            }
-        }
-    }
-    let mut pieces = vec![frame];
-    pieces.extend([[1, 1, 1], [2, 1, 1], [3, 1, 1], [1, 1, 2], [2, 1, 2]].map(|c| vec![c]));
+    let pieces = puzzles::closed_box_cells();
     let boxed = VoxelModel::from_cells(pieces, vec![false; 6]);
     let models = [
         ("burr_key", VoxelModel::of(&puzzles::burr_key()).unwrap()),
