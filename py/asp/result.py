@@ -72,8 +72,9 @@ class Plan:
     @property
     def bearings(self) -> list[dict[str, Any]]:
         """The rolling bearings found in the model (format 1.12), each planned as one unit:
-        ``parts``, ``rings`` (inner, outer) and their ``names``, ``balls``, ``others`` (cage,
-        shields), ``centre``, ``axis``, ``pitch_radius``, ``ball_radius`` and ``rows``
+        ``parts``, ``rings`` (inner, outer) and their ``names``, ``balls`` (the rolling
+        elements), ``rolling_elements`` (format 1.14: ``"balls"`` or ``"rollers"``), ``others``
+        (cage, shields), ``centre``, ``axis``, ``pitch_radius``, ``ball_radius`` and ``rows``
         (``docs/plan-format.md``, "Bearings"). Empty when there is none."""
         return self._copy("bearings", [])
 

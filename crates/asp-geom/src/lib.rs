@@ -41,4 +41,4 @@ pub use meta::{Grasp, PartMeta};
 pub use overlap::OverlapPolicy;
 pub use partset::PartSet;
 pub use physics::{PhysicsConfig, PhysicsStability};
-pub use world::{Bearing, World, WorldConfig};
+pub use world::{Bearing, RollingElement, World, WorldConfig};

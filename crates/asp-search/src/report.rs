@@ -21,7 +21,7 @@ pub use precedence::{PrecedenceEdge, PrecedenceEntry, PrecedenceReason, Preceden
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.13";
+pub const FORMAT_VERSION: &str = "1.14";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -316,9 +316,9 @@ impl FitEntry {
     }
 }
 
-/// A rolling bearing of a plan (format 1.12): balls captive between an inner and an outer ring
-/// (plus a cage, shields), recognised from the geometry and planned as one unit, never taken
-/// apart.
+/// A rolling bearing of a plan (format 1.12): balls (or, since 1.14, rollers) captive between an
+/// inner and an outer ring (plus a cage, shields), recognised from the geometry and planned as one
+/// unit, never taken apart.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct BearingEntry {
     /// Every part of the bearing, ascending.
@@ -327,8 +327,11 @@ pub struct BearingEntry {
     pub rings: [usize; 2],
     /// Their names.
     pub names: [String; 2],
-    /// The balls.
+    /// The rolling elements (balls or rollers, as `rolling_elements` says).
     pub balls: Vec<usize>,
+    /// What rolls: `balls` or `rollers` (since 1.14; absent before, and then balls).
+    #[serde(default = "balls_name")]
+    pub rolling_elements: String,
     /// The other parts held with the balls (cage, shields, seals).
     pub others: Vec<usize>,
     /// The centre of the balls' centres, model units.
@@ -337,10 +340,15 @@ pub struct BearingEntry {
     pub axis: [f64; 3],
     /// The radius of the circle through the balls' centres, model units.
     pub pitch_radius: f64,
-    /// The balls' radius, model units.
+    /// The balls' radius (the rollers' mean radius), model units.
     pub ball_radius: f64,
-    /// The rows of balls.
+    /// The rows of rolling elements.
     pub rows: usize,
+}
+
+/// What a bearing of a plan written before 1.14 rolls on.
+fn balls_name() -> String {
+    "balls".into()
 }
 
 impl BearingEntry {
@@ -356,6 +364,7 @@ impl BearingEntry {
                 rings: b.rings,
                 names: b.rings.map(|p| world.name(p).to_string()),
                 balls: b.balls.clone(),
+                rolling_elements: b.elements.plural().into(),
                 others: b.others.clone(),
                 centre: [b.centre.x, b.centre.y, b.centre.z].map(len),
                 axis: [b.axis.x as f64, b.axis.y as f64, b.axis.z as f64],

@@ -447,6 +447,29 @@ fn a_ball_bearing_goes_in_as_one_unit() {
     assert!(text.contains("a rolling bearing (balls captive between two rings), one unit, not taken apart"), "{text}");
 }
 
+/// A cylindrical roller bearing with ribs on both rings, in a housing on a shaft: without roller
+/// bearings recognised the plan is `partial` (the rollers never leave their raceways between
+/// the ribs); recognised, the bearing goes in as one unit along the axis and the plan is `found`.
+#[test]
+fn a_roller_bearing_goes_in_as_one_unit() {
+    use asp_search::report::{PlanStatus, SubassemblyStatus};
+    let settings = PlanSettings { timeout: Some(120.0), ..PlanSettings::default() };
+    let r = plan_assembly(asp_geom::fixtures::roller_bearing(64, 10, true), &settings, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Found, "{json}");
+    assert!(r.report.locked_cores.is_empty(), "{json}");
+    let b = &r.report.bearings[0];
+    assert_eq!((b.rings, b.balls.len(), b.rolling_elements.as_str()), ([2, 3], 10, "rollers"), "{json}");
+    let steps = &r.report.assembly_sequence;
+    assert_eq!(steps.len(), 2, "the bearing and the shaft: {json}");
+    let unit = steps.iter().find_map(|s| s.subassembly.as_ref()).expect("the bearing's step");
+    assert_eq!((unit.status, unit.parts.len()), (SubassemblyStatus::Unit, 12), "{json}");
+    let text = r.report.to_text();
+    assert!(text.contains("rolling bearing: inner ring in outer ring, 10 rollers in 1 row"), "{text}");
+    assert!(text.contains("roller radius"), "{text}");
+    assert!(text.contains("a rolling bearing (rollers captive between two rings), one unit, not taken apart"), "{text}");
+}
+
 /// A housing under a fixed roof with a block that must leave along an L, out of the top the roof
 /// covers: the search slides the two out from under the roof as one subassembly, whose own plan
 /// tries straight lines only and cannot open it; planned as a model of its own (its base fixed),

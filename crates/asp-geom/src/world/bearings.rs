@@ -1,13 +1,19 @@
-//! Rolling bearings recognised from their geometry: balls captive between an inner and an outer
-//! raced ring. A bought unit: its balls cannot leave the grooves, so no straight motion takes it
-//! apart, and a planner that tries ends with the bearing, and whatever it sits in, as a locked
+//! Rolling bearings recognised from their geometry: balls or rollers captive between an inner
+//! and an outer raced ring. A bought unit: its rolling elements cannot leave the raceways, so no
+//! straight motion takes it apart, and a planner that tries ends with the bearing, and whatever it sits in, as a locked
 //! core. Recognised, a bearing is planned as one unit (it goes in whole) and its rings are never
 //! taken for nuts or washers of a fastener.
 //!
 //! A bearing is recognised from what any tessellation keeps:
-//! - *balls*: parts whose vertices lie on one sphere (fitted, every vertex within 3 % of its
-//!   radius or the contact tolerance) and whose bounds are that sphere's cube (no dome, no cap);
-//! - *two rings* that every ball of the bearing touches (within the contact distance): one whose
+//! - *rolling elements*: balls, parts whose vertices lie on one sphere (fitted, every vertex
+//!   within 3 % of its radius or the contact tolerance) and whose bounds are that sphere's cube
+//!   (no dome, no cap); or rollers, closed parts that are a solid cylinder or cone frustum
+//!   (cylindrical, needle and tapered rollers: about one of their principal axes, every vertex
+//!   away from the axis on one straight side line within 3 % of the radius, the vertices near
+//!   the axis only at the ends, the volume the solid's within tessellation, 0.5 to 12 diameters
+//!   long, tapered by at most 15°), each roller's axis in the plane through the bearing's axis
+//!   and its centre, within 45° of the bearing's axis (no pin laid across a circle);
+//! - *two rings* that every rolling element of the bearing touches (within the contact distance): one whose
 //!   vertices lie mostly inside the balls' pitch circle, one mostly outside;
 //! - *the balls' centres* on one or more circles about a common axis (rows): at least three balls
 //!   per row, their centres within 3 % of the row's pitch radius and in the row's plane; the axis
@@ -31,15 +37,54 @@ const SPHERE_BOUNDS: f32 = 0.08;
 const SAME_SIZE: f32 = 0.03;
 /// The fewest balls of one row.
 const MIN_BALLS: usize = 3;
+/// A roller is between this many and [`ROLLER_LONGEST`] diameters long.
+const ROLLER_SHORTEST: f32 = 0.5;
+/// See [`ROLLER_SHORTEST`] (a needle roller is up to about ten diameters long).
+const ROLLER_LONGEST: f32 = 12.0;
+/// The steepest side of a tapered roller: tan 15°.
+const ROLLER_TAPER: f32 = 0.268;
+/// A roller's volume over its fitted solid's: a 12-gon's area is 0.955 of its circle's, and
+/// chamfered ends take a little more.
+const ROLLER_VOLUME: (f32, f32) = (0.85, 1.05);
 
-/// A rolling bearing found in a world: balls between an inner and an outer ring, plus the parts
-/// held with them (cage, shields).
+/// What rolls between a bearing's rings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RollingElement {
+    /// Balls (a ball bearing).
+    Ball,
+    /// Cylinders or cone frustums (a cylindrical, needle or tapered roller bearing).
+    Roller,
+}
+
+impl RollingElement {
+    /// `balls` or `rollers`, as the plan and the text name them.
+    pub fn plural(self) -> &'static str {
+        match self {
+            RollingElement::Ball => "balls",
+            RollingElement::Roller => "rollers",
+        }
+    }
+}
+
+/// One rolling element found: its centre, its (mean) radius, what it is, and a roller's axis.
+#[derive(Clone, Copy, Debug)]
+struct Element {
+    centre: Vec3,
+    radius: f32,
+    kind: RollingElement,
+    axis: Vec3,
+}
+
+/// A rolling bearing found in a world: balls or rollers between an inner and an outer ring, plus
+/// the parts held with them (cage, shields).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Bearing {
     /// The inner ring and the outer ring (part indices).
     pub rings: [usize; 2],
-    /// The balls, in part order.
+    /// The rolling elements (balls or rollers, as [`Bearing::elements`] says), in part order.
     pub balls: Vec<usize>,
+    /// What the rolling elements are.
+    pub elements: RollingElement,
     /// The other parts of the bearing (cage, shields, seals), in part order.
     pub others: Vec<usize>,
     /// The centre of the balls' centres (on the axis), metres.
@@ -48,9 +93,9 @@ pub struct Bearing {
     pub axis: Vec3,
     /// The radius of the circle through the balls' centres, metres.
     pub pitch_radius: f32,
-    /// The balls' radius, metres.
+    /// The balls' radius (a roller's mean radius), metres.
     pub ball_radius: f32,
-    /// How many rows of balls (circles of ball centres at different places along the axis).
+    /// How many rows of rolling elements (circles of ball centres at different places along the axis).
     pub rows: usize,
 }
 
@@ -110,8 +155,15 @@ pub(crate) fn fit_sphere(vertices: &[Vec3], tolerance: f32) -> Option<(Vec3, f32
 }
 
 /// The unit eigenvector of the smallest eigenvalue of the covariance of `points` about `mean`
-/// (the normal of the plane they spread in; power iteration on `trace·I − C`).
+/// (the normal of the plane they spread in).
 fn least_spread(points: &[Vec3], mean: Vec3) -> Vec3 {
+    principal_axes(points, mean)[0]
+}
+
+/// The principal axes of `points` about `mean`: the unit eigenvectors of the covariance's
+/// smallest and largest eigenvalues (power iteration on `trace·I − C` and on `C`), and the
+/// third, orthogonal to both.
+fn principal_axes(points: &[Vec3], mean: Vec3) -> [Vec3; 3] {
     let mut c = [[0.0f64; 3]; 3];
     for p in points {
         let d = *p - mean;
@@ -123,24 +175,84 @@ fn least_spread(points: &[Vec3], mean: Vec3) -> Vec3 {
         }
     }
     let trace = c[0][0] + c[1][1] + c[2][2];
-    let m = |v: [f64; 3]| -> [f64; 3] {
-        let mut out = [0.0; 3];
-        for i in 0..3 {
-            out[i] = trace * v[i] - (c[i][0] * v[0] + c[i][1] * v[1] + c[i][2] * v[2]);
+    let power = |shift: f64, sign: f64| -> Vec3 {
+        // start off every axis so that no eigenvector is missed by symmetry
+        let mut v = [0.577_f64, 0.578, 0.576];
+        for _ in 0..200 {
+            let mut w = [0.0; 3];
+            for i in 0..3 {
+                w[i] = shift * v[i] + sign * (c[i][0] * v[0] + c[i][1] * v[1] + c[i][2] * v[2]);
+            }
+            let l = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+            if l == 0.0 {
+                break;
+            }
+            v = [w[0] / l, w[1] / l, w[2] / l];
         }
-        out
+        Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32).normalize_or(Vec3::Z)
     };
-    // start off every axis so that no eigenvector is missed by symmetry
-    let mut v = [0.577_f64, 0.578, 0.576];
-    for _ in 0..200 {
-        let w = m(v);
-        let l = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
-        if l == 0.0 {
-            break;
-        }
-        v = [w[0] / l, w[1] / l, w[2] / l];
+    let (least, most) = (power(trace, -1.0), power(0.0, 1.0));
+    let third = least.cross(most).normalize_or(least.any_orthonormal_vector());
+    [least, most, third]
+}
+
+/// The roller `vertices` (a closed mesh with `triangles`) are, if they are one: a solid cylinder
+/// or cone frustum about one of their principal axes (see the module documentation). Returns its
+/// centre (the middle of its axis), its mean radius and its axis.
+pub(crate) fn fit_roller(vertices: &[Vec3], triangles: &[[u32; 3]], tolerance: f32) -> Option<(Vec3, f32, Vec3)> {
+    if vertices.len() < 12 {
+        return None;
     }
-    Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32).normalize_or(Vec3::Z)
+    let mean = vertices.iter().copied().sum::<Vec3>() / vertices.len() as f32;
+    let volume = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| (vertices[i as usize] - mean).as_dvec3());
+            a.dot(b.cross(c)) / 6.0
+        })
+        .sum::<f64>()
+        .abs() as f32;
+    principal_axes(vertices, mean).into_iter().find_map(|axis| {
+        let rt: Vec<(f32, f32)> = vertices.iter().map(|&v| radial_axial(v, mean, axis)).collect();
+        let rmax = rt.iter().map(|x| x.0).fold(0.0, f32::max);
+        let (t0, t1) = rt.iter().fold((f32::MAX, f32::MIN), |(lo, hi), x| (lo.min(x.1), hi.max(x.1)));
+        let length = t1 - t0;
+        if !(rmax > 0.0 && length > 0.0 && (ROLLER_SHORTEST..=ROLLER_LONGEST).contains(&(length / (2.0 * rmax)))) {
+            return None;
+        }
+        let slack = (SPHERE_DEVIATION * rmax).max(tolerance);
+        let near_end = |t: f32| (t - t0).min(t1 - t) <= 0.1 * length + slack;
+        // the side: the vertices away from the axis, on one line r = a + b t (least squares,
+        // once more without the chamfers' inner edges the first line finds)
+        let side: Vec<(f32, f32)> = rt.iter().copied().filter(|x| x.0 > 0.5 * rmax).collect();
+        let line = |points: &[(f32, f32)]| -> (f32, f32) {
+            let n = points.len() as f32;
+            let (mt, mr) = (points.iter().map(|x| x.1).sum::<f32>() / n, points.iter().map(|x| x.0).sum::<f32>() / n);
+            let stt: f32 = points.iter().map(|x| (x.1 - mt).powi(2)).sum();
+            let b = if stt > 0.0 { points.iter().map(|x| (x.1 - mt) * (x.0 - mr)).sum::<f32>() / stt } else { 0.0 };
+            (mr - b * mt, b)
+        };
+        let (a, b) = line(&side);
+        let kept: Vec<(f32, f32)> = side.iter().copied().filter(|&(r, t)| r - (a + b * t) >= -slack || !near_end(t)).collect();
+        let (a, b) = if kept.len() >= 6 && kept.len() < side.len() { line(&kept) } else { (a, b) };
+        if b.abs() > ROLLER_TAPER {
+            return None;
+        }
+        // chamfered ends lie inside the line, never outside it
+        let on_side = side.iter().all(|&(r, t)| {
+            let off = r - (a + b * t);
+            off.abs() <= slack || (off < 0.0 && near_end(t))
+        });
+        // near the axis only the ends' centres: no hole, no neck
+        let solid_ends = rt.iter().all(|&(r, t)| r > 0.5 * rmax || near_end(t));
+        if !(on_side && solid_ends) {
+            return None;
+        }
+        let (r0, r1) = (a + b * t0, a + b * t1);
+        let solid = std::f32::consts::PI * length * (r0 * r0 + r0 * r1 + r1 * r1) / 3.0;
+        let share = volume / solid;
+        (share >= ROLLER_VOLUME.0 && share <= ROLLER_VOLUME.1).then(|| (mean + axis * (0.5 * (t0 + t1)), a + b * 0.5 * (t0 + t1), axis))
+    })
 }
 
 /// The distance of `x` from the line through `centre` along unit `axis`, and its coordinate
@@ -163,18 +275,27 @@ impl World {
     /// holds the ones found with the world.
     pub fn find_bearings(&self) -> Vec<Bearing> {
         let n = self.num_parts();
-        // the balls: parts on a sphere (triangle meshes; unions of boxes are not round)
-        let balls: BTreeMap<usize, (Vec3, f32)> = (0..n)
+        // the rolling elements: parts on a sphere, or closed ones that are a cylinder or a cone
+        // (triangle meshes; unions of boxes are not round)
+        let elements: BTreeMap<usize, Element> = (0..n)
             .filter(|&p| self.geoms[p].boxes.is_none())
-            .filter_map(|p| fit_sphere(self.geoms[p].mesh.vertices(), self.tolerance).map(|s| (p, s)))
+            .filter_map(|p| {
+                let mesh = &self.geoms[p].mesh;
+                if let Some((centre, radius)) = fit_sphere(mesh.vertices(), self.tolerance) {
+                    return Some((p, Element { centre, radius, kind: RollingElement::Ball, axis: Vec3::ZERO }));
+                }
+                let (centre, radius, axis) =
+                    self.geoms[p].closed.then(|| fit_roller(mesh.vertices(), mesh.indices(), self.tolerance)).flatten()?;
+                Some((p, Element { centre, radius, kind: RollingElement::Roller, axis }))
+            })
             .collect();
-        if balls.len() < MIN_BALLS {
+        if elements.len() < MIN_BALLS {
             return Vec::new();
         }
-        // per pair of non-ball parts, the balls touching both
+        // per pair of other parts, the elements touching both
         let mut by_pair: BTreeMap<(usize, usize), Vec<usize>> = BTreeMap::new();
-        for &b in balls.keys() {
-            let others: Vec<usize> = self.contacts[b].iter().filter(|&q| q < n && !balls.contains_key(&q)).collect();
+        for &b in elements.keys() {
+            let others: Vec<usize> = self.contacts[b].iter().filter(|&q| q < n && !elements.contains_key(&q)).collect();
             for (i, &a) in others.iter().enumerate() {
                 for &c in &others[i + 1..] {
                     by_pair.entry((a, c)).or_default().push(b);
@@ -183,14 +304,14 @@ impl World {
         }
         let mut used = PartSet::empty(n + 1);
         let mut found = Vec::new();
-        // the pairs with the most balls first: a cage touches every ball too, but is no ring
+        // the pairs with the most elements first: a cage touches every ball too, but is no ring
         let mut pairs: Vec<((usize, usize), Vec<usize>)> = by_pair.into_iter().filter(|(_, b)| b.len() >= MIN_BALLS).collect();
         pairs.sort_by(|a, b| b.1.len().cmp(&a.1.len()).then(a.0.cmp(&b.0)));
         for ((a, c), members) in pairs {
             if used.contains(a) || used.contains(c) || members.iter().any(|&b| used.contains(b)) {
                 continue;
             }
-            if let Some(bearing) = self.bearing_of(a, c, &members, &balls) {
+            if let Some(bearing) = self.bearing_of(a, c, &members, &elements) {
                 for p in bearing.parts() {
                     used.insert(p);
                 }
@@ -201,18 +322,35 @@ impl World {
         found
     }
 
-    /// The bearing of `members` (balls touching both `a` and `c`), if the balls are of one size
-    /// on circles about one axis and `a` and `c` are rings on either side of them.
-    fn bearing_of(&self, a: usize, c: usize, members: &[usize], balls: &BTreeMap<usize, (Vec3, f32)>) -> Option<Bearing> {
+    /// The bearing of `members` (rolling elements touching both `a` and `c`), if they are of one
+    /// kind and size on circles about one axis (a roller's own axis in the plane through that
+    /// axis, within 45° of it) and `a` and `c` are rings on either side of them.
+    fn bearing_of(&self, a: usize, c: usize, members: &[usize], elements: &BTreeMap<usize, Element>) -> Option<Bearing> {
         let n = self.num_parts();
-        let radius = median(members.iter().map(|b| balls[b].1).collect());
-        let members: Vec<usize> = members.iter().copied().filter(|b| (balls[b].1 - radius).abs() <= SAME_SIZE * radius).collect();
+        let radius = median(members.iter().map(|b| elements[b].radius).collect());
+        let kind = elements[&members[0]].kind;
+        let members: Vec<usize> = members
+            .iter()
+            .copied()
+            .filter(|b| elements[b].kind == kind && (elements[b].radius - radius).abs() <= SAME_SIZE * radius)
+            .collect();
         if members.len() < MIN_BALLS {
             return None;
         }
-        let centres: Vec<Vec3> = members.iter().map(|b| balls[b].0).collect();
+        let centres: Vec<Vec3> = members.iter().map(|b| elements[b].centre).collect();
         let mean = centres.iter().copied().sum::<Vec3>() / centres.len() as f32;
         let axis = least_spread(&centres, mean);
+        if kind == RollingElement::Roller {
+            let laid_right = members.iter().all(|b| {
+                let e = &elements[b];
+                let out = (e.centre - mean - axis * (e.centre - mean).dot(axis)).normalize_or_zero();
+                let across = axis.cross(out);
+                e.axis.dot(across).abs() <= 0.1 && e.axis.dot(axis).abs() >= std::f32::consts::FRAC_1_SQRT_2
+            });
+            if !laid_right {
+                return None;
+            }
+        }
         // rows: the centres' places along the axis, split where they jump by more than a radius
         let mut along: Vec<(f32, usize)> = centres.iter().enumerate().map(|(i, &x)| (radial_axial(x, mean, axis).1, i)).collect();
         along.sort_by(|x, y| x.0.total_cmp(&y.0));
@@ -259,7 +397,7 @@ impl World {
         let mut others = Vec::new();
         loop {
             let joins: Vec<usize> = (0..n)
-                .filter(|&q| !held.contains(q) && !balls.contains_key(&q) && held.iter().any(|h| self.contacts[h].contains(q)))
+                .filter(|&q| !held.contains(q) && !elements.contains_key(&q) && held.iter().any(|h| self.contacts[h].contains(q)))
                 .filter(|&q| {
                     self.geoms[q].mesh.vertices().iter().all(|&v| {
                         let (r, t) = radial_axial(v, mean, axis);
@@ -282,6 +420,7 @@ impl World {
         Some(Bearing {
             rings: [inner, outer],
             balls: ball_parts,
+            elements: kind,
             others,
             centre: mean,
             axis,
@@ -319,6 +458,45 @@ mod tests {
         // a cube's corners and edge midpoints are not on one sphere
         let cube: Vec<Vec3> = (0..27).map(|i| Vec3::new((i % 3) as f32, (i / 3 % 3) as f32, (i / 9) as f32)).collect();
         assert!(fit_sphere(&cube, 1e-6).is_none());
+    }
+
+    /// A cylinder, a needle and a cone frustum (a tapered roller), about any axis and however
+    /// faceted, are rollers; a tube, a box, a ball, a bolt (head and shank), a disc and a rod too
+    /// long are not.
+    #[test]
+    fn cylinders_and_cones_are_rollers_and_tubes_boxes_balls_and_bolts_are_not() {
+        use crate::fixtures::{ball_mesh, revolve};
+        let mm = 0.001;
+        let turn = crate::math::Rot::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
+        let roller = |profile: &[(f32, f32)], n: u32| -> Option<(Vec3, f32, Vec3)> {
+            let m = revolve(profile, n, 0.1, Vec3::ZERO);
+            let v: Vec<Vec3> = m.vertices.iter().map(|&x| turn * x + Vec3::new(0.01, 0.02, -0.03)).collect();
+            fit_roller(&v, &m.triangles, 1e-6)
+        };
+        let cylinder = |r: f32, l: f32| vec![(0.0, 0.0), (r, 0.0), (r, l), (0.0, l)];
+        for n in [12, 16, 48] {
+            let (c, r, axis) = roller(&cylinder(3.0 * mm, 8.0 * mm), n).unwrap_or_else(|| panic!("a {n}-gon cylinder"));
+            assert!(axis.dot(turn * Vec3::Z).abs() > 0.9999, "{n}: {axis:?}");
+            assert!((c - (turn * Vec3::new(0.0, 0.0, 4.0 * mm) + Vec3::new(0.01, 0.02, -0.03))).length() < 1e-6, "{n}: {c:?}");
+            assert!((r - 3.0 * mm).abs() < 0.05 * 3.0 * mm, "{n}: {r}");
+        }
+        assert!(roller(&cylinder(1.0 * mm, 15.0 * mm), 12).is_some(), "a needle");
+        assert!(roller(&cylinder(4.0 * mm, 4.5 * mm), 24).is_some(), "a short roller");
+        let chamfered = [(0.0, 0.0), (2.7 * mm, 0.0), (3.0 * mm, 0.3 * mm), (3.0 * mm, 7.7 * mm), (2.7 * mm, 8.0 * mm), (0.0, 8.0 * mm)];
+        assert!(roller(&chamfered, 16).is_some(), "a roller with chamfered ends");
+        let (_, r, _) = roller(&[(0.0, 0.0), (3.0 * mm, 0.0), (2.6 * mm, 8.0 * mm), (0.0, 8.0 * mm)], 24).expect("a tapered roller");
+        assert!((r - 2.8 * mm).abs() < 0.1 * mm, "{r}");
+        let tube = [(1.5 * mm, 0.0), (3.0 * mm, 0.0), (3.0 * mm, 8.0 * mm), (1.5 * mm, 8.0 * mm)];
+        assert!(roller(&tube, 16).is_none(), "a tube");
+        let bolt = [(0.0, 0.0), (5.0 * mm, 0.0), (5.0 * mm, 4.0 * mm), (3.0 * mm, 4.0 * mm), (3.0 * mm, 20.0 * mm), (0.0, 20.0 * mm)];
+        assert!(roller(&bolt, 24).is_none(), "a bolt");
+        assert!(roller(&cylinder(10.0 * mm, 1.0 * mm), 24).is_none(), "a disc");
+        assert!(roller(&cylinder(1.0 * mm, 40.0 * mm), 24).is_none(), "a rod");
+        assert!(roller(&[(0.0, 0.0), (3.0 * mm, 0.0), (0.5 * mm, 8.0 * mm), (0.0, 8.0 * mm)], 24).is_none(), "a cone, not a roller");
+        let cube = crate::mesh::Mesh::cuboid(Vec3::ZERO, Vec3::new(0.006, 0.006, 0.008));
+        assert!(fit_roller(&cube.vertices, &cube.triangles, 1e-6).is_none(), "a box");
+        let ball = ball_mesh(Vec3::ZERO, 0.004, 8, 16);
+        assert!(fit_roller(&ball.vertices, &ball.triangles, 1e-6).is_none(), "a ball");
     }
 
     #[test]

@@ -22,7 +22,7 @@ mod removal;
 
 pub(crate) use removal::best_free_direction;
 
-pub use bearings::Bearing;
+pub use bearings::{Bearing, RollingElement};
 use classify::Regions;
 pub use directions::candidate_directions;
 use geom::{contains_point, nests, Geom};

@@ -1,10 +1,10 @@
-//! Rolling bearings recognised from their geometry ([`asp_geom::Bearing`]): balls captive
-//! between two raced rings, whatever the tessellation and the number of balls, in a housing on a
-//! shaft or alone; and nothing taken for one that is not.
+//! Rolling bearings recognised from their geometry ([`asp_geom::Bearing`]): balls or rollers
+//! captive between two raced rings, whatever the tessellation and the number of them, in a
+//! housing on a shaft or alone; and nothing taken for one that is not.
 
 use asp_geom::fits::Role;
 use asp_geom::math::Vec3;
-use asp_geom::{fixtures, World, WorldConfig};
+use asp_geom::{fixtures, RollingElement, World, WorldConfig};
 
 fn world(a: asp_geom::Assembly, fasteners: bool) -> World {
     World::new(a, &WorldConfig { fasteners, ..WorldConfig::default() }).unwrap()
@@ -21,7 +21,7 @@ fn a_ball_bearing_in_a_housing_on_a_shaft_is_found_whatever_its_facets_and_balls
         assert_eq!(b.rings, [inner, outer], "{facets}/{balls}");
         assert_eq!(b.balls, (4..4 + balls as usize).collect::<Vec<_>>(), "{facets}/{balls}");
         assert!(b.others.is_empty(), "the housing and the shaft are not the bearing's: {:?}", b.others);
-        assert_eq!(b.rows, 1);
+        assert_eq!((b.rows, b.elements), (1, RollingElement::Ball));
         assert!(b.axis.dot(Vec3::Z).abs() > 0.9999, "{:?}", b.axis);
         assert!((b.pitch_radius - 0.01675).abs() < 2e-5, "{}", b.pitch_radius);
         assert!((b.ball_radius - 0.003954).abs() < 5e-5, "{}", b.ball_radius);
@@ -30,6 +30,47 @@ fn a_ball_bearing_in_a_housing_on_a_shaft_is_found_whatever_its_facets_and_balls
         // the rings are a bearing's, not nuts of a fastener
         assert_eq!((w.role(inner), w.role(outer)), (Role::Other, Role::Other));
     }
+}
+
+/// A cylindrical roller bearing (ribs on both rings) is found as the ball bearing is, however
+/// faceted its rings and however many rollers; its rings are no nuts.
+#[test]
+fn a_roller_bearing_in_a_housing_on_a_shaft_is_found_whatever_its_facets_and_rollers() {
+    for (facets, rollers) in [(32, 8), (64, 10), (128, 14)] {
+        let w = world(fixtures::roller_bearing(facets, rollers, true), true);
+        let b = w.bearings();
+        assert_eq!(b.len(), 1, "{facets} facets, {rollers} rollers: {b:?}");
+        let b = &b[0];
+        assert_eq!(b.elements, RollingElement::Roller);
+        assert_eq!(b.rings, [2, 3], "{facets}/{rollers}");
+        assert_eq!(b.balls, (4..4 + rollers as usize).collect::<Vec<_>>(), "{facets}/{rollers}");
+        assert!(b.others.is_empty(), "{:?}", b.others);
+        assert_eq!(b.rows, 1);
+        assert!(b.axis.dot(Vec3::Z).abs() > 0.9999, "{:?}", b.axis);
+        assert!((b.pitch_radius - 0.01675).abs() < 2e-5, "{}", b.pitch_radius);
+        assert!((b.ball_radius - 0.003).abs() < 1.5e-4, "{}", b.ball_radius);
+        assert!((b.centre - Vec3::new(0.0, 0.0, 0.007)).length() < 1e-5, "{:?}", b.centre);
+        assert_eq!((w.role(2), w.role(3)), (Role::Other, Role::Other));
+    }
+}
+
+/// Rollers laid across their circle (pins tangent to it, not along the axis) between two rings
+/// are no bearing: a roller's axis lies in the plane through the bearing's axis.
+#[test]
+fn rollers_laid_across_their_circle_are_no_bearing() {
+    let mut a = fixtures::roller_bearing(64, 10, false);
+    let mm = 0.001;
+    for (k, p) in a.parts.iter_mut().skip(2).enumerate() {
+        // each roller turned 90° about its radial line, so that it lies tangent to the circle
+        let angle = std::f32::consts::TAU * k as f32 / 10.0;
+        let out = Vec3::new(angle.cos(), angle.sin(), 0.0);
+        let centre = out * 16.75 * mm + Vec3::Z * 7.0 * mm;
+        let turn = asp_geom::math::Rot::from_axis_angle(out, std::f32::consts::FRAC_PI_2);
+        for v in p.mesh.vertices.iter_mut() {
+            *v = centre + turn * (*v - centre);
+        }
+    }
+    assert!(world(a, true).bearings().is_empty());
 }
 
 #[test]
@@ -67,15 +108,26 @@ fn a_bearing_written_to_gltf_and_read_back_is_found() {
     assert_eq!(w.bearings().len(), 1);
     assert_eq!(w.bearings()[0].balls.len(), 9);
     assert_eq!(w.name(w.bearings()[0].rings[1]), "outer ring");
-    // the shipped example is this file
-    let shipped = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/bearing/ball_bearing_6204.glb");
+    shipped_is(&path, "ball_bearing_6204.glb");
+    // the roller bearing too
+    let path = dir.path().join("roller.glb");
+    write_glb(&fixtures::roller_bearing(64, 10, true), &path).unwrap();
+    let w = world(load(&path, &LoadOptions { up: Some(asp_geom::math::Axis::Z), ..LoadOptions::default() }).unwrap(), true);
+    assert_eq!((w.bearings().len(), w.bearings()[0].elements, w.bearings()[0].balls.len()), (1, RollingElement::Roller, 10));
+    shipped_is(&path, "roller_bearing_nup204.glb");
+}
+
+/// The shipped example `tests/data/bearing/NAME` is the file at `path` (`ASP_WRITE_EXAMPLES=1`
+/// rewrites it).
+fn shipped_is(path: &std::path::Path, name: &str) {
+    let shipped = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/bearing").join(name);
     if std::env::var_os("ASP_WRITE_EXAMPLES").is_some() {
         std::fs::create_dir_all(shipped.parent().unwrap()).unwrap();
-        std::fs::copy(&path, &shipped).unwrap();
+        std::fs::copy(path, &shipped).unwrap();
     }
     assert_eq!(
-        std::fs::read(&shipped).unwrap(),
-        std::fs::read(&path).unwrap(),
-        "tests/data/bearing is the fixture's glTF (ASP_WRITE_EXAMPLES=1 rewrites it)"
+        std::fs::read(&shipped).unwrap_or_default(),
+        std::fs::read(path).unwrap(),
+        "tests/data/bearing/{name} is the fixture's glTF (ASP_WRITE_EXAMPLES=1 rewrites it)"
     );
 }

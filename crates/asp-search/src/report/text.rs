@@ -122,13 +122,15 @@ fn write_table(out: &mut impl Write, r: &PlanReport) -> std::io::Result<()> {
     for b in &r.bearings {
         writeln!(
             out,
-            "rolling bearing: {} in {}, {} balls in {} row{} (pitch radius {}, ball radius {}), goes in as one unit",
+            "rolling bearing: {} in {}, {} {} in {} row{} (pitch radius {}, {} radius {}), goes in as one unit",
             b.names[0],
             b.names[1],
             b.balls.len(),
+            b.rolling_elements,
             b.rows,
             if b.rows == 1 { "" } else { "s" },
             sig(b.pitch_radius),
+            b.rolling_elements.trim_end_matches('s'),
             sig(b.ball_radius)
         )?;
     }
@@ -239,10 +241,10 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
                 SubassemblyStatus::Partial => "built on its base in this order, but not all of it part by part:".to_string(),
                 SubassemblyStatus::NoPlan => "cannot be taken apart (it goes in as one unit):".to_string(),
                 SubassemblyStatus::Unplanned => "not planned".to_string(),
-                SubassemblyStatus::Unit if r.bearings.iter().any(|b| b.parts == sorted(&g.parts)) => {
-                    "a rolling bearing (balls captive between two rings), one unit, not taken apart".to_string()
-                }
-                SubassemblyStatus::Unit => "declared one unit (--unit-group), not taken apart".to_string(),
+                SubassemblyStatus::Unit => match r.bearings.iter().find(|b| b.parts == sorted(&g.parts)) {
+                    Some(b) => format!("a rolling bearing ({} captive between two rings), one unit, not taken apart", b.rolling_elements),
+                    None => "declared one unit (--unit-group), not taken apart".to_string(),
+                },
                 other => format!("{} before its own plan was found; the parts that come off:", other.as_str().replace('_', " ")),
             };
             writeln!(out, "{inner}subassembly {} on base {}: {how}", members.join(", "), step.name)?;
