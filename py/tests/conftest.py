@@ -17,6 +17,7 @@ ROOT = Path(__file__).resolve().parents[2]
 LACK = "tests/data/ikea/table_lack_0825.glb"
 PUMP = "tests/data/pump"
 BEARING = "tests/data/bearing/ball_bearing_6204.glb"
+ROLLER_BEARING = "tests/data/bearing/roller_bearing_nup204.glb"
 
 # every wall-time figure of a plan JSON: the one thing two runs of the same plan may differ in
 # (`stats.timings` since format 1.4: load, world, search, path_planner)

@@ -8,7 +8,7 @@ import re
 import pytest
 
 import asp
-from conftest import BEARING, LACK, PUMP, without_seconds
+from conftest import BEARING, LACK, PUMP, ROLLER_BEARING, without_seconds
 
 
 @pytest.mark.parametrize(
@@ -310,4 +310,13 @@ def test_a_ball_bearing_is_one_unit(root, asp_cli):
     code, out, err = asp_cli("plan", BEARING, "--up", "z", "--json")
     assert code == 0, err
     assert without_seconds(plan.json) == without_seconds(out)
+
+
+def test_a_roller_bearing_is_one_unit():
+    # rollers between two ribbed rings: a bearing too, and the plan says what rolls
+    plan = asp.load(ROLLER_BEARING, up="z").plan()
+    assert plan.status == "found" and plan.locked_cores == []
+    (bearing,) = plan.bearings
+    assert bearing["rolling_elements"] == "rollers" and len(bearing["balls"]) == 10
+    assert "rolling bearing: inner ring in outer ring, 10 rollers in 1 row" in plan.table()
     assert asp.load(LACK, up="z").plan().bearings == []
