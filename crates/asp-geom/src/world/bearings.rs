@@ -393,15 +393,19 @@ impl World {
         let hi = ri.iter().chain(ro).map(|x| x.1).fold(f32::MIN, f32::max) + slack;
         let mut held = PartSet::from_indices(n + 1, members.iter().copied().chain([inner, outer]));
         // the other parts: in contact with the bearing and wholly inside its envelope (a cage
-        // touching only another cage half counts too: grow until nothing joins)
+        // touching only another cage half counts too: grow until nothing joins); a part that
+        // touches at least three of the rolling elements is their cage also where it stands out
+        // of the rings' faces by up to an element's radius (a tapered roller bearing's cage)
         let mut others = Vec::new();
         loop {
             let joins: Vec<usize> = (0..n)
                 .filter(|&q| !held.contains(q) && !elements.contains_key(&q) && held.iter().any(|h| self.contacts[h].contains(q)))
                 .filter(|&q| {
+                    let cage = members.iter().filter(|&&b| self.contacts[b].contains(q)).count() >= MIN_BALLS;
+                    let reach = if cage { radius } else { 0.0 };
                     self.geoms[q].mesh.vertices().iter().all(|&v| {
                         let (r, t) = radial_axial(v, mean, axis);
-                        r >= bore && r <= outside && t >= lo && t <= hi
+                        r >= bore && r <= outside && t >= lo - reach && t <= hi + reach
                     })
                 })
                 .collect();

@@ -54,6 +54,28 @@ fn a_roller_bearing_in_a_housing_on_a_shaft_is_found_whatever_its_facets_and_rol
     }
 }
 
+/// A cage that stands out of the rings' faces (as a tapered roller bearing's does) is the
+/// bearing's when it touches the rolling elements; a washer against the inner ring that stands out
+/// as far is not.
+#[test]
+fn a_cage_standing_out_of_the_faces_is_the_bearings_and_a_washer_is_not() {
+    use asp_geom::fixtures::{part, revolve};
+    let mm = 0.001;
+    let mut a = fixtures::roller_bearing(64, 10, false);
+    // an annulus under the rollers' lower ends (at z = 3 mm), between the ribs, 3.5 mm down to
+    // 0.5 mm below the rings' faces
+    let cage =
+        revolve(&[(15.4 * mm, -0.5 * mm), (18.1 * mm, -0.5 * mm), (18.1 * mm, 3.0 * mm), (15.4 * mm, 3.0 * mm)], 64, 0.0, Vec3::ZERO);
+    a.parts.push(part("cage", cage, false));
+    // a washer on the inner ring's upper face, 0.5 mm thick, inside the rib
+    let washer =
+        revolve(&[(10.5 * mm, 14.0 * mm), (14.5 * mm, 14.0 * mm), (14.5 * mm, 14.5 * mm), (10.5 * mm, 14.5 * mm)], 64, 0.0, Vec3::ZERO);
+    a.parts.push(part("washer", washer, false));
+    let w = world(a, true);
+    let b = &w.bearings()[0];
+    assert_eq!(b.others, vec![12], "the cage, not the washer: {b:?}");
+}
+
 /// Rollers laid across their circle (pins tangent to it, not along the axis) between two rings
 /// are no bearing: a roller's axis lies in the plane through the bearing's axis.
 #[test]
