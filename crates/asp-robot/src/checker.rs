@@ -24,18 +24,7 @@ use crate::removal::{RemovalPlanner, RobotFailure, RobotRemoval};
 
 /// A deterministic seed for the robot's plan of `part` in `state`.
 pub fn step_seed(seed: u64, state: &PartSet, part: usize) -> u64 {
-    let mut h = mix(seed ^ 0x243f_6a88_85a3_08d3);
-    for w in state.words() {
-        h = mix(h ^ w);
-    }
-    mix(h ^ part as u64)
-}
-
-fn mix(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
+    asp_geom::seed::derive(seed, asp_geom::seed::Stream::Robot, state, part as u64)
 }
 
 /// The unit direction of a removal's first move (a straight line's direction, a path's first
