@@ -1,5 +1,5 @@
 //! Seeds derived from a run's seed: SplitMix64, and the one derivation every randomised choice
-//! that depends on a disassembly state takes ([`derive`]). A derived seed depends only on its
+//! that depends on a disassembly state takes ([`derive()`]). A derived seed depends only on its
 //! inputs (never on a search's history, thread or episode), so the same state gets the same
 //! samples wherever it is reached.
 //!

@@ -40,7 +40,9 @@ fn first_direction(motion: &Motion) -> Option<asp_geom::math::Vec3> {
     }
 }
 
-/// Robot removability on top of a collision-world checker.
+/// Robot removability on top of a collision-world checker. It names no
+/// [`FeasibilityChecker::decorated`] checker on purpose: it offers no groups (the robot carries
+/// one part at a time), and its refusal reasons are its own.
 pub struct RobotChecker<'c> {
     inner: &'c dyn FeasibilityChecker,
     planner: RemovalPlanner<&'c World>,
@@ -264,26 +266,9 @@ impl FeasibilityChecker for HoldingChecker<'_> {
         self.admit(&PartSet::from_indices(self.inner.num_parts(), [part]), state, outcome)
     }
 
-    fn group_candidates(&self, state: &PartSet) -> Vec<PartSet> {
-        self.inner.group_candidates(state)
-    }
-
-    fn in_movable_group(&self, part: usize, state: &PartSet) -> bool {
-        self.inner.in_movable_group(part, state)
-    }
-
     fn test_group_removal(&self, group: &PartSet, state: &PartSet) -> Outcome {
         let outcome = self.inner.test_group_removal(group, state);
         self.admit(group, state, outcome)
-    }
-
-    /// A subassembly is planned on its own base by the inner checker (nothing held inside it).
-    fn subassembly(&self, group: &PartSet) -> Option<(usize, Box<dyn FeasibilityChecker + '_>)> {
-        self.inner.subassembly(group)
-    }
-
-    fn is_unit(&self, group: &PartSet) -> bool {
-        self.inner.is_unit(group)
     }
 
     fn stability(&self, state: &PartSet) -> Stability {
@@ -292,5 +277,11 @@ impl FeasibilityChecker for HoldingChecker<'_> {
 
     fn counters(&self) -> CounterSnapshot {
         self.inner.counters()
+    }
+
+    /// The inner checker: its groups, a subassembly planned on its own base (nothing held
+    /// inside it), its units and refusal reasons are this checker's.
+    fn decorated(&self) -> Option<&dyn FeasibilityChecker> {
+        Some(self.inner)
     }
 }
