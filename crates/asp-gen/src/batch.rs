@@ -10,10 +10,7 @@ use std::path::Path;
 /// The seed of assembly `index` of a batch: SplitMix64 of the pair, so neighbouring batch
 /// seeds and indices give unrelated streams and any assembly can be made on its own.
 pub fn assembly_seed(batch_seed: u64, index: usize) -> u64 {
-    let mut z = batch_seed ^ (index as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+    asp_geom::seed::finalise(batch_seed ^ (index as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15))
 }
 
 /// The file name of assembly `index` in a batch of `count`: `soma5_000.glb`, or just

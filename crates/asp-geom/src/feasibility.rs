@@ -170,6 +170,11 @@ impl Counters {
 }
 
 /// Removal test + stability, as a planner sees them. Implementations count every test they run.
+///
+/// A checker that decorates another (held parts, declared units) names it in
+/// [`FeasibilityChecker::decorated`]: every optional method it does not define then forwards to
+/// the decorated checker, so a decorator changes what it means to change and forgets nothing.
+/// The defaults below are a checker's that decorates nothing.
 pub trait FeasibilityChecker: Send + Sync {
     /// Number of parts (indices `0..num_parts()`).
     fn num_parts(&self) -> usize;
@@ -183,13 +188,18 @@ pub trait FeasibilityChecker: Send + Sync {
     /// The counters so far.
     fn counters(&self) -> CounterSnapshot;
 
+    /// The checker this one decorates, to which every optional method it does not define
+    /// forwards. Default: `None` (it decorates nothing).
+    fn decorated(&self) -> Option<&dyn FeasibilityChecker> {
+        None
+    }
+
     /// Candidate subassemblies of `state`: sets of at least two present, non-fixed parts that can
     /// translate together along one straight line without colliding with the rest (for each
     /// candidate direction, the closure of a part under "is blocked by"), smallest first, without
     /// duplicates. Default: none (a checker that cannot move groups).
     fn group_candidates(&self, state: &PartSet) -> Vec<PartSet> {
-        let _ = state;
-        Vec::new()
+        self.decorated().map_or_else(Vec::new, |c| c.group_candidates(state))
     }
 
     /// Whether some rigid group of parts of `state` that contains `part` and no fixed part could
@@ -197,31 +207,30 @@ pub trait FeasibilityChecker: Send + Sync {
     /// part). Removing other parts never makes such a closure smaller, so `false` holds in every
     /// state that contains this one. Default: `false` (a checker that cannot move groups).
     fn in_movable_group(&self, part: usize, state: &PartSet) -> bool {
-        let _ = (part, state);
-        false
+        self.decorated().is_some_and(|c| c.in_movable_group(part, state))
     }
 
     /// Tests whether the parts of `group` (present, non-fixed) can leave `state` together as one
     /// rigid body along a straight line, and whether what remains is stable. Counts the test.
     /// Default: blocked by nothing nameable (a checker that cannot move groups).
     fn test_group_removal(&self, group: &PartSet, state: &PartSet) -> Outcome {
-        let _ = state;
-        Outcome::Collision { blockers: PartSet::empty(group.len()) }
+        match self.decorated() {
+            Some(c) => c.test_group_removal(group, state),
+            None => Outcome::Collision { blockers: PartSet::empty(group.len()) },
+        }
     }
 
     /// The checker of a subassembly planned on its own: its base part (one of `group`) and a
     /// checker in which that base is the only fixed part (no virtual ground), so the group's own
     /// disassembly can be planned. Default: `None` (subassemblies stay unplanned).
     fn subassembly(&self, group: &PartSet) -> Option<(usize, Box<dyn FeasibilityChecker + '_>)> {
-        let _ = group;
-        None
+        self.decorated()?.subassembly(group)
     }
 
     /// Whether `group` is a unit declared by the user (a purchased component: planned as one
     /// part on purpose, never taken apart). Default: `false`.
     fn is_unit(&self, group: &PartSet) -> bool {
-        let _ = group;
-        false
+        self.decorated().is_some_and(|c| c.is_unit(group))
     }
 
     /// Why a checker that decorates another (a robot arm that must also carry the part out)
@@ -230,7 +239,6 @@ pub trait FeasibilityChecker: Send + Sync {
     /// in that state (the test then returned [`Outcome::Collision`]), `None` when it never
     /// refused it there. Removability labels record it. Default: `None` (nothing decorates).
     fn refusal_reason(&self, part: usize, state: &PartSet) -> Option<&'static str> {
-        let _ = (part, state);
-        None
+        self.decorated()?.refusal_reason(part, state)
     }
 }

@@ -25,6 +25,7 @@ pub mod physics;
 pub mod puzzles;
 pub mod rrt;
 pub mod sample;
+pub mod seed;
 pub mod surface;
 pub mod sweep;
 pub mod validate;

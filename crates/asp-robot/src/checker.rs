@@ -24,18 +24,7 @@ use crate::removal::{RemovalPlanner, RobotFailure, RobotRemoval};
 
 /// A deterministic seed for the robot's plan of `part` in `state`.
 pub fn step_seed(seed: u64, state: &PartSet, part: usize) -> u64 {
-    let mut h = mix(seed ^ 0x243f_6a88_85a3_08d3);
-    for w in state.words() {
-        h = mix(h ^ w);
-    }
-    mix(h ^ part as u64)
-}
-
-fn mix(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
+    asp_geom::seed::derive(seed, asp_geom::seed::Stream::Robot, state, part as u64)
 }
 
 /// The unit direction of a removal's first move (a straight line's direction, a path's first
@@ -51,7 +40,9 @@ fn first_direction(motion: &Motion) -> Option<asp_geom::math::Vec3> {
     }
 }
 
-/// Robot removability on top of a collision-world checker.
+/// Robot removability on top of a collision-world checker. It names no
+/// [`FeasibilityChecker::decorated`] checker on purpose: it offers no groups (the robot carries
+/// one part at a time), and its refusal reasons are its own.
 pub struct RobotChecker<'c> {
     inner: &'c dyn FeasibilityChecker,
     planner: RemovalPlanner<&'c World>,
@@ -275,26 +266,9 @@ impl FeasibilityChecker for HoldingChecker<'_> {
         self.admit(&PartSet::from_indices(self.inner.num_parts(), [part]), state, outcome)
     }
 
-    fn group_candidates(&self, state: &PartSet) -> Vec<PartSet> {
-        self.inner.group_candidates(state)
-    }
-
-    fn in_movable_group(&self, part: usize, state: &PartSet) -> bool {
-        self.inner.in_movable_group(part, state)
-    }
-
     fn test_group_removal(&self, group: &PartSet, state: &PartSet) -> Outcome {
         let outcome = self.inner.test_group_removal(group, state);
         self.admit(group, state, outcome)
-    }
-
-    /// A subassembly is planned on its own base by the inner checker (nothing held inside it).
-    fn subassembly(&self, group: &PartSet) -> Option<(usize, Box<dyn FeasibilityChecker + '_>)> {
-        self.inner.subassembly(group)
-    }
-
-    fn is_unit(&self, group: &PartSet) -> bool {
-        self.inner.is_unit(group)
     }
 
     fn stability(&self, state: &PartSet) -> Stability {
@@ -303,5 +277,11 @@ impl FeasibilityChecker for HoldingChecker<'_> {
 
     fn counters(&self) -> CounterSnapshot {
         self.inner.counters()
+    }
+
+    /// The inner checker: its groups, a subassembly planned on its own base (nothing held
+    /// inside it), its units and refusal reasons are this checker's.
+    fn decorated(&self) -> Option<&dyn FeasibilityChecker> {
+        Some(self.inner)
     }
 }

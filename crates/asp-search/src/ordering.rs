@@ -164,21 +164,10 @@ impl PartOrdering for Reshuffled {
     }
 }
 
-/// A seed derived from a base seed, a state and a salt (e.g. a part index): the same inputs give
-/// the same seed, and nearby inputs unrelated ones (SplitMix64 mixing).
+/// The depth-first search's seed of the randomised work on `state` named by `salt` (a part
+/// index): [`asp_geom::seed::derive`] in the search's stream.
 pub fn state_seed(seed: u64, state: &PartSet, salt: u64) -> u64 {
-    let mut h = mix(seed ^ 0x9e37_79b9_7f4a_7c15);
-    for &w in state.words() {
-        h = mix(h ^ w);
-    }
-    mix(h ^ salt)
-}
-
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
+    asp_geom::seed::derive(seed, asp_geom::seed::Stream::Search, state, salt)
 }
 
 /// Bookkeeping (thesis 3.1.1, Dorn et al.): a part whose straight-line test collided is not

@@ -111,18 +111,6 @@ impl<'s, 'm> StepContext<'s, 'm> {
     /// ([`crate::Mdp::with_seed`]), the present parts and the moving part: the same step gives the same
     /// seed in every thread, episode and replay.
     pub fn seed(&self) -> u64 {
-        let mut h = splitmix(self.seed ^ 0x6a09_e667_f3bc_c909);
-        for w in self.state.present().words() {
-            h = splitmix(h ^ w);
-        }
-        splitmix(h ^ self.part as u64)
+        asp_geom::seed::derive(self.seed, asp_geom::seed::Stream::Step, &self.state.present(), self.part as u64)
     }
-}
-
-/// SplitMix64's finaliser: a cheap, well-mixed hash of one word.
-fn splitmix(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }

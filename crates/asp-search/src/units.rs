@@ -79,6 +79,12 @@ impl FeasibilityChecker for UnitChecker<'_> {
         self.inner().counters()
     }
 
+    /// The wrapped checker: whatever a unit does not change is its answer (a robot's refusal
+    /// reasons among them).
+    fn decorated(&self) -> Option<&dyn FeasibilityChecker> {
+        Some(self.inner())
+    }
+
     /// The wrapped checker's groups with their units made whole, then every unit present (none
     /// with a fixed part), smallest first, without duplicates.
     fn group_candidates(&self, state: &PartSet) -> Vec<PartSet> {
@@ -91,14 +97,6 @@ impl FeasibilityChecker for UnitChecker<'_> {
         }
         found.sort_by_key(|g| (g.len(), g.iter().next()));
         found
-    }
-
-    fn in_movable_group(&self, part: usize, state: &PartSet) -> bool {
-        self.inner().in_movable_group(part, state)
-    }
-
-    fn test_group_removal(&self, group: &PartSet, state: &PartSet) -> Outcome {
-        self.inner().test_group_removal(group, state)
     }
 
     /// The wrapped checker's subassembly, with the units inside the group.
@@ -116,4 +114,50 @@ impl FeasibilityChecker for UnitChecker<'_> {
 /// Whether two sets hold the same parts (whatever room each has).
 fn same(a: &PartSet, b: &PartSet) -> bool {
     a.is_subset(b) && b.is_subset(a)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A checker that refuses every removal with a reason, and moves parts 1 and 2 as a group.
+    struct Refusing;
+
+    impl FeasibilityChecker for Refusing {
+        fn num_parts(&self) -> usize {
+            4
+        }
+        fn is_fixed(&self, part: usize) -> bool {
+            part == 0
+        }
+        fn test_removal(&self, _part: usize, state: &PartSet, _kind: MotionKind) -> Outcome {
+            Outcome::Collision { blockers: state.clone() }
+        }
+        fn stability(&self, _state: &PartSet) -> Stability {
+            Stability::Stable
+        }
+        fn counters(&self) -> CounterSnapshot {
+            CounterSnapshot::default()
+        }
+        fn in_movable_group(&self, part: usize, _state: &PartSet) -> bool {
+            part == 1 || part == 2
+        }
+        fn refusal_reason(&self, _part: usize, _state: &PartSet) -> Option<&'static str> {
+            Some("no path")
+        }
+    }
+
+    /// What units do not change is the wrapped checker's answer, the methods the unit checker
+    /// does not define among them: a robot's refusal reason reaches the caller through units.
+    #[test]
+    fn a_unit_checker_forwards_what_units_do_not_change() {
+        let inner = Refusing;
+        let units = UnitChecker::new(&inner, vec![PartSet::from_indices(5, [2, 3])]);
+        let all = PartSet::full(4);
+        assert_eq!(units.refusal_reason(1, &all), Some("no path"));
+        assert!(units.in_movable_group(1, &all) && !units.in_movable_group(3, &all));
+        assert!(units.decorated().is_some());
+        // what it does define is its own: a unit's part never leaves alone
+        assert!(units.is_unit(&PartSet::from_indices(5, [2, 3])) && !inner.is_unit(&PartSet::from_indices(5, [2, 3])));
+    }
 }
