@@ -78,6 +78,14 @@ class Plan:
         (``docs/plan-format.md``, "Bearings"). Empty when there is none."""
         return self._copy("bearings", [])
 
+    @property
+    def components(self) -> list[dict[str, Any]]:
+        """The components drawn as several interpenetrating solids of one product (format 1.14),
+        each planned as one unit: ``parts``, their ``names`` and the ``product`` that holds them
+        (``docs/plan-format.md``, "Components drawn as several solids"). Empty when there is
+        none."""
+        return self._copy("components", [])
+
     def table(self) -> str:
         """The plan as text, exactly as ``asp plan`` prints it for the same run: the table and,
         for optimising runs, the optimiser's summary."""

@@ -85,6 +85,7 @@ fn finish_report(report: &mut PlanReport, world: &World, outcome: &PlanOutcome, 
     report.overlaps = asp_search::report::OverlapsEntry::of(world);
     report.fits = asp_search::report::FitEntry::of(world);
     report.bearings = asp_search::report::BearingEntry::of(world);
+    report.components = asp_search::report::ComponentEntry::of(world);
     report.stats.timings = Some(timings(outcome, world_seconds));
 }
 

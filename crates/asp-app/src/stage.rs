@@ -87,14 +87,15 @@ impl Model<'_> {
     }
 
     /// The collision world's checker and the seconds its build took, built the first time it
-    /// is asked for; `units` then gain the world's rolling bearings ([`with_bearings`]).
+    /// is asked for; `units` then gain the world's rolling bearings and components drawn as several
+    /// solids ([`with_found_units`]).
     pub fn world(&mut self, settings: &PlanSettings, units: &mut Vec<PartSet>) -> Result<(&Checker, f64)> {
         if self.checker.is_none() {
             let assembly = self.assembly.take().ok_or_else(|| AppError::config("the pipeline lost its model"))?;
             let started = Instant::now();
             let built = checker(assembly.into_owned(), settings)?;
             self.world_seconds = started.elapsed().as_secs_f64();
-            *units = with_bearings(std::mem::take(units), built.world());
+            *units = with_found_units(std::mem::take(units), built.world());
             self.checker = Some(built);
         }
         let seconds = self.world_seconds;
@@ -195,13 +196,15 @@ fn grid_view(assembly: &Assembly, settings: &PlanSettings) -> std::result::Resul
     }
 }
 
-/// `units` with every rolling bearing `world` found ([`asp_geom::Bearing`]) as one more unit: a
-/// bought unit whose balls never leave their grooves goes in whole. A declared unit that shares
-/// a part with a bearing is merged with it (units are disjoint).
-fn with_bearings(mut units: Vec<PartSet>, world: &World) -> Vec<PartSet> {
+/// `units` with every rolling bearing `world` found ([`asp_geom::Bearing`]) and every component
+/// drawn as several interpenetrating solids ([`World::fused_components`]) as one more unit: a
+/// bought unit whose balls never leave their grooves, or one piece drawn as several, goes in
+/// whole. A declared unit that shares a part with one is merged with it (units are disjoint).
+fn with_found_units(mut units: Vec<PartSet>, world: &World) -> Vec<PartSet> {
     let n = world.num_parts();
-    for b in world.bearings() {
-        let mut merged = PartSet::from_indices(n + 1, b.parts());
+    let found = world.bearings().iter().map(|b| b.parts()).chain(world.fused_components());
+    for parts in found {
+        let mut merged = PartSet::from_indices(n + 1, parts);
         units.retain(|u| {
             let meets = u.intersects(&merged);
             if meets {

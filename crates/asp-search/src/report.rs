@@ -75,6 +75,10 @@ pub struct PlanReport {
     /// as one unit (feasibility planning; absent when there is none). Since format 1.12.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub bearings: Vec<BearingEntry>,
+    /// The components drawn as several interpenetrating solids of one product (format 1.14),
+    /// each planned as one unit; empty when there is none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub components: Vec<ComponentEntry>,
     /// Non-fatal problems found in the model, one line each.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
@@ -376,6 +380,33 @@ impl BearingEntry {
     }
 }
 
+/// A component of a plan drawn as several solids of one product that interpenetrate (format
+/// 1.14; [`asp_geom::World::fused_components`]): planned as one unit, never taken apart.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ComponentEntry {
+    /// Its parts, ascending (the unit's parts).
+    pub parts: Vec<usize>,
+    /// Their names.
+    pub names: Vec<String>,
+    /// The product of the file's tree that holds them (the last name of their path).
+    pub product: String,
+}
+
+impl ComponentEntry {
+    /// Every component drawn as several solids that `world` found.
+    pub fn of(world: &asp_geom::World) -> Vec<ComponentEntry> {
+        world
+            .fused_components()
+            .into_iter()
+            .map(|parts| ComponentEntry {
+                names: parts.iter().map(|&p| world.name(p).to_string()).collect(),
+                product: world.assembly().parts[parts[0]].path.last().cloned().unwrap_or_default(),
+                parts,
+            })
+            .collect()
+    }
+}
+
 /// One assembly step.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct AssemblyStep {
@@ -659,6 +690,7 @@ impl PlanReport {
             grid: None,
             file_subassemblies: Vec::new(),
             bearings: Vec::new(),
+            components: Vec::new(),
             precedence: None,
         }
     }

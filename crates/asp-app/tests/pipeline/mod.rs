@@ -447,6 +447,41 @@ fn a_ball_bearing_goes_in_as_one_unit() {
     assert!(text.contains("a rolling bearing (balls captive between two rings), one unit, not taken apart"), "{text}");
 }
 
+/// A screw drawn as two solids of one product (its body and a thread solid sunk into it, as
+/// bd_warehouse draws threaded fasteners): the two interpenetrate, so no motion separates them;
+/// they are one component as drawn, planned as one unit, named in a warning and in the plan's
+/// `components`. The same two solids as parts of different products (or of no product) stay a
+/// locked core the plan explains.
+#[test]
+fn solids_of_one_product_that_interpenetrate_go_in_as_one_component() {
+    use asp_geom::fixtures::{assemble, box_part};
+    use asp_search::report::{PlanStatus, SubassemblyStatus};
+    let model = |paths: [&str; 2]| {
+        let mut base = box_part("plate", [0.0, 0.0, 0.0], [0.1, 0.1, 0.01]);
+        base.fixed = true;
+        // a bar drawn through the middle of a thicker one: no motion separates them
+        let mut body = box_part("body", [0.04, 0.03, 0.01], [0.05, 0.06, 0.025]);
+        let mut thread = box_part("thread", [0.03, 0.04, 0.015], [0.06, 0.05, 0.02]);
+        body.path = vec!["bracket".into(), paths[0].into()];
+        thread.path = vec!["bracket".into(), paths[1].into()];
+        assemble("fused", vec![base, body, thread], asp_geom::math::Axis::Z)
+    };
+    let settings = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
+    let r = plan_assembly(model(["screw", "screw"]), &settings, None).unwrap();
+    let json = r.report.to_json();
+    assert_eq!(r.report.status, PlanStatus::Found, "{json}");
+    assert_eq!(r.report.components.len(), 1, "{json}");
+    assert_eq!((r.report.components[0].parts.clone(), r.report.components[0].product.as_str()), (vec![1, 2], "screw"));
+    let unit = r.report.assembly_sequence.iter().find_map(|s| s.subassembly.as_ref()).expect("the screw's step");
+    assert_eq!(unit.status, SubassemblyStatus::Unit, "{json}");
+    assert!(r.report.warnings.iter().any(|w| w.contains("parts 'body', 'thread' of 'screw' interpenetrate: one component")), "{json}");
+    assert!(r.report.to_text().contains("one component drawn as several interpenetrating solids, one unit"));
+    // two products: a lock, explained, not a unit
+    let r = plan_assembly(model(["screw", "nut"]), &settings, None).unwrap();
+    assert_eq!(r.report.status, PlanStatus::Partial, "{}", r.report.to_json());
+    assert!(r.report.components.is_empty());
+}
+
 /// A cylindrical roller bearing with ribs on both rings, in a housing on a shaft: without roller
 /// bearings recognised the plan is `partial` (the rollers never leave their raceways between
 /// the ribs); recognised, the bearing goes in as one unit along the axis and the plan is `found`.

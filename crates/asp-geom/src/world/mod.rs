@@ -17,6 +17,7 @@ mod bearings;
 mod classify;
 mod directions;
 mod fits;
+mod fused;
 mod geom;
 mod removal;
 
@@ -221,6 +222,8 @@ impl World {
         }
         // after the fits: a pair with a fit is one
         world.classify_overlaps(regions);
+        let fused = world.fused_warnings();
+        world.warnings.extend(fused);
         world.prepare_pair_shapes();
         Ok(world)
     }

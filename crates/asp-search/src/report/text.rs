@@ -243,6 +243,9 @@ fn write_steps(out: &mut dyn Write, r: &PlanReport, sequence: &[AssemblyStep], w
                 SubassemblyStatus::Unplanned => "not planned".to_string(),
                 SubassemblyStatus::Unit => match r.bearings.iter().find(|b| b.parts == sorted(&g.parts)) {
                     Some(b) => format!("a rolling bearing ({} captive between two rings), one unit, not taken apart", b.rolling_elements),
+                    None if r.components.iter().any(|c| c.parts == sorted(&g.parts)) => {
+                        "one component drawn as several interpenetrating solids, one unit, not taken apart".to_string()
+                    }
                     None => "declared one unit (--unit-group), not taken apart".to_string(),
                 },
                 other => format!("{} before its own plan was found; the parts that come off:", other.as_str().replace('_', " ")),
