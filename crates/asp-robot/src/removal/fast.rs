@@ -485,3 +485,54 @@ fn dist(a: [f32; 3], b: [f32; 3]) -> f32 {
     let (x, y, z) = (a[0] - b[0], a[1] - b[1], a[2] - b[2]);
     (x * x + y * y + z * z).sqrt()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use asp_geom::WorldConfig;
+    use rand::SeedableRng;
+
+    /// After a check, every shape counted as placed has every small sphere where this
+    /// configuration puts it (a self pair trusts them; the shape's own test skips the spheres
+    /// its enclosing sphere clears, and once counted the shape placed anyway, so its pairs read
+    /// centres of an earlier configuration).
+    #[test]
+    fn a_shape_counted_as_placed_has_every_sphere_where_this_configuration_puts_it() {
+        let assembly = asp_gen::ProfileAssembly::generate(&asp_gen::ProfileParams::single_layer(), 3).unwrap().to_assembly("p");
+        let world = World::new(assembly, &WorldConfig::default()).unwrap();
+        let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
+        let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
+        let n = world.num_parts();
+        let held = (0..n).find(|&p| !world.fixed().contains(p)).unwrap();
+        let grasp = planner.grasps(held)[0].clone();
+        let present = PartSet::full(n);
+        let obstacles = planner.obstacles(&present, held);
+        let shrunk = world.eroded(held, planner.config.margin.max(world.tolerance()));
+        let space = SphereSpace::new(&planner, held, &shrunk, Pose::from_parts(grasp.position, grasp.orientation), grasp.width, &obstacles);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let (mut partly, mut checked) = (0, 0);
+        for _ in 0..3000 {
+            let q = planner.cell.robot.random_configuration(&mut rng);
+            space.check(&q, None);
+            let scratch = space.scratch.borrow();
+            for (k, shape) in space.shapes.iter().enumerate() {
+                if !scratch.at.placed.get(k).copied().unwrap_or(false) {
+                    continue;
+                }
+                checked += 1;
+                let f = &scratch.frames[shape.body];
+                let s = &space.spheres;
+                let stale = shape.spheres.clone().filter(|&i| {
+                    let c = f.point([s.x[i], s.y[i], s.z[i]]);
+                    let d = scratch.at.centres[i];
+                    (c[0] - d[0]).abs() + (c[1] - d[1]).abs() + (c[2] - d[2]).abs() > 1e-6
+                });
+                let stale = stale.count();
+                partly += (stale > 0) as usize;
+                assert_eq!(stale, 0, "shape {k}: {stale} of its spheres are not where {q:?} puts them");
+            }
+        }
+        assert!(checked > 100, "only {checked} shapes were placed: the test shows little");
+        assert_eq!(partly, 0);
+    }
+}
