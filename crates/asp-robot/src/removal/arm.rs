@@ -354,6 +354,19 @@ impl<'a, W: Borrow<World>> ArmCheck<'a, W> {
     pub fn edge_free_exact(&self, a: &[f64], b: &[f64]) -> bool {
         self.exact.edge_valid(&a.to_vec(), &b.to_vec())
     }
+
+    /// The interior samples [`ArmCheck::edge_free`] stands for: `a + (b − a) i/n` for
+    /// `i = 1..n` (the walk skips those its clearances prove free).
+    pub fn edge_samples(&self, a: &[f64], b: &[f64]) -> Vec<Vec<f64>> {
+        let n = (self.spheres.metric(a, b) / self.spheres.resolution).ceil().max(1.0) as usize;
+        (1..n)
+            .map(|i| {
+                let mut q = Vec::new();
+                lerp_into(a, b, i as f64 / n as f64, &mut q);
+                q
+            })
+            .collect()
+    }
 }
 
 /// `out` = `a + (b − a) t`.

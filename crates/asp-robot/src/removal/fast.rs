@@ -42,18 +42,37 @@ enum Eval {
 #[derive(Debug, Default)]
 struct Scratch {
     frames: Vec<Frame>,
-    /// Per shape: whether its small spheres' world centres are in `centres` (this sample).
-    placed: Vec<bool>,
-    centres: Vec<[f32; 3]>,
+    at: Placing,
     /// Boxes already tested exactly against the current shape.
     tested: Vec<u32>,
     /// The configuration of the current sample of an edge.
     q: Vec<f64>,
+    /// Per shape, then per self pair: how far it moves per sample of the current edge.
+    moves: Vec<f32>,
     /// Per shape, then per self pair: where along the edge it was last evaluated, and its
     /// clearance there.
     last: Vec<(f32, f32)>,
-    /// Per shape, then per self pair: how far it moves per sample of the current edge.
-    moves: Vec<f32>,
+}
+
+/// The world positions of one sample's spheres, computed as they are asked for.
+#[derive(Debug, Default)]
+struct Placing {
+    /// Per shape: whether its small spheres' world centres are in `centres` (this sample).
+    placed: Vec<bool>,
+    centres: Vec<[f32; 3]>,
+    /// Per shape: its enclosing sphere's world centre (NaN: not yet placed this sample).
+    bounds: Vec<[f32; 3]>,
+}
+
+impl Placing {
+    /// Ready for a new sample of `shapes` shapes and `spheres` small spheres.
+    fn reset(&mut self, shapes: usize, spheres: usize) {
+        self.placed.clear();
+        self.placed.resize(shapes, false);
+        self.centres.resize(spheres, [0.0; 3]);
+        self.bounds.clear();
+        self.bounds.resize(shapes, [f32::NAN; 3]);
+    }
 }
 
 /// What a walk along an edge did: configurations examined (some shape evaluated) and skipped
@@ -147,8 +166,7 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
             world_shapes(&planner.arm[..planner.base_shapes], &poses)
         };
         let base_blocked = planner.shapes_collide(&base_placed, 0, obstacles);
-        let n = shapes.len();
-        let scratch = Scratch { placed: vec![false; n], ..Scratch::default() };
+        let scratch = Scratch::default();
         SphereSpace {
             planner,
             obstacles,
@@ -219,26 +237,41 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
         })
     }
 
-    /// Places shape `k`'s small spheres (world centres into `centres`, once per sample).
-    fn place(&self, k: usize, frames: &[Frame], placed: &mut [bool], centres: &mut [[f32; 3]]) {
-        if placed[k] {
+    /// Places shape `k`'s small spheres (world centres into `at.centres`, once per sample).
+    #[inline]
+    fn place(&self, k: usize, frames: &[Frame], at: &mut Placing) {
+        if at.placed[k] {
             return;
         }
         let f = &frames[self.shapes[k].body];
         let s = &self.spheres;
         for i in self.shapes[k].spheres.clone() {
-            centres[i] = f.point([s.x[i], s.y[i], s.z[i]]);
+            at.centres[i] = f.point([s.x[i], s.y[i], s.z[i]]);
         }
-        placed[k] = true;
+        at.placed[k] = true;
+    }
+
+    /// Shape `k`'s enclosing sphere's world centre (once per sample: the shape and each of its
+    /// self pairs ask for it).
+    #[inline]
+    fn bound_centre(&self, k: usize, frames: &[Frame], at: &mut Placing) -> [f32; 3] {
+        let b = at.bounds[k];
+        if !b[0].is_nan() {
+            return b;
+        }
+        let shape = &self.shapes[k];
+        let b = frames[shape.body].point(shape.bound.centre.to_array());
+        at.bounds[k] = b;
+        b
     }
 
     /// Shape `k` against the obstacles (the arm's shapes against the floor too) at the body
     /// frames `frames`: its enclosing sphere, else its small spheres (those the enclosing
     /// sphere's clearance does not already clear), else the exact test where one comes near.
-    fn eval_shape(&self, k: usize, frames: &[Frame], placed: &mut [bool], centres: &mut [[f32; 3]], tested: &mut Vec<u32>) -> Eval {
+    fn eval_shape(&self, k: usize, frames: &[Frame], at: &mut Placing, tested: &mut Vec<u32>) -> Eval {
         let shape = &self.shapes[k];
         let f = &frames[shape.body];
-        let b = f.point(shape.bound.centre.to_array());
+        let b = self.bound_centre(k, frames, at);
         let is_held = k == self.held_shape;
         // the field's bound, then the exact box distances
         let mut d = self.distance(b, !is_held, false);
@@ -250,6 +283,9 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
         }
         let mut clearance = f32::INFINITY;
         let mut pose = None;
+        // whether every small sphere's centre is placed (a sphere the enclosing one's clearance
+        // clears is not; a self pair of this shape then places them all)
+        let mut all = true;
         tested.clear();
         let s = &self.spheres;
         for i in shape.spheres.clone() {
@@ -258,12 +294,14 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
             let slack = d - s.off[i] - r;
             if slack >= 0.0 {
                 clearance = clearance.min(slack);
+                all = false;
                 continue;
             }
-            centres[i] = f.point([s.x[i], s.y[i], s.z[i]]);
-            let mut di = self.distance(centres[i], !is_held, false);
+            let c = f.point([s.x[i], s.y[i], s.z[i]]);
+            at.centres[i] = c;
+            let mut di = self.distance(c, !is_held, false);
             if di < r {
-                di = self.distance(centres[i], !is_held, true);
+                di = self.distance(c, !is_held, true);
             }
             if di >= r {
                 clearance = clearance.min(di - r);
@@ -275,27 +313,28 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
             }
             clearance = 0.0;
             let pose = *pose.get_or_insert_with(|| f.mul(&shape.local).to_pose());
-            if self.exact_near(k, &pose, centres[i], r, tested) {
+            if self.exact_near(k, &pose, c, r, tested) {
                 return Eval::Hit;
             }
         }
-        placed[k] = true;
+        at.placed[k] = all;
         Eval::Clear(clearance)
     }
 
     /// Self pair `p` ([`RemovalPlanner::self_pairs`]) at the body frames `frames`: enclosing
     /// spheres, small spheres, then the exact test.
-    fn eval_pair(&self, p: usize, frames: &[Frame], placed: &mut [bool], centres: &mut [[f32; 3]]) -> Eval {
+    fn eval_pair(&self, p: usize, frames: &[Frame], at: &mut Placing) -> Eval {
         let (i, j) = self.planner.self_pairs[p];
         let (si, sj) = (&self.shapes[i], &self.shapes[j]);
-        let (bi, bj) = (frames[si.body].point(si.bound.centre.to_array()), frames[sj.body].point(sj.bound.centre.to_array()));
+        let (bi, bj) = (self.bound_centre(i, frames, at), self.bound_centre(j, frames, at));
         let gap = dist(bi, bj) - si.bound.radius - sj.bound.radius;
         if gap > 0.0 {
             return Eval::Clear(gap);
         }
-        self.place(i, frames, placed, centres);
-        self.place(j, frames, placed, centres);
+        self.place(i, frames, at);
+        self.place(j, frames, at);
         let rs = &self.spheres.r;
+        let centres = &at.centres;
         let mut gap = f32::INFINITY;
         for a in si.spheres.clone() {
             // the small sphere against the other shape's enclosing one, then its small ones
@@ -338,14 +377,13 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
             return Found::Robot;
         }
         let mut guard = self.scratch.borrow_mut();
-        let Scratch { frames, placed, centres, tested, .. } = &mut *guard;
+        let Scratch { frames, at, tested, .. } = &mut *guard;
         self.planner.model.body_frames(q, frames);
-        centres.resize(self.spheres.len(), [0.0; 3]);
-        placed.iter_mut().for_each(|p| *p = false);
+        at.reset(self.shapes.len(), self.spheres.len());
         let mut clearance = f32::INFINITY;
         let mut held_near = false;
         for k in self.moving() {
-            match self.eval_shape(k, frames, placed, centres, tested) {
+            match self.eval_shape(k, frames, at, tested) {
                 Eval::Hit => return Found::Robot,
                 Eval::HeldNear => held_near = true,
                 Eval::Clear(c) => clearance = clearance.min(c),
@@ -353,7 +391,7 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
         }
         if self.planner.config.self_collision {
             for p in 0..self.planner.self_pairs.len() {
-                match self.eval_pair(p, frames, placed, centres) {
+                match self.eval_pair(p, frames, at) {
                     Eval::Hit => return Found::Robot,
                     Eval::HeldNear => {}
                     Eval::Clear(c) => clearance = clearance.min(c),
@@ -383,8 +421,7 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
             return false;
         }
         let mut guard = self.scratch.borrow_mut();
-        let Scratch { frames, placed, centres, tested, q, last, moves } = &mut *guard;
-        centres.resize(self.spheres.len(), [0.0; 3]);
+        let Scratch { frames, at, tested, q, last, moves } = &mut *guard;
         let pairs = if self.planner.config.self_collision { self.planner.self_pairs.len() } else { 0 };
         let shapes = self.shapes.len();
         // how far each shape, then each pair, moves per sample
@@ -397,10 +434,10 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
         last.clear();
         last.resize(shapes + pairs, (0.0, -1.0));
         for i in 1..n {
-            let at = i as f32;
+            let at_i = i as f32;
             // shape k (or pair) is clear here when it was `c` clear at sample `s` and has moved
             // less than `c` since
-            let due = |x: &(f32, f32), m: f32| (at - x.0) * m >= x.1;
+            let due = |x: &(f32, f32), m: f32| (at_i - x.0) * m >= x.1;
             if !(0..shapes + pairs).any(|k| (k >= shapes || self.shapes[k].body != 0) && due(&last[k], moves[k])) {
                 walk.skipped += 1;
                 continue;
@@ -410,29 +447,29 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
             q.clear();
             q.extend(a.iter().zip(b).map(|(x, y)| x + (y - x) * t));
             self.planner.model.body_frames(q, frames);
-            placed.iter_mut().for_each(|p| *p = false);
+            at.reset(shapes, self.spheres.len());
             let mut held_near = false;
             for k in self.moving() {
                 if !due(&last[k], moves[k]) {
                     continue;
                 }
-                match self.eval_shape(k, frames, placed, centres, tested) {
+                match self.eval_shape(k, frames, at, tested) {
                     Eval::Hit => return false,
                     Eval::HeldNear => {
                         held_near = true;
-                        last[k] = (at, 0.0);
+                        last[k] = (at_i, 0.0);
                     }
-                    Eval::Clear(c) => last[k] = (at, c),
+                    Eval::Clear(c) => last[k] = (at_i, c),
                 }
             }
             for p in 0..pairs {
                 if !due(&last[shapes + p], moves[shapes + p]) {
                     continue;
                 }
-                match self.eval_pair(p, frames, placed, centres) {
+                match self.eval_pair(p, frames, at) {
                     Eval::Hit => return false,
                     Eval::HeldNear => {}
-                    Eval::Clear(c) => last[shapes + p] = (at, c),
+                    Eval::Clear(c) => last[shapes + p] = (at_i, c),
                 }
             }
             if held_near && self.held_hits(frames) {
@@ -447,4 +484,55 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
 fn dist(a: [f32; 3], b: [f32; 3]) -> f32 {
     let (x, y, z) = (a[0] - b[0], a[1] - b[1], a[2] - b[2]);
     (x * x + y * y + z * z).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use asp_geom::WorldConfig;
+    use rand::SeedableRng;
+
+    /// After a check, every shape counted as placed has every small sphere where this
+    /// configuration puts it (a self pair trusts them; the shape's own test skips the spheres
+    /// its enclosing sphere clears, and once counted the shape placed anyway, so its pairs read
+    /// centres of an earlier configuration).
+    #[test]
+    fn a_shape_counted_as_placed_has_every_sphere_where_this_configuration_puts_it() {
+        let assembly = asp_gen::ProfileAssembly::generate(&asp_gen::ProfileParams::single_layer(), 3).unwrap().to_assembly("p");
+        let world = World::new(assembly, &WorldConfig::default()).unwrap();
+        let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
+        let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
+        let n = world.num_parts();
+        let held = (0..n).find(|&p| !world.fixed().contains(p)).unwrap();
+        let grasp = planner.grasps(held)[0].clone();
+        let present = PartSet::full(n);
+        let obstacles = planner.obstacles(&present, held);
+        let shrunk = world.eroded(held, planner.config.margin.max(world.tolerance()));
+        let space = SphereSpace::new(&planner, held, &shrunk, Pose::from_parts(grasp.position, grasp.orientation), grasp.width, &obstacles);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let (mut partly, mut checked) = (0, 0);
+        for _ in 0..3000 {
+            let q = planner.cell.robot.random_configuration(&mut rng);
+            space.check(&q, None);
+            let scratch = space.scratch.borrow();
+            for (k, shape) in space.shapes.iter().enumerate() {
+                if !scratch.at.placed.get(k).copied().unwrap_or(false) {
+                    continue;
+                }
+                checked += 1;
+                let f = &scratch.frames[shape.body];
+                let s = &space.spheres;
+                let stale = shape.spheres.clone().filter(|&i| {
+                    let c = f.point([s.x[i], s.y[i], s.z[i]]);
+                    let d = scratch.at.centres[i];
+                    (c[0] - d[0]).abs() + (c[1] - d[1]).abs() + (c[2] - d[2]).abs() > 1e-6
+                });
+                let stale = stale.count();
+                partly += (stale > 0) as usize;
+                assert_eq!(stale, 0, "shape {k}: {stale} of its spheres are not where {q:?} puts them");
+            }
+        }
+        assert!(checked > 100, "only {checked} shapes were placed: the test shows little");
+        assert_eq!(partly, 0);
+    }
 }
