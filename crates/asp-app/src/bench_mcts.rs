@@ -84,12 +84,12 @@ pub fn bench_model(
         return Err(AppError::config(format!("checkpoints must be positive and increasing, got {checkpoints:?}")));
     }
     asp_search::extension::check_objective_names(&o.objectives, &o.extensions)?;
-    let pareto = o.pareto || o.objectives.split(',').filter(|s| !s.trim().is_empty()).count() > 1;
+    let pareto = o.pareto || o.objectives.len() > 1;
     let assembly = Arc::new(pipeline::load(path, plan)?);
     let o = OptimiseSettings { pareto, ..o.clone() };
     let problem = pipeline::optimiser_problem(&assembly, plan, &o)?;
     let threads = o.threads.unwrap_or(1);
-    let measure = if pareto { "hypervolume".to_string() } else { o.objectives.trim().to_string() };
+    let measure = if pareto { "hypervolume".to_string() } else { o.objectives.join(",") };
     let mut rows = Vec::new();
     for setting in settings {
         let policy = setting.policy.prepare(&problem.mdp)?;

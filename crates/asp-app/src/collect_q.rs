@@ -242,8 +242,12 @@ pub fn collect_model_transitions(item: &ModelItem, out: &Path, settings: &Transi
 fn collect_one(item: &ModelItem, out: &Path, settings: &TransitionSettings) -> Result<(TransitionsModel, QGraphConfig, Vec<String>)> {
     let seed = collect::seed_of(settings.seed, item.index, 0);
     let plan = PlanSettings { seed, ..settings.plan.clone() };
-    let count = settings.optimise.objectives.split(',').filter(|s| !s.trim().is_empty()).count();
-    let o = OptimiseSettings { pareto: count > 1, threads: Some(1), time_limit: None, ..settings.optimise.clone() };
+    let o = OptimiseSettings {
+        pareto: settings.optimise.objectives.len() > 1,
+        threads: Some(1),
+        time_limit: None,
+        ..settings.optimise.clone()
+    };
     let assembly = Arc::new(pipeline::load(&item.path, &plan)?);
     let problem = pipeline::optimiser_problem(&assembly, &plan, &o)?.mdp;
     let (ranges, graph, objectives) = problem_entry(&problem)?;

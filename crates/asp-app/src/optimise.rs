@@ -28,10 +28,10 @@ pub struct OptimiserProblem {
 /// problem's seed. Several objectives need `o.pareto`.
 pub fn optimiser_problem(assembly: &Arc<Assembly>, settings: &PlanSettings, o: &OptimiseSettings) -> Result<OptimiserProblem> {
     asp_search::extension::check_objective_names(&o.objectives, &o.extensions)?;
-    if o.objectives.split(',').filter(|s| !s.trim().is_empty()).count() > 1 && !o.pareto {
+    if o.objectives.len() > 1 && !o.pareto {
         return Err(AppError::config(format!(
             "objectives {}: several objectives need a Pareto search (or give one objective)",
-            o.objectives
+            o.objectives.join(",")
         )));
     }
     let world = world_config(assembly, settings)?;

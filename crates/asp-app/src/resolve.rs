@@ -272,7 +272,7 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
     if names.iter().any(|n| n == asp_robot::ROBOT_PATH) && extensions.is_empty() {
         return Err(AppError::setting("objective", format!("{list}: robot-path needs a robot (`robot` panda or a URDF file)")));
     }
-    asp_search::extension::check_objective_names(&list, &extensions).map_err(|e| AppError::setting("objective", e.to_string()))?;
+    asp_search::extension::check_objective_names(names, &extensions).map_err(|e| AppError::setting("objective", e.to_string()))?;
     let pareto = r.pareto.unwrap_or(false);
     if names.len() > 1 && !pareto {
         return Err(AppError::setting("objective", format!("{list}: several objectives need `pareto` (or give one objective)")));
@@ -300,7 +300,7 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
         return Err(AppError::setting("exploration", format!("must be 0 or more, got {exploration}")));
     }
     Ok(Some(OptimiseSettings {
-        objectives: list,
+        objectives: names.clone(),
         pareto,
         episodes: at_least_one("episodes", r.episodes)?.unwrap_or(DEFAULT_EPISODES),
         budget: at_least_one("budget", r.budget)?.unwrap_or(DEFAULT_BUDGET),

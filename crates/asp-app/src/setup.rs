@@ -169,8 +169,9 @@ impl std::fmt::Debug for PlanSettings {
 /// The optimiser's settings (`asp plan --objective`).
 #[derive(Clone, Debug)]
 pub struct OptimiseSettings {
-    /// Objective names, comma-separated (`access`, `dirchange`, `pathlen`).
-    pub objectives: String,
+    /// Objective names in order (`access`, `dirchange`, `pathlen`, an extension's), one per
+    /// objective: several make a Pareto problem.
+    pub objectives: Vec<String>,
     /// Search the Pareto front (several objectives need it).
     pub pareto: bool,
     /// MCTS episodes.
@@ -208,7 +209,7 @@ pub struct OptimiseSettings {
 impl Default for OptimiseSettings {
     fn default() -> Self {
         OptimiseSettings {
-            objectives: String::new(),
+            objectives: Vec::new(),
             pareto: false,
             episodes: DEFAULT_EPISODES,
             budget: DEFAULT_BUDGET,

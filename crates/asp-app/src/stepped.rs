@@ -12,7 +12,7 @@
 //! # use asp_app::stepped::{SteppedSearch, Poll};
 //! # use asp_app::pipeline::{OptimiseSettings, PlanSettings};
 //! # use std::path::Path;
-//! let o = OptimiseSettings { objectives: "access".into(), ..OptimiseSettings::default() };
+//! let o = OptimiseSettings { objectives: vec!["access".into()], ..OptimiseSettings::default() };
 //! let plan = PlanSettings { optimise: Some(o), ..PlanSettings::default() };
 //! let mut search = SteppedSearch::start(Path::new("cube.glb"), &plan, true).unwrap();
 //! for _ in 0..10 {
@@ -92,8 +92,7 @@ impl SteppedSearch {
         let Some(o) = settings.optimise.clone() else {
             return Err(AppError::config("a stepped search needs objectives (the optimiser's settings)"));
         };
-        let count = o.objectives.split(',').filter(|s| !s.trim().is_empty()).count();
-        let o = OptimiseSettings { pareto: o.pareto || count > 1, threads: Some(1), ..o };
+        let o = OptimiseSettings { pareto: o.pareto || o.objectives.len() > 1, threads: Some(1), ..o };
         let stop = settings.cancel.clone().unwrap_or_default();
         let settings = PlanSettings { cancel: Some(stop.clone()), ..settings.clone() };
         let problem = pipeline::optimiser_problem(&assembly, &settings, &o)?;

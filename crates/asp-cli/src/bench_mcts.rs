@@ -47,7 +47,7 @@ pub fn run(a: &MctsArgs) -> anyhow::Result<std::process::ExitCode> {
                     _ => asp_search::QUse::Both,
                 };
                 let paths: Vec<std::path::PathBuf> = models.split(',').map(str::trim).filter(|p| !p.is_empty()).map(Into::into).collect();
-                let objectives: Vec<&str> = optimise.objectives.split(',').collect();
+                let objectives: Vec<&str> = optimise.objectives.iter().map(String::as_str).collect();
                 let policy = QPolicy::new(&paths, &objectives, a.epsilon.unwrap_or(DEFAULT_EPSILON), uses).map_err(crate::request::cli_error)?;
                 MctsSetting { name: name.into(), policy: Arc::new(policy) }
             }

@@ -198,7 +198,7 @@ pub fn q_graph_settings(dict: &Bound<'_, PyDict>) -> Result<(PlanSettings, asp_a
     request.insert("pareto".into(), Value::Bool(true));
     let mut plan = asp_app::resolve(&PlanRequest::from_value(Value::Object(request))?)?;
     let mut optimise = plan.optimise.take().ok_or_else(|| Error::config("objective: no objective given"))?;
-    optimise.pareto = optimise.objectives.split(',').count() > 1;
+    optimise.pareto = optimise.objectives.len() > 1;
     Ok((plan, optimise, neighbours))
 }
 

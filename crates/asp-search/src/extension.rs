@@ -48,11 +48,11 @@ pub trait MdpExtension: Send + Sync + Debug {
     }
 }
 
-/// Checks a comma-separated list of objective names against the built-in ones and those the
-/// `extensions` provide (before a model is loaded: for early, clear errors).
-pub fn check_objective_names(list: &str, extensions: &[Arc<dyn MdpExtension>]) -> Result<()> {
+/// Checks objective names (blanks left out, none an error) against the built-in ones and those
+/// the `extensions` provide (before a model is loaded: for early, clear errors).
+pub fn check_objective_names<S: AsRef<str>>(names: &[S], extensions: &[Arc<dyn MdpExtension>]) -> Result<()> {
     let provided: Vec<String> = extensions.iter().flat_map(|e| e.objective_names()).collect();
-    let names = collect_names(list)?;
+    let names = collect_names(names)?;
     for name in &names {
         if objective_by_name(name).is_err() && !provided.iter().any(|p| p == name.trim()) {
             return Err(unknown(name, &provided));
@@ -61,12 +61,16 @@ pub fn check_objective_names(list: &str, extensions: &[Arc<dyn MdpExtension>]) -
     Ok(())
 }
 
-/// The objectives of a comma-separated list on one model: the built-in ones by name, the
-/// others from the first extension that provides them.
-pub fn resolve_objectives(list: &str, extensions: &[Arc<dyn MdpExtension>], model: &ModelContext<'_>) -> Result<Vec<Arc<dyn Objective>>> {
+/// The objectives named by `names` (blanks left out, repeats an error) on one model: the
+/// built-in ones by name, the others from the first extension that provides them.
+pub fn resolve_objectives<S: AsRef<str>>(
+    names: &[S],
+    extensions: &[Arc<dyn MdpExtension>],
+    model: &ModelContext<'_>,
+) -> Result<Vec<Arc<dyn Objective>>> {
     let provided: Vec<String> = extensions.iter().flat_map(|e| e.objective_names()).collect();
     collect_objectives(
-        list,
+        names,
         |name| {
             if let Ok(o) = objective_by_name(name) {
                 return Ok(Some(o));

@@ -223,11 +223,13 @@ pub fn objective_by_name(name: &str) -> Result<Arc<dyn Objective>> {
 /// Parses a comma-separated list of built-in objective names (e.g. `access,dirchange`);
 /// repeats are an error.
 pub fn parse_objectives(list: &str) -> Result<Vec<Arc<dyn Objective>>> {
-    collect_objectives(list, |name| objective_by_name(name).map(Some), &[])
+    let names: Vec<&str> = list.split(',').collect();
+    collect_objectives(&names, |name| objective_by_name(name).map(Some), &[])
 }
 
-pub(crate) fn collect_names(list: &str) -> Result<Vec<&str>> {
-    let names: Vec<&str> = list.split(',').filter(|s| !s.trim().is_empty()).collect();
+/// The names of `names`, trimmed, blanks left out; none is an error.
+pub(crate) fn collect_names<S: AsRef<str>>(names: &[S]) -> Result<Vec<&str>> {
+    let names: Vec<&str> = names.iter().map(|s| s.as_ref().trim()).filter(|s| !s.is_empty()).collect();
     if names.is_empty() {
         return Err(SearchError::config("no objective given"));
     }
@@ -240,13 +242,13 @@ pub(crate) fn unknown(name: &str, provided: &[String]) -> SearchError {
     SearchError::UnknownObjective { name: name.to_string(), known: known.join(", ") }
 }
 
-pub(crate) fn collect_objectives(
-    list: &str,
+pub(crate) fn collect_objectives<S: AsRef<str>>(
+    names: &[S],
     mut by_name: impl FnMut(&str) -> Result<Option<Arc<dyn Objective>>>,
     provided: &[String],
 ) -> Result<Vec<Arc<dyn Objective>>> {
     let mut out: Vec<Arc<dyn Objective>> = Vec::new();
-    for name in collect_names(list)? {
+    for name in collect_names(names)? {
         let o = match by_name(name) {
             Ok(Some(o)) => o,
             Ok(None) | Err(SearchError::UnknownObjective { .. }) => return Err(unknown(name, provided)),

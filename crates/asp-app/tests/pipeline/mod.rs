@@ -110,7 +110,7 @@ fn an_optimisers_no_plan_is_explained_by_its_deepest_dead_end() {
     parts.push(asp_geom::fixtures::box_part("lid", [0.0, 0.0, 5.0], [5.0, 3.0, 6.0]));
     let a = asp_geom::fixtures::assemble("l_path_under_a_lid", parts, asp_geom::math::Axis::Z);
     for objectives in ["access", "dirchange"] {
-        let o = OptimiseSettings { objectives: objectives.into(), episodes: 50, ..OptimiseSettings::default() };
+        let o = OptimiseSettings { objectives: vec![objectives.into()], episodes: 50, ..OptimiseSettings::default() };
         let settings = PlanSettings { optimise: Some(o), ..PlanSettings::default() };
         let r = plan_assembly(a.clone(), &settings, None).unwrap();
         let json = r.report.to_json();
@@ -389,7 +389,7 @@ fn the_plan_says_which_guidance_ran() {
     let cube = asp_gen::SomaCube::random(3, &mut rng).unwrap().to_assembly(0.05, "soma3");
     let run = |policy: Option<QPolicy>| {
         let o = OptimiseSettings {
-            objectives: "access".into(),
+            objectives: vec!["access".into()],
             episodes: 5,
             threads: Some(1),
             resolution: 5,

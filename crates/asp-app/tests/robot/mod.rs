@@ -105,7 +105,7 @@ fn depth_first_search_with_the_robot_plans_checked_paths_deterministically() {
 fn the_optimiser_minimises_the_robot_path_and_repeats_itself() {
     let setup = RobotSetup::panda();
     let optimise = |threads| OptimiseSettings {
-        objectives: "robot-path".into(),
+        objectives: vec!["robot-path".into()],
         episodes: 3,
         budget: 2,
         threads: Some(threads),
@@ -217,7 +217,7 @@ fn robot_search(lazy: bool) -> (Vec<usize>, f64, u64, u64) {
     let assembly = Arc::new(stacks());
     let ext = Arc::new(RobotExtension::new(RobotSetup::panda()));
     let o = OptimiseSettings {
-        objectives: "robot-path".into(),
+        objectives: vec!["robot-path".into()],
         resolution: 5,
         extensions: vec![ext.clone() as Arc<dyn MdpExtension>],
         ..OptimiseSettings::default()

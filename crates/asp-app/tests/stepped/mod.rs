@@ -119,7 +119,7 @@ fn stepped_search_handle_gives_the_plan_of_asp_plan() {
     let path = dir.path().join("soma.glb");
     asp_geom::io::write_glb(&soma(4, 8), &path).unwrap();
     let o = OptimiseSettings {
-        objectives: "access,dirchange".into(),
+        objectives: vec!["access".into(), "dirchange".into()],
         pareto: true,
         episodes: 6,
         threads: Some(1),

@@ -235,7 +235,12 @@ fn the_data_set_has_the_documented_files_and_rebuilds_the_maps() {
     let settings = TransitionSettings {
         seed: 3,
         plan: PlanSettings { tolerance: Some(1e-5), ..PlanSettings::default() },
-        optimise: OptimiseSettings { objectives: "access,dirchange".into(), episodes: 12, resolution: 5, ..OptimiseSettings::default() },
+        optimise: OptimiseSettings {
+            objectives: vec!["access".into(), "dirchange".into()],
+            episodes: 12,
+            resolution: 5,
+            ..OptimiseSettings::default()
+        },
         ..TransitionSettings::default()
     };
     let out = dir.path().join("q");
@@ -268,7 +273,8 @@ fn the_data_set_has_the_documented_files_and_rebuilds_the_maps() {
         };
         let assembly = std::sync::Arc::new(asp_app::pipeline::load(Path::new(entry["model"].as_str().unwrap()), &plan).unwrap());
         let o = OptimiseSettings {
-            objectives: entry["maps"]["objective"].as_str().unwrap().into(),
+            // the index names the objectives comma-separated
+            objectives: entry["maps"]["objective"].as_str().unwrap().split(',').map(String::from).collect(),
             pareto: true,
             resolution: entry["maps"]["resolution"].as_u64().unwrap() as usize,
             ..OptimiseSettings::default()
@@ -345,15 +351,19 @@ fn collection_errors_name_the_cause() {
     let dir = tempfile::tempdir().unwrap();
     let model = soma_file(dir.path(), 1);
     let out = dir.path().join("q");
-    let with = |objectives: &str, episodes: usize| TransitionSettings {
-        optimise: OptimiseSettings { objectives: objectives.into(), episodes, ..OptimiseSettings::default() },
+    let with = |objectives: &[&str], episodes: usize| TransitionSettings {
+        optimise: OptimiseSettings {
+            objectives: objectives.iter().map(|s| s.to_string()).collect(),
+            episodes,
+            ..OptimiseSettings::default()
+        },
         ..TransitionSettings::default()
     };
-    let err = collect_transitions(std::slice::from_ref(&model), &out, &with("speed", 5), &|_| {}).unwrap_err();
+    let err = collect_transitions(std::slice::from_ref(&model), &out, &with(&["speed"], 5), &|_| {}).unwrap_err();
     assert!(err.to_string().contains("speed"), "{err}");
-    let err = collect_transitions(std::slice::from_ref(&model), &out, &with("access", 0), &|_| {}).unwrap_err();
+    let err = collect_transitions(std::slice::from_ref(&model), &out, &with(&["access"], 0), &|_| {}).unwrap_err();
     assert!(err.to_string().contains("episodes"), "{err}");
     let missing = dir.path().join("missing.glb");
-    let err = collect_transitions(&[model, missing], &out, &with("access", 5), &|_| {}).unwrap_err();
+    let err = collect_transitions(&[model, missing], &out, &with(&["access"], 5), &|_| {}).unwrap_err();
     assert!(err.to_string().contains("missing.glb"), "{err}");
 }

@@ -428,16 +428,16 @@ fn objectives_from_an_extension_resolve_by_name() {
         }
     }
     let ext: Vec<Arc<dyn MdpExtension>> = vec![Arc::new(Parity)];
-    check_objective_names("access,parity", &ext).unwrap();
-    let err = check_objective_names("access,speed", &ext).unwrap_err();
+    check_objective_names(&["access", "parity"], &ext).unwrap();
+    let err = check_objective_names(&["access", "speed"], &ext).unwrap_err();
     assert!(err.to_string().contains("parity"), "the message lists the extension's names: {err}");
-    assert!(check_objective_names("parity", &[]).is_err());
+    assert!(check_objective_names(&["parity"], &[]).is_err());
     let cube = Arc::new(soma(3, 1));
     let maps = maps(&cube, 5);
     let model = ModelContext { assembly: &cube, maps: &maps, seed: 0 };
-    let objectives = resolve_objectives("parity, access", &ext, &model).unwrap();
+    let objectives = resolve_objectives(&["parity", " access"], &ext, &model).unwrap();
     assert_eq!(objectives.iter().map(|o| o.name()).collect::<Vec<_>>(), vec!["parity", "access"]);
-    assert!(resolve_objectives("parity,parity", &ext, &model).is_err());
+    assert!(resolve_objectives(&["parity", "parity"], &ext, &model).is_err());
     assert_eq!(parse_objectives("access").unwrap().len(), 1);
 }
 
