@@ -113,7 +113,8 @@ pub(crate) struct Run<'a> {
     pub progress: Option<&'a (dyn Fn(&Progress) + Sync)>,
     /// The model, and its world once built.
     pub model: Model<'a>,
-    /// The parts kept together: the declared units, and the world's bearings once it is built.
+    /// The parts kept together: the declared units, and the world's bearings and components drawn
+    /// as several solids once it is built.
     pub units: Vec<PartSet>,
     /// The grid planner's voxel view of the model, or why the grid planner does not run on it.
     pub grid: std::result::Result<VoxelModel, &'static str>,
