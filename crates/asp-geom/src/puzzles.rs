@@ -2,7 +2,7 @@
 //! and benchmarks: six-piece burrs and a small puzzle that no straight-line or group removal
 //! takes apart. All in 1 cm cells, +Z up, no fixed part; every piece carries its cells
 //! (`extras.asp.voxels`). The piece shapes were found by a seeded search over notched sticks
-//! (`asp-geom/tests/grid`, `issue_9_find_puzzles`, ignored) and are stored as literal cells.
+//! (`asp-geom/tests/grid`, `find_puzzles`, ignored) and are stored as literal cells.
 
 use crate::assembly::Assembly;
 use crate::fixtures::{assemble, voxel_part};

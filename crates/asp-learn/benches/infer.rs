@@ -12,6 +12,7 @@
 use std::hint::black_box;
 use std::path::PathBuf;
 
+use asp_learn::qnet::GraphView;
 use asp_learn::{RemovabilityModel, ShapePolicy};
 use criterion::{criterion_group, criterion_main, Criterion};
 
@@ -93,7 +94,8 @@ fn q_forward(c: &mut Criterion) {
         let (mut out, mut s) = (vec![0.0; parts], asp_learn::qnet::Scratch::default());
         group.bench_function(format!("width{width}/parts{parts}"), |b| {
             b.iter(|| {
-                net.forward(black_box(&x), n, &sources, &targets, &edges, &wanted, &mut out, &mut s);
+                let graph = GraphView { x: black_box(&x), h0: None, n, sources: &sources, targets: &targets, edges: &edges };
+                net.forward(graph, &wanted, &mut out, &mut s);
                 black_box(out[0])
             })
         });

@@ -17,7 +17,7 @@ use asp_search::{OrderingFactory, OrderingSource, PartOrdering, SearchError};
 
 use crate::error::Result;
 use crate::model::{Checker, RemovabilityModel};
-use crate::qnet::QNet;
+use crate::qnet::{GraphView, QNet};
 
 impl RemovabilityModel {
     /// Score every node of a state graph ([`AssemblyGraph::state`]); outputs follow
@@ -142,10 +142,17 @@ impl GnnOrdering {
     /// other features.
     pub fn new(graph: Arc<AssemblyGraph>, model: Arc<RemovabilityModel>) -> Result<Self> {
         model.check_graph(&graph)?;
+        let encoded = Encoded::of(&graph, &model);
+        Ok(GnnOrdering::with(graph, model, encoded, None))
+    }
+
+    /// An ordering on `graph` with the model's node and edge encodings `encoded` (shared by the
+    /// orderings of one factory) and ties broken by `tie` (else by index).
+    fn with(graph: Arc<AssemblyGraph>, model: Arc<RemovabilityModel>, encoded: Option<Arc<Encoded>>, tie: Option<Shuffled>) -> Self {
         let parts = graph.num_parts();
-        Ok(GnnOrdering {
-            tie: None,
-            encoded: Encoded::of(&graph, &model),
+        GnnOrdering {
+            tie,
+            encoded,
             state: StateBuffers::default(),
             graph,
             model,
@@ -156,7 +163,7 @@ impl GnnOrdering {
             failures: 0,
             first_failure: None,
             skipped: 0,
-        })
+        }
     }
 
     /// The predicted removability of every part of the model in `state` (`-inf` for parts
@@ -209,7 +216,8 @@ impl GnnOrdering {
         b.out.clear();
         b.out.resize(n, 0.0);
         if n > 0 {
-            encoded.net.forward_encoded(&b.h0, &[], n, &b.sources, &b.targets, &b.edges, &b.wanted, &mut b.out, &mut b.net);
+            let graph = GraphView { x: &[], h0: Some(&b.h0), n, sources: &b.sources, targets: &b.targets, edges: &b.edges };
+            encoded.net.forward(graph, &b.wanted, &mut b.out, &mut b.net);
         }
         self.by_part.fill(f32::NEG_INFINITY);
         for (&part, &p) in b.nodes.iter().zip(&b.out) {
@@ -298,21 +306,7 @@ impl OrderingFactory for GnnFactory {
     }
 
     fn make(&self, num_parts: usize, seed: u64) -> Box<dyn PartOrdering> {
-        let parts = self.graph.num_parts();
-        Box::new(GnnOrdering {
-            tie: Some(Shuffled::new(num_parts, seed)),
-            encoded: self.encoded.clone(),
-            state: StateBuffers::default(),
-            graph: self.graph.clone(),
-            model: self.model.clone(),
-            scratch: StateGraph::default(),
-            buffers: Scratch::default(),
-            out: Vec::new(),
-            by_part: vec![f32::NEG_INFINITY; parts],
-            failures: 0,
-            first_failure: None,
-            skipped: 0,
-        })
+        Box::new(GnnOrdering::with(self.graph.clone(), self.model.clone(), self.encoded.clone(), Some(Shuffled::new(num_parts, seed))))
     }
 }
 

@@ -12,7 +12,7 @@
 
 use crate::error::{LearnError, Result};
 use crate::model::{GraphModel, ModelKind};
-use crate::qnet::{QNet, Scratch};
+use crate::qnet::{GraphView, QNet, Scratch};
 use asp_geom::distmap::{DirMask, MapState};
 use asp_search::policy::{EpsilonGreedy, Policy, PolicyContext, QFunction, QUse, QWorker};
 use asp_search::qgraph::{self, QGraph, QGraphBuilder, QGraphConfig};
@@ -23,6 +23,24 @@ use std::sync::Arc;
 /// The smallest value a learned Q-function reports: the product over several objectives
 /// (thesis 6.4.4) needs positive factors.
 pub const MIN_Q: f64 = 1e-6;
+
+/// `values` (one per action) into `out`, each at least [`MIN_Q`]; a value that is not finite is
+/// the model's error, naming the part.
+fn checked_values(
+    out: &mut [f64],
+    values: impl Iterator<Item = f32>,
+    actions: &[usize],
+    plugin: impl Fn(String) -> SearchError,
+) -> asp_search::Result<()> {
+    for (o, (v, &a)) in out.iter_mut().zip(values.zip(actions)) {
+        let v = f64::from(v);
+        if !v.is_finite() {
+            return Err(plugin(format!("the model gave {v} for part {a}")));
+        }
+        *o = v.max(MIN_Q);
+    }
+    Ok(())
+}
 
 /// A Q model as a [`QFunction`].
 #[derive(Debug, Clone)]
@@ -267,6 +285,28 @@ impl PairCache {
         net.encode_edge(&self.row, &mut self.context, &mut self.row_scratch);
     }
 
+    /// The edges of the state graph `g` (its last node the context) as the forward pass reads
+    /// them: `sources`, `targets` and each edge's encoding in `edges`, from the cache.
+    fn encode_edges(&mut self, net: &QNet, builder: &QGraphBuilder, maps: &asp_geom::distmap::DistanceMaps, g: &QGraph) {
+        self.prepare(net, builder, maps);
+        let (n, e, w) = (g.num_nodes(), g.num_edges(), net.width());
+        let context = n - 1;
+        self.edges.clear();
+        self.sources.clear();
+        self.targets.clear();
+        for k in 0..e {
+            let (s_pos, t_pos) = (g.edge_index[k] as usize, g.edge_index[e + k] as usize);
+            self.sources.push(s_pos as u32);
+            self.targets.push(t_pos as u32);
+            if s_pos == context {
+                self.edges.extend_from_slice(&self.context);
+            } else {
+                let at = self.pair(net, builder, maps, g.nodes[t_pos] as usize, g.nodes[s_pos] as usize);
+                self.edges.extend_from_slice(&self.encodings[at..at + w]);
+            }
+        }
+    }
+
     /// The offset of the encoding of the edge from part `s` to part `t` in `encodings`.
     fn pair(&mut self, net: &QNet, builder: &QGraphBuilder, maps: &asp_geom::distmap::DistanceMaps, t: usize, s: usize) -> usize {
         let key = t * self.parts + s;
@@ -336,7 +376,7 @@ impl Member<'_> {
         let plugin = |reason: String| SearchError::plugin(format!("Q-function {}", self.q.model.path()), reason);
         let Ok(net) = &self.q.net else { return Err(plugin("no Rust forward pass".into())) };
         let maps = state.maps();
-        let (n, e) = (g.num_nodes(), g.num_edges());
+        let n = g.num_nodes();
         let parts = &g.nodes[..n - 1];
         let w = net.width();
         let cache = &mut self.nodes;
@@ -372,32 +412,11 @@ impl Member<'_> {
         builder.context_row(history, &mut cache.row);
         net.encode_nodes(&cache.row, 1, &mut cache.h0[(n - 1) * w..n * w], &mut cache.scratch);
         let c = &mut self.fast;
-        c.prepare(net, builder, maps);
-        let context = n - 1;
-        c.edges.clear();
-        c.sources.clear();
-        c.targets.clear();
-        for k in 0..e {
-            let (s_pos, t_pos) = (g.edge_index[k] as usize, g.edge_index[e + k] as usize);
-            c.sources.push(s_pos as u32);
-            c.targets.push(t_pos as u32);
-            if s_pos == context {
-                c.edges.extend_from_slice(&c.context);
-            } else {
-                let at = c.pair(net, builder, maps, g.nodes[t_pos] as usize, g.nodes[s_pos] as usize);
-                c.edges.extend_from_slice(&c.encodings[at..at + w]);
-            }
-        }
+        c.encode_edges(net, builder, maps, g);
         c.values.resize(actions.len(), 0.0);
-        net.forward_encoded(&cache.h0, &[], n, &c.sources, &c.targets, &c.edges, &c.wanted, &mut c.values, &mut c.scratch);
-        for (o, (&v, &a)) in out.iter_mut().zip(c.values.iter().zip(actions)) {
-            let v = f64::from(v);
-            if !v.is_finite() {
-                return Err(plugin(format!("the model gave {v} for part {a}")));
-            }
-            *o = v.max(MIN_Q);
-        }
-        Ok(())
+        let graph = GraphView { x: &[], h0: Some(&cache.h0), n, sources: &c.sources, targets: &c.targets, edges: &c.edges };
+        net.forward(graph, &c.wanted, &mut c.values, &mut c.scratch);
+        checked_values(out, c.values.iter().copied(), actions, plugin)
     }
 
     /// The model's values of `actions` in the state whose graph is `g` (its structure; with edge
@@ -415,48 +434,24 @@ impl Member<'_> {
         let parts = &g.nodes[..n - 1];
         if let Ok(net) = &self.q.net {
             let c = &mut self.fast;
-            c.prepare(net, builder, maps);
-            let context = n - 1;
-            c.edges.clear();
-            c.sources.clear();
-            c.targets.clear();
-            for k in 0..e {
-                let (s_pos, t_pos) = (g.edge_index[k] as usize, g.edge_index[e + k] as usize);
-                c.sources.push(s_pos as u32);
-                c.targets.push(t_pos as u32);
-                if s_pos == context {
-                    c.edges.extend_from_slice(&c.context);
-                } else {
-                    let at = c.pair(net, builder, maps, g.nodes[t_pos] as usize, g.nodes[s_pos] as usize);
-                    c.edges.extend_from_slice(&c.encodings[at..at + net.width()]);
-                }
-            }
+            c.encode_edges(net, builder, maps, g);
             c.wanted.clear();
             for &a in actions {
                 let k = parts.binary_search(&(a as i64)).map_err(|_| plugin(format!("action {a} is not a present part")))?;
                 c.wanted.push(k);
             }
             c.values.resize(actions.len(), 0.0);
-            net.forward(&g.x, n, &c.sources, &c.targets, &c.edges, &c.wanted, &mut c.values, &mut c.scratch);
-            for (o, (&v, &a)) in out.iter_mut().zip(c.values.iter().zip(actions)) {
-                let v = f64::from(v);
-                if !v.is_finite() {
-                    return Err(plugin(format!("the model gave {v} for part {a}")));
-                }
-                *o = v.max(MIN_Q);
-            }
-            return Ok(());
+            let graph = GraphView { x: &g.x, h0: None, n, sources: &c.sources, targets: &c.targets, edges: &c.edges };
+            net.forward(graph, &c.wanted, &mut c.values, &mut c.scratch);
+            return checked_values(out, c.values.iter().copied(), actions, plugin);
         }
         let scores = self.q.model.score(&g.x, n, &g.edge_index, e, &g.edge_attr).map_err(|err| plugin(err.to_string()))?;
-        for (o, &a) in out.iter_mut().zip(actions) {
+        let mut wanted = Vec::with_capacity(actions.len());
+        for &a in actions {
             let k = parts.binary_search(&(a as i64)).map_err(|_| plugin(format!("action {a} is not a present part")))?;
-            let v = f64::from(scores[k]);
-            if !v.is_finite() {
-                return Err(plugin(format!("the model gave {v} for part {a}")));
-            }
-            *o = v.max(MIN_Q);
+            wanted.push(scores[k]);
         }
-        Ok(())
+        checked_values(out, wanted.into_iter(), actions, plugin)
     }
 }
 

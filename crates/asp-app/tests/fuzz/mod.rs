@@ -703,7 +703,7 @@ fn run(cases: u64) {
 /// Every planner, on generated models, ends in a plan with a status or a
 /// one-line error, and its plans keep the invariants (the module documentation lists them).
 #[test]
-fn issue_28_every_planner_on_generated_models_gives_a_status_or_a_one_line_error() {
+fn every_planner_on_generated_models_gives_a_status_or_a_one_line_error() {
     run(DEFAULT_CASES);
 }
 
@@ -711,6 +711,6 @@ fn issue_28_every_planner_on_generated_models_gives_a_status_or_a_one_line_error
 /// load 7-9); `cargo test -p asp-app --test tests fuzz -- --ignored`.
 #[test]
 #[ignore = "10,000 cases take 9 min on two cores; the suite runs 500 (run with --ignored)"]
-fn issue_28_every_planner_on_many_generated_models() {
+fn every_planner_on_many_generated_models() {
     run(20 * DEFAULT_CASES);
 }

@@ -6,7 +6,7 @@ use asp_app::pipeline::{plan_assembly, PlanSettings};
 /// when parts must move in turn before anything can leave, and leaves other voxel models to the
 /// depth-first search.
 #[test]
-fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
+fn the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
     let settings = PlanSettings { timeout: Some(30.0), ..PlanSettings::default() };
     for (a, moves) in [
         (asp_geom::puzzles::burr_level(), asp_geom::puzzles::BURR_LEVEL_MOVES),
@@ -38,7 +38,7 @@ fn issue_9_the_pipeline_plans_interlocking_puzzles_by_grid_moves() {
 /// `found`: without the grid the burr only lifts off the ground as one subassembly that cannot
 /// be taken apart (straight lines and groups only), so the plan is `partial` and names the core.
 #[test]
-fn issue_28_a_plan_that_lifts_a_locked_core_in_one_piece_is_partial() {
+fn a_plan_that_lifts_a_locked_core_in_one_piece_is_partial() {
     use asp_search::report::{PlanStatus, SubassemblyStatus};
     let off = PlanSettings { grid: false, path_planner: false, timeout: Some(30.0), ..PlanSettings::default() };
     let r = plan_assembly(asp_geom::puzzles::burr_level(), &off, None).unwrap();
@@ -76,7 +76,7 @@ fn issue_28_a_plan_that_lifts_a_locked_core_in_one_piece_is_partial() {
 /// On a voxel puzzle the grid planner answers before the path planner, with or
 /// without a fixed piece (with one fixed, the path planner used to run for half a minute first).
 #[test]
-fn issue_28_voxel_puzzles_with_a_fixed_piece_get_the_grid_before_the_path_planner() {
+fn voxel_puzzles_with_a_fixed_piece_get_the_grid_before_the_path_planner() {
     let settings = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
     use asp_geom::puzzles::{burr_level, small_puzzle, two_small_puzzles};
     for (fixed, puzzle) in
@@ -207,7 +207,7 @@ fn crossed_bars_beside_a_locked_post() -> asp_geom::Assembly {
 /// base are locked by their shapes (each blocked along every direction, no overlap), which
 /// nothing frees; the model is no voxel model (the bars share cells), but the post's core alone is.
 #[test]
-fn issue_28_an_artefact_and_an_interlock_are_told_apart() {
+fn an_artefact_and_an_interlock_are_told_apart() {
     use asp_search::report::{CoreGridReason, LenientStatus, PlanStatus};
     let settings = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
     let r = plan_assembly(crossed_bars_beside_a_locked_post(), &settings, None).unwrap();
@@ -266,7 +266,7 @@ fn issue_28_an_artefact_and_an_interlock_are_told_apart() {
 /// On a voxel model the grid planner runs on a locked core (and finds no moves
 /// that take it apart); with `--no-grid` the core says it was not tried, and why.
 #[test]
-fn issue_28_a_locked_core_says_whether_the_grid_planner_tried_it() {
+fn a_locked_core_says_whether_the_grid_planner_tried_it() {
     use asp_search::report::CoreGridReason;
     let on = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
     let r = plan_assembly(asp_geom::fixtures::ring_on_locked_post(), &on, None).unwrap();
@@ -286,7 +286,7 @@ fn issue_28_a_locked_core_says_whether_the_grid_planner_tried_it() {
 /// the locked post's core goes in whole as a `unit` step and the plan is `found`, not `partial`;
 /// a unit with a fixed part is part of the base; an unknown name is an error naming the setting.
 #[test]
-fn issue_28_a_declared_unit_is_planned_as_one_part_and_the_plan_is_found() {
+fn a_declared_unit_is_planned_as_one_part_and_the_plan_is_found() {
     use asp_search::report::{PlanStatus, SubassemblyStatus};
     let unit = |names: &[&str]| vec![names.iter().map(|n| n.to_string()).collect::<Vec<_>>()];
     let settings = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };
@@ -321,7 +321,7 @@ fn issue_28_a_declared_unit_is_planned_as_one_part_and_the_plan_is_found() {
 /// step; two parts declared one unit stay whole though their fit would let them part, and the
 /// ring that goes on between them is then locked in a `partial` core.
 #[test]
-fn issue_28_the_pumps_core_declared_one_unit_is_found() {
+fn the_pumps_core_declared_one_unit_is_found() {
     use asp_search::report::{LenientStatus, PlanStatus, SubassemblyStatus};
     let p = |n: &str| format!("PumpAssembly - {n}");
     let core = ["BackLid2-1", "LargeScrew1-1", "LargeScrew2-1", "Pump-1", "Ring-1", "Shaft-1"];
@@ -354,7 +354,7 @@ fn issue_28_the_pumps_core_declared_one_unit_is_found() {
 /// fasten (without it the frame collapses in its assembled state and nothing can leave). The
 /// plans are `found`: every part gets its own motion (a subassembly's parts in its own plan).
 #[test]
-fn issue_26_generated_profile_assemblies_plan_under_physics() {
+fn generated_profile_assemblies_plan_under_physics() {
     use asp_app::pipeline::StabilitySetting;
     use asp_gen::profiles::{ConnectorMode, ProfileAssembly, ProfileParams};
     use asp_search::report::PlanStatus;
@@ -541,7 +541,7 @@ fn a_core_that_comes_apart_on_its_own_is_planned_as_a_model_of_its_own() {
 /// plan lists the pair as a `planar_slab` 1.5 mm deep with its normal (the table says so too),
 /// and a board stabbed 8 mm into another as `interpenetration`.
 #[test]
-fn issue_38_boards_sunk_into_each_other_plan_found_lifted_along_the_slab_normal() {
+fn boards_sunk_into_each_other_plan_found_lifted_along_the_slab_normal() {
     use asp_geom::overlap::OverlapClass;
     let turn = asp_geom::math::Rot::from_axis_angle(asp_geom::math::Vec3::new(1.0, 2.0, 0.5).normalize(), 0.3);
     let settings = PlanSettings { timeout: Some(60.0), ..PlanSettings::default() };

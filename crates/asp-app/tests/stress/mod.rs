@@ -18,7 +18,7 @@ use asp_search::{PlanOutcome, Status};
 const PER_KIND: usize = 6;
 
 #[test]
-fn issue_28_stress_cases_come_apart_completely_and_pass_the_re_check() {
+fn stress_cases_come_apart_completely_and_pass_the_re_check() {
     let settings = PlanSettings::default();
     let (mut groups, mut drawn, mut screws) = (0, 0, 0);
     for stress in [StressKind::Chair, StressKind::Carcass, StressKind::Bolted] {

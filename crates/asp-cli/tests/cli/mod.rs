@@ -114,7 +114,7 @@ fn reach_model(dir: &Path) -> PathBuf {
 /// block, which leaves its housing only along a path: the arm now lifts path motions too (up
 /// when free), so what stops it is the grasp: the block is wider than the gripper opens.
 #[test]
-fn issue_25_a_robot_refusal_is_explained_by_the_arms_reason() {
+fn a_robot_refusal_is_explained_by_the_arms_reason() {
     let dir = tempfile::tempdir().unwrap();
     let model = reach_model(dir.path());
     let out = dir.path().join("reach.json");
@@ -147,7 +147,7 @@ fn issue_25_a_robot_refusal_is_explained_by_the_arms_reason() {
 /// out even on their own (exit 1), with the arm's reason; `--json -` prints the check; a bad
 /// robot base is a one-line error naming its flag (exit 2).
 #[test]
-fn issue_24_the_robot_cell_check_names_what_the_arm_cannot_reach() {
+fn the_robot_cell_check_names_what_the_arm_cannot_reach() {
     let dir = tempfile::tempdir().unwrap();
     let model = reach_model(dir.path());
     let m = model.to_str().unwrap();
@@ -276,7 +276,7 @@ fn physics_stability_takes_the_keystone_before_a_pillar() {
 /// `--stability physics`, decided from the checker and not from a clock: the same seed gives
 /// the same plan and the same tests, twice, as `--order gnn --bookkeeping` does.
 #[test]
-fn issue_26_the_default_ordering_under_physics_is_gnn_with_bookkeeping_and_repeats() {
+fn the_default_ordering_under_physics_is_gnn_with_bookkeeping_and_repeats() {
     let dir = tempfile::tempdir().unwrap();
     let model = fixture_file(dir.path(), &fixtures::figure_6_2(1.0), "fig.glb");
     let run = |extra: &[&str]| {
@@ -297,7 +297,7 @@ fn issue_26_the_default_ordering_under_physics_is_gnn_with_bookkeeping_and_repea
 /// robot checker's shipped model): the same plan and tests as `--order gnn --bookkeeping`, twice
 /// for a seed, and fewer tests than the file's order, which tries the bottom of a stack first.
 #[test]
-fn issue_26_the_default_ordering_under_the_robot_is_gnn_with_bookkeeping_and_repeats() {
+fn the_default_ordering_under_the_robot_is_gnn_with_bookkeeping_and_repeats() {
     let dir = tempfile::tempdir().unwrap();
     let mut plate = fixtures::box_part("plate", [-0.1, -0.25, -0.02], [0.5, 0.25, 0.0]);
     plate.fixed = true;
@@ -322,7 +322,7 @@ fn issue_26_the_default_ordering_under_the_robot_is_gnn_with_bookkeeping_and_rep
 }
 
 #[test]
-fn issue_9_ctrl_c_prints_and_writes_the_best_result_so_far() {
+fn ctrl_c_prints_and_writes_the_best_result_so_far() {
     // cube81 one piece at a time: every piece is blocked, and the path planner is tried on each
     // of the 81 in turn (many seconds); Ctrl-C stops it between two path planner calls
     let dir = tempfile::tempdir().unwrap();
@@ -357,7 +357,7 @@ fn issue_9_ctrl_c_prints_and_writes_the_best_result_so_far() {
 }
 
 #[test]
-fn issue_9_one_process_plans_many_models_and_exits_with_the_worst_outcome() {
+fn one_process_plans_many_models_and_exits_with_the_worst_outcome() {
     let dir = tempfile::tempdir().unwrap();
     let tube = fixture_file(dir.path(), &fixtures::tube(), "tube.glb");
     let arch = fixture_file(dir.path(), &fixtures::arch(), "arch.glb");
@@ -452,7 +452,7 @@ fn replay_json(steps: &serde_json::Value, pos: &mut Vec<Vec<[i32; 3]>>, present:
 }
 
 #[test]
-fn issue_9_plans_an_interlocking_burr_by_grid_moves() {
+fn plans_an_interlocking_burr_by_grid_moves() {
     let dir = tempfile::tempdir().unwrap();
     let a = asp_geom::puzzles::burr_level();
     let model = fixture_file(dir.path(), &a, "burr.glb");
@@ -487,7 +487,7 @@ fn issue_9_plans_an_interlocking_burr_by_grid_moves() {
 /// A plan that lifts a locked core in one piece is `partial`, exit code 1, in
 /// the JSON (with the core and why), the table and `--each`'s summary.
 #[test]
-fn issue_28_a_plan_with_a_locked_core_is_partial_with_exit_code_1() {
+fn a_plan_with_a_locked_core_is_partial_with_exit_code_1() {
     let dir = tempfile::tempdir().unwrap();
     let models = dir.path().join("models");
     std::fs::create_dir(&models).unwrap();
@@ -525,7 +525,7 @@ fn issue_28_a_plan_with_a_locked_core_is_partial_with_exit_code_1() {
 }
 
 #[test]
-fn issue_9_grid_subassemblies_with_moves_replay_from_the_json() {
+fn grid_subassemblies_with_moves_replay_from_the_json() {
     // two puzzles side by side: the depth-first search only lifts subassemblies it cannot take
     // apart, so the grid plan is the fallback; each puzzle's own plan moves pieces on its frame
     let dir = tempfile::tempdir().unwrap();
@@ -570,7 +570,7 @@ fn gen_profiles_attaches_connectors_on_request() {
 /// post's core goes in whole, the plan is `found` (exit 0); a name the model lacks is an error
 /// naming the flag (exit 2).
 #[test]
-fn issue_28_unit_group_plans_named_parts_as_one_unit() {
+fn unit_group_plans_named_parts_as_one_unit() {
     let dir = tempfile::tempdir().unwrap();
     let model = fixture_file(dir.path(), &fixtures::ring_on_locked_post(), "post.glb");
     let model = model.to_str().unwrap();
@@ -630,7 +630,7 @@ fn plan_each_in_parallel_prints_in_model_order() {
 /// `--model` trained on another checker's labels (its `asp.checker`) is one
 /// line naming the file and both checkers, exit status 2, for `asp plan` and `asp bench feasible`.
 #[test]
-fn issue_26_a_model_of_another_checker_exits_2_naming_both() {
+fn a_model_of_another_checker_exits_2_naming_both() {
     let dir = tempfile::tempdir().unwrap();
     let model = fixture_file(dir.path(), &fixtures::arch(), "arch.glb");
     // asp-learn's fixture with `asp.checker` = physics appended (ModelProto field 14)
@@ -657,7 +657,7 @@ fn issue_26_a_model_of_another_checker_exits_2_naming_both() {
 /// shelf's mesh) is named in a warning and moves as one; `--split-bodies` plans each body as a
 /// part of its own, named `NAME#1`, `NAME#2`, ...
 #[test]
-fn issue_38_split_bodies_makes_each_body_a_part() {
+fn split_bodies_makes_each_body_a_part() {
     use asp_geom::math::{Axis, Vec3};
     use asp_geom::{Mesh, Part, Units};
     let dir = tempfile::tempdir().unwrap();

@@ -336,7 +336,7 @@ fn q_models_are_checked_before_the_search() {
 /// work (`--timeout 10` on an MCTS run used to be ignored while the run went on for its whole
 /// episode budget); one line, exit 2, nothing written.
 #[test]
-fn issue_23_settings_of_the_other_search_are_refused_naming_what_applies() {
+fn settings_of_the_other_search_are_refused_naming_what_applies() {
     let dir = tempfile::tempdir().unwrap();
     let model = jenga(dir.path());
     let m = model.to_str().unwrap();

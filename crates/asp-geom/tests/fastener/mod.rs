@@ -15,7 +15,7 @@ fn world(interference: f32, fasteners: bool) -> World {
 }
 
 #[test]
-fn issue_9_the_fixture_is_a_closed_helical_bolt_in_a_nut_whose_threads_touch() {
+fn the_fixture_is_a_closed_helical_bolt_in_a_nut_whose_threads_touch() {
     let w = world(0.0, true);
     for p in 0..3 {
         assert!(w.is_closed(p), "{}", w.name(p));
@@ -40,7 +40,7 @@ fn issue_9_the_fixture_is_a_closed_helical_bolt_in_a_nut_whose_threads_touch() {
 }
 
 #[test]
-fn issue_9_a_threaded_bolt_in_a_threaded_nut_leaves_by_screwing_only_the_way_its_head_allows() {
+fn a_threaded_bolt_in_a_threaded_nut_leaves_by_screwing_only_the_way_its_head_allows() {
     for interference in [0.0, 0.0001] {
         let w = world(interference, true);
         let all = PartSet::full(3);
@@ -72,7 +72,7 @@ fn issue_9_a_threaded_bolt_in_a_threaded_nut_leaves_by_screwing_only_the_way_its
 }
 
 #[test]
-fn issue_9_without_the_screw_rule_the_bolt_and_nut_lock_each_other() {
+fn without_the_screw_rule_the_bolt_and_nut_lock_each_other() {
     for interference in [0.0, 0.0001] {
         let w = world(interference, false);
         let all = PartSet::full(3);
@@ -88,7 +88,7 @@ fn issue_9_without_the_screw_rule_the_bolt_and_nut_lock_each_other() {
 }
 
 #[test]
-fn issue_9_smooth_pins_are_not_threads_and_the_fit_finds_a_prisms_axis() {
+fn smooth_pins_are_not_threads_and_the_fit_finds_a_prisms_axis() {
     // a round dowel pressed into two boards is rotationally symmetric and in contact, but has
     // no thread flanks: it leaves by a straight line, as before
     let w = World::new(fixtures::dowel_in_two_boards(), &WorldConfig::default()).unwrap();

@@ -123,7 +123,7 @@ fn coincident_parts_are_reported_and_separate() {
 /// of the strict world that measures nothing again; it must test exactly as a world built with
 /// the lenient policy (a small overlap shrunk, a gross one ignored, the rest unchanged).
 #[test]
-fn issue_28_the_lenient_copy_of_a_strict_world_tests_as_a_lenient_world() {
+fn the_lenient_copy_of_a_strict_world_tests_as_a_lenient_world() {
     let bolt = fixtures::bolt_and_nut(0.0005);
     for a in [fixtures::pressed_peg(), fixtures::dowel_in_two_boards(), bolt, fixtures::ring_on_locked_post()] {
         let name = a.source.display().to_string();
@@ -159,7 +159,7 @@ fn tilt() -> asp_geom::math::Rot {
 /// board, it is refused. Samples at the sliver fans' centroids and vertices around the holes
 /// inside the slab graze the other board's hole walls as it lifts.
 #[test]
-fn issue_38_a_board_sunk_into_another_lifts_off_along_the_slab_normal_only() {
+fn a_board_sunk_into_another_lifts_off_along_the_slab_normal_only() {
     for (facets, thickness) in [(16, 0.003), (96, 0.003), (16, 0.010), (96, 0.010)] {
         for turn in [asp_geom::math::Rot::IDENTITY, tilt()] {
             let w = world(fixtures::sunk_boards(facets, thickness, turn), OverlapPolicy::Strict).unwrap();
@@ -191,7 +191,7 @@ fn issue_38_a_board_sunk_into_another_lifts_off_along_the_slab_normal_only() {
 /// The slab's normal joins the candidate directions: with no normal clusters and no planar
 /// contact directions (fasteners off), the tilted boards' only lift is the slab's own normal.
 #[test]
-fn issue_38_the_slab_normal_is_a_candidate_direction() {
+fn the_slab_normal_is_a_candidate_direction() {
     let config = WorldConfig { normal_clusters: 0, fasteners: false, ..WorldConfig::default() };
     let w = World::new(fixtures::sunk_boards(16, 0.003, tilt()), &config).unwrap();
     let normal = w.overlap_notes()[0].normal.unwrap();

@@ -212,7 +212,7 @@ fn bvh_descent_sweeps_agree_with_the_per_triangle_search() {
 /// touching it blocked it. A part thinner than twice the tolerance keeps its shape; its pair
 /// tests shrink the other part instead.
 #[test]
-fn issue_28_a_sheet_of_zero_thickness_leaves_neither_through_the_floor_nor_through_parts() {
+fn a_sheet_of_zero_thickness_leaves_neither_through_the_floor_nor_through_parts() {
     use asp_geom::fixtures::{assemble, box_part};
     use asp_geom::math::Axis;
     // a box, a flat sheet on the floor beside it, no part fixed (the virtual ground under both)
@@ -251,7 +251,7 @@ fn issue_28_a_sheet_of_zero_thickness_leaves_neither_through_the_floor_nor_throu
 /// at least one triangle"); it is refused as the loader refuses it, naming the part and saying
 /// what to do.
 #[test]
-fn issue_28_a_part_collapsed_onto_a_line_is_refused_in_the_loaders_words() {
+fn a_part_collapsed_onto_a_line_is_refused_in_the_loaders_words() {
     use asp_geom::fixtures::{assemble, box_part, part};
     use asp_geom::math::Axis;
     use asp_geom::mesh::Mesh;

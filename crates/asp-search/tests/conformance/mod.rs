@@ -373,7 +373,7 @@ fn same_seed_same_plan() {
 /// random stream and kept skipped parts from the path planner. Bookkeeping must only skip tests
 /// whose answer is known: the same states in the same order, the same plan, never more tests.
 #[test]
-fn issue_8_bookkeeping_never_makes_a_run_worse() {
+fn bookkeeping_never_makes_a_run_worse() {
     let mut saved = 0;
     for seed in [0, 1] {
         let assembly = asp_gen::ProfileAssembly::generate(&asp_gen::ProfileParams::double_layer(), 4242 + seed)

@@ -6,7 +6,7 @@ use asp_geom::{fixtures, Checker, CheckerConfig, Motion, World, WorldConfig};
 use asp_search::{Budget, Dfs, Problem, Status};
 
 #[test]
-fn issue_9_a_bolt_in_a_nut_on_a_plate_comes_apart_by_screwing_and_every_step_rechecks() {
+fn a_bolt_in_a_nut_on_a_plate_comes_apart_by_screwing_and_every_step_rechecks() {
     for interference in [0.0, 0.0001] {
         let world = World::new(fixtures::bolt_and_nut(interference), &WorldConfig::default()).unwrap();
         let checker = Checker::new(world, CheckerConfig::default());
@@ -27,7 +27,7 @@ fn issue_9_a_bolt_in_a_nut_on_a_plate_comes_apart_by_screwing_and_every_step_rec
 }
 
 #[test]
-fn issue_9_the_independent_recheck_refuses_screw_steps_that_push_a_head_into_material_or_leave_the_axis() {
+fn the_independent_recheck_refuses_screw_steps_that_push_a_head_into_material_or_leave_the_axis() {
     use crate::verify::verify_from;
     use asp_geom::math::Vec3;
     use asp_geom::PartSet;

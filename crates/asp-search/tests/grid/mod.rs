@@ -164,7 +164,7 @@ fn check_fixture(a: &Assembly, expect_first: usize) -> GridSolution {
 }
 
 #[test]
-fn issue_9_burr_with_a_key_comes_apart_with_its_key_first() {
+fn burr_with_a_key_comes_apart_with_its_key_first() {
     let a = puzzles::burr_key();
     let s = check_fixture(&a, 0);
     assert_eq!(s.plan.steps[0].parts, vec![1], "the key (piece 1) leaves alone: {:?}", s.plan.steps[0]);
@@ -173,7 +173,7 @@ fn issue_9_burr_with_a_key_comes_apart_with_its_key_first() {
 }
 
 #[test]
-fn issue_9_level_burr_needs_its_minimal_moves_before_the_first_separation() {
+fn level_burr_needs_its_minimal_moves_before_the_first_separation() {
     let a = puzzles::burr_level();
     const { assert!(puzzles::BURR_LEVEL_MOVES >= 1, "the fixture is a level >= 2 burr") };
     check_fixture(&a, puzzles::BURR_LEVEL_MOVES);
@@ -181,7 +181,7 @@ fn issue_9_level_burr_needs_its_minimal_moves_before_the_first_separation() {
 }
 
 #[test]
-fn issue_9_small_puzzle_needs_moves_and_comes_apart() {
+fn small_puzzle_needs_moves_and_comes_apart() {
     let a = puzzles::small_puzzle();
     const { assert!(puzzles::SMALL_PUZZLE_MOVES >= 1) };
     check_fixture(&a, puzzles::SMALL_PUZZLE_MOVES);
@@ -189,7 +189,7 @@ fn issue_9_small_puzzle_needs_moves_and_comes_apart() {
 }
 
 #[test]
-fn issue_9_two_puzzles_come_apart_as_subassemblies_with_their_own_moves() {
+fn two_puzzles_come_apart_as_subassemblies_with_their_own_moves() {
     let a = puzzles::two_small_puzzles();
     let s = check_fixture(&a, 0);
     let first = &s.plan.steps[0];
@@ -200,7 +200,7 @@ fn issue_9_two_puzzles_come_apart_as_subassemblies_with_their_own_moves() {
 }
 
 #[test]
-fn issue_9_polycube_meshes_without_cells_give_the_same_model_and_plan() {
+fn polycube_meshes_without_cells_give_the_same_model_and_plan() {
     for a in [puzzles::burr_key(), puzzles::burr_level(), puzzles::small_puzzle(), fixtures::hooked_bracket(), fixtures::figure_6_2(0.02)] {
         let with_cells = VoxelModel::of(&a).expect("cells");
         let meshes = VoxelModel::of(&as_meshes(&a)).expect("voxelised");
@@ -221,7 +221,7 @@ fn issue_9_polycube_meshes_without_cells_give_the_same_model_and_plan() {
 }
 
 #[test]
-fn issue_9_non_voxel_meshes_are_not_voxel_models() {
+fn non_voxel_meshes_are_not_voxel_models() {
     // a faceted peg, a part off the common grid, a mesh whose cells metadata lies
     assert!(VoxelModel::of(&fixtures::pressed_peg()).is_none());
     assert!(VoxelModel::of(&fixtures::dowel_in_two_boards()).is_none());
@@ -249,7 +249,7 @@ fn issue_9_non_voxel_meshes_are_not_voxel_models() {
 }
 
 #[test]
-fn issue_9_hooked_bracket_lifts_then_slides_on_the_grid() {
+fn hooked_bracket_lifts_then_slides_on_the_grid() {
     // a fixed wall: the bracket moves up (a move), then leaves along +x
     let a = fixtures::hooked_bracket();
     let model = VoxelModel::of(&a).unwrap();
@@ -264,7 +264,7 @@ fn issue_9_hooked_bracket_lifts_then_slides_on_the_grid() {
 }
 
 #[test]
-fn issue_9_a_locked_core_is_stuck_not_solved() {
+fn a_locked_core_is_stuck_not_solved() {
     // ring on a locked post: cap lifts off; base, post and ring lock each other
     let a = fixtures::ring_on_locked_post();
     let model = VoxelModel::of(&a).unwrap();
@@ -279,7 +279,7 @@ fn issue_9_a_locked_core_is_stuck_not_solved() {
 }
 
 #[test]
-fn issue_9_the_state_budget_ends_the_search() {
+fn the_state_budget_ends_the_search() {
     let model = VoxelModel::of(&puzzles::burr_level()).unwrap();
     let s = grid::solve(&model, &GridConfig { max_states: 3, ..GridConfig::default() }, &|| false);
     assert_eq!(s.plan.status, Status::BudgetExhausted);
@@ -293,7 +293,7 @@ fn issue_9_the_state_budget_ends_the_search() {
 /// units: a panic (`Option::unwrap()` on `None`) or a wrong reference. The key burr with its
 /// pieces reordered (the largest piece not first) panicked on its third separation.
 #[test]
-fn issue_28_no_fixed_part_and_the_reference_not_first_does_not_panic() {
+fn no_fixed_part_and_the_reference_not_first_does_not_panic() {
     let pieces = pieces(&puzzles::burr_key());
     let order = [2, 1, 0, 3, 4, 5];
     let reordered: Vec<Vec<Cell>> = order.iter().map(|&i| pieces[i].clone()).collect();
@@ -416,7 +416,7 @@ fn random_puzzle(rng: &mut Rng, n: usize) -> Vec<Vec<Cell>> {
 /// separation's move count equals the brute-force BFS over every subset of pieces (the fixed
 /// pieces merged into one, which the brute force never moves relative to the others' frame).
 #[test]
-fn issue_28_random_polycube_puzzles_replay_and_match_the_brute_force() {
+fn random_polycube_puzzles_replay_and_match_the_brute_force() {
     let mut rng = Rng(0x2800_0000_0000_0001);
     let (mut compared, mut moved) = (0, 0);
     for round in 0..300 {
@@ -470,14 +470,14 @@ fn issue_28_random_polycube_puzzles_replay_and_match_the_brute_force() {
 /// No panic on 1,000 random puzzles (the 10,000 of the goal in the ignored
 /// test below); every plan replays on cells.
 #[test]
-fn issue_28_grid_fuzz_1000_random_puzzles() {
+fn grid_fuzz_1000_random_puzzles() {
     grid_fuzz(1_000, 0x2801);
 }
 
 /// The goal of 10,000 random puzzles (`--ignored`).
 #[test]
 #[ignore = "10,000 puzzles: the goal's figure, slower than the suite's 1,000"]
-fn issue_28_grid_fuzz_10000_random_puzzles() {
+fn grid_fuzz_10000_random_puzzles() {
     grid_fuzz(10_000, 0x2802);
 }
 
@@ -498,7 +498,7 @@ fn grid_fuzz(count: usize, seed: u64) {
 /// Not a test: the seeded search that found the puzzles' shapes (run with `--ignored`).
 #[test]
 #[ignore = "a tool, not a test: the seeded search that found the puzzles"]
-fn issue_9_find_puzzles() {
+fn find_puzzles() {
     let sticks = puzzles::burr_sticks();
     let mut best: Option<(usize, Vec<Vec<Cell>>)> = None;
     let mut key: Option<Vec<Vec<Cell>>> = None;
@@ -630,7 +630,7 @@ fn issue_9_find_puzzles() {
 /// into `$ASP_PUZZLES_OUT` for benchmarks (`docs/benchmarks.md`).
 #[test]
 #[ignore = "a tool, not a test: writes the puzzles to $ASP_PUZZLES_OUT for benchmarks"]
-fn issue_9_write_puzzle_glbs() {
+fn write_puzzle_glbs() {
     let dir = std::path::PathBuf::from(std::env::var("ASP_PUZZLES_OUT").expect("ASP_PUZZLES_OUT"));
     std::fs::create_dir_all(&dir).unwrap();
     for a in [puzzles::burr_key(), puzzles::burr_level(), puzzles::small_puzzle(), fixtures::hooked_bracket()] {
@@ -645,7 +645,7 @@ fn issue_9_write_puzzle_glbs() {
 /// 3 × 4 cavity without ever getting out (every one of the 95,040 states visited, then stuck).
 #[test]
 #[ignore = "a benchmark, not a test: figures in docs/benchmarks.md"]
-fn issue_9_bench_grid() {
+fn bench_grid() {
     let pieces = puzzles::closed_box_cells();
     let boxed = VoxelModel::from_cells(pieces, vec![false; 6]);
     let models = [

@@ -15,7 +15,7 @@ fn plan(planner: &Dfs) -> (Checker, PlanOutcome) {
 }
 
 #[test]
-fn issue_9_a_ring_locked_around_a_post_locked_in_a_base_is_a_named_core_with_a_partial_plan() {
+fn a_ring_locked_around_a_post_locked_in_a_base_is_a_named_core_with_a_partial_plan() {
     for path_planner in [false, true] {
         let (checker, outcome) = plan(&Dfs::builder().subassemblies(false).path_planner(path_planner).build());
         let Status::NoPlan { stuck, state } = &outcome.status else { panic!("{:?}", outcome.status) };
@@ -41,7 +41,7 @@ fn issue_9_a_ring_locked_around_a_post_locked_in_a_base_is_a_named_core_with_a_p
 }
 
 #[test]
-fn issue_9_with_subassemblies_the_locked_core_leaves_as_one_group_that_cannot_be_taken_apart() {
+fn with_subassemblies_the_locked_core_leaves_as_one_group_that_cannot_be_taken_apart() {
     let (checker, outcome) = plan(&Dfs::builder().build());
     assert_eq!(outcome.status, Status::Found);
     verify_plan(checker.world(), &outcome);
@@ -88,7 +88,7 @@ fn groups_leave_only_when_no_single_part_can() {
 }
 
 #[test]
-fn issue_9_a_hooked_bracket_lifts_then_slides_out() {
+fn a_hooked_bracket_lifts_then_slides_out() {
     let world = World::new(asp_geom::fixtures::hooked_bracket(), &WorldConfig::default()).unwrap();
     let checker = Checker::new(world, CheckerConfig::default());
     let problem = Problem::full(&checker);

@@ -165,7 +165,7 @@ fn groups(removals: &[asp_search::Step]) -> Vec<(PartSet, Option<Status>)> {
 }
 
 #[test]
-fn issue_9_the_pumps_lift_their_stuck_core_off_as_one_subassembly_built_on_the_body() {
+fn the_pumps_lift_their_stuck_core_off_as_one_subassembly_built_on_the_body() {
     // the pump lies on its side on the large screw's head: body, back lid and that screw leave
     // the ground together, and the subassembly is built on the body
     for rel in ["pump", "pump-extension"] {
@@ -215,7 +215,7 @@ fn pump_extension_without_subassemblies_ends_at_its_locked_core() {
 }
 
 #[test]
-fn issue_9_interlocking_cubes_come_apart_in_halves_and_every_step_rechecks() {
+fn interlocking_cubes_come_apart_in_halves_and_every_step_rechecks() {
     // hollow corners joined by bars whose tenons sit in the corners' face holes: no piece can
     // leave alone, a face of the frame (its corners and bars) can; the halves come apart the
     // same way, down to single pieces
@@ -249,7 +249,7 @@ fn all_steps(removals: &[asp_search::Step]) -> Vec<(usize, asp_geom::Motion)> {
 }
 
 #[test]
-fn issue_9_pump_threaded_bolts_leave_by_screwing_and_every_step_rechecks() {
+fn pump_threaded_bolts_leave_by_screwing_and_every_step_rechecks() {
     // the AutomatedAssemblyPlanner's pump with threaded bolts (27 parts, tests/data/README.md);
     // among them the body, its lid held by an M5 bolt in a tapped hole of the body (drawn smooth
     // at the major diameter), and an M16 bolt through the body's flange and the back lid into a nut.

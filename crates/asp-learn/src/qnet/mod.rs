@@ -29,6 +29,9 @@
 
 use pulp::Simd;
 
+mod kernels;
+use kernels::{compose, exp, transpose, Dense};
+
 /// What the Rust forward pass reads from a loaded ONNX graph model: its feature sizes, its
 /// metadata, its initialisers by name, and the reference forward pass (tract) it checks itself
 /// against. The model loader implements it, so this module depends on no loader.
@@ -64,144 +67,24 @@ const SCORE_CLAMP: f32 = 50.0;
 /// Largest |fast − tract| / max(1, |tract|) the self-check at load accepts.
 const SELF_CHECK_TOLERANCE: f32 = 1e-4;
 
-/// A linear map `y = x W + b` with `W` stored `[in, out]` (PyTorch's weight transposed).
-#[derive(Clone, Debug)]
-struct Dense {
-    input: usize,
-    output: usize,
-    w: Vec<f32>,
-    b: Vec<f32>,
-}
-
-impl Dense {
-    /// `out[rows, output] = x[rows, input] W (+ b)`, row-major.
-    #[inline(always)]
-    fn apply<S: Simd>(&self, simd: S, x: &[f32], rows: usize, bias: bool, out: &mut [f32]) {
-        gemm(simd, x, rows, self.input, &self.w, self.output, bias.then_some(&self.b[..]), &mut out[..rows * self.output]);
-    }
-}
-
-/// `out[r, :] = bias + x[r, :] W` for row-major `x [rows, k]`, `W [k, cols]` and `out [rows,
-/// cols]`. Tiles of four rows by two SIMD vectors of columns (then by one vector) are summed in
-/// registers with fused multiply-adds, so each load of a row of `W` serves four rows of `x`;
-/// columns past the last whole vector (all of them without SIMD) are summed row by row over
-/// contiguous columns, in the same order per value.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn gemm<S: Simd>(simd: S, x: &[f32], rows: usize, k: usize, w: &[f32], cols: usize, bias: Option<&[f32]>, out: &mut [f32]) {
-    let lanes = lanes::<S>();
-    // without SIMD (one lane) every column takes the plain loop below: a scalar mul_add would be
-    // a library call
-    let (two, one) = if lanes > 1 { (cols / (2 * lanes) * 2 * lanes, cols / lanes * lanes) } else { (0, 0) };
-    let mut r0 = 0;
-    while r0 + 4 <= rows {
-        gemm_rows::<S, 4, 2>(simd, x, r0, k, w, cols, 0..two, bias, out);
-        gemm_rows::<S, 4, 1>(simd, x, r0, k, w, cols, two..one, bias, out);
-        r0 += 4;
-    }
-    while r0 < rows {
-        gemm_rows::<S, 1, 2>(simd, x, r0, k, w, cols, 0..two, bias, out);
-        gemm_rows::<S, 1, 1>(simd, x, r0, k, w, cols, two..one, bias, out);
-        r0 += 1;
-    }
-    if one == cols {
-        return;
-    }
-    for r in 0..rows {
-        let o = &mut out[r * cols + one..(r + 1) * cols];
-        match bias {
-            Some(b) => o.copy_from_slice(&b[one..cols]),
-            None => o.fill(0.0),
-        }
-        for (j, row) in w[..k * cols].chunks_exact(cols).enumerate() {
-            let xv = x[r * k + j];
-            for (o, &wv) in o.iter_mut().zip(&row[one..]) {
-                *o += xv * wv;
-            }
-        }
-    }
-}
-
-/// `f32` lanes of a SIMD vector of `S`.
-#[inline(always)]
-fn lanes<S: Simd>() -> usize {
-    std::mem::size_of::<S::f32s>() / std::mem::size_of::<f32>()
-}
-
-/// Rows `r0..r0 + R` of [`gemm`], the columns `span` (whole tiles of `V` vectors): `R × V`
-/// accumulators in registers, so each load of a row of `W` serves `R` rows of `x`.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn gemm_rows<S: Simd, const R: usize, const V: usize>(
-    simd: S,
-    x: &[f32],
-    r0: usize,
-    k: usize,
-    w: &[f32],
-    cols: usize,
-    span: std::ops::Range<usize>,
-    bias: Option<&[f32]>,
-    out: &mut [f32],
-) {
-    let tile = V * lanes::<S>();
-    let xs: [&[f32]; R] = std::array::from_fn(|r| &x[(r0 + r) * k..(r0 + r + 1) * k]);
-    for c0 in span.step_by(tile) {
-        let c1 = c0 + tile;
-        let start = bias.map_or([simd.splat_f32s(0.0); V], |b| vectors::<S, V>(&b[c0..c1]));
-        let mut acc = [start; R];
-        for (j, row) in w[..k * cols].chunks_exact(cols).enumerate() {
-            let wv = vectors::<S, V>(&row[c0..c1]);
-            #[allow(clippy::needless_range_loop)] // unrolled: the accumulators stay in registers
-            for r in 0..R {
-                let xv = simd.splat_f32s(xs[r][j]);
-                for v in 0..V {
-                    acc[r][v] = simd.mul_add_f32s(xv, wv[v], acc[r][v]);
-                }
-            }
-        }
-        for (r, acc) in acc.iter().enumerate() {
-            let at = (r0 + r) * cols;
-            let o: &mut [S::f32s] = pulp::bytemuck::cast_slice_mut(&mut out[at + c0..at + c1]);
-            o.copy_from_slice(acc);
-        }
-    }
-}
-
-/// `V` SIMD vectors from `V · lanes` floats (a function, not a closure: closures are not
-/// inlined into the SIMD-compiled caller).
-#[inline(always)]
-fn vectors<S: Simd, const V: usize>(v: &[f32]) -> [S::f32s; V] {
-    let v: &[S::f32s] = pulp::bytemuck::cast_slice(v);
-    std::array::from_fn(|k| v[k])
-}
-
-/// `e^x` for `x <= SCORE_CLAMP` (Cephes' `expf` polynomial after reduction by `ln 2`; within a
-/// few ulp of the correctly rounded value; `x` is clamped to `[-87, 88]`, so far below the
-/// range it gives `e^-87`, not 0). Branch-free, so loops of it vectorise, where the C library's
-/// `expf` is a call per element.
-#[inline(always)]
-fn exp(x: f32) -> f32 {
-    const LOG2E: f32 = std::f32::consts::LOG2_E;
-    const LN2_HI: f32 = 0.693_359_4;
-    const LN2_LO: f32 = -2.121_944_4e-4;
-    // 1.5 · 2^23: adding it rounds to an integer held in the low mantissa bits
-    const MAGIC: f32 = 12_582_912.0;
-    let x = x.clamp(-87.0, 88.0);
-    let t = x * LOG2E + MAGIC;
-    let k = t - MAGIC;
-    let r = x - k * LN2_HI - k * LN2_LO;
-    let mut p = 1.987_569_1e-4f32;
-    p = p * r + 1.398_199_9e-3;
-    p = p * r + 8.333_452e-3;
-    p = p * r + 4.166_579_6e-2;
-    p = p * r + 1.666_666_5e-1;
-    p = p * r + 0.5;
-    let y = p * r * r + r + 1.0;
-    // 2^k from the integer in t's mantissa (k in -126..=127 after the clamp)
-    // (wrapping u32 arithmetic is the two's complement of k + 127, and has no overflow check
-    // that would keep the loop from vectorising)
-    let scale = f32::from_bits(t.to_bits().wrapping_sub(MAGIC.to_bits()).wrapping_add(127) << 23);
-    y * scale
+/// One state graph as [`QNet::forward`] reads it.
+#[derive(Clone, Copy, Debug)]
+pub struct GraphView<'a> {
+    /// The node attributes `[n, node_dim]`. With `h0` given, only a Q head's pooling reads them
+    /// (their first column weighs each node; an empty `x` weighs every node 1), and they may be
+    /// empty for a removability model.
+    pub x: &'a [f32],
+    /// The nodes' encodings `[n, width]` ([`QNet::encode_nodes`], cached per part by callers),
+    /// or `None` to encode `x`.
+    pub h0: Option<&'a [f32]>,
+    /// Nodes.
+    pub n: usize,
+    /// Edge `k` runs from node `sources[k]`...
+    pub sources: &'a [u32],
+    /// ... to node `targets[k]`...
+    pub targets: &'a [u32],
+    /// ... and `edges[k * width..(k + 1) * width]` is its [`QNet::encode_edge`].
+    pub edges: &'a [f32],
 }
 
 /// The Q network's weights (immutable, shared by every thread).
@@ -473,33 +356,20 @@ impl QNet {
         self.encode_edges(edge_attr, e, &mut enc, &mut rows);
         let sources: Vec<u32> = edge_index[..e].iter().map(|&v| v as u32).collect();
         let targets: Vec<u32> = edge_index[e..].iter().map(|&v| v as u32).collect();
-        self.forward(x, n, &sources, &targets, &enc[..e * self.width], wanted, out, s);
+        let graph = GraphView { x, h0: None, n, sources: &sources, targets: &targets, edges: &enc[..e * self.width] };
+        self.forward(graph, wanted, out, s);
         s.enc = enc;
         s.rows = rows;
     }
 
-    /// The Q-values of the `wanted` nodes into `out`: `x [n, node_dim]` the node attributes,
-    /// edge `k` from `sources[k]` to `targets[k]` with `edges[k * width..]` its
-    /// [`encode_edge`](Self::encode_edge).
+    /// The Q-values (or removabilities) of the `wanted` nodes of `graph` into `out`.
     ///
     /// Runs on the widest SIMD instruction set the CPU has (`pulp`, see the module's notes).
-    #[allow(clippy::too_many_arguments)]
-    pub fn forward(
-        &self,
-        x: &[f32],
-        n: usize,
-        sources: &[u32],
-        targets: &[u32],
-        edges: &[f32],
-        wanted: &[usize],
-        out: &mut [f32],
-        s: &mut Scratch,
-    ) {
-        pulp::Arch::new().dispatch(Forward { net: self, x, h0: None, n, sources, targets, edges, wanted, out, s });
+    pub fn forward(&self, graph: GraphView<'_>, wanted: &[usize], out: &mut [f32], s: &mut Scratch) {
+        pulp::Arch::new().dispatch(Forward { net: self, graph, wanted, out, s });
     }
 
-    /// Node attribute rows (`x [rows, node_dim]`) to what [`forward_encoded`](Self::forward_encoded)
-    /// reads of each node (`width` floats: the node encoder's output). Depends only on the row,
+    /// Node attribute rows (`x [rows, node_dim]`) to what [`GraphView::h0`] holds of each node (`width` floats: the node encoder's output). Depends only on the row,
     /// so callers cache it per part.
     pub fn encode_nodes(&self, x: &[f32], rows: usize, out: &mut [f32], scratch: &mut Vec<f32>) {
         let nd = self.node_dim;
@@ -516,26 +386,6 @@ impl QNet {
             }
         }
         pulp::Arch::new().dispatch(Encode(&self.node_encoder, xs, rows, &mut out[..rows * self.width]));
-    }
-
-    /// [`forward`](Self::forward) from encoded nodes: `h0 [n, width]` the rows of
-    /// [`encode_nodes`](Self::encode_nodes) (cached per part) instead of `x`. `x` is read only by a
-    /// Q head's pooling (its first column weighs each node; an empty `x` weighs every node 1) and
-    /// may be empty for a removability model.
-    #[allow(clippy::too_many_arguments)]
-    pub fn forward_encoded(
-        &self,
-        h0: &[f32],
-        x: &[f32],
-        n: usize,
-        sources: &[u32],
-        targets: &[u32],
-        edges: &[f32],
-        wanted: &[usize],
-        out: &mut [f32],
-        s: &mut Scratch,
-    ) {
-        pulp::Arch::new().dispatch(Forward { net: self, x, h0: Some(h0), n, sources, targets, edges, wanted, out, s });
     }
 
     fn normalise_nodes(&self, x: &[f32], xs: &mut [f32]) {
@@ -560,20 +410,8 @@ impl QNet {
     /// The forward pass, row-major throughout (node `t`'s or edge `k`'s `width` features are
     /// contiguous), so every per-edge loop runs over contiguous features and vectorises.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn forward_any<S: Simd>(
-        &self,
-        simd: S,
-        x: &[f32],
-        h0: Option<&[f32]>,
-        n: usize,
-        sources: &[u32],
-        targets: &[u32],
-        edges: &[f32],
-        wanted: &[usize],
-        out: &mut [f32],
-        s: &mut Scratch,
-    ) {
+    fn forward_any<S: Simd>(&self, simd: S, graph: GraphView<'_>, wanted: &[usize], out: &mut [f32], s: &mut Scratch) {
+        let GraphView { x, h0, n, sources, targets, edges } = graph;
         let w = self.width;
         let e = sources.len();
         let nd = self.node_dim;
@@ -726,12 +564,7 @@ impl QNet {
 /// instruction set with [`QNet::forward_any`] inlined.
 struct Forward<'a> {
     net: &'a QNet,
-    x: &'a [f32],
-    h0: Option<&'a [f32]>,
-    n: usize,
-    sources: &'a [u32],
-    targets: &'a [u32],
-    edges: &'a [f32],
+    graph: GraphView<'a>,
     wanted: &'a [usize],
     out: &'a mut [f32],
     s: &'a mut Scratch,
@@ -742,43 +575,14 @@ impl pulp::WithSimd for Forward<'_> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) {
-        let Forward { net, x, h0, n, sources, targets, edges, wanted, out, s } = self;
-        net.forward_any(simd, x, h0, n, sources, targets, edges, wanted, out, s);
+        let Forward { net, graph, wanted, out, s } = self;
+        net.forward_any(simd, graph, wanted, out, s);
     }
-}
-
-/// `[rows, cols]` row-major to `[cols, rows]`.
-fn transpose(m: &[f32], rows: usize, cols: usize) -> Vec<f32> {
-    let mut t = vec![0.0; m.len()];
-    for r in 0..rows {
-        for c in 0..cols {
-            t[c * rows + r] = m[r * cols + c];
-        }
-    }
-    t
-}
-
-/// `first` then `second` as one map (`x W1 W2 + b1 W2 (+ b2)`), products in `f64`.
-fn compose(first: &Dense, second: &Dense, second_bias: bool) -> Dense {
-    let (i, k, o) = (first.input, first.output, second.output);
-    let mut w = vec![0.0f32; i * o];
-    for r in 0..i {
-        for c in 0..o {
-            let v: f64 = (0..k).map(|j| f64::from(first.w[r * k + j]) * f64::from(second.w[j * o + c])).sum();
-            w[r * o + c] = v as f32;
-        }
-    }
-    let b = (0..o)
-        .map(|c| {
-            let v: f64 = (0..k).map(|j| f64::from(first.b[j]) * f64::from(second.w[j * o + c])).sum();
-            (v + if second_bias { f64::from(second.b[c]) } else { 0.0 }) as f32
-        })
-        .collect();
-    Dense { input: i, output: o, w, b }
 }
 
 #[cfg(test)]
 mod tests {
+    use super::kernels::gemm;
     use super::*;
 
     /// [`gemm`] on the widest instruction set of this CPU (what the forward pass runs).
