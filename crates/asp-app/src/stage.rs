@@ -11,7 +11,7 @@ use crate::why::GridRan;
 use asp_geom::grid::VoxelModel;
 use asp_geom::{Assembly, Checker, PartSet, World};
 use asp_search::grid::GridRun;
-use asp_search::report::RobotReport;
+use asp_search::report::ExtensionReport;
 use asp_search::{Budget, PlanOutcome, Progress};
 use std::borrow::Cow;
 use std::time::Instant;
@@ -127,7 +127,7 @@ pub(crate) struct Run<'a> {
     pub grid_ran: GridRan,
     /// The last depth-first search's outcome, with its extension's report (a robot's): the plan
     /// when no stage ends the run.
-    pub outcome: Option<(PlanOutcome, Option<RobotReport>)>,
+    pub outcome: Option<(PlanOutcome, Option<ExtensionReport>)>,
     /// Each stage the run reached, in order, with what became of it.
     pub trace: Vec<(&'static str, Decision)>,
 }

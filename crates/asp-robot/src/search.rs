@@ -13,7 +13,7 @@
 //!   carry over between numbers of replans ([`RobotModel`]). The lift direction is the
 //!   distance maps' straight-line removal direction of the step.
 //!
-//! Both describe their plan's steps for the plan JSON ([`RobotReport`]).
+//! Both describe their plan's steps for the plan JSON ([`ExtensionReport`]).
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
@@ -24,7 +24,7 @@ use asp_geom::{Assembly, Checker, FeasibilityChecker, Motion, PartSet, World, Wo
 use asp_search::extension::{MdpExtension, ModelContext};
 use asp_search::mdp::{ActionFilter, Verdict};
 use asp_search::objective::Objective;
-use asp_search::report::{RobotEntry, RobotReason, RobotRefusal, RobotReport, RobotStepEntry};
+use asp_search::report::{ExtensionReport, RobotEntry, RobotReason, RobotRefusal, RobotStepEntry};
 use asp_search::step::{StepContext, StepKind};
 use asp_search::CheckerExtension;
 use asp_search::{Mdp, PathLength, PlanOutcome, SearchError, Status, StuckReason};
@@ -64,7 +64,7 @@ impl RobotSetup {
 }
 
 /// The report entries of a robot: the cell and one entry per step (`None` where not planned).
-pub fn robot_report(assembly: &Assembly, cell: &RobotCell, steps: Vec<Option<RobotRemoval>>) -> RobotReport {
+pub fn robot_report(assembly: &Assembly, cell: &RobotCell, steps: Vec<Option<RobotRemoval>>) -> ExtensionReport {
     let u = |m: f64| assembly.units.from_metres(m);
     let v3 = |v: Vec3| [u(v.x as f64), u(v.y as f64), u(v.z as f64)];
     let pose7 = |p: &Pose| {
@@ -88,7 +88,7 @@ pub fn robot_report(assembly: &Assembly, cell: &RobotCell, steps: Vec<Option<Rob
             })
         })
         .collect();
-    RobotReport {
+    ExtensionReport {
         entry: Some(RobotEntry {
             name: cell.robot.name.clone(),
             source: cell.robot.source.display().to_string(),
@@ -118,7 +118,7 @@ impl CheckerExtension for CellSetup {
         checker: &Checker,
         seed: u64,
         search: &mut dyn FnMut(&dyn FeasibilityChecker) -> asp_search::Result<PlanOutcome>,
-    ) -> asp_search::Result<(PlanOutcome, Option<RobotReport>)> {
+    ) -> asp_search::Result<(PlanOutcome, Option<ExtensionReport>)> {
         let world = checker.world();
         let holding = (self.grippers >= 2).then(|| HoldingChecker::new(checker, self.grippers));
         let base: &dyn FeasibilityChecker = match &holding {
@@ -148,7 +148,7 @@ impl CheckerExtension for CellSetup {
         }
         let mut report = match &robot {
             Some((cell, _)) => robot_report(world.assembly(), cell, steps),
-            None => RobotReport::default(),
+            None => ExtensionReport::default(),
         };
         report.held = held;
         Ok((outcome, Some(report)))
@@ -659,7 +659,7 @@ impl MdpExtension for RobotExtension {
         Ok(vec![Arc::new(RobotFilter(m))])
     }
 
-    fn describe(&self, model: &ModelContext<'_>, sequence: &[usize]) -> asp_search::Result<Option<RobotReport>> {
+    fn describe(&self, model: &ModelContext<'_>, sequence: &[usize]) -> asp_search::Result<Option<ExtensionReport>> {
         let robot = self.model(model)?;
         // the steps' seeds as the search saw them: a problem with the run's seed
         let mdp = Mdp::new(model.maps.clone(), vec![Arc::new(PathLength) as Arc<dyn Objective>])?

@@ -45,7 +45,7 @@ pub struct RobotStepEntry {
 /// What an extension (a robot, held parts) adds to a plan: the report-level entry and, per
 /// removal of the plan outcome (removal order), the step's robot entry and held parts.
 #[derive(Clone, Debug, PartialEq, Default)]
-pub struct RobotReport {
+pub struct ExtensionReport {
     /// The robot, if any.
     pub entry: Option<RobotEntry>,
     /// One per removal, in removal order (`None`: not planned for a robot).

@@ -5,7 +5,7 @@
 
 use crate::error::Result;
 use crate::problem::PlanOutcome;
-use crate::report::RobotReport;
+use crate::report::ExtensionReport;
 use asp_geom::Checker;
 
 /// Decorates the feasibility planner's checker: [`CheckerExtension::solve`] builds its
@@ -20,5 +20,5 @@ pub trait CheckerExtension: Send + Sync + std::fmt::Debug {
         checker: &Checker,
         seed: u64,
         search: &mut dyn FnMut(&dyn asp_geom::FeasibilityChecker) -> Result<PlanOutcome>,
-    ) -> Result<(PlanOutcome, Option<RobotReport>)>;
+    ) -> Result<(PlanOutcome, Option<ExtensionReport>)>;
 }

@@ -1,9 +1,9 @@
 //! The seam for crates above asp-search (a robot, held parts): an [`MdpExtension`] adds named
 //! objectives and feasibility filters to the planning pipeline for a model, and what it plans
-//! for the answer to the plan ([`RobotReport`]); [`check_objective_names`] and
+//! for the answer to the plan ([`ExtensionReport`]); [`check_objective_names`] and
 //! [`resolve_objectives`] look objective names up among the built-in ones and the extensions'.
 
-use crate::annotation::RobotReport;
+use crate::annotation::ExtensionReport;
 use crate::error::Result;
 use crate::mdp::ActionFilter;
 use crate::objective::{collect_names, collect_objectives, objective_by_name, unknown, Objective};
@@ -43,7 +43,7 @@ pub trait MdpExtension: Send + Sync + Debug {
 
     /// What it adds to the plan of `sequence` (removal order) on this model, e.g. a robot's
     /// grasps and paths per step; default `None`.
-    fn describe(&self, _model: &ModelContext<'_>, _sequence: &[usize]) -> Result<Option<RobotReport>> {
+    fn describe(&self, _model: &ModelContext<'_>, _sequence: &[usize]) -> Result<Option<ExtensionReport>> {
         Ok(None)
     }
 }
