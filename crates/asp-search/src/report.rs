@@ -242,7 +242,7 @@ pub struct OverlapPair {
 impl OverlapsEntry {
     /// The overlaps `world` measured; `None` when no pair overlaps.
     pub fn of(world: &asp_geom::World) -> Option<OverlapsEntry> {
-        let notes = world.overlap_notes();
+        let notes = world.overlaps().notes();
         if notes.is_empty() {
             return None;
         }
@@ -269,7 +269,7 @@ impl OverlapsEntry {
                 normal: n.normal.map(|v| [v.x as f64, v.y as f64, v.z as f64]),
             })
             .collect();
-        Some(OverlapsEntry { policy: world.overlap_policy(), pairs })
+        Some(OverlapsEntry { policy: world.overlaps().policy(), pairs })
     }
 }
 
@@ -303,7 +303,9 @@ impl FitEntry {
         let len = |m: f32| units.from_metres(m as f64);
         let v = |x: asp_geom::math::Vec3| [x.x as f64, x.y as f64, x.z as f64];
         world
-            .all_fits()
+            .overlaps()
+            .fits()
+            .all()
             .values()
             .flatten()
             .map(|f| FitEntry {
@@ -313,7 +315,7 @@ impl FitEntry {
                 point: v(f.point).map(|c| units.from_metres(c)),
                 axis: v(f.axis),
                 radii: [len(f.shaft_radius), len(f.hole_radius)],
-                roles: [world.role(f.shaft), world.role(f.hole)],
+                roles: [world.overlaps().fits().role(f.shaft), world.overlaps().fits().role(f.hole)],
                 turns: f.turns,
             })
             .collect()
@@ -361,6 +363,8 @@ impl BearingEntry {
         let units = &world.assembly().units;
         let len = |m: f32| units.from_metres(m as f64);
         world
+            .overlaps()
+            .fits()
             .bearings()
             .iter()
             .map(|b| BearingEntry {
@@ -381,7 +385,7 @@ impl BearingEntry {
 }
 
 /// A component of a plan drawn as several solids of one product that interpenetrate (format
-/// 1.14; [`asp_geom::World::fused_components`]): planned as one unit, never taken apart.
+/// 1.14; [`asp_geom::world::Overlaps::fused_components`]): planned as one unit, never taken apart.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct ComponentEntry {
     /// Its parts, ascending (the unit's parts).
@@ -396,8 +400,10 @@ impl ComponentEntry {
     /// Every component drawn as several solids that `world` found.
     pub fn of(world: &asp_geom::World) -> Vec<ComponentEntry> {
         world
+            .overlaps()
             .fused_components()
-            .into_iter()
+            .iter()
+            .cloned()
             .map(|parts| ComponentEntry {
                 names: parts.iter().map(|&p| world.name(p).to_string()).collect(),
                 product: world.assembly().parts[parts[0]].path.last().cloned().unwrap_or_default(),
