@@ -12,10 +12,10 @@
 
 use super::fits::{Fits, SCREW_ALIGNED};
 use super::pairs::Pairs;
-use crate::boxes;
+use crate::boxes::{self, sweep_overlap};
 use crate::fastener::Thread;
 use crate::fits::Fit;
-use crate::math::{sweep_overlap, Vec3};
+use crate::math::Vec3;
 use crate::partset::PartSet;
 use crate::sweep;
 use rayon::prelude::*;

@@ -9,8 +9,8 @@
 
 use super::overlaps::Overlaps;
 use super::shapes::Shapes;
-use crate::boxes;
-use crate::math::{sweep_overlap, Aabb, Pose, Vec3};
+use crate::boxes::{self, sweep_overlap};
+use crate::math::{Aabb, Pose, Vec3};
 use crate::overlap;
 use crate::sweep;
 use parry3d::shape::TriMesh;
