@@ -76,7 +76,7 @@ pub fn check_cell(path: &Path, request: &PlanRequest) -> Result<CellCheck> {
     let units = |m: f64| assembly.units.from_metres(m);
     let v3 = |v: asp_geom::math::Vec3| [units(shortest(v.x)), units(shortest(v.y)), units(shortest(v.z))];
     let n = world.num_parts();
-    let movable: Vec<usize> = (0..n).filter(|&p| !world.fixed().contains(p)).collect();
+    let movable: Vec<usize> = (0..n).filter(|&p| !world.contacts().fixed().contains(p)).collect();
     let parts = movable
         .par_iter()
         .map(|&p| {

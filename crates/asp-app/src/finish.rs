@@ -29,7 +29,7 @@ pub(crate) fn outcome_result(run: &mut Run<'_>, plan_core: Option<PlanCore<'_>>)
     let settings = run.settings;
     let (checker, world_seconds) = run.model.world(settings, &mut run.units)?;
     let world = checker.world();
-    let mut report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
+    let mut report = PlanReport::new(world.assembly(), &outcome, world.shapes().tolerance(), world.warnings());
     if let Some(r) = robot {
         report.attach_robot(r);
     }
@@ -63,7 +63,7 @@ pub(crate) fn grid_result(
     if let Some(b) = before {
         outcome.stats.add_effort(&b.stats);
     }
-    let mut report = PlanReport::new(assembly, &outcome, world.tolerance(), world.warnings());
+    let mut report = PlanReport::new(assembly, &outcome, world.shapes().tolerance(), world.warnings());
     let u = |x: f32| assembly.units.from_metres(x as f64);
     let cell = run.model.cell;
     report.grid = Some(GridEntry {

@@ -198,12 +198,12 @@ fn grid_view(assembly: &Assembly, settings: &PlanSettings) -> std::result::Resul
 }
 
 /// `units` with every rolling bearing `world` found ([`asp_geom::Bearing`]) and every component
-/// drawn as several interpenetrating solids ([`World::fused_components`]) as one more unit: a
+/// drawn as several interpenetrating solids ([`asp_geom::world::Overlaps::fused_components`]) as one more unit: a
 /// bought unit whose balls never leave their grooves, or one piece drawn as several, goes in
 /// whole. A declared unit that shares a part with one is merged with it (units are disjoint).
 fn with_found_units(mut units: Vec<PartSet>, world: &World) -> Vec<PartSet> {
     let n = world.num_parts();
-    let found = world.bearings().iter().map(|b| b.parts()).chain(world.fused_components());
+    let found = world.overlaps().fits().bearings().iter().map(|b| b.parts()).chain(world.overlaps().fused_components().iter().cloned());
     for parts in found {
         let mut merged = PartSet::from_indices(n + 1, parts);
         units.retain(|u| {

@@ -170,10 +170,10 @@ fn mesh_and_box_removal_tests_agree_on_generated_assemblies_at_any_scale() {
             }
             let exact = World::new(assembly.clone(), &WorldConfig::default()).unwrap();
             let meshes = World::new(assembly, &WorldConfig { exact_boxes: false, ..WorldConfig::default() }).unwrap();
-            assert_eq!(exact.directions(), meshes.directions());
+            assert_eq!(exact.blocking().directions(), meshes.blocking().directions());
             for p in 0..exact.num_parts() {
-                for (k, (a, b)) in exact.blocking_row(p).iter().zip(meshes.blocking_row(p)).enumerate() {
-                    assert_eq!(a, b, "{} ×{scale}: '{}' along {:?}", file.display(), exact.name(p), exact.directions()[k]);
+                for (k, (a, b)) in exact.blocking().row(p).iter().zip(meshes.blocking().row(p)).enumerate() {
+                    assert_eq!(a, b, "{} ×{scale}: '{}' along {:?}", file.display(), exact.name(p), exact.blocking().directions()[k]);
                 }
             }
         }
@@ -201,7 +201,7 @@ fn recheck_on_boxes(path: &std::path::Path, world: &World, removals: &[asp_searc
     let parts = &world.assembly().parts;
     let boxes: Vec<Vec<asp_geom::math::Aabb>> =
         parts.iter().map(|p| asp_geom::boxes::part_boxes(p).unwrap().expect("generated parts are boxes")).collect();
-    let tol = world.tolerance();
+    let tol = world.shapes().tolerance();
     let mut present: Vec<bool> = vec![true; parts.len()];
     for (k, step) in removals.iter().enumerate() {
         let p = step.part;
@@ -223,7 +223,7 @@ fn recheck_on_boxes(path: &std::path::Path, world: &World, removals: &[asp_searc
             }
         }
         let state = asp_geom::PartSet::from_indices(parts.len(), (0..parts.len()).filter(|&q| present[q]));
-        if world.contact_stability(&state) != asp_geom::Stability::Stable {
+        if world.contacts().stability(&state) != asp_geom::Stability::Stable {
             return Err(format!("{}: step {k}: the remainder is not linked to the fixed parts", path.display()));
         }
     }

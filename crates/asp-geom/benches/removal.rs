@@ -36,7 +36,9 @@ fn bench(c: &mut Criterion) {
             )
         });
         let world = World::new(assembly.clone(), &WorldConfig::default()).expect("world");
-        c.bench_function(&format!("bearings/{name}"), |b| b.iter(|| black_box(world.find_bearings().len())));
+        c.bench_function(&format!("bearings/{name}"), |b| {
+            b.iter(|| black_box(asp_geom::world::find_bearings(world.shapes(), world.contacts()).len()))
+        });
         let n = world.num_parts();
         let full = PartSet::full(n);
         let mut group = c.benchmark_group(format!("removal_test/{name}"));
@@ -48,18 +50,18 @@ fn bench(c: &mut Criterion) {
                     k += 1;
                     (World::new(assembly.clone(), &WorldConfig::default()).expect("world"), k % n)
                 },
-                |(w, p)| black_box(w.linear_removal(p, &full).is_ok()),
+                |(w, p)| black_box(w.removal().linear(p, &full).is_ok()),
                 BatchSize::PerIteration,
             )
         });
         for p in 0..n {
-            world.blocking_row(p);
+            world.blocking().row(p);
         }
         let mut k = 0;
         group.bench_function("warm", |b| {
             b.iter(|| {
                 k += 1;
-                black_box(world.linear_removal(k % n, &full).is_ok())
+                black_box(world.removal().linear(k % n, &full).is_ok())
             })
         });
         group.finish();
@@ -70,8 +72,8 @@ fn bench(c: &mut Criterion) {
             let mut blocked = 0;
             for p in 0..n {
                 for q in (0..n).filter(|&q| q != p) {
-                    let (moving, fixed) = world.pair_shapes(p, q);
-                    for &dir in world.directions() {
+                    let (moving, fixed) = world.blocking().pairs().shapes(p, q);
+                    for &dir in world.blocking().directions() {
                         let hit = if reference {
                             asp_geom::sweep::sweep_hits_at_reference(&moving, &Pose::IDENTITY, dir, &fixed, diag)
                         } else {
@@ -89,7 +91,7 @@ fn bench(c: &mut Criterion) {
         group.bench_function("bvh_descent", |b| b.iter(|| black_box(row_sweeps(false))));
         group.bench_function("per_triangle", |b| b.iter(|| black_box(row_sweeps(true))));
         group.finish();
-        c.bench_function(&format!("stability/{name}"), |b| b.iter(|| black_box(world.contact_stability(&full))));
+        c.bench_function(&format!("stability/{name}"), |b| b.iter(|| black_box(world.contacts().stability(&full))));
         if name == "tube" || name == "table_lack_0825" {
             // the physics check of the state with part 1 removed (rapier, 1 s simulated)
             let physics = PhysicsStability::new(&world, &PhysicsConfig::default());

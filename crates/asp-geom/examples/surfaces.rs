@@ -25,8 +25,8 @@ fn main() {
         if !only.is_empty() && !only.iter().any(|n| n == world.name(p)) {
             continue;
         }
-        let s = world.surfaces(p);
-        println!("{} ({:?}): {} planes, {} cylinders", world.name(p), world.role(p), s.planes.len(), s.cylinders.len());
+        let s = world.shapes().surfaces(p);
+        println!("{} ({:?}): {} planes, {} cylinders", world.name(p), world.overlaps().fits().role(p), s.planes.len(), s.cylinders.len());
         for c in &s.cylinders {
             println!(
                 "  {} r {:.4} mm axis {:.4?} at {:.3?} mm, sagitta {:.4} mm, {} triangles, {:?}",
@@ -40,7 +40,7 @@ fn main() {
             );
         }
     }
-    for ((p, q), fits) in world.all_fits() {
+    for ((p, q), fits) in world.overlaps().fits().all() {
         for f in fits {
             println!(
                 "fit {} / {}: {} (shaft {:.4}, hole {:.4} mm), turns {:?}",

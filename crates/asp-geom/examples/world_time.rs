@@ -45,7 +45,7 @@ fn main() {
         let w = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let full = PartSet::full(parts);
-        let free = (0..parts).filter(|&p| world.linear_removal(p, &full).is_ok()).count();
+        let free = (0..parts).filter(|&p| world.removal().linear(p, &full).is_ok()).count();
         let r = t.elapsed().as_secs_f64();
         (load_s, world_s, tests_s) = (load_s + l, world_s + w, tests_s + r);
         if !many {

@@ -8,6 +8,10 @@
 //! the mesh: the same volume, and every mesh vertex on a box. A box-box test is then exact
 //! interval arithmetic: touching faces are exactly in contact and sliding along them is exactly
 //! free, with none of the thresholds of a triangle-mesh query.
+//!
+//! The box sweeps live here and nowhere else: [`sweep_overlap`] (when two boxes overlap along a
+//! translation, the broad phase of every pair test) and [`first_overlap`] (when a box first
+//! overlaps another deeper than a tolerance, the exact test of box parts).
 
 use crate::assembly::Part;
 use crate::math::{Aabb, Vec3};
@@ -154,6 +158,29 @@ pub fn single_box(mesh: &Mesh) -> Option<Aabb> {
     (corners && vol > 0.0 && (mesh.signed_volume().abs() - vol).abs() <= 1e-4 * vol).then_some(b)
 }
 
+/// The interval of times `t >= 0` during which box `moving` translated by `t * dir`
+/// overlaps box `fixed` with positive volume (touching faces do not count).
+/// Returns `None` when they never overlap.
+pub fn sweep_overlap(moving: &Aabb, dir: Vec3, fixed: &Aabb) -> Option<(f32, f32)> {
+    let (mut t0, mut t1) = (0.0f32, f32::INFINITY);
+    for i in 0..3 {
+        // overlap on axis i when fixed.min < moving.max + t d  and  moving.min + t d < fixed.max
+        let lo = fixed.mins[i] - moving.maxs[i];
+        let hi = fixed.maxs[i] - moving.mins[i];
+        let d = dir[i];
+        if d.abs() < 1e-9 {
+            if !(lo < 0.0 && hi > 0.0) {
+                return None;
+            }
+        } else {
+            let (a, b) = if d > 0.0 { (lo / d, hi / d) } else { (hi / d, lo / d) };
+            t0 = t0.max(a);
+            t1 = t1.min(b);
+        }
+    }
+    (t0 < t1).then_some((t0, t1))
+}
+
 /// Whether box `moving + t * dir` ever (`t >= 0`) overlaps `fixed` deeper than `tol` on every
 /// axis (touching or grazing within `tol` is free: the moving box is shrunk by `tol`), and if so
 /// when it first touches: the entry time without the tolerance, so exact contact reads 0.
@@ -260,5 +287,17 @@ mod tests {
         let sunk = Aabb::new(Vec3::new(0.0, 0.0, 0.9), Vec3::new(1.0, 1.0, 2.0));
         assert!((overlap_depth(&a, &sunk) - 0.1).abs() < 1e-6);
         assert!((box_distance(&a, &right, Vec3::ONE) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn sweep_overlap_of_boxes() {
+        let a = Aabb::new(Vec3::ZERO, Vec3::ONE);
+        let b = Aabb::new(Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 1.0, 2.0));
+        // a moving up runs into b (touching at t = 0, overlapping until t = 2)
+        assert_eq!(sweep_overlap(&a, Vec3::Z, &b), Some((0.0, 2.0)));
+        // moving down never overlaps
+        assert_eq!(sweep_overlap(&a, -Vec3::Z, &b), None);
+        // sliding sideways along the shared face never overlaps with volume
+        assert_eq!(sweep_overlap(&a, Vec3::X, &b), None);
     }
 }

@@ -57,9 +57,9 @@ impl Checker {
     pub fn stability_holding(&self, state: &PartSet, held: &PartSet) -> Stability {
         match &self.physics {
             None => {
-                let mut base = self.world.fixed().clone();
+                let mut base = self.world.contacts().fixed().clone();
                 base.union_with(held);
-                self.world.contact_stability_among(&self.world.with_fixed(state), &base)
+                self.world.contacts().stability_among(&self.world.contacts().with_fixed(state), &base)
             }
             Some(physics) => physics.stability_holding(&self.world, state, held),
         }
@@ -72,14 +72,14 @@ impl FeasibilityChecker for Checker {
     }
 
     fn is_fixed(&self, part: usize) -> bool {
-        self.world.fixed().contains(part)
+        self.world.contacts().fixed().contains(part)
     }
 
     fn test_removal(&self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome {
         let motion = match kind {
-            MotionKind::Linear => self.world.linear_removal(part, state),
+            MotionKind::Linear => self.world.removal().linear(part, state),
             // two straight moves in turn first (exact and cheap), then random sampling
-            MotionKind::Path { seed } => match self.world.two_step_removal(part, state) {
+            MotionKind::Path { seed } => match self.world.removal().two_step(part, state) {
                 Some(motion) => Ok(motion),
                 None => plan_removal_path(&self.world, part, state, &self.config.rrt, seed),
             },
@@ -89,7 +89,7 @@ impl FeasibilityChecker for Checker {
 
     fn stability(&self, state: &PartSet) -> Stability {
         match &self.physics {
-            None => self.world.contact_stability(state),
+            None => self.world.contacts().stability(state),
             Some(physics) => physics.stability(&self.world, state),
         }
     }
@@ -99,15 +99,15 @@ impl FeasibilityChecker for Checker {
     }
 
     fn group_candidates(&self, state: &PartSet) -> Vec<PartSet> {
-        group_candidates(&self.world, state, self.world.fixed())
+        group_candidates(&self.world, state, self.world.contacts().fixed())
     }
 
     fn in_movable_group(&self, part: usize, state: &PartSet) -> bool {
-        in_movable_group(&self.world, part, state, self.world.fixed())
+        in_movable_group(&self.world, part, state, self.world.contacts().fixed())
     }
 
     fn test_group_removal(&self, group: &PartSet, state: &PartSet) -> Outcome {
-        let motion = self.world.group_removal_among(group, state, &self.world.with_fixed(state));
+        let motion = self.world.removal().group_among(group, state, &self.world.contacts().with_fixed(state));
         self.finish(MotionKind::Linear, motion, &without(state, group))
     }
 
@@ -149,9 +149,9 @@ fn group_candidates(world: &World, state: &PartSet, fixed: &PartSet) -> Vec<Part
     let mut present = state.clone();
     present.union_with(fixed);
     let mut found: Vec<PartSet> = Vec::new();
-    for k in 0..world.directions().len() {
+    for k in 0..world.blocking().directions().len() {
         for p in state.iter().filter(|&p| !fixed.contains(p)) {
-            let closure = world.group_closure(&PartSet::from_indices(world.num_parts() + 1, [p]), k, &present);
+            let closure = world.blocking().group_closure(&PartSet::from_indices(world.num_parts() + 1, [p]), k, &present);
             if closure.len() >= 2 && !closure.intersects(fixed) && !found.contains(&closure) {
                 found.push(closure);
             }
@@ -166,14 +166,14 @@ fn in_movable_group(world: &World, part: usize, state: &PartSet, fixed: &PartSet
     let mut present = state.clone();
     present.union_with(fixed);
     let seed = PartSet::from_indices(world.num_parts() + 1, [part]);
-    (0..world.directions().len()).any(|k| !world.group_closure(&seed, k, &present).intersects(fixed))
+    (0..world.blocking().directions().len()).any(|k| !world.blocking().group_closure(&seed, k, &present).intersects(fixed))
 }
 
 /// The base of a subassembly planned on its own: its largest part (by the volume of its
 /// bounds; the lowest index among equals), which the others are put onto.
 fn subassembly_base(world: &World, group: &PartSet) -> Option<usize> {
     let volume = |p: usize| {
-        let b = world.aabb(p);
+        let b = world.shapes().aabb(p);
         (b.maxs - b.mins).as_dvec3().element_product()
     };
     group.iter().filter(|&p| p < world.num_parts()).fold(None, |best: Option<usize>, p| match best {
@@ -222,7 +222,7 @@ impl FeasibilityChecker for OnBase<'_> {
 
     fn test_removal(&self, part: usize, state: &PartSet, kind: MotionKind) -> Outcome {
         let motion = match kind {
-            MotionKind::Linear => self.world.linear_removal_among(part, state, &self.present(state)),
+            MotionKind::Linear => self.world.removal().linear_among(part, state, &self.present(state)),
             // no path planner inside a subassembly: a failed test that names no blocker
             MotionKind::Path { .. } => Err(PartSet::empty(self.world.num_parts() + 1)),
         };
@@ -230,7 +230,7 @@ impl FeasibilityChecker for OnBase<'_> {
     }
 
     fn stability(&self, state: &PartSet) -> Stability {
-        self.world.contact_stability_among(&self.present(state), &self.fixed)
+        self.world.contacts().stability_among(&self.present(state), &self.fixed)
     }
 
     fn counters(&self) -> CounterSnapshot {
@@ -246,7 +246,7 @@ impl FeasibilityChecker for OnBase<'_> {
     }
 
     fn test_group_removal(&self, group: &PartSet, state: &PartSet) -> Outcome {
-        let motion = self.world.group_removal_among(group, state, &self.present(state));
+        let motion = self.world.removal().group_among(group, state, &self.present(state));
         self.finish(motion, &without(state, group))
     }
 

@@ -64,29 +64,6 @@ pub fn aabb_of(points: impl IntoIterator<Item = Vec3>) -> Option<Aabb> {
     Some(Aabb::new(mins, maxs))
 }
 
-/// The interval of times `t >= 0` during which box `moving` translated by `t * dir`
-/// overlaps box `fixed` with positive volume (touching faces do not count).
-/// Returns `None` when they never overlap.
-pub fn sweep_overlap(moving: &Aabb, dir: Vec3, fixed: &Aabb) -> Option<(f32, f32)> {
-    let (mut t0, mut t1) = (0.0f32, f32::INFINITY);
-    for i in 0..3 {
-        // overlap on axis i when fixed.min < moving.max + t d  and  moving.min + t d < fixed.max
-        let lo = fixed.mins[i] - moving.maxs[i];
-        let hi = fixed.maxs[i] - moving.mins[i];
-        let d = dir[i];
-        if d.abs() < 1e-9 {
-            if !(lo < 0.0 && hi > 0.0) {
-                return None;
-            }
-        } else {
-            let (a, b) = if d > 0.0 { (lo / d, hi / d) } else { (hi / d, lo / d) };
-            t0 = t0.max(a);
-            t1 = t1.min(b);
-        }
-    }
-    (t0 < t1).then_some((t0, t1))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -97,17 +74,5 @@ mod tests {
         assert_eq!(Axis::parse("y"), Some(Axis::Y));
         assert_eq!(Axis::parse("+x").unwrap().to_string(), "+x");
         assert_eq!(Axis::parse("w"), None);
-    }
-
-    #[test]
-    fn sweep_overlap_of_boxes() {
-        let a = Aabb::new(Vec3::ZERO, Vec3::ONE);
-        let b = Aabb::new(Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 1.0, 2.0));
-        // a moving up runs into b (touching at t = 0, overlapping until t = 2)
-        assert_eq!(sweep_overlap(&a, Vec3::Z, &b), Some((0.0, 2.0)));
-        // moving down never overlaps
-        assert_eq!(sweep_overlap(&a, -Vec3::Z, &b), None);
-        // sliding sideways along the shared face never overlaps with volume
-        assert_eq!(sweep_overlap(&a, Vec3::X, &b), None);
     }
 }

@@ -15,7 +15,7 @@
 //!   above the sinking of soft contacts, so resting stacks do not count as moving.
 //! - **Parts overlap.** Two kinds are told apart:
 //!   - *Interference fits* — pairs the [`World`] found overlapping in the input deeper than the
-//!     tolerance ([`World::overlaps`]): a pressed pin, a thread modelled at nominal diameter. Such
+//!     tolerance ([`crate::world::Overlaps::pairs`]): a pressed pin, a thread modelled at nominal diameter. Such
 //!     a joint carries gravity loads by friction, so the two parts are bonded into one rigid body
 //!     (static when one of them is fixed). Simulating them as separate bodies would either push
 //!     them apart violently or let a pressed pin slide out of its hole.
@@ -35,7 +35,7 @@
 //! - **Parts are fastened.** A connector screwed to the profiles it joins, a bolt in its nut:
 //!   what the model says is fastened ([`crate::meta::PartMeta::fastened_to`], written by the
 //!   profile generator for every connector) and the threaded contacts the world detects
-//!   ([`World::threads`]) bond their two parts into one rigid body while both are present,
+//!   ([`crate::world::Fits::threads`]) bond their two parts into one rigid body while both are present,
 //!   like interference fits. Without that, a profile frame held only by its connectors' side
 //!   contacts collapses in its assembled state and no removal is ever stable.
 //!
@@ -186,13 +186,13 @@ impl PhysicsStability {
     /// `config` is replaced by the default; call [`PhysicsConfig::validate`] first to report it.
     pub fn new(world: &World, config: &PhysicsConfig) -> Self {
         let config = config.or_default();
-        let count = world.num_parts() + usize::from(world.ground().is_some());
+        let count = world.num_parts() + usize::from(world.shapes().ground().is_some());
         let diag = world.assembly().diagonal().max(f32::MIN_POSITIVE);
         // rapier's tolerances are tuned for objects about one length unit in size: use the
         // median part size, so a few tiny screws or one huge base do not skew it
         let mut sizes: Vec<f32> = (0..world.num_parts())
             .map(|i| {
-                let b = world.aabb(i);
+                let b = world.shapes().aabb(i);
                 (b.maxs - b.mins).length()
             })
             .filter(|s| s.is_finite() && *s > 0.0)
@@ -200,8 +200,8 @@ impl PhysicsStability {
         sizes.sort_by(f32::total_cmp);
         let length_unit = sizes.get(sizes.len() / 2).copied().unwrap_or(diag);
         let (fastened, _) = world.assembly().fastenings();
-        let threaded = world.threads().keys().map(|&(p, q)| (p.min(q), p.max(q)));
-        let bonds: BTreeSet<(usize, usize)> = world.overlaps().keys().copied().chain(fastened).chain(threaded).collect();
+        let threaded = world.overlaps().fits().threads().keys().map(|&(p, q)| (p.min(q), p.max(q)));
+        let bonds: BTreeSet<(usize, usize)> = world.overlaps().pairs().keys().copied().chain(fastened).chain(threaded).collect();
         PhysicsStability {
             bonds: bonds.into_iter().collect(),
             threshold: config.displacement_fraction * diag,
@@ -266,12 +266,12 @@ impl PhysicsStability {
 
     /// [`PhysicsStability::displacements`] with the `held` parts static too.
     pub fn displacements_holding(&self, world: &World, state: &PartSet, held: &PartSet) -> Vec<(usize, f32)> {
-        let present = world.with_fixed(state);
+        let present = world.contacts().with_fixed(state);
         let count = self.shapes.len();
         let parts: Vec<usize> = present.iter().filter(|&i| i < count).collect();
         let group = bonded_groups(&self.bonds, &parts);
         let static_groups: BTreeSet<usize> =
-            parts.iter().filter(|&&i| world.fixed().contains(i) || held.contains(i)).map(|i| group[i]).collect();
+            parts.iter().filter(|&&i| world.contacts().fixed().contains(i) || held.contains(i)).map(|i| group[i]).collect();
         let is_static = |g: usize| static_groups.contains(&g);
         if parts.iter().all(|i| is_static(group[i])) {
             return Vec::new();
@@ -422,15 +422,15 @@ impl PhysicsHooks for ContactHook {
 
 /// Whether part `i`'s collider is a triangle mesh: a fixed part other than the ground.
 fn has_triangle_mesh(world: &World, i: usize) -> bool {
-    world.fixed().contains(i) && world.ground() != Some(i)
+    world.contacts().fixed().contains(i) && world.shapes().ground() != Some(i)
 }
 
 /// The collider of part `i` (ground included): a box for the ground, the exact triangle mesh for
 /// fixed parts (static, so it need not be solid: no filled holes), convex pieces for the others.
 fn part_shape(world: &World, i: usize, config: &PhysicsConfig) -> Option<PartShape> {
-    let aabb = world.aabb(i);
+    let aabb = world.shapes().aabb(i);
     let centre = (aabb.mins + aabb.maxs) * 0.5;
-    if world.ground() == Some(i) {
+    if world.shapes().ground() == Some(i) {
         let half = (aabb.maxs - aabb.mins) * 0.5;
         return Some(PartShape {
             shape: SharedShape::cuboid(half.x, half.y, half.z),
@@ -439,11 +439,11 @@ fn part_shape(world: &World, i: usize, config: &PhysicsConfig) -> Option<PartSha
             radius: half.length(),
         });
     }
-    let mesh = world.mesh(i);
+    let mesh = world.shapes().mesh(i);
     let shape = if has_triangle_mesh(world, i) {
         static_mesh(mesh)
     } else {
-        convex_shape(mesh, world.is_closed(i), config).unwrap_or_else(|| thin_box(aabb, world.assembly().diagonal()))
+        convex_shape(mesh, world.shapes().is_closed(i), config).unwrap_or_else(|| thin_box(aabb, world.assembly().diagonal()))
     };
     let com = shape.mass_properties(1.0).local_com;
     let com = if com.is_finite() { com } else { centre };

@@ -152,12 +152,12 @@ impl VoxelChecker {
     }
 
     /// For each candidate direction (+x, −x, +y, −y, +z, −z), every part (ground included)
-    /// that blocks `p` along it: the world's [`crate::World::blocking_row`].
+    /// that blocks `p` along it: the world's [`crate::world::Blocking::row`].
     pub fn blocking_row(&self, p: usize) -> Vec<PartSet> {
         self.rows[p].iter().map(|&m| self.set(m)).collect()
     }
 
-    /// Parts in contact with part `i` (ground included): the world's [`crate::World::contacts`].
+    /// Parts in contact with part `i` (ground included): the world's [`crate::world::Contacts::of`].
     pub fn contacts(&self, i: usize) -> PartSet {
         self.set(self.contacts[i])
     }

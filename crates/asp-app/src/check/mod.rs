@@ -118,15 +118,15 @@ impl Tester<'_> {
     /// The parts of `state` (and the base) blocking `parts` removed along `dir` (unit).
     fn blockers_along(&self, parts: &[usize], state: &PartSet, dir: Vec3) -> PartSet {
         let world = self.world();
-        let present = world.with_fixed(state);
+        let present = world.contacts().with_fixed(state);
         let group = self.group(parts);
-        if let Some(k) = world.directions().iter().position(|d| d.dot(dir) > 0.99999) {
-            return world.group_blockers(&group, k, &present);
+        if let Some(k) = world.blocking().directions().iter().position(|d| d.dot(dir) > 0.99999) {
+            return world.blocking().group_blockers(&group, k, &present);
         }
         let mut blockers = PartSet::empty(world.num_parts() + 1);
         for &p in parts {
             for q in present.iter().filter(|q| !group.contains(*q)) {
-                if world.pair_blocks(p, q, dir) {
+                if world.blocking().pair_blocks(p, q, dir) {
                     blockers.insert(q);
                 }
             }
@@ -145,12 +145,13 @@ impl Tester<'_> {
         }
         let group = self.group(parts);
         let distance = match parts {
-            [p] => world.clearance(*p, state, dir),
-            _ => world.group_clearance(&group, state, dir),
+            [p] => world.removal().clearance(*p, state, dir),
+            _ => world.removal().group_clearance(&group, state, dir),
         };
         let motion = match parts {
             [p] => {
-                let partner = world.with_fixed(state).iter().filter(|&q| q != *p).find_map(|q| world.thread(*p, q));
+                let partner =
+                    world.contacts().with_fixed(state).iter().filter(|&q| q != *p).find_map(|q| world.overlaps().fits().thread(*p, q));
                 match partner.filter(|t| t.axis.direction.dot(dir).abs() > 0.9999) {
                     Some(t) => Motion::Screw { axis_point: t.axis.point, direction: dir, distance },
                     None => Motion::Linear { direction: dir, distance },
@@ -177,9 +178,9 @@ impl Tester<'_> {
     /// Per candidate direction, the blockers of `parts` in `state` (removal directions).
     fn per_direction(&self, parts: &[usize], state: &PartSet) -> Vec<(Vec3, PartSet)> {
         let world = self.world();
-        let present = world.with_fixed(state);
+        let present = world.contacts().with_fixed(state);
         let group = self.group(parts);
-        world.directions().iter().enumerate().map(|(k, d)| (*d, world.group_blockers(&group, k, &present))).collect()
+        world.blocking().directions().iter().enumerate().map(|(k, d)| (*d, world.blocking().group_blockers(&group, k, &present))).collect()
     }
 }
 
@@ -253,7 +254,7 @@ pub fn check_assembly(assembly: Assembly, steps: &[GivenStep], settings: &PlanSe
             }
         }
     }
-    let base_parts = named(&mut world.fixed().iter());
+    let base_parts = named(&mut world.contacts().fixed().iter());
     Ok(CheckReport {
         format_version: CHECK_FORMAT_VERSION.into(),
         model: assembly.source.display().to_string(),
@@ -284,7 +285,7 @@ fn check_units(tester: &Tester<'_>, units: &[Unit], budget: &Budget) -> Checked 
     let v3 = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
     let full = PartSet::full(n);
     // the state before step i is removed: the base and steps 0..=i
-    let mut base = PartSet::from_indices(n, (0..n).filter(|&p| world.fixed().contains(p)));
+    let mut base = PartSet::from_indices(n, (0..n).filter(|&p| world.contacts().fixed().contains(p)));
     let mut states = Vec::with_capacity(units.len());
     for unit in units {
         for &p in &unit.parts {

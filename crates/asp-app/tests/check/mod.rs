@@ -123,7 +123,7 @@ fn check_repairs_to_a_near_feasible_sequence() {
     assert_eq!(again.status, CheckStatus::Feasible, "{}", again.to_text());
     let world = pipeline::checker(fixtures::tube(), &settings).unwrap();
     let left = verify_removals(world.world(), &removals(&r));
-    assert!(left.iter().all(|p| world.world().fixed().contains(p)));
+    assert!(left.iter().all(|p| world.world().contacts().fixed().contains(p)));
     // and no farther than the planner's own sequence (which ignores the given order), nearer
     // than the reversed order
     let from_planner = pipeline::plan_assembly(fixtures::tube(), &settings, None).unwrap();

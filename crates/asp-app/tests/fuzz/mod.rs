@@ -587,7 +587,7 @@ fn check(case: u64, assembly: &Assembly, request: &PlanRequest, result: asp_app:
         // pair's boxes, the re-check the meshes, and the two measure the overlap differently)
         let pairs = report.overlaps.as_ref().map_or(&[][..], |o| &o.pairs[..]);
         let w = world.world();
-        if pairs.iter().any(|pair| pair.parts.iter().all(|&p| w.boxes(p).is_some())) {
+        if pairs.iter().any(|pair| pair.parts.iter().all(|&p| w.shapes().boxes(p).is_some())) {
             return "found, overlapping boxes";
         }
         let outcome = PlanOutcome { status: Status::Found, removals: removals(&report.assembly_sequence, n), stats: Default::default() };

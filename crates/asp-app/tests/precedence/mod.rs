@@ -86,7 +86,7 @@ fn sampled_extensions_are_feasible(what: &str, assembly: Assembly, seed: u64, sa
         }
         let removal: Vec<Step> = order.iter().rev().map(|&i| steps[i].clone()).collect();
         let left = verifier.verify_removals(world, &removal);
-        assert!(left.iter().all(|p| world.fixed().contains(p)), "{what}: {order:?} leaves parts");
+        assert!(left.iter().all(|p| world.contacts().fixed().contains(p)), "{what}: {order:?} leaves parts");
         seen.insert(order);
     }
     (g, seen.len())

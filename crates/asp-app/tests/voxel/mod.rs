@@ -50,14 +50,14 @@ fn the_voxel_checker_blocks_and_touches_as_the_world() {
         let name = a.source.display().to_string();
         let voxels = VoxelChecker::new(&a, &config).unwrap_or_else(|| panic!("{name}: a voxel model"));
         let world = World::new(a, &config).unwrap();
-        assert_eq!(voxels.tolerance(), world.tolerance(), "{name}");
+        assert_eq!(voxels.tolerance(), world.shapes().tolerance(), "{name}");
         assert_eq!(voxels.warnings(), world.warnings(), "{name}");
-        assert_eq!(world.directions().len(), 6, "{name}");
+        assert_eq!(world.blocking().directions().len(), 6, "{name}");
         for p in 0..world.num_parts() {
-            assert_eq!(voxels.blocking_row(p), world.blocking_row(p), "{name}: part {p}'s blockers along ±x, ±y, ±z");
+            assert_eq!(voxels.blocking_row(p), world.blocking().row(p), "{name}: part {p}'s blockers along ±x, ±y, ±z");
         }
-        for p in 0..world.num_parts() + usize::from(world.ground().is_some()) {
-            assert_eq!(voxels.contacts(p), *world.contacts(p), "{name}: part {p}'s contacts");
+        for p in 0..world.num_parts() + usize::from(world.shapes().ground().is_some()) {
+            assert_eq!(voxels.contacts(p), *world.contacts().of(p), "{name}: part {p}'s contacts");
         }
     }
 }

@@ -351,16 +351,16 @@ impl RowSweeps<'_> {
             }
             _ => {
                 let world = self.world.expect("built when a part is a mesh");
-                let (_, erosion) = world.pair_erosion(i, j);
-                let (moving, fixed) = world.pair_shapes(i, j);
-                let ignored = world.ignores(i, j);
-                let strict = world.is_strict_pair(i, j);
+                let (_, erosion) = world.overlaps().erosion(i, j);
+                let (moving, fixed) = world.blocking().pairs().shapes(i, j);
+                let ignored = world.overlaps().ignores(i, j);
+                let strict = world.overlaps().is_strict(i, j);
                 for (d, m) in self.dirs.iter().enumerate() {
                     let near = first_overlap(&self.aabbs[i], *m, &self.aabbs[j], 0.0).is_some_and(|t| t < d_max);
                     let mut v = if !ignored && near { cast_distance(&moving, &fixed, *m, d_max, erosion) } else { d_max };
                     if strict && near && v > 0.0 {
                         // an input overlap: no sample may enter new material
-                        if let Some(t) = world.strict_entry(i, j, Vec3::ZERO, *m, v, false) {
+                        if let Some(t) = world.blocking().pairs().strict_entry(i, j, Vec3::ZERO, *m, v, false) {
                             v = v.min(if t <= erosion { 0.0 } else { t });
                         }
                     }
@@ -389,8 +389,8 @@ fn contact_graph(
     };
     if let Some(w) = world {
         // the world's contact graph (its ground, when present, is index n)
-        for i in 0..w.num_parts() + usize::from(w.ground().is_some()) {
-            for j in w.contacts(i).iter().filter(|&j| j > i) {
+        for i in 0..w.num_parts() + usize::from(w.shapes().ground().is_some()) {
+            for j in w.contacts().of(i).iter().filter(|&j| j > i) {
                 touch(i, j);
             }
         }

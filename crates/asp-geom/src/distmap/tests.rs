@@ -175,9 +175,9 @@ fn the_world_and_the_maps_classify_parts_alike_under_one_flag() {
     let maps = DistanceMaps::build_on(world.clone(), &config).unwrap();
     let kinds: Vec<PartGeometry> = (0..3).map(|i| maps.geometry(i)).collect();
     assert_eq!(kinds, [PartGeometry::Box, PartGeometry::Voxels, PartGeometry::Mesh]);
-    assert_eq!(world.boxes(0).map(<[Aabb]>::len), Some(1));
-    assert_eq!(world.boxes(1).map(<[Aabb]>::len), Some(2));
-    assert!(world.boxes(2).is_none());
+    assert_eq!(world.shapes().boxes(0).map(<[Aabb]>::len), Some(1));
+    assert_eq!(world.shapes().boxes(1).map(<[Aabb]>::len), Some(2));
+    assert!(world.shapes().boxes(2).is_none());
     // the mismatch is said once, though the maps and the world both classified the part
     assert_eq!(maps.warnings().iter().filter(|w| w.contains("extras.asp.boxes")).count(), 1, "{:?}", maps.warnings());
 
@@ -185,7 +185,7 @@ fn the_world_and_the_maps_classify_parts_alike_under_one_flag() {
     let meshes = MapConfig::builder().resolution(3).exact_boxes(false).build().unwrap();
     let world = std::sync::Arc::new(World::new(asm.clone(), &meshes.world_config(&asm)).unwrap());
     let maps = DistanceMaps::build_on(world.clone(), &meshes).unwrap();
-    assert!((0..3).all(|i| maps.geometry(i) == PartGeometry::Mesh && world.boxes(i).is_none()));
+    assert!((0..3).all(|i| maps.geometry(i) == PartGeometry::Mesh && world.shapes().boxes(i).is_none()));
     assert!(DistanceMaps::build_on(world, &config).is_err(), "a world with the other setting is refused");
 }
 

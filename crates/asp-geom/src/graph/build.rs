@@ -58,17 +58,17 @@ struct PairFeatures {
 
 impl AssemblyGraph {
     /// The graph of the assembled model of `world`: samples and descriptors per part (in
-    /// parallel), contacts from [`World::contacts`], contact regions within
-    /// [`World::contact_distance`], gravity from the assembly's up axis.
+    /// parallel), contacts from [`crate::world::Contacts::of`], contact regions within
+    /// [`crate::world::Contacts::distance`], gravity from the assembly's up axis.
     pub fn build(world: &World, config: &GraphConfig) -> Result<AssemblyGraph> {
         config.validate()?;
         let n = world.num_parts();
-        let eps = world.contact_distance();
+        let eps = world.contacts().distance();
         let up = world.assembly().up.vector();
         let samples: Vec<SurfaceSample> = (0..n)
             .into_par_iter()
             .map(|i| {
-                let m = world.mesh(i);
+                let m = world.shapes().mesh(i);
                 sample_triangles(m.vertices(), m.indices(), config.points_per_part)
             })
             .collect();
@@ -77,12 +77,12 @@ impl AssemblyGraph {
         let part_h: Vec<Vec<f32>> =
             samples.par_iter().map_init(Vec::new, |scratch, s| region_descriptor(s, None, config, scratch)).collect();
         let pairs: Vec<(usize, usize)> =
-            (0..n).flat_map(|i| world.contacts(i).iter().filter(move |&j| j > i && j < n).map(move |j| (i, j))).collect();
+            (0..n).flat_map(|i| world.contacts().of(i).iter().filter(move |&j| j > i && j < n).map(move |j| (i, j))).collect();
         let pair_features: Vec<PairFeatures> = pairs
             .par_iter()
             .map(|&(i, j)| {
-                let q_ij = contact_region(&samples[i], world.mesh(j), world.aabb(j), eps);
-                let q_ji = contact_region(&samples[j], world.mesh(i), world.aabb(i), eps);
+                let q_ij = contact_region(&samples[i], world.shapes().mesh(j), world.shapes().aabb(j), eps);
+                let q_ji = contact_region(&samples[j], world.shapes().mesh(i), world.shapes().aabb(i), eps);
                 let mut scratch = Vec::new();
                 PairFeatures {
                     h: [
@@ -100,12 +100,12 @@ impl AssemblyGraph {
         for (i, h) in part_h.iter().enumerate() {
             nodes.extend_from_slice(h);
             nodes.push(world.assembly().parts[i].fixed as u8 as f32);
-            nodes.push(world.contacts(i).intersects(world.fixed()) as u8 as f32);
+            nodes.push(world.contacts().of(i).intersects(world.contacts().fixed()) as u8 as f32);
         }
         let mut edges = Vec::with_capacity(2 * pairs.len());
         let mut edge_attr = Vec::with_capacity(2 * pairs.len() * config.edge_dim());
         for s in 0..n {
-            for t in world.contacts(s).iter().filter(|&t| t < n && t != s) {
+            for t in world.contacts().of(s).iter().filter(|&t| t < n && t != s) {
                 let f = &pair_features[by_pair[&(s.min(t), s.max(t))]];
                 // slot 0 is the region on the lower index, slot 1 on the higher
                 let (on_t, on_s) = if s < t { (1, 0) } else { (0, 1) };

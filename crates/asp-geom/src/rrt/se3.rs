@@ -105,7 +105,7 @@ impl Space for RemovalSpace<'_> {
     }
 
     fn valid(&self, q: &Config) -> bool {
-        !self.blocked(self.world.collision_at(self.part, &self.pose(q), self.state))
+        !self.blocked(self.world.removal().collision_at(self.part, &self.pose(q), self.state))
     }
 
     /// Pivot straight, slerp about it (f32, as the plan's `path` motions).
@@ -122,7 +122,7 @@ impl Space for RemovalSpace<'_> {
     /// Exact: continuous collision detection over the whole edge, ends included.
     fn edge_valid(&self, a: &Config, b: &Config) -> bool {
         let (pa, pb) = (self.pose(a), self.pose(b));
-        !self.blocked(self.world.collision_between(self.part, &pa, &pb, self.centre, self.state))
+        !self.blocked(self.world.removal().collision_between(self.part, &pa, &pb, self.centre, self.state))
     }
 
     /// None: [`Space::edge_valid`] is exact.
@@ -170,15 +170,15 @@ pub fn plan_removal_path(
 fn search(world: &World, part: usize, state: &PartSet, config: &RrtConfig, seed: u64) -> std::result::Result<Motion, PartSet> {
     let start_time = Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (part as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-    let bb = *world.aabb(part);
+    let bb = *world.shapes().aabb(part);
     let extent = bb.maxs - bb.mins;
     let diag = world.assembly().diagonal();
     // the sampling box: the bounds of the present parts, grown by the part's size
     let mut lo = bb.mins;
     let mut hi = bb.maxs;
     for q in state.iter().filter(|&q| q < world.num_parts()) {
-        lo = lo.min(world.aabb(q).mins);
-        hi = hi.max(world.aabb(q).maxs);
+        lo = lo.min(world.shapes().aabb(q).mins);
+        hi = hi.max(world.shapes().aabb(q).maxs);
     }
     lo -= extent;
     hi += extent;
@@ -195,9 +195,10 @@ fn search(world: &World, part: usize, state: &PartSet, config: &RrtConfig, seed:
     };
     let identity = Config { t: Vec3::ZERO, r: Rot::IDENTITY };
     let goals: Vec<Config> = world
+        .blocking()
         .directions()
         .iter()
-        .map(|dir| Config { t: *dir * world.clearance(part, state, *dir), r: Rot::IDENTITY })
+        .map(|dir| Config { t: *dir * world.removal().clearance(part, state, *dir), r: Rot::IDENTITY })
         .filter(|q| space.valid(q))
         .collect();
     if goals.is_empty() {

@@ -22,7 +22,8 @@
 //!   or rings that lie wholly inside the rings' envelope (between the inner ring's bore and the
 //!   outer ring's outside, between their faces).
 
-use super::World;
+use super::contacts::Contacts;
+use super::shapes::Shapes;
 use crate::math::Vec3;
 use crate::partset::PartSet;
 use std::collections::BTreeMap;
@@ -269,170 +270,171 @@ fn median(mut values: Vec<f32>) -> f32 {
     values[values.len() / 2]
 }
 
-impl World {
-    /// Every rolling bearing among the parts (see the module documentation), in the order of
-    /// their first ball; a part belongs to at most one bearing. Found anew: [`World::bearings`]
-    /// holds the ones found with the world.
-    pub fn find_bearings(&self) -> Vec<Bearing> {
-        let n = self.num_parts();
-        // the rolling elements: parts on a sphere, or closed ones that are a cylinder or a cone
-        // (triangle meshes; unions of boxes are not round)
-        let elements: BTreeMap<usize, Element> = (0..n)
-            .filter(|&p| self.geoms[p].boxes.is_none())
-            .filter_map(|p| {
-                let mesh = &self.geoms[p].mesh;
-                if let Some((centre, radius)) = fit_sphere(mesh.vertices(), self.tolerance) {
-                    return Some((p, Element { centre, radius, kind: RollingElement::Ball, axis: Vec3::ZERO }));
-                }
-                let (centre, radius, axis) =
-                    self.geoms[p].closed.then(|| fit_roller(mesh.vertices(), mesh.indices(), self.tolerance)).flatten()?;
-                Some((p, Element { centre, radius, kind: RollingElement::Roller, axis }))
+/// Every rolling bearing among the parts (see the module documentation), in the order of
+/// their first ball; a part belongs to at most one bearing. Found anew: the world's
+/// [`super::Fits::bearings`] holds the ones found with it.
+pub fn find_bearings(shapes: &Shapes, contacts: &Contacts) -> Vec<Bearing> {
+    let n = shapes.parts();
+    // the rolling elements: parts on a sphere, or closed ones that are a cylinder or a cone
+    // (triangle meshes; unions of boxes are not round)
+    let elements: BTreeMap<usize, Element> = (0..n)
+        .filter(|&p| shapes.boxes(p).is_none())
+        .filter_map(|p| {
+            let mesh = shapes.mesh(p);
+            if let Some((centre, radius)) = fit_sphere(mesh.vertices(), shapes.tolerance()) {
+                return Some((p, Element { centre, radius, kind: RollingElement::Ball, axis: Vec3::ZERO }));
+            }
+            let (centre, radius, axis) =
+                shapes.is_closed(p).then(|| fit_roller(mesh.vertices(), mesh.indices(), shapes.tolerance())).flatten()?;
+            Some((p, Element { centre, radius, kind: RollingElement::Roller, axis }))
+        })
+        .collect();
+    if elements.len() < MIN_BALLS {
+        return Vec::new();
+    }
+    // per pair of other parts, the elements touching both
+    let mut by_pair: BTreeMap<(usize, usize), Vec<usize>> = BTreeMap::new();
+    for &b in elements.keys() {
+        let others: Vec<usize> = contacts.of(b).iter().filter(|&q| q < n && !elements.contains_key(&q)).collect();
+        for (i, &a) in others.iter().enumerate() {
+            for &c in &others[i + 1..] {
+                by_pair.entry((a, c)).or_default().push(b);
+            }
+        }
+    }
+    let mut used = PartSet::empty(n + 1);
+    let mut found = Vec::new();
+    // the pairs with the most elements first: a cage touches every ball too, but is no ring
+    let mut pairs: Vec<((usize, usize), Vec<usize>)> = by_pair.into_iter().filter(|(_, b)| b.len() >= MIN_BALLS).collect();
+    pairs.sort_by(|a, b| b.1.len().cmp(&a.1.len()).then(a.0.cmp(&b.0)));
+    for ((a, c), members) in pairs {
+        if used.contains(a) || used.contains(c) || members.iter().any(|&b| used.contains(b)) {
+            continue;
+        }
+        if let Some(bearing) = bearing_of(shapes, contacts, a, c, &members, &elements) {
+            for p in bearing.parts() {
+                used.insert(p);
+            }
+            found.push(bearing);
+        }
+    }
+    found.sort_by_key(|b| b.balls[0]);
+    found
+}
+
+/// The bearing of `members` (rolling elements touching both `a` and `c`), if they are of one
+/// kind and size on circles about one axis (a roller's own axis in the plane through that
+/// axis, within 45° of it) and `a` and `c` are rings on either side of them.
+fn bearing_of(
+    shapes: &Shapes,
+    contacts: &Contacts,
+    a: usize,
+    c: usize,
+    members: &[usize],
+    elements: &BTreeMap<usize, Element>,
+) -> Option<Bearing> {
+    let n = shapes.parts();
+    let radius = median(members.iter().map(|b| elements[b].radius).collect());
+    let kind = elements[&members[0]].kind;
+    let members: Vec<usize> =
+        members.iter().copied().filter(|b| elements[b].kind == kind && (elements[b].radius - radius).abs() <= SAME_SIZE * radius).collect();
+    if members.len() < MIN_BALLS {
+        return None;
+    }
+    let centres: Vec<Vec3> = members.iter().map(|b| elements[b].centre).collect();
+    let mean = centres.iter().copied().sum::<Vec3>() / centres.len() as f32;
+    let axis = least_spread(&centres, mean);
+    if kind == RollingElement::Roller {
+        let laid_right = members.iter().all(|b| {
+            let e = &elements[b];
+            let out = (e.centre - mean - axis * (e.centre - mean).dot(axis)).normalize_or_zero();
+            let across = axis.cross(out);
+            e.axis.dot(across).abs() <= 0.1 && e.axis.dot(axis).abs() >= std::f32::consts::FRAC_1_SQRT_2
+        });
+        if !laid_right {
+            return None;
+        }
+    }
+    // rows: the centres' places along the axis, split where they jump by more than a radius
+    let mut along: Vec<(f32, usize)> = centres.iter().enumerate().map(|(i, &x)| (radial_axial(x, mean, axis).1, i)).collect();
+    along.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut rows: Vec<Vec<usize>> = vec![vec![along[0].1]];
+    for w in along.windows(2) {
+        if w[1].0 - w[0].0 > radius {
+            rows.push(Vec::new());
+        }
+        rows.last_mut().expect("one row at least").push(w[1].1);
+    }
+    let mut pitch = Vec::new();
+    for row in &rows {
+        if row.len() < MIN_BALLS {
+            return None;
+        }
+        let radial: Vec<f32> = row.iter().map(|&i| radial_axial(centres[i], mean, axis).0).collect();
+        let r = radial.iter().sum::<f32>() / radial.len() as f32;
+        if r <= radius || radial.iter().any(|x| (x - r).abs() > SAME_SIZE * r) {
+            return None;
+        }
+        pitch.push(r);
+    }
+    let pitch_radius = pitch.iter().sum::<f32>() / pitch.len() as f32;
+    // the rings: one mostly inside the pitch circle, one mostly outside
+    let ring_radii = |p: usize| -> Vec<(f32, f32)> { shapes.mesh(p).vertices().iter().map(|&v| radial_axial(v, mean, axis)).collect() };
+    let (ra, rc) = (ring_radii(a), ring_radii(c));
+    let (ma, mc) = (median(ra.iter().map(|x| x.0).collect()), median(rc.iter().map(|x| x.0).collect()));
+    let margin = 0.3 * radius;
+    let (inner, outer, ri, ro) = if ma < mc { (a, c, &ra, &rc) } else { (c, a, &rc, &ra) };
+    let (mi, mo) = (ma.min(mc), ma.max(mc));
+    if !(mi < pitch_radius - margin && mo > pitch_radius + margin) {
+        return None;
+    }
+    // the envelope of the rings: from the bore out to the outside, between the faces
+    let slack = contacts.distance().max(shapes.tolerance());
+    let bore = ri.iter().map(|x| x.0).fold(f32::MAX, f32::min) - slack;
+    let outside = ro.iter().map(|x| x.0).fold(0.0, f32::max) + slack;
+    let lo = ri.iter().chain(ro).map(|x| x.1).fold(f32::MAX, f32::min) - slack;
+    let hi = ri.iter().chain(ro).map(|x| x.1).fold(f32::MIN, f32::max) + slack;
+    let mut held = PartSet::from_indices(n + 1, members.iter().copied().chain([inner, outer]));
+    // the other parts: in contact with the bearing and wholly inside its envelope (a cage
+    // touching only another cage half counts too: grow until nothing joins); a part that
+    // touches at least three of the rolling elements is their cage also where it stands out
+    // of the rings' faces by up to an element's radius (a tapered roller bearing's cage)
+    let mut others = Vec::new();
+    loop {
+        let joins: Vec<usize> = (0..n)
+            .filter(|&q| !held.contains(q) && !elements.contains_key(&q) && held.iter().any(|h| contacts.of(h).contains(q)))
+            .filter(|&q| {
+                let cage = members.iter().filter(|&&b| contacts.of(b).contains(q)).count() >= MIN_BALLS;
+                let reach = if cage { radius } else { 0.0 };
+                shapes.mesh(q).vertices().iter().all(|&v| {
+                    let (r, t) = radial_axial(v, mean, axis);
+                    r >= bore && r <= outside && t >= lo - reach && t <= hi + reach
+                })
             })
             .collect();
-        if elements.len() < MIN_BALLS {
-            return Vec::new();
+        if joins.is_empty() {
+            break;
         }
-        // per pair of other parts, the elements touching both
-        let mut by_pair: BTreeMap<(usize, usize), Vec<usize>> = BTreeMap::new();
-        for &b in elements.keys() {
-            let others: Vec<usize> = self.contacts[b].iter().filter(|&q| q < n && !elements.contains_key(&q)).collect();
-            for (i, &a) in others.iter().enumerate() {
-                for &c in &others[i + 1..] {
-                    by_pair.entry((a, c)).or_default().push(b);
-                }
-            }
+        for q in joins {
+            held.insert(q);
+            others.push(q);
         }
-        let mut used = PartSet::empty(n + 1);
-        let mut found = Vec::new();
-        // the pairs with the most elements first: a cage touches every ball too, but is no ring
-        let mut pairs: Vec<((usize, usize), Vec<usize>)> = by_pair.into_iter().filter(|(_, b)| b.len() >= MIN_BALLS).collect();
-        pairs.sort_by(|a, b| b.1.len().cmp(&a.1.len()).then(a.0.cmp(&b.0)));
-        for ((a, c), members) in pairs {
-            if used.contains(a) || used.contains(c) || members.iter().any(|&b| used.contains(b)) {
-                continue;
-            }
-            if let Some(bearing) = self.bearing_of(a, c, &members, &elements) {
-                for p in bearing.parts() {
-                    used.insert(p);
-                }
-                found.push(bearing);
-            }
-        }
-        found.sort_by_key(|b| b.balls[0]);
-        found
     }
-
-    /// The bearing of `members` (rolling elements touching both `a` and `c`), if they are of one
-    /// kind and size on circles about one axis (a roller's own axis in the plane through that
-    /// axis, within 45° of it) and `a` and `c` are rings on either side of them.
-    fn bearing_of(&self, a: usize, c: usize, members: &[usize], elements: &BTreeMap<usize, Element>) -> Option<Bearing> {
-        let n = self.num_parts();
-        let radius = median(members.iter().map(|b| elements[b].radius).collect());
-        let kind = elements[&members[0]].kind;
-        let members: Vec<usize> = members
-            .iter()
-            .copied()
-            .filter(|b| elements[b].kind == kind && (elements[b].radius - radius).abs() <= SAME_SIZE * radius)
-            .collect();
-        if members.len() < MIN_BALLS {
-            return None;
-        }
-        let centres: Vec<Vec3> = members.iter().map(|b| elements[b].centre).collect();
-        let mean = centres.iter().copied().sum::<Vec3>() / centres.len() as f32;
-        let axis = least_spread(&centres, mean);
-        if kind == RollingElement::Roller {
-            let laid_right = members.iter().all(|b| {
-                let e = &elements[b];
-                let out = (e.centre - mean - axis * (e.centre - mean).dot(axis)).normalize_or_zero();
-                let across = axis.cross(out);
-                e.axis.dot(across).abs() <= 0.1 && e.axis.dot(axis).abs() >= std::f32::consts::FRAC_1_SQRT_2
-            });
-            if !laid_right {
-                return None;
-            }
-        }
-        // rows: the centres' places along the axis, split where they jump by more than a radius
-        let mut along: Vec<(f32, usize)> = centres.iter().enumerate().map(|(i, &x)| (radial_axial(x, mean, axis).1, i)).collect();
-        along.sort_by(|x, y| x.0.total_cmp(&y.0));
-        let mut rows: Vec<Vec<usize>> = vec![vec![along[0].1]];
-        for w in along.windows(2) {
-            if w[1].0 - w[0].0 > radius {
-                rows.push(Vec::new());
-            }
-            rows.last_mut().expect("one row at least").push(w[1].1);
-        }
-        let mut pitch = Vec::new();
-        for row in &rows {
-            if row.len() < MIN_BALLS {
-                return None;
-            }
-            let radial: Vec<f32> = row.iter().map(|&i| radial_axial(centres[i], mean, axis).0).collect();
-            let r = radial.iter().sum::<f32>() / radial.len() as f32;
-            if r <= radius || radial.iter().any(|x| (x - r).abs() > SAME_SIZE * r) {
-                return None;
-            }
-            pitch.push(r);
-        }
-        let pitch_radius = pitch.iter().sum::<f32>() / pitch.len() as f32;
-        // the rings: one mostly inside the pitch circle, one mostly outside
-        let ring_radii =
-            |p: usize| -> Vec<(f32, f32)> { self.geoms[p].mesh.vertices().iter().map(|&v| radial_axial(v, mean, axis)).collect() };
-        let (ra, rc) = (ring_radii(a), ring_radii(c));
-        let (ma, mc) = (median(ra.iter().map(|x| x.0).collect()), median(rc.iter().map(|x| x.0).collect()));
-        let margin = 0.3 * radius;
-        let (inner, outer, ri, ro) = if ma < mc { (a, c, &ra, &rc) } else { (c, a, &rc, &ra) };
-        let (mi, mo) = (ma.min(mc), ma.max(mc));
-        if !(mi < pitch_radius - margin && mo > pitch_radius + margin) {
-            return None;
-        }
-        // the envelope of the rings: from the bore out to the outside, between the faces
-        let slack = self.contact_distance.max(self.tolerance);
-        let bore = ri.iter().map(|x| x.0).fold(f32::MAX, f32::min) - slack;
-        let outside = ro.iter().map(|x| x.0).fold(0.0, f32::max) + slack;
-        let lo = ri.iter().chain(ro).map(|x| x.1).fold(f32::MAX, f32::min) - slack;
-        let hi = ri.iter().chain(ro).map(|x| x.1).fold(f32::MIN, f32::max) + slack;
-        let mut held = PartSet::from_indices(n + 1, members.iter().copied().chain([inner, outer]));
-        // the other parts: in contact with the bearing and wholly inside its envelope (a cage
-        // touching only another cage half counts too: grow until nothing joins); a part that
-        // touches at least three of the rolling elements is their cage also where it stands out
-        // of the rings' faces by up to an element's radius (a tapered roller bearing's cage)
-        let mut others = Vec::new();
-        loop {
-            let joins: Vec<usize> = (0..n)
-                .filter(|&q| !held.contains(q) && !elements.contains_key(&q) && held.iter().any(|h| self.contacts[h].contains(q)))
-                .filter(|&q| {
-                    let cage = members.iter().filter(|&&b| self.contacts[b].contains(q)).count() >= MIN_BALLS;
-                    let reach = if cage { radius } else { 0.0 };
-                    self.geoms[q].mesh.vertices().iter().all(|&v| {
-                        let (r, t) = radial_axial(v, mean, axis);
-                        r >= bore && r <= outside && t >= lo - reach && t <= hi + reach
-                    })
-                })
-                .collect();
-            if joins.is_empty() {
-                break;
-            }
-            for q in joins {
-                held.insert(q);
-                others.push(q);
-            }
-        }
-        others.sort_unstable();
-        let mut ball_parts = members;
-        ball_parts.sort_unstable();
-        // the centre on the axis: the balls' mean, in the middle of the rows
-        Some(Bearing {
-            rings: [inner, outer],
-            balls: ball_parts,
-            elements: kind,
-            others,
-            centre: mean,
-            axis,
-            pitch_radius,
-            ball_radius: radius,
-            rows: rows.len(),
-        })
-    }
+    others.sort_unstable();
+    let mut ball_parts = members;
+    ball_parts.sort_unstable();
+    // the centre on the axis: the balls' mean, in the middle of the rows
+    Some(Bearing {
+        rings: [inner, outer],
+        balls: ball_parts,
+        elements: kind,
+        others,
+        centre: mean,
+        axis,
+        pitch_radius,
+        ball_radius: radius,
+        rows: rows.len(),
+    })
 }
 
 #[cfg(test)]

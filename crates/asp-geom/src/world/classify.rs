@@ -3,9 +3,14 @@
 //! sunk into another between parallel planar faces; its normal joins the candidate directions,
 //! the one lift that separates the pair), or interpenetration.
 
-use super::*;
+use super::fits::{Fits, AXIS_ALIGNED};
+use super::overlaps::Overlaps;
+use super::shapes::Shapes;
 use crate::fits::{Cylinder, FitClass, Plane};
-use crate::overlap::OverlapRegion;
+use crate::math::{Aabb, Vec3};
+use crate::overlap::{self, OverlapClass, OverlapNote, OverlapRegion};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
 
 /// The overlap regions measured with the contacts, per pair (low, high).
 pub(super) type Regions = BTreeMap<(usize, usize), OverlapRegion>;
@@ -25,153 +30,158 @@ const SLAB_DEPTH: f32 = 0.25;
 /// The most planar faces per part that may bound a slab (the largest near the other part).
 const SLAB_FACES: usize = 64;
 
-impl World {
-    /// Classifies every overlap note (after the fits are found: a pair with a fit that is not a
-    /// clearance fit is one), in parallel, measuring the overlap region of the pairs whose
-    /// depth the contacts measured by shrinking; each slab's normal, both ways, joins the
-    /// candidate directions unless one lies within 0.1°.
-    pub(super) fn classify_overlaps(&mut self, regions: Regions) {
-        let this = &*self;
-        let classes: Vec<(OverlapClass, Option<Vec3>)> = this.notes.par_iter().map(|n| this.classify(n, regions.get(&n.parts))).collect();
-        for (n, (class, normal)) in self.notes.iter_mut().zip(classes) {
-            n.class = class;
-            n.normal = normal;
-        }
-        let normals: Vec<Vec3> = self.notes.iter().filter_map(|n| n.normal).collect();
-        for n in normals {
-            for d in [n, -n] {
-                if !self.directions.iter().any(|e| e.dot(d) > fits::AXIS_ALIGNED) {
-                    self.directions.push(d);
-                }
+/// Classifies every overlap note (after the fits are found: a pair with a fit that is not a
+/// clearance fit is one), in parallel, measuring the overlap region of the pairs whose
+/// depth the contacts measured by shrinking; each slab's normal, both ways, joins the
+/// candidate directions unless one lies within 0.1°.
+pub(super) fn classify_overlaps(overlaps: &mut Overlaps, shapes: &Shapes, distance: f32, directions: &mut Vec<Vec3>, regions: Regions) {
+    let (notes, fits) = (&overlaps.notes, &overlaps.fits);
+    let classes: Vec<(OverlapClass, Option<Vec3>)> =
+        notes.par_iter().map(|n| classify(shapes, fits, distance, n, regions.get(&n.parts))).collect();
+    for (n, (class, normal)) in overlaps.notes.iter_mut().zip(classes) {
+        n.class = class;
+        n.normal = normal;
+    }
+    let normals: Vec<Vec3> = overlaps.notes.iter().filter_map(|n| n.normal).collect();
+    for n in normals {
+        for d in [n, -n] {
+            if !directions.iter().any(|e| e.dot(d) > AXIS_ALIGNED) {
+                directions.push(d);
             }
         }
     }
+}
 
-    /// The class of one overlap note, and a slab's normal (the first part's outward normal).
-    fn classify(&self, note: &OverlapNote, region: Option<&OverlapRegion>) -> (OverlapClass, Option<Vec3>) {
-        let (i, j) = note.parts;
-        if self.fits(i, j).iter().any(|f| f.class != FitClass::Clearance) {
-            return (OverlapClass::Fit, None);
+/// The class of one overlap note, and a slab's normal (the first part's outward normal).
+fn classify(
+    shapes: &Shapes,
+    fits: &Fits,
+    distance: f32,
+    note: &OverlapNote,
+    region: Option<&OverlapRegion>,
+) -> (OverlapClass, Option<Vec3>) {
+    let (i, j) = note.parts;
+    if fits.between(i, j).iter().any(|f| f.class != FitClass::Clearance) {
+        return (OverlapClass::Fit, None);
+    }
+    let common = common_box(shapes, distance, i, j);
+    let measured;
+    let region = match region {
+        Some(r) => r,
+        None => {
+            measured = overlap::overlap_region(shapes.mesh(i), shapes.mesh(j), overlap::REGION_SAMPLES);
+            &measured
         }
-        let common = self.common_box(i, j);
-        let measured;
-        let region = match region {
-            Some(r) => r,
-            None => {
-                measured = overlap::overlap_region(&self.geoms[i].mesh, &self.geoms[j].mesh, overlap::REGION_SAMPLES);
-                &measured
+    };
+    // two faceted round faces of one surface, one of each part, that the overlap lies on:
+    // coaxial, of one radius within their sagittas; their sagittas together
+    let points: Vec<Vec3> = region.points().collect();
+    let tol = shapes.tolerance();
+    let on = |c: &Cylinder| {
+        cylinder_meets(c, &common)
+            && points.iter().any(|&x| (crate::surface::radial(x, c.point, c.axis) - c.radius).abs() <= c.tolerance + 2.0 * tol)
+    };
+    let faces = |k: usize| -> Vec<&Cylinder> { shapes.surfaces(k).cylinders.iter().filter(|c| on(c)).collect() };
+    let (ci, cj) = (faces(i), faces(j));
+    let parallel = 1.5f32.to_radians().cos();
+    let sagitta = ci
+        .iter()
+        .flat_map(|a| cj.iter().map(move |b| (a, b)))
+        .filter(|(a, b)| {
+            a.axis.dot(b.axis).abs() >= parallel
+                && crate::surface::radial(b.point, a.point, a.axis) <= 0.1 * a.radius.min(b.radius)
+                && (a.radius - b.radius).abs() <= a.tolerance + b.tolerance + 2.0 * tol
+        })
+        .map(|(a, b)| a.tolerance + b.tolerance)
+        .fold(0.0, f32::max);
+    if !note.bound && note.depth <= sagitta + 2.0 * tol {
+        return (OverlapClass::Tessellation, None);
+    }
+    let depth = region.depth().unwrap_or(note.depth);
+    match slab_normal(shapes, i, j, region, depth, &common) {
+        Some(n) => (OverlapClass::PlanarSlab, Some(n)),
+        None => (OverlapClass::Interpenetration, None),
+    }
+}
+
+/// The two parts' common box, grown by the contact distance.
+fn common_box(shapes: &Shapes, distance: f32, i: usize, j: usize) -> Aabb {
+    let (a, b) = (shapes.aabb(i), shapes.aabb(j));
+    let m = Vec3::splat(distance);
+    Aabb::new(a.mins.max(b.mins) - m, a.maxs.min(b.maxs) + m)
+}
+
+/// The normal of the slab the overlap `region` of `i` and `j` (`depth` deep) is, if it is
+/// one: a planar face of `i` and one of `j` facing each other, `i`'s lying inside `j` by
+/// the depth (within [`SLAB_DEPTH`]), nearly every sample of the region ([`SLAB_SHARE`])
+/// between the two, and the region thin across the normal ([`SLAB_THIN`]). The unit normal
+/// is `i`'s outward one (`j` lifts off `i` along it); of several, the pair of largest faces.
+fn slab_normal(shapes: &Shapes, i: usize, j: usize, region: &OverlapRegion, depth: f32, common: &Aabb) -> Option<Vec3> {
+    let points: Vec<Vec3> = region.points().collect();
+    if points.is_empty() {
+        return None;
+    }
+    let (fi, fj) = (slab_faces(shapes, i, common), slab_faces(shapes, j, common));
+    let tol = shapes.tolerance();
+    let mut best: Option<(f32, Vec3)> = None;
+    for (a, na) in &fi {
+        for (b, nb) in &fj {
+            if na.dot(*nb) > -FACING {
+                continue;
             }
-        };
-        // two faceted round faces of one surface, one of each part, that the overlap lies on:
-        // coaxial, of one radius within their sagittas; their sagittas together
-        let points: Vec<Vec3> = region.points().collect();
-        let tol = self.tolerance;
-        let on = |c: &Cylinder| {
-            cylinder_meets(c, &common)
-                && points.iter().any(|&x| (crate::surface::radial(x, c.point, c.axis) - c.radius).abs() <= c.tolerance + 2.0 * tol)
-        };
-        let faces = |k: usize| -> Vec<&Cylinder> { self.geoms[k].surfaces().cylinders.iter().filter(|c| on(c)).collect() };
-        let (ci, cj) = (faces(i), faces(j));
-        let parallel = 1.5f32.to_radians().cos();
-        let sagitta = ci
-            .iter()
-            .flat_map(|a| cj.iter().map(move |b| (a, b)))
-            .filter(|(a, b)| {
-                a.axis.dot(b.axis).abs() >= parallel
-                    && crate::surface::radial(b.point, a.point, a.axis) <= 0.1 * a.radius.min(b.radius)
-                    && (a.radius - b.radius).abs() <= a.tolerance + b.tolerance + 2.0 * tol
+            let n = (*na - *nb).normalize_or_zero();
+            // `i`'s face lies `gap` beyond `j`'s, into `j`
+            let (ha, hb) = (a.point.dot(n), b.point.dot(n));
+            let gap = ha - hb;
+            if gap <= 0.0 || (gap - depth).abs() > SLAB_DEPTH * depth + 2.0 * tol {
+                continue;
+            }
+            let slack = 2.0 * tol + 0.05 * gap;
+            let within = points.iter().filter(|x| (hb - slack..=ha + slack).contains(&x.dot(n))).count();
+            if (within as f32) < SLAB_SHARE * points.len() as f32 || gap > SLAB_THIN * width_across(&points, n) {
+                continue;
+            }
+            let w = a.area.min(b.area);
+            if best.is_none_or(|(bw, _)| w > bw) {
+                best = Some((w, n));
+            }
+        }
+    }
+    best.map(|(_, n)| n)
+}
+
+/// Part `k`'s planar faces that reach the box `common`, the largest [`SLAB_FACES`], each with
+/// its area-weighted mean normal (a sliver's own normal is too noisy to stand for a face).
+fn slab_faces<'a>(shapes: &'a Shapes, k: usize, common: &Aabb) -> Vec<(&'a Plane, Vec3)> {
+    let mesh = shapes.mesh(k);
+    let (v, t) = (mesh.vertices(), mesh.indices());
+    let mut faces: Vec<(&Plane, Vec3)> = shapes
+        .surfaces(k)
+        .planes
+        .iter()
+        .filter(|p| {
+            p.triangles.iter().any(|&x| {
+                let [a, b, c] = t[x as usize].map(|i| v[i as usize]);
+                let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+                (0..3).all(|d| lo[d] <= common.maxs[d] && hi[d] >= common.mins[d])
             })
-            .map(|(a, b)| a.tolerance + b.tolerance)
-            .fold(0.0, f32::max);
-        if !note.bound && note.depth <= sagitta + 2.0 * tol {
-            return (OverlapClass::Tessellation, None);
-        }
-        let depth = region.depth().unwrap_or(note.depth);
-        match self.slab_normal(i, j, region, depth, &common) {
-            Some(n) => (OverlapClass::PlanarSlab, Some(n)),
-            None => (OverlapClass::Interpenetration, None),
-        }
-    }
-
-    /// The two parts' common box, grown by the contact distance.
-    fn common_box(&self, i: usize, j: usize) -> Aabb {
-        let (a, b) = (&self.geoms[i].aabb, &self.geoms[j].aabb);
-        let m = Vec3::splat(self.contact_distance);
-        Aabb::new(a.mins.max(b.mins) - m, a.maxs.min(b.maxs) + m)
-    }
-
-    /// The normal of the slab the overlap `region` of `i` and `j` (`depth` deep) is, if it is
-    /// one: a planar face of `i` and one of `j` facing each other, `i`'s lying inside `j` by
-    /// the depth (within [`SLAB_DEPTH`]), nearly every sample of the region ([`SLAB_SHARE`])
-    /// between the two, and the region thin across the normal ([`SLAB_THIN`]). The unit normal
-    /// is `i`'s outward one (`j` lifts off `i` along it); of several, the pair of largest faces.
-    fn slab_normal(&self, i: usize, j: usize, region: &OverlapRegion, depth: f32, common: &Aabb) -> Option<Vec3> {
-        let points: Vec<Vec3> = region.points().collect();
-        if points.is_empty() {
-            return None;
-        }
-        let (fi, fj) = (self.slab_faces(i, common), self.slab_faces(j, common));
-        let tol = self.tolerance;
-        let mut best: Option<(f32, Vec3)> = None;
-        for (a, na) in &fi {
-            for (b, nb) in &fj {
-                if na.dot(*nb) > -FACING {
-                    continue;
-                }
-                let n = (*na - *nb).normalize_or_zero();
-                // `i`'s face lies `gap` beyond `j`'s, into `j`
-                let (ha, hb) = (a.point.dot(n), b.point.dot(n));
-                let gap = ha - hb;
-                if gap <= 0.0 || (gap - depth).abs() > SLAB_DEPTH * depth + 2.0 * tol {
-                    continue;
-                }
-                let slack = 2.0 * tol + 0.05 * gap;
-                let within = points.iter().filter(|x| (hb - slack..=ha + slack).contains(&x.dot(n))).count();
-                if (within as f32) < SLAB_SHARE * points.len() as f32 || gap > SLAB_THIN * width_across(&points, n) {
-                    continue;
-                }
-                let w = a.area.min(b.area);
-                if best.is_none_or(|(bw, _)| w > bw) {
-                    best = Some((w, n));
-                }
-            }
-        }
-        best.map(|(_, n)| n)
-    }
-
-    /// Part `k`'s planar faces that reach the box `common`, the largest [`SLAB_FACES`], each with
-    /// its area-weighted mean normal (a sliver's own normal is too noisy to stand for a face).
-    fn slab_faces(&self, k: usize, common: &Aabb) -> Vec<(&Plane, Vec3)> {
-        let g = &self.geoms[k];
-        let (v, t) = (g.mesh.vertices(), g.mesh.indices());
-        let mut faces: Vec<(&Plane, Vec3)> = g
-            .surfaces()
-            .planes
-            .iter()
-            .filter(|p| {
-                p.triangles.iter().any(|&x| {
+        })
+        .map(|p| {
+            let n: Vec3 = p
+                .triangles
+                .iter()
+                .map(|&x| {
                     let [a, b, c] = t[x as usize].map(|i| v[i as usize]);
-                    let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
-                    (0..3).all(|d| lo[d] <= common.maxs[d] && hi[d] >= common.mins[d])
+                    (b - a).cross(c - a)
                 })
-            })
-            .map(|p| {
-                let n: Vec3 = p
-                    .triangles
-                    .iter()
-                    .map(|&x| {
-                        let [a, b, c] = t[x as usize].map(|i| v[i as usize]);
-                        (b - a).cross(c - a)
-                    })
-                    .sum();
-                (p, n.normalize_or_zero())
-            })
-            .filter(|(_, n)| *n != Vec3::ZERO)
-            .collect();
-        faces.sort_by(|a, b| b.0.area.total_cmp(&a.0.area));
-        faces.truncate(SLAB_FACES);
-        faces
-    }
+                .sum();
+            (p, n.normalize_or_zero())
+        })
+        .filter(|(_, n)| *n != Vec3::ZERO)
+        .collect();
+    faces.sort_by(|a, b| b.0.area.total_cmp(&a.0.area));
+    faces.truncate(SLAB_FACES);
+    faces
 }
 
 /// Whether cylinder `c` (its axis segment grown by its radius) reaches box `b`.
@@ -200,6 +210,7 @@ mod tests {
     use super::*;
     use crate::fixtures::{stabbed_board, sunk_boards};
     use crate::math::Rot;
+    use crate::world::{World, WorldConfig};
 
     /// A turn off every axis (the slab's normal is then no axis and no cluster of the model's).
     fn tilt() -> Rot {
@@ -217,7 +228,7 @@ mod tests {
             for facets in [16, 96] {
                 for turn in [Rot::IDENTITY, tilt()] {
                     let w = World::new(sunk_boards(facets, thickness, turn), &WorldConfig::default()).unwrap();
-                    let notes = w.overlap_notes();
+                    let notes = w.overlaps().notes();
                     assert_eq!(notes.len(), 1, "{facets}: {notes:?}");
                     let n = &notes[0];
                     assert_eq!((n.gross, n.bound), (gross, false), "{thickness} m, {facets} facets: {n:?}");
@@ -225,7 +236,7 @@ mod tests {
                     assert_eq!(n.class, OverlapClass::PlanarSlab, "{thickness} m, {facets}: {n:?}");
                     let normal = n.normal.expect("a slab has a normal");
                     assert!(normal.dot(turn * Vec3::Z) > 0.99999, "{facets}: {normal:?}");
-                    assert!(w.directions().iter().any(|d| d.dot(normal) > fits::AXIS_ALIGNED), "{facets}: the lift is a candidate");
+                    assert!(w.blocking().directions().iter().any(|d| d.dot(normal) > AXIS_ALIGNED), "{facets}: the lift is a candidate");
                     if gross {
                         let said = w.warnings().iter().any(|s| s.contains("by about 0.001") && s.contains("measured where they overlap"));
                         assert!(said, "{:?}", w.warnings());
@@ -241,7 +252,7 @@ mod tests {
     fn a_board_stabbed_into_another_is_interpenetration() {
         for facets in [16, 96] {
             let w = World::new(stabbed_board(facets, tilt()), &WorldConfig::default()).unwrap();
-            let n = &w.overlap_notes()[0];
+            let n = &w.overlaps().notes()[0];
             assert_eq!((n.class, n.normal), (OverlapClass::Interpenetration, None), "{facets}: {n:?}");
             assert!(n.depth > 0.003 && n.depth < 0.0081, "{facets}: {n:?}");
         }
@@ -252,12 +263,12 @@ mod tests {
     #[test]
     fn fits_and_pressed_pegs_are_no_slabs() {
         let w = World::new(crate::fixtures::bolted_joint([24, 32, 24]), &WorldConfig::default()).unwrap();
-        assert!(!w.overlap_notes().is_empty());
-        for n in w.overlap_notes() {
+        assert!(!w.overlaps().notes().is_empty());
+        for n in w.overlaps().notes() {
             assert!(matches!(n.class, OverlapClass::Fit | OverlapClass::Tessellation), "{n:?}");
         }
         let w = World::new(crate::fixtures::pressed_peg(), &WorldConfig::default()).unwrap();
-        let n = &w.overlap_notes()[0];
+        let n = &w.overlaps().notes()[0];
         assert_eq!(n.class, OverlapClass::Interpenetration, "{n:?}");
         assert!((n.depth - 0.5).abs() < 0.05, "the peg is 0.5 into the plate: {n:?}");
     }

@@ -1,12 +1,29 @@
-//! Coaxial fits in the collision world ([`crate::fits`]): found with the world, their axes
-//! among the candidate directions, and the pair test along an axis with the fit band exempt.
+//! The fits, threads and bearings among the parts in contact ([`crate::fits`],
+//! [`crate::fastener`], [`super::bearings`]), a part of the overlaps component: found when the
+//! world is built, their axes among the candidate directions, and the answers the pair tests
+//! read along an axis (which fits the motion follows, which partner turns).
+//!
+//! They live with the overlaps because they are what makes an input overlap meant (a pressed
+//! pin, a screw in its thread, a ball in its race) and what the strict sample rule exempts.
 
-use super::*;
+use super::bearings::Bearing;
+use super::contacts::Contacts;
+use super::shapes::Shapes;
+use crate::assembly::Assembly;
+use crate::fastener::{self, Thread};
 use crate::fits::{self, Fit, Role};
+use crate::math::{Aabb, Vec3};
+use crate::overlap::OverlapNote;
+use crate::partset::PartSet;
+use rayon::prelude::*;
+use std::collections::{BTreeMap, BTreeSet};
+use std::sync::OnceLock;
 
 /// A direction is a fit's axis when their cosine exceeds this (0.1°): the exact axis joins the
 /// candidates unless one lies this close.
 pub(super) const AXIS_ALIGNED: f32 = 0.999_998_5;
+/// A direction is along a thread's axis when their cosine exceeds this (0.8°).
+pub(super) const SCREW_ALIGNED: f32 = 0.9999;
 /// The most directions the pairs' planar contacts add to the candidates.
 const MAX_CONTACT_DIRECTIONS: usize = 48;
 
@@ -17,15 +34,68 @@ fn plane_meets_box(point: Vec3, normal: Vec3, b: &Aabb) -> bool {
     (c - point).dot(normal).abs() <= h.dot(normal.abs())
 }
 
-impl World {
+/// The fits, threads, bearings and roles of the parts.
+pub struct Fits {
+    /// Threaded contacts (ordered pairs).
+    threads: BTreeMap<(usize, usize), Thread>,
+    /// Coaxial fits per pair (low, high).
+    fits: BTreeMap<(usize, usize), Vec<Fit>>,
+    /// Per ordered pair with a fit that is not a clearance fit: the first part's samples for the
+    /// fit test (whole surface and dense near the other), made when first needed.
+    pub(super) samples: BTreeMap<(usize, usize), OnceLock<Vec<Vec3>>>,
+    /// What each part is (nut, washer, bolt, pin, other), from its shape and name.
+    roles: Vec<Role>,
+    /// The rolling bearings among the parts ([`Bearing`]).
+    bearings: Vec<Bearing>,
+}
+
+impl Fits {
+    /// None found yet among `parts` parts.
+    pub(super) fn new(parts: usize) -> Fits {
+        Fits {
+            threads: BTreeMap::new(),
+            fits: BTreeMap::new(),
+            samples: BTreeMap::new(),
+            roles: vec![Role::Other; parts],
+            bearings: Vec::new(),
+        }
+    }
+
+    /// A copy with the same findings and fresh sample caches.
+    pub(super) fn share(&self) -> Fits {
+        Fits {
+            threads: self.threads.clone(),
+            fits: self.fits.clone(),
+            samples: self.samples.keys().map(|&k| (k, OnceLock::new())).collect(),
+            roles: self.roles.clone(),
+            bearings: self.bearings.clone(),
+        }
+    }
+
+    /// Finds the bearings, then the fits (a bearing's rings are no nuts), then the threads among
+    /// the parts in contact, adding their axes and the pairs' planar contact directions to
+    /// `directions`.
+    pub(super) fn find(
+        &mut self,
+        assembly: &Assembly,
+        shapes: &Shapes,
+        contacts: &Contacts,
+        notes: &[OverlapNote],
+        directions: &mut Vec<Vec3>,
+    ) {
+        self.bearings = super::bearings::find_bearings(shapes, contacts);
+        self.find_fits(assembly, shapes, contacts, notes, directions);
+        self.find_threads(assembly.len(), shapes, contacts, directions);
+    }
+
     /// Finds every fit between parts in contact (touching or overlapping in the input; meshes
     /// only, unions of boxes have no round faces) and adds each fit's axis, both ways, to the
     /// candidate directions.
-    pub(super) fn find_fits(&mut self) {
-        let n = self.num_parts();
+    fn find_fits(&mut self, assembly: &Assembly, shapes: &Shapes, contacts: &Contacts, notes: &[OverlapNote], directions: &mut Vec<Vec3>) {
+        let n = assembly.len();
         let pairs: Vec<(usize, usize)> = (0..n)
-            .flat_map(|p| self.contacts[p].iter().filter(move |&q| q < n && q > p).map(move |q| (p, q)))
-            .filter(|&(p, q)| self.geoms[p].boxes.is_none() && self.geoms[q].boxes.is_none())
+            .flat_map(|p| contacts.of(p).iter().filter(move |&q| q < n && q > p).map(move |q| (p, q)))
+            .filter(|&(p, q)| shapes.boxes(p).is_none() && shapes.boxes(q).is_none())
             .collect();
         let parts: BTreeSet<usize> = pairs.iter().flat_map(|&(p, q)| [p, q]).collect();
         // each part's surfaces and role once, in parallel
@@ -33,10 +103,7 @@ impl World {
             .into_iter()
             .collect::<Vec<_>>()
             .par_iter()
-            .map(|&p| {
-                let g = &self.geoms[p];
-                (p, fits::role(self.name(p), g.surfaces(), g.mesh.vertices()))
-            })
+            .map(|&p| (p, fits::role(&assembly.parts[p].name, shapes.surfaces(p), shapes.mesh(p).vertices())))
             .collect();
         // a bearing's parts are a bought unit, never a fastener (a ring is no nut)
         let in_bearing: BTreeSet<usize> = self.bearings.iter().flat_map(|b| b.parts()).collect();
@@ -46,131 +113,104 @@ impl World {
         let found: Vec<((usize, usize), Vec<Fit>)> = pairs
             .par_iter()
             .filter_map(|&(p, q)| {
-                let (gp, gq) = (&self.geoms[p], &self.geoms[q]);
                 let f = fits::fits_between(
                     p,
-                    gp.surfaces(),
+                    shapes.surfaces(p),
                     self.roles[p],
                     q,
-                    gq.surfaces(),
+                    shapes.surfaces(q),
                     self.roles[q],
-                    self.tolerance,
-                    self.contact_distance,
+                    shapes.tolerance(),
+                    contacts.distance(),
                 );
                 (!f.is_empty()).then_some(((p, q), f))
             })
             .collect();
-        self.add_contact_directions(&pairs);
+        add_contact_directions(shapes, contacts, notes, &pairs, directions);
         for (pair, f) in found {
             for fit in &f {
                 for d in [fit.axis, -fit.axis] {
-                    if !self.directions.iter().any(|e| e.dot(d) > AXIS_ALIGNED) {
-                        self.directions.push(d);
+                    if !directions.iter().any(|e| e.dot(d) > AXIS_ALIGNED) {
+                        directions.push(d);
                     }
                 }
                 if fit.class != fits::FitClass::Clearance {
-                    self.fit_samples.entry((fit.shaft, fit.hole)).or_default();
-                    self.fit_samples.entry((fit.hole, fit.shaft)).or_default();
+                    self.samples.entry((fit.shaft, fit.hole)).or_default();
+                    self.samples.entry((fit.hole, fit.shaft)).or_default();
                 }
             }
             self.fits.insert(pair, f);
         }
     }
 
-    /// Adds the directions the pairs' own planar contacts define: each contact plane's normal
-    /// (a panel lifts off along it, also when the two are sunk a little into each other) and
-    /// the line two non-parallel contact planes of one part share (a slide along a rail, in a
-    /// T-slot or a channel), both ways, unless a candidate lies within 0.1°. Model-wide normal clusters
-    /// average a lift 2° off an axis into the axis; these are the pair's exact ones. At most
-    /// [`MAX_CONTACT_DIRECTIONS`] are added, the largest contacts first.
-    fn add_contact_directions(&mut self, pairs: &[(usize, usize)]) {
-        let slack = self.contact_distance;
-        // per pair, its planar contacts (weight, the first part's outward normal)
-        type Contacts = Vec<(f32, Vec3)>;
-        let per_pair: Vec<((usize, usize), Contacts)> = pairs
+    /// Finds every threaded contact (ordered pairs of parts in contact, the first with a
+    /// symmetry axis; see [`crate::fastener`]) and adds each thread's axis, both ways, to the
+    /// candidate `directions`.
+    fn find_threads(&mut self, n: usize, shapes: &Shapes, contacts: &Contacts, directions: &mut Vec<Vec3>) {
+        let pairs: Vec<(usize, usize)> =
+            (0..n).flat_map(|p| contacts.of(p).iter().filter(move |&q| q < n && q != p).map(move |q| (p, q))).collect();
+        // each candidate fastener's axis once, in parallel (pairs sharing a part would wait on
+        // its cache one after the other)
+        let movers: BTreeSet<usize> = pairs.iter().map(|&(p, _)| p).filter(|&p| shapes.boxes(p).is_none()).collect();
+        movers.into_iter().collect::<Vec<_>>().par_iter().for_each(|&p| {
+            shapes.symmetry_axis(p);
+        });
+        let found: Vec<((usize, usize), Thread)> = pairs
             .par_iter()
-            .map(|&(p, q)| {
-                let (gp, gq) = (&self.geoms[p], &self.geoms[q]);
-                let depth = self.notes.iter().find(|n| n.parts == (p, q)).map_or(0.0, |n| n.depth);
-                let reach = slack + depth;
-                let common =
-                    Aabb::new(gp.aabb.mins.max(gq.aabb.mins) - Vec3::splat(reach), gp.aabb.maxs.min(gq.aabb.maxs) + Vec3::splat(reach));
-                let large = |planes: &[fits::Plane]| {
-                    let total: f32 = planes.iter().map(|x| x.area).sum();
-                    planes.iter().filter(|x| x.area >= 0.005 * total).cloned().collect::<Vec<_>>()
-                };
-                let (pp, pq) = (large(&gp.surfaces().planes), large(&gq.surfaces().planes));
-                // opposite planes of the two parts within reach of each other, meeting the
-                // pair's common box: a planar contact (or a slab)
-                let mut contacts: Vec<(f32, Vec3)> = Vec::new();
-                for a in &pp {
-                    for b in &pq {
-                        if a.normal.dot(b.normal) <= -0.9995
-                            && (b.point - a.point).dot(a.normal).abs() <= reach
-                            && plane_meets_box(a.point, a.normal, &common)
-                        {
-                            contacts.push((a.area.min(b.area), a.normal));
-                        }
-                    }
+            .filter_map(|&(p, q)| {
+                // a union of boxes (voxels, profiles) has no 60° symmetry
+                if shapes.boxes(p).is_some() {
+                    return None;
                 }
-                ((p, q), contacts)
+                let axis = shapes.symmetry_axis(p)?;
+                let t = fastener::threaded_contact(&axis, shapes.mesh(p), shapes.mesh(q), 4.0 * shapes.tolerance())?;
+                Some(((p, q), t))
             })
             .collect();
-        // per part, the normals of all its planar contacts: each normal, and the line any two
-        // non-parallel ones share (the part slides along it between them)
-        let mut per_part: BTreeMap<usize, Vec<(f32, Vec3)>> = BTreeMap::new();
-        for ((p, q), contacts) in per_pair {
-            for (w, n) in contacts {
-                per_part.entry(p).or_default().push((w, n));
-                per_part.entry(q).or_default().push((w, -n));
+        // a bolt in a nut: both are threaded in each other, and the zone covers both threads
+        // (the nut's roots and the bolt's crests), whichever moves
+        let mut found = found;
+        let radii: BTreeMap<(usize, usize), f32> = found.iter().map(|&(k, t)| (k, t.radius)).collect();
+        for ((p, q), t) in found.iter_mut() {
+            if let Some(&r) = radii.get(&(*q, *p)) {
+                t.radius = t.radius.max(r);
             }
         }
-        let mut found: Vec<(f32, Vec3)> = Vec::new();
-        for (_, mut contacts) in per_part {
-            contacts.sort_by(|a, b| b.0.total_cmp(&a.0));
-            contacts.truncate(8);
-            found.extend(contacts.iter().flat_map(|&(w, n)| [(w, n), (w, -n)]));
-            for (i, &(wa, na)) in contacts.iter().enumerate() {
-                for &(wb, nb) in &contacts[i + 1..] {
-                    let line = na.cross(nb);
-                    if line.length() > 0.05 {
-                        let l = line.normalize();
-                        found.extend([(wa.min(wb), l), (wa.min(wb), -l)]);
-                    }
+        for (_, t) in &found {
+            for d in [t.axis.direction, -t.axis.direction] {
+                if !directions.iter().any(|e| e.dot(d) > SCREW_ALIGNED) {
+                    directions.push(d);
                 }
             }
         }
-        found.sort_by(|a, b| b.0.total_cmp(&a.0));
-        let mut added = 0;
-        for (_, d) in found {
-            if added >= MAX_CONTACT_DIRECTIONS {
-                break;
-            }
-            if !self.directions.iter().any(|e| e.dot(d) > AXIS_ALIGNED) {
-                self.directions.push(d);
-                added += 1;
-            }
-        }
+        self.threads = found.into_iter().collect();
     }
 
-    /// Part `p`'s cylinders and planes ([`crate::fits::recognise`]; made once when first asked).
-    pub fn surfaces(&self, p: usize) -> &fits::Surfaces {
-        self.geoms[p].surfaces()
+    /// The threaded contact of `p` with `q` (see [`crate::fastener`]), found with the world:
+    /// `p` and `q` touch or overlap, `p` has a symmetry axis, its side faces touching `q` are
+    /// mostly thread flanks, and `q` is symmetric about the axis near it.
+    pub fn thread(&self, p: usize, q: usize) -> Option<Thread> {
+        self.threads.get(&(p, q)).copied()
+    }
+
+    /// Every threaded contact (ordered pairs).
+    pub fn threads(&self) -> &BTreeMap<(usize, usize), Thread> {
+        &self.threads
     }
 
     /// The fits between `p` and `q` (either order).
-    pub fn fits(&self, p: usize, q: usize) -> &[Fit] {
+    pub fn between(&self, p: usize, q: usize) -> &[Fit] {
         self.fits.get(&(p.min(q), p.max(q))).map_or(&[], Vec::as_slice)
     }
 
     /// Every pair with fits, (low, high), and its fits.
-    pub fn all_fits(&self) -> &BTreeMap<(usize, usize), Vec<Fit>> {
+    pub fn all(&self) -> &BTreeMap<(usize, usize), Vec<Fit>> {
         &self.fits
     }
 
     /// The rolling bearings among the parts (balls captive between two rings; see
-    /// [`super::Bearing`]), found with the world when fasteners are (`WorldConfig::fasteners`).
-    pub fn bearings(&self) -> &[super::Bearing] {
+    /// [`Bearing`]), found with the world when fasteners are (`WorldConfig::fasteners`).
+    pub fn bearings(&self) -> &[Bearing] {
         &self.bearings
     }
 
@@ -182,54 +222,98 @@ impl World {
 
     /// The fits of `p` and `q` that are not clearance fits and whose axis the motion along unit
     /// `dir` follows.
-    pub(super) fn fits_along(&self, p: usize, q: usize, dir: Vec3) -> Vec<&Fit> {
-        self.fits(p, q).iter().filter(|f| f.class != fits::FitClass::Clearance && f.axis.dot(dir).abs() > AXIS_ALIGNED).collect()
+    pub(super) fn along(&self, p: usize, q: usize, dir: Vec3) -> Vec<&Fit> {
+        self.between(p, q).iter().filter(|f| f.class != fits::FitClass::Clearance && f.axis.dot(dir).abs() > AXIS_ALIGNED).collect()
     }
 
-    /// The pair test of `p` moving along unit `dir` (up to `t_max`) against `q` when the motion
-    /// follows the axis of their `fits`: blocked when `q` must turn to move along it (the part
-    /// holding a fastener's thread, a bolt whose nut is still on), else the strict sample rule
-    /// on the samples of both parts outside every fit's band (see [`crate::fits`]).
-    pub(super) fn fit_blocks(&self, p: usize, q: usize, fits: &[&Fit], dir: Vec3, t_max: f32) -> bool {
-        if fits.iter().any(|f| f.turns == Some(q)) {
-            return true;
-        }
-        // each band about the line through the fit's axis point along the motion: a sample
-        // moving along `dir` keeps its distance from that line
-        let outside = |s: &[Vec3]| -> Vec<Vec3> {
-            s.iter()
-                .copied()
-                .filter(|&x| {
-                    !fits.iter().any(|f| {
-                        let r = crate::surface::radial(x, f.point, dir);
-                        r >= f.band.0 && r <= f.band.1
-                    })
-                })
-                .collect()
-        };
-        let (sp, sq) = (outside(self.fit_pair_samples(p, q)), outside(self.fit_pair_samples(q, p)));
-        overlap::strict_entry(&sp, &self.geoms[p].mesh, &sq, &self.geoms[q].mesh, Vec3::ZERO, dir, t_max, true, self.tolerance).is_some()
-    }
-
-    /// Part `p`'s samples for its fit tests with `q`: its whole-surface samples and dense ones
-    /// near `q` (made once per pair).
-    fn fit_pair_samples(&self, p: usize, q: usize) -> &[Vec3] {
-        let Some(cell) = self.fit_samples.get(&(p, q)) else { return self.strict_pair_samples(p, q) };
-        cell.get_or_init(|| {
-            let mut all = self.strict_samples(p).to_vec();
-            let (a, b) = (self.geoms[p].mesh.local_aabb(), self.geoms[q].mesh.local_aabb());
-            all.extend(overlap::local_inward_samples(&self.geoms[p].mesh, &a, &b, self.tolerance));
-            all
-        })
-    }
-
-    /// The partner of `p` among `present` along whose fit axis `direction` runs and which `p`
-    /// must turn on (a nut on its bolt, a screw in its tapped hole): its removal there is a
-    /// `screw` motion about the fit's axis.
-    pub(super) fn turned_on(&self, p: usize, present: &PartSet, direction: Vec3) -> Option<&Fit> {
+    /// The partner of `p` among `present` real parts (fewer than `n`) along whose fit axis
+    /// `direction` runs and which `p` must turn on (a nut on its bolt, a screw in its tapped
+    /// hole): its removal there is a `screw` motion about the fit's axis.
+    pub(super) fn turned_on(&self, p: usize, n: usize, present: &PartSet, direction: Vec3) -> Option<&Fit> {
         present
             .iter()
-            .filter(|&q| q != p && q < self.num_parts())
-            .find_map(|q| self.fits(p, q).iter().find(|f| f.turns == Some(p) && f.axis.dot(direction).abs() > AXIS_ALIGNED))
+            .filter(|&q| q != p && q < n)
+            .find_map(|q| self.between(p, q).iter().find(|f| f.turns == Some(p) && f.axis.dot(direction).abs() > AXIS_ALIGNED))
+    }
+}
+
+/// Adds the directions the pairs' own planar contacts define: each contact plane's normal
+/// (a panel lifts off along it, also when the two are sunk a little into each other) and
+/// the line two non-parallel contact planes of one part share (a slide along a rail, in a
+/// T-slot or a channel), both ways, unless a candidate lies within 0.1°. Model-wide normal clusters
+/// average a lift 2° off an axis into the axis; these are the pair's exact ones. At most
+/// [`MAX_CONTACT_DIRECTIONS`] are added, the largest contacts first.
+fn add_contact_directions(
+    shapes: &Shapes,
+    contacts: &Contacts,
+    notes: &[OverlapNote],
+    pairs: &[(usize, usize)],
+    directions: &mut Vec<Vec3>,
+) {
+    let slack = contacts.distance();
+    // per pair, its planar contacts (weight, the first part's outward normal)
+    type Planar = Vec<(f32, Vec3)>;
+    let per_pair: Vec<((usize, usize), Planar)> = pairs
+        .par_iter()
+        .map(|&(p, q)| {
+            let (ap, aq) = (shapes.aabb(p), shapes.aabb(q));
+            let depth = notes.iter().find(|n| n.parts == (p, q)).map_or(0.0, |n| n.depth);
+            let reach = slack + depth;
+            let common = Aabb::new(ap.mins.max(aq.mins) - Vec3::splat(reach), ap.maxs.min(aq.maxs) + Vec3::splat(reach));
+            let large = |planes: &[fits::Plane]| {
+                let total: f32 = planes.iter().map(|x| x.area).sum();
+                planes.iter().filter(|x| x.area >= 0.005 * total).cloned().collect::<Vec<_>>()
+            };
+            let (pp, pq) = (large(&shapes.surfaces(p).planes), large(&shapes.surfaces(q).planes));
+            // opposite planes of the two parts within reach of each other, meeting the
+            // pair's common box: a planar contact (or a slab)
+            let mut contacts: Vec<(f32, Vec3)> = Vec::new();
+            for a in &pp {
+                for b in &pq {
+                    if a.normal.dot(b.normal) <= -0.9995
+                        && (b.point - a.point).dot(a.normal).abs() <= reach
+                        && plane_meets_box(a.point, a.normal, &common)
+                    {
+                        contacts.push((a.area.min(b.area), a.normal));
+                    }
+                }
+            }
+            ((p, q), contacts)
+        })
+        .collect();
+    // per part, the normals of all its planar contacts: each normal, and the line any two
+    // non-parallel ones share (the part slides along it between them)
+    let mut per_part: BTreeMap<usize, Vec<(f32, Vec3)>> = BTreeMap::new();
+    for ((p, q), contacts) in per_pair {
+        for (w, n) in contacts {
+            per_part.entry(p).or_default().push((w, n));
+            per_part.entry(q).or_default().push((w, -n));
+        }
+    }
+    let mut found: Vec<(f32, Vec3)> = Vec::new();
+    for (_, mut contacts) in per_part {
+        contacts.sort_by(|a, b| b.0.total_cmp(&a.0));
+        contacts.truncate(8);
+        found.extend(contacts.iter().flat_map(|&(w, n)| [(w, n), (w, -n)]));
+        for (i, &(wa, na)) in contacts.iter().enumerate() {
+            for &(wb, nb) in &contacts[i + 1..] {
+                let line = na.cross(nb);
+                if line.length() > 0.05 {
+                    let l = line.normalize();
+                    found.extend([(wa.min(wb), l), (wa.min(wb), -l)]);
+                }
+            }
+        }
+    }
+    found.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut added = 0;
+    for (_, d) in found {
+        if added >= MAX_CONTACT_DIRECTIONS {
+            break;
+        }
+        if !directions.iter().any(|e| e.dot(d) > AXIS_ALIGNED) {
+            directions.push(d);
+            added += 1;
+        }
     }
 }

@@ -1,10 +1,18 @@
 //! One part's collision geometry: its parry mesh, bounds, cached eroded copies, exact boxes,
 //! strict-overlap samples and symmetry axis.
 
-use super::*;
 use crate::erode::{eroded_mesh, eroded_near};
+use crate::error::{GeomError, Result};
+use crate::fastener::SymmetryAxis;
 use crate::fits::Surfaces;
+use crate::math::{Aabb, Vec3};
+use crate::mesh::{Mesh, Topology};
 use crate::surface::PartFaces;
+use crate::sweep;
+use parry3d::query::PointQuery;
+use parry3d::shape::{TriMesh, TriMeshFlags};
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// One part's collision geometry.
 pub(super) struct Geom {

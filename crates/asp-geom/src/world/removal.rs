@@ -1,74 +1,93 @@
-//! The removal tests on a built [`World`]: straight-line removal of a part or a group, the
-//! two-step removal, contact stability, and the collision queries along a motion.
+//! The removal tests ([`Removal`], a view the world lends): straight-line removal of a part or a
+//! rigid group, the two-step removal, the travel that clears the rest, and the collision queries
+//! of the path planner along a motion. They read the blocking rows and the pair tests; they hold
+//! no state of their own, so every planner asks the same world the same questions.
 
-use super::*;
+use super::blocking::Blocking;
+use super::clearance::clearance_past;
+use super::contacts::Contacts;
+use super::fits::SCREW_ALIGNED;
+use super::geom::{contains_point, nests};
+use crate::feasibility::Motion;
+use crate::math::{Aabb, Pose, Rot, Vec3};
+use crate::partset::PartSet;
+use crate::sweep;
+use parry3d::query::{self, NonlinearRigidMotion};
 
-impl World {
+/// The removal tests on the world's blocking rows and contacts.
+#[derive(Clone, Copy)]
+pub struct Removal<'a> {
+    pub(super) blocking: Blocking<'a>,
+    pub(super) contacts: &'a Contacts,
+    /// The assembly's up direction (ties between free directions go to the one closest to it).
+    pub(super) up: Vec3,
+}
+
+impl<'a> Removal<'a> {
+    /// The blocking relation these tests read.
+    pub fn blocking(&self) -> Blocking<'a> {
+        self.blocking
+    }
+
     /// The straight-line removal test of `p` in `state`: the free direction with the shortest
     /// travel (ties go to the direction closest to up), or the union of all blockers when every
     /// direction is blocked.
-    pub fn linear_removal(&self, p: usize, state: &PartSet) -> std::result::Result<Motion, PartSet> {
-        self.linear_removal_among(p, state, &self.with_fixed(state))
+    pub fn linear(&self, p: usize, state: &PartSet) -> std::result::Result<Motion, PartSet> {
+        self.linear_among(p, state, &self.contacts.with_fixed(state))
     }
 
-    /// [`World::linear_removal`] among an explicit set of `present` parts (the state plus the
-    /// base parts that count as present, e.g. a subassembly on its own base without the ground).
-    pub fn linear_removal_among(&self, p: usize, state: &PartSet, present: &PartSet) -> std::result::Result<Motion, PartSet> {
-        let row = self.blocking_row(p);
+    /// [`Removal::linear`] among an explicit set of `present` parts (the state plus the base
+    /// parts that count as present, e.g. a subassembly on its own base without the ground).
+    pub fn linear_among(&self, p: usize, state: &PartSet, present: &PartSet) -> std::result::Result<Motion, PartSet> {
+        let row = self.blocking.row(p);
         let motion = self.best_free_direction(|k| row[k].intersection(present), |dir| self.clearance(p, state, dir))?;
         // along the axis of a threaded partner still present, the part screws out
         if let Motion::Linear { direction, distance } = motion {
-            let partner = present.iter().filter(|&q| q != p).find_map(|q| self.thread(p, q));
+            let fits = &self.blocking.pairs.overlaps.fits;
+            let partner = present.iter().filter(|&q| q != p).find_map(|q| fits.thread(p, q));
             if let Some(t) = partner.filter(|t| t.axis.direction.dot(direction).abs() > SCREW_ALIGNED) {
                 return Ok(Motion::Screw { axis_point: t.axis.point, direction, distance });
             }
-            if let Some(f) = self.turned_on(p, present, direction) {
+            if let Some(f) = fits.turned_on(p, self.parts(), present, direction) {
                 return Ok(Motion::Screw { axis_point: f.point, direction, distance });
             }
         }
         Ok(motion)
     }
 
-    /// The parts of `present` that block the rigid `group` moving along candidate direction `k`:
-    /// straight-line blocking is a property of part pairs, so this is the union of the members'
-    /// blocking rows, minus the group.
-    pub fn group_blockers(&self, group: &PartSet, k: usize, present: &PartSet) -> PartSet {
-        let mut blockers = PartSet::empty(self.geoms.len());
-        for p in group.iter().filter(|&p| p < self.num_parts()) {
-            blockers.union_with(&self.blocking_row(p)[k].intersection(present));
-        }
-        for p in group.iter() {
-            blockers.remove(p);
-        }
-        blockers
-    }
-
-    /// The smallest set of `present` parts that contains `seeds` and can translate along
-    /// candidate direction `k` as one rigid body: `seeds` closed under "is blocked by" (a
-    /// directional blocking graph's closure). It contains a fixed part when the seeds cannot
-    /// leave along `k` without one.
-    pub fn group_closure(&self, seeds: &PartSet, k: usize, present: &PartSet) -> PartSet {
-        let mut group = seeds.clone();
-        let mut frontier: Vec<usize> = seeds.iter().collect();
-        while let Some(p) = frontier.pop() {
-            if p >= self.num_parts() {
-                continue; // the ground never moves: a closure that reaches it is refused anyway
-            }
-            for q in self.blocking_row(p)[k].intersection(present).iter() {
-                if !group.contains(q) {
-                    group.insert(q);
-                    frontier.push(q);
-                }
-            }
-        }
-        group
-    }
-
     /// The straight-line removal test of a rigid `group` of parts of `state` among the `present`
     /// parts: the free direction with the shortest travel for the group's bounds to clear the
     /// rest (ties go to the direction closest to up), or every blocker.
-    pub fn group_removal_among(&self, group: &PartSet, state: &PartSet, present: &PartSet) -> std::result::Result<Motion, PartSet> {
-        self.best_free_direction(|k| self.group_blockers(group, k, present), |dir| self.group_clearance(group, state, dir))
+    pub fn group_among(&self, group: &PartSet, state: &PartSet, present: &PartSet) -> std::result::Result<Motion, PartSet> {
+        self.best_free_direction(|k| self.blocking.group_blockers(group, k, present), |dir| self.group_clearance(group, state, dir))
+    }
+
+    /// How far `p` must travel along `dir` for its bounds to clear the bounds of the other
+    /// present real parts, plus the contact distance. With no other part left, it clears its own
+    /// starting bounds (so the last part is lifted by its size, not by nothing).
+    pub fn clearance(&self, p: usize, state: &PartSet, dir: Vec3) -> f32 {
+        self.clearance_of(self.shapes().aabb(p), state.iter().filter(|&q| q != p), dir)
+    }
+
+    /// [`Removal::clearance`] of a group of parts moving together: its bounds clear the bounds
+    /// of the other present real parts.
+    pub fn group_clearance(&self, group: &PartSet, state: &PartSet, dir: Vec3) -> f32 {
+        let bounds = self.shapes().bounds(group.iter()).expect("a group has parts");
+        self.clearance_of(&bounds, state.iter().filter(|&q| !group.contains(q)), dir)
+    }
+
+    fn clearance_of(&self, a: &Aabb, others: impl Iterator<Item = usize>, dir: Vec3) -> f32 {
+        let n = self.parts();
+        let others = self.shapes().bounds(others.filter(|&q| q < n));
+        clearance_past(a, others, dir, self.contacts.distance())
+    }
+
+    fn shapes(&self) -> &'a super::Shapes {
+        self.blocking.pairs.shapes
+    }
+
+    fn parts(&self) -> usize {
+        self.shapes().parts()
     }
 
     /// The free candidate direction (no blockers) with the shortest travel, ties to the one
@@ -78,7 +97,7 @@ impl World {
         blockers_along: impl Fn(usize) -> PartSet,
         travel: impl Fn(Vec3) -> f32,
     ) -> std::result::Result<Motion, PartSet> {
-        best_free_direction(&self.directions, self.assembly.up.vector(), self.geoms.len(), blockers_along, travel)
+        best_free_direction(self.blocking.directions(), self.up, self.shapes().count(), blockers_along, travel)
     }
 
     /// A removal of `p` from `state` by two straight moves in turn when no single straight line
@@ -87,35 +106,36 @@ impl World {
     /// direction until its bounds clear the rest. Both moves are tested exactly (box intervals,
     /// or triangle sweeps of the pair's shapes); the first that works, in direction order, is a
     /// `Path` of pure translations.
-    pub fn two_step_removal(&self, p: usize, state: &PartSet) -> Option<Motion> {
-        let present = self.with_fixed(state);
-        let others: Vec<usize> = present.iter().filter(|&q| q != p && !self.ignores(p, q)).collect();
-        let row = self.blocking_row(p);
-        let a = self.geoms[p].aabb;
+    pub fn two_step(&self, p: usize, state: &PartSet) -> Option<Motion> {
+        let (shapes, pairs, overlaps) = (self.shapes(), self.blocking.pairs, self.blocking.pairs.overlaps);
+        let present = self.contacts.with_fixed(state);
+        let others: Vec<usize> = present.iter().filter(|&q| q != p && !overlaps.ignores(p, q)).collect();
+        let row = self.blocking.row(p);
+        let a = *shapes.aabb(p);
         let pivot = (a.mins + a.maxs) * 0.5;
-        for (k1, &d1) in self.directions.iter().enumerate() {
+        for (k1, &d1) in self.blocking.directions().iter().enumerate() {
             let blockers = row[k1].intersection(&present);
             if blockers.is_empty() {
                 continue;
             }
-            let reach = blockers.iter().filter_map(|q| self.pair_travel(p, q, Vec3::ZERO, d1)).fold(f32::INFINITY, f32::min);
-            if !reach.is_finite() || reach <= 2.0 * self.tolerance {
+            let reach = blockers.iter().filter_map(|q| pairs.travel(p, q, Vec3::ZERO, d1)).fold(f32::INFINITY, f32::min);
+            if !reach.is_finite() || reach <= 2.0 * shapes.tolerance() {
                 continue;
             }
             // just short of the contact (half the tolerance: the part clears what it rose
             // above by that much, and presses into nothing deeper than the tolerance), or half way
-            for s in [reach - 0.5 * self.tolerance, 0.5 * reach] {
+            for s in [reach - 0.5 * shapes.tolerance(), 0.5 * reach] {
                 let shift = d1 * s;
                 let moved = Aabb::new(a.mins + shift, a.maxs + shift);
-                for &d2 in &self.directions {
+                for &d2 in self.blocking.directions() {
                     if d2.dot(d1).abs() > 0.999 {
                         continue;
                     }
                     let length = self.clearance_of(&moved, state.iter().filter(|&q| q != p), d2);
-                    if others.iter().all(|&q| self.pair_travel(p, q, shift, d2).is_none_or(|t| t > length))
-                        && present.iter().filter(|&q| self.is_strict_pair(p, q)).all(|q| {
-                            self.strict_entry(p, q, Vec3::ZERO, d1, s, true).is_none()
-                                && self.strict_entry(p, q, shift, d2, length, true).is_none()
+                    if others.iter().all(|&q| pairs.travel(p, q, shift, d2).is_none_or(|t| t > length))
+                        && present.iter().filter(|&q| overlaps.is_strict(p, q)).all(|q| {
+                            pairs.strict_entry(p, q, Vec3::ZERO, d1, s, true).is_none()
+                                && pairs.strict_entry(p, q, shift, d2, length, true).is_none()
                         })
                     {
                         let poses = [Vec3::ZERO, shift, shift + d2 * length].map(Pose::from_translation).to_vec();
@@ -127,54 +147,16 @@ impl World {
         None
     }
 
-    /// How far `p`, displaced by `from`, travels along unit `dir` before it first penetrates `q`
-    /// deeper than the tolerance (boxes: when they first touch); `None` when never.
-    fn pair_travel(&self, p: usize, q: usize, from: Vec3, dir: Vec3) -> Option<f32> {
-        let (a, b) = (&self.geoms[p].aabb, &self.geoms[q].aabb);
-        let moved = Aabb::new(a.mins + from, a.maxs + from);
-        let (_, t1) = sweep_overlap(&moved, dir, b)?;
-        if let (Some(bp), Some(bq)) = (&self.geoms[p].boxes, &self.geoms[q].boxes) {
-            let (_, amount) = self.pair_erosion(p, q);
-            return bp
-                .iter()
-                .flat_map(|x| bq.iter().map(move |y| (x, y)))
-                .filter_map(|(x, y)| boxes::first_overlap(&Aabb::new(x.mins + from, x.maxs + from), dir, y, amount))
-                .reduce(f32::min);
-        }
-        let (moving, fixed) = self.pair_shapes(p, q);
-        if from == Vec3::ZERO {
-            return sweep::sweep_distance(&moving, dir, &fixed, t1);
-        }
-        // from a displaced start only whether it hits at all matters (the second move)
-        sweep::sweep_hits_at(&moving, &Pose::from_translation(from), dir, &fixed, t1).then_some(0.0)
-    }
-
-    /// Contact-graph stability: every present part is linked through contacts to a fixed part.
-    pub fn contact_stability(&self, state: &PartSet) -> Stability {
-        self.contact_stability_among(&self.with_fixed(state), &self.fixed)
-    }
-
-    /// Contact-graph stability of the `present` parts on the `base` parts among them: every
-    /// present part is linked through contacts to a present base part.
-    pub fn contact_stability_among(&self, present: &PartSet, base: &PartSet) -> Stability {
-        let reached = present.intersection(base).reached_within(present, |i| self.contacts[i].iter());
-        let floating = PartSet::from_indices(self.geoms.len(), present.iter().filter(|&i| !reached.contains(i)));
-        if floating.is_empty() {
-            Stability::Stable
-        } else {
-            Stability::Unstable { floating }
-        }
-    }
-
     /// The first present part that part `p` penetrates deeper than the tolerance while moving
     /// from pose `a` to pose `b` (pivot moving straight, rotation by slerp about it; see
     /// [`crate::feasibility::interpolate_about`]) — exact continuous collision detection with
     /// parry's nonlinear shape cast.
     pub fn collision_between(&self, p: usize, a: &Pose, b: &Pose, pivot: Vec3, state: &PartSet) -> Option<usize> {
-        let present = self.with_fixed(state);
+        let (shapes, pairs, overlaps) = (self.shapes(), self.blocking.pairs, self.blocking.pairs.overlaps);
+        let present = self.contacts.with_fixed(state);
         let (ca, cb) = (a.transform_point(pivot), b.transform_point(pivot));
         let radius = {
-            let bb = &self.geoms[p].aabb;
+            let bb = shapes.aabb(p);
             (bb.maxs - pivot).abs().max((bb.mins - pivot).abs()).length()
         };
         let region = Aabb::new(ca.min(cb) - Vec3::splat(radius), ca.max(cb) + Vec3::splat(radius));
@@ -182,30 +164,30 @@ impl World {
         let motion = NonlinearRigidMotion::new(*a, pivot, cb - ca, rel.to_scaled_axis());
         let still = NonlinearRigidMotion::constant_position(Pose::IDENTITY);
         let hit = present.iter().filter(|&q| q != p).find(|&q| {
-            let qb = &self.geoms[q].aabb;
+            let qb = shapes.aabb(q);
             if !(0..3).all(|k| region.mins[k] < qb.maxs[k] && qb.mins[k] < region.maxs[k]) {
                 return false;
             }
-            if self.is_strict_pair(p, q) {
+            if overlaps.is_strict(p, q) {
                 // a part overlapping `q` in the input may leave it only along straight motions
                 // that enter no new material: rotating edges count as collisions
-                let turned = |r: crate::math::Rot| r.angle_between(crate::math::Rot::IDENTITY) >= 1e-6;
+                let turned = |r: Rot| r.angle_between(Rot::IDENTITY) >= 1e-6;
                 if turned(rel) || turned(a.rotation) {
                     return true;
                 }
                 let shift = cb - ca;
                 let len = shift.length();
                 let dir = shift / len.max(f32::MIN_POSITIVE);
-                if self.strict_entry(p, q, a.translation, dir, len, true).is_some() {
+                if pairs.strict_entry(p, q, a.translation, dir, len, true).is_some() {
                     return true;
                 }
             }
-            if self.ignores(p, q) {
+            if overlaps.ignores(p, q) {
                 return false;
             }
-            let (moving, fixed) = self.pair_shapes(p, q);
+            let (moving, fixed) = pairs.shapes(p, q);
             let fixed = &*fixed;
-            if rel.angle_between(crate::math::Rot::IDENTITY) < 1e-6 {
+            if rel.angle_between(Rot::IDENTITY) < 1e-6 {
                 // pure translation: the exact triangle sweep
                 let shift = cb - ca;
                 let len = shift.length();
@@ -220,21 +202,19 @@ impl World {
     /// The first present part that part `p`, displaced by `pose` (applied to its assembled world
     /// position), penetrates deeper than the tolerance — the static test of the path planner.
     pub fn collision_at(&self, p: usize, pose: &Pose, state: &PartSet) -> Option<usize> {
-        let present = self.with_fixed(state);
-        let bb = self.geoms[p].aabb.transform_by(pose);
+        let (shapes, overlaps) = (self.shapes(), self.blocking.pairs.overlaps);
+        let present = self.contacts.with_fixed(state);
+        let bb = shapes.aabb(p).transform_by(pose);
         let id = Pose::IDENTITY;
-        let hit = present.iter().filter(|&q| q != p && !self.ignores(p, q)).find(|&q| {
-            let qb = &self.geoms[q].aabb;
+        let hit = present.iter().filter(|&q| q != p && !overlaps.ignores(p, q)).find(|&q| {
+            let qb = shapes.aabb(q);
             if !(0..3).all(|k| bb.mins[k] < qb.maxs[k] && qb.mins[k] < bb.maxs[k]) {
                 return false;
             }
-            let (k, amount) = self.pair_erosion(p, q);
-            let shrunk = self.eroded(k, amount);
-            let (shrunk_pose, raw, raw_pose, raw_closed) = if k == p {
-                (*pose, &self.geoms[q].mesh, id, self.geoms[q].closed)
-            } else {
-                (id, &self.geoms[p].mesh, *pose, self.geoms[p].closed)
-            };
+            let (k, amount) = overlaps.erosion(p, q);
+            let shrunk = shapes.eroded(k, amount);
+            let (shrunk_pose, raw, raw_pose, raw_closed) =
+                if k == p { (*pose, shapes.mesh(q), id, shapes.is_closed(q)) } else { (id, shapes.mesh(p), *pose, shapes.is_closed(p)) };
             let (bs, br) = (shrunk.aabb(&shrunk_pose), raw.aabb(&raw_pose));
             // surfaces crossing (exact triangle tests, `p` placed by `pose`), or one wholly inside
             // the other: only for closed surfaces whose boxes nest
@@ -243,7 +223,7 @@ impl World {
                 || (raw_closed
                     && nests(&bs, &br)
                     && contains_point(raw, raw_pose.inverse_transform_point(shrunk_pose.transform_point(shrunk.vertices()[0]))))
-                || (self.geoms[k].closed
+                || (shapes.is_closed(k)
                     && nests(&br, &bs)
                     && contains_point(&shrunk, shrunk_pose.inverse_transform_point(raw_pose.transform_point(raw.vertices()[0]))))
         });
@@ -281,5 +261,46 @@ pub(crate) fn best_free_direction(
     match best {
         Some((distance, direction)) => Ok(Motion::Linear { direction, distance }),
         None => Err(blockers),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::feasibility::{Motion, Stability};
+    use crate::fixtures::{assemble, part};
+    use crate::math::{Axis, Pose, Vec3};
+    use crate::mesh::Mesh;
+    use crate::partset::PartSet;
+    use crate::world::{World, WorldConfig};
+
+    /// Three unit cubes stacked on the ground (index 3).
+    fn stack() -> World {
+        let cube = |z: f32| part("cube", Mesh::cuboid(Vec3::new(0.0, 0.0, z), Vec3::new(1.0, 1.0, z + 1.0)), false);
+        World::new(assemble("stack", vec![cube(0.0), cube(1.0), cube(2.0)], Axis::Z), &WorldConfig::default()).unwrap()
+    }
+
+    #[test]
+    fn the_top_of_a_stack_lifts_off_by_the_contact_distance() {
+        let w = stack();
+        let all = PartSet::from_indices(4, [0, 1, 2]);
+        let r = w.removal();
+        assert_eq!(r.linear(2, &all), Ok(Motion::Linear { direction: Vec3::Z, distance: w.contacts().distance() }));
+        // sideways it clears the others' bounds after its own width
+        assert!((r.clearance(2, &all, Vec3::X) - 1.0 - w.contacts().distance()).abs() < 1e-6);
+        // the two upper cubes as one group lift off the lowest
+        let group = PartSet::from_indices(4, [1, 2]);
+        assert_eq!(r.group_clearance(&group, &all, Vec3::Z), w.contacts().distance());
+        assert!(matches!(r.group_among(&group, &all, &w.contacts().with_fixed(&all)), Ok(Motion::Linear { .. })));
+    }
+
+    #[test]
+    fn a_cube_pushed_into_the_one_below_collides_with_it_and_a_gap_unsettles_the_top() {
+        let w = stack();
+        let all = PartSet::from_indices(4, [0, 1, 2]);
+        let down = Pose::from_translation(Vec3::new(0.0, 0.0, -0.5));
+        assert_eq!(w.removal().collision_at(2, &down, &all), Some(1));
+        assert_eq!(w.removal().collision_at(2, &Pose::from_translation(Vec3::Z), &all), None);
+        let floating = PartSet::from_indices(4, [2]);
+        assert_eq!(w.contacts().stability(&PartSet::from_indices(4, [0, 2])), Stability::Unstable { floating });
     }
 }

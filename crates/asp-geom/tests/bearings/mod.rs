@@ -15,7 +15,7 @@ fn a_ball_bearing_in_a_housing_on_a_shaft_is_found_whatever_its_facets_and_balls
     for (facets, balls) in [(32, 7), (64, 9), (128, 12)] {
         let w = world(fixtures::ball_bearing(facets, balls, true), true);
         let (inner, outer) = (2, 3);
-        let b = w.bearings();
+        let b = w.overlaps().fits().bearings();
         assert_eq!(b.len(), 1, "{facets} facets, {balls} balls: {b:?}");
         let b = &b[0];
         assert_eq!(b.rings, [inner, outer], "{facets}/{balls}");
@@ -28,7 +28,7 @@ fn a_ball_bearing_in_a_housing_on_a_shaft_is_found_whatever_its_facets_and_balls
         assert!((b.centre - Vec3::new(0.0, 0.0, 0.007)).length() < 1e-5, "{:?}", b.centre);
         assert_eq!(b.parts(), (2..4 + balls as usize).collect::<Vec<_>>());
         // the rings are a bearing's, not nuts of a fastener
-        assert_eq!((w.role(inner), w.role(outer)), (Role::Other, Role::Other));
+        assert_eq!((w.overlaps().fits().role(inner), w.overlaps().fits().role(outer)), (Role::Other, Role::Other));
     }
 }
 
@@ -38,7 +38,7 @@ fn a_ball_bearing_in_a_housing_on_a_shaft_is_found_whatever_its_facets_and_balls
 fn a_roller_bearing_in_a_housing_on_a_shaft_is_found_whatever_its_facets_and_rollers() {
     for (facets, rollers) in [(32, 8), (64, 10), (128, 14)] {
         let w = world(fixtures::roller_bearing(facets, rollers, true), true);
-        let b = w.bearings();
+        let b = w.overlaps().fits().bearings();
         assert_eq!(b.len(), 1, "{facets} facets, {rollers} rollers: {b:?}");
         let b = &b[0];
         assert_eq!(b.elements, RollingElement::Roller);
@@ -50,7 +50,7 @@ fn a_roller_bearing_in_a_housing_on_a_shaft_is_found_whatever_its_facets_and_rol
         assert!((b.pitch_radius - 0.01675).abs() < 2e-5, "{}", b.pitch_radius);
         assert!((b.ball_radius - 0.003).abs() < 1.5e-4, "{}", b.ball_radius);
         assert!((b.centre - Vec3::new(0.0, 0.0, 0.007)).length() < 1e-5, "{:?}", b.centre);
-        assert_eq!((w.role(2), w.role(3)), (Role::Other, Role::Other));
+        assert_eq!((w.overlaps().fits().role(2), w.overlaps().fits().role(3)), (Role::Other, Role::Other));
     }
 }
 
@@ -72,7 +72,7 @@ fn a_cage_standing_out_of_the_faces_is_the_bearings_and_a_washer_is_not() {
         revolve(&[(10.5 * mm, 14.0 * mm), (14.5 * mm, 14.0 * mm), (14.5 * mm, 14.5 * mm), (10.5 * mm, 14.5 * mm)], 64, 0.0, Vec3::ZERO);
     a.parts.push(part("washer", washer, false));
     let w = world(a, true);
-    let b = &w.bearings()[0];
+    let b = &w.overlaps().fits().bearings()[0];
     assert_eq!(b.others, vec![12], "the cage, not the washer: {b:?}");
 }
 
@@ -92,15 +92,15 @@ fn rollers_laid_across_their_circle_are_no_bearing() {
             *v = centre + turn * (*v - centre);
         }
     }
-    assert!(world(a, true).bearings().is_empty());
+    assert!(world(a, true).overlaps().fits().bearings().is_empty());
 }
 
 #[test]
 fn a_bearing_alone_is_found_and_not_when_fasteners_are_off() {
     let w = world(fixtures::ball_bearing(64, 8, false), true);
-    assert_eq!(w.bearings().len(), 1);
-    assert_eq!(w.bearings()[0].rings, [0, 1]);
-    assert!(world(fixtures::ball_bearing(64, 8, false), false).bearings().is_empty());
+    assert_eq!(w.overlaps().fits().bearings().len(), 1);
+    assert_eq!(w.overlaps().fits().bearings()[0].rings, [0, 1]);
+    assert!(world(fixtures::ball_bearing(64, 8, false), false).overlaps().fits().bearings().is_empty());
 }
 
 #[test]
@@ -108,14 +108,14 @@ fn balls_without_rings_or_off_a_circle_are_no_bearing() {
     // the balls of a bearing, without its outer ring: they touch one ring only
     let mut a = fixtures::ball_bearing(64, 8, false);
     a.parts.remove(1);
-    assert!(world(a, true).bearings().is_empty());
+    assert!(world(a, true).overlaps().fits().bearings().is_empty());
     // two balls are no row
     let mut a = fixtures::ball_bearing(64, 8, false);
     a.parts.truncate(4);
-    assert!(world(a, true).bearings().is_empty());
+    assert!(world(a, true).overlaps().fits().bearings().is_empty());
     // fasteners and fits without balls
     for a in [fixtures::bolted_joint([26, 16, 12]), fixtures::pressed_pin([32, 32], 0.0), fixtures::ring_on_locked_post()] {
-        assert!(world(a, true).bearings().is_empty());
+        assert!(world(a, true).overlaps().fits().bearings().is_empty());
     }
 }
 
@@ -127,15 +127,18 @@ fn a_bearing_written_to_gltf_and_read_back_is_found() {
     write_glb(&fixtures::ball_bearing(64, 9, true), &path).unwrap();
     let a = load(&path, &LoadOptions { up: Some(asp_geom::math::Axis::Z), ..LoadOptions::default() }).unwrap();
     let w = world(a, true);
-    assert_eq!(w.bearings().len(), 1);
-    assert_eq!(w.bearings()[0].balls.len(), 9);
-    assert_eq!(w.name(w.bearings()[0].rings[1]), "outer ring");
+    assert_eq!(w.overlaps().fits().bearings().len(), 1);
+    assert_eq!(w.overlaps().fits().bearings()[0].balls.len(), 9);
+    assert_eq!(w.name(w.overlaps().fits().bearings()[0].rings[1]), "outer ring");
     shipped_is(&path, "ball_bearing_6204.glb");
     // the roller bearing too
     let path = dir.path().join("roller.glb");
     write_glb(&fixtures::roller_bearing(64, 10, true), &path).unwrap();
     let w = world(load(&path, &LoadOptions { up: Some(asp_geom::math::Axis::Z), ..LoadOptions::default() }).unwrap(), true);
-    assert_eq!((w.bearings().len(), w.bearings()[0].elements, w.bearings()[0].balls.len()), (1, RollingElement::Roller, 10));
+    assert_eq!(
+        (w.overlaps().fits().bearings().len(), w.overlaps().fits().bearings()[0].elements, w.overlaps().fits().bearings()[0].balls.len()),
+        (1, RollingElement::Roller, 10)
+    );
     shipped_is(&path, "roller_bearing_nup204.glb");
 }
 

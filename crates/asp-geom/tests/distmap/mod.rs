@@ -364,9 +364,9 @@ fn maps_agree_with_the_collision_world_on_voxel_cubes() {
         //    reference; the world's tolerant mesh test never frees what they block
         for (axis, sign, d) in axes {
             let m = dir(&maps, d);
-            let k = world.directions().iter().position(|w| (*w - d).length() < 1e-5).unwrap();
+            let k = world.blocking().directions().iter().position(|w| (*w - d).length() < 1e-5).unwrap();
             for p in 0..n {
-                let row = &world.blocking_row(p)[k];
+                let row = &world.blocking().row(p)[k];
                 for q in (0..n).filter(|&q| q != p) {
                     let exact = voxel_blocks(&cube, p, q, axis, sign);
                     assert_eq!(maps.blocked(p, q).contains(m), exact, "cube {seed}: {q} blocks {p} along {d:?}?");

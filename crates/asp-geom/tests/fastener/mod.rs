@@ -18,16 +18,16 @@ fn world(interference: f32, fasteners: bool) -> World {
 fn the_fixture_is_a_closed_helical_bolt_in_a_nut_whose_threads_touch() {
     let w = world(0.0, true);
     for p in 0..3 {
-        assert!(w.is_closed(p), "{}", w.name(p));
+        assert!(w.shapes().is_closed(p), "{}", w.name(p));
     }
     // the thread surfaces coincide: the shrunk sweep's erosion of the V-thread leaves them
     // crossing a little (a small overlap, as in CAD), never a gross one
-    assert!(w.overlap_notes().iter().all(|n| !n.gross && n.depth < 0.0002), "{:?}", w.overlap_notes());
-    assert!(w.contacts(BOLT).contains(NUT) && w.contacts(BOLT).contains(PLATE) && w.contacts(NUT).contains(PLATE));
+    assert!(w.overlaps().notes().iter().all(|n| !n.gross && n.depth < 0.0002), "{:?}", w.overlaps().notes());
+    assert!(w.contacts().of(BOLT).contains(NUT) && w.contacts().of(BOLT).contains(PLATE) && w.contacts().of(NUT).contains(PLATE));
     // the thread is helical: the bolt's surface is not invariant under a pure turn of 180° at
     // a fixed height (the crest lands on the root), only with half a pitch's shift
-    let m = w.mesh(BOLT);
-    let axis = w.symmetry_axis(BOLT).expect("the bolt has an axis");
+    let m = w.shapes().mesh(BOLT);
+    let axis = w.shapes().symmetry_axis(BOLT).expect("the bolt has an axis");
     assert!(axis.direction.dot(Vec3::Z).abs() > 0.99999, "{axis:?}");
     assert!(axis.radial(Vec3::ZERO) < 1e-5, "{axis:?}");
     // a crest vertex (angle 0, height 0) turned by 180° about the Z axis
@@ -44,17 +44,17 @@ fn a_threaded_bolt_in_a_threaded_nut_leaves_by_screwing_only_the_way_its_head_al
     for interference in [0.0, 0.0001] {
         let w = world(interference, true);
         let all = PartSet::full(3);
-        let t = w.thread(BOLT, NUT).unwrap_or_else(|| panic!("interference {interference}: bolt and nut are threaded"));
+        let t = w.overlaps().fits().thread(BOLT, NUT).unwrap_or_else(|| panic!("interference {interference}: bolt and nut are threaded"));
         assert!(t.axis.direction.dot(Vec3::Z).abs() > 0.99999);
         // the zone reaches the thread's major radius (plus the contact slack), not the head
         assert!(t.radius > 0.0049 && t.radius < 0.0052, "{t:?}");
-        assert!(w.thread(NUT, BOLT).is_some(), "the nut turns off the bolt too");
+        assert!(w.overlaps().fits().thread(NUT, BOLT).is_some(), "the nut turns off the bolt too");
         // the plate's square clearance hole is no thread; the head's bearing face is no flank
-        assert!(w.thread(BOLT, PLATE).is_none() && w.thread(NUT, PLATE).is_none());
+        assert!(w.overlaps().fits().thread(BOLT, PLATE).is_none() && w.overlaps().fits().thread(NUT, PLATE).is_none());
         // the bolt: out upward only (its head stops it downward, its thread and the plate's
         // hole sideways), by screwing
         assert_eq!(free_axes(&w, BOLT, &all), vec!["+z"], "interference {interference}");
-        match w.linear_removal(BOLT, &all) {
+        match w.removal().linear(BOLT, &all) {
             Ok(Motion::Screw { direction, axis_point, distance }) => {
                 assert!(direction.dot(Vec3::Z) > 0.9999, "{direction:?}");
                 assert!(t.axis.radial(axis_point) < 1e-5 && distance > 0.0);
@@ -63,11 +63,11 @@ fn a_threaded_bolt_in_a_threaded_nut_leaves_by_screwing_only_the_way_its_head_al
         }
         // the nut: off downward only, by screwing
         assert_eq!(free_axes(&w, NUT, &all), vec!["-z"], "interference {interference}");
-        assert!(matches!(w.linear_removal(NUT, &all), Ok(Motion::Screw { direction, .. }) if direction.dot(-Vec3::Z) > 0.9999));
+        assert!(matches!(w.removal().linear(NUT, &all), Ok(Motion::Screw { direction, .. }) if direction.dot(-Vec3::Z) > 0.9999));
         // with the nut gone the bolt leaves the plate's plain hole upward by a straight line
         let no_nut = PartSet::from_indices(3, [PLATE, BOLT]);
         assert_eq!(free_axes(&w, BOLT, &no_nut), vec!["+z"]);
-        assert!(matches!(w.linear_removal(BOLT, &no_nut), Ok(Motion::Linear { .. })));
+        assert!(matches!(w.removal().linear(BOLT, &no_nut), Ok(Motion::Linear { .. })));
     }
 }
 
@@ -76,13 +76,13 @@ fn without_the_screw_rule_the_bolt_and_nut_lock_each_other() {
     for interference in [0.0, 0.0001] {
         let w = world(interference, false);
         let all = PartSet::full(3);
-        assert!(w.thread(BOLT, NUT).is_none());
+        assert!(w.overlaps().fits().thread(BOLT, NUT).is_none());
         // the flanks stop every straight line along the axis: the pair is locked
         assert_eq!(free_axes(&w, BOLT, &all), Vec::<&str>::new(), "interference {interference}");
         assert_eq!(free_axes(&w, NUT, &all), Vec::<&str>::new(), "interference {interference}");
-        let blockers = w.linear_removal(BOLT, &all).expect_err("locked");
+        let blockers = w.removal().linear(BOLT, &all).expect_err("locked");
         assert!(blockers.contains(NUT), "{blockers:?}");
-        let blockers = w.linear_removal(NUT, &all).expect_err("locked");
+        let blockers = w.removal().linear(NUT, &all).expect_err("locked");
         assert!(blockers.contains(BOLT), "{blockers:?}");
     }
 }
@@ -92,7 +92,7 @@ fn smooth_pins_are_not_threads_and_the_fit_finds_a_prisms_axis() {
     // a round dowel pressed into two boards is rotationally symmetric and in contact, but has
     // no thread flanks: it leaves by a straight line, as before
     let w = World::new(fixtures::dowel_in_two_boards(), &WorldConfig::default()).unwrap();
-    assert!(w.threads().is_empty(), "{:?}", w.threads());
+    assert!(w.overlaps().fits().threads().is_empty(), "{:?}", w.overlaps().fits().threads());
     // the kinematic fit finds a faceted prism's axis exactly
     let prism = fixtures::prism(1.0, 2.0, 0.3, 0.0, 1.0, 16);
     let (axis, _) = fastener::kinematic_axis(&prism.vertices, &prism.triangles).unwrap();

@@ -19,15 +19,15 @@ fn a_bolted_joint_is_two_line_to_line_fits_and_a_nut_that_turns() {
     let (base, top, bolt, nut) = (0, 1, 2, 3);
     for facets in BOLTED {
         let w = world(fixtures::bolted_joint(facets), true);
-        assert_eq!((w.role(bolt), w.role(nut)), (Role::Bolt, Role::Nut), "{facets:?}");
-        assert_eq!((w.role(base), w.role(top)), (Role::Other, Role::Other), "{facets:?}");
+        assert_eq!((w.overlaps().fits().role(bolt), w.overlaps().fits().role(nut)), (Role::Bolt, Role::Nut), "{facets:?}");
+        assert_eq!((w.overlaps().fits().role(base), w.overlaps().fits().role(top)), (Role::Other, Role::Other), "{facets:?}");
         for plate in [base, top] {
-            let f = w.fits(bolt, plate);
+            let f = w.overlaps().fits().between(bolt, plate);
             assert_eq!(f.len(), 1, "{facets:?}: {f:?}");
             assert_eq!((f[0].class, f[0].shaft, f[0].hole, f[0].turns), (FitClass::LineToLine, bolt, plate, None), "{facets:?}");
             assert!(f[0].axis.dot(Vec3::Z).abs() > 0.99999 && (f[0].shaft_radius - 0.005).abs() < 2e-5);
         }
-        let f = w.fits(bolt, nut);
+        let f = w.overlaps().fits().between(bolt, nut);
         assert_eq!(f.len(), 1, "{facets:?}");
         assert_eq!((f[0].class, f[0].turns), (FitClass::LineToLine, Some(nut)), "{facets:?}");
     }
@@ -44,14 +44,14 @@ fn a_nut_unscrews_first_then_the_bolt_pulls_out_along_its_axis_whatever_the_tess
         assert!(free_axes(&w, top, &all).is_empty(), "{facets:?}");
         // the nut unscrews downward (upward is the base plate)
         assert_eq!(free_axes(&w, nut, &all), vec!["-z"], "{facets:?}");
-        match w.linear_removal(nut, &all) {
+        match w.removal().linear(nut, &all) {
             Ok(Motion::Screw { direction, .. }) => assert!(direction.dot(-Vec3::Z) > 0.9999),
             other => panic!("{facets:?}: the nut unscrews, got {other:?}"),
         }
         // then the bolt leaves upward only (its head stops it downward), a straight pull
         let no_nut = PartSet::from_indices(4, [0, top, bolt]);
         assert_eq!(free_axes(&w, bolt, &no_nut), vec!["+z"], "{facets:?}");
-        assert!(matches!(w.linear_removal(bolt, &no_nut), Ok(Motion::Linear { direction, .. }) if direction.dot(Vec3::Z) > 0.9999));
+        assert!(matches!(w.removal().linear(bolt, &no_nut), Ok(Motion::Linear { direction, .. }) if direction.dot(Vec3::Z) > 0.9999));
         // then the plate lifts
         let plates = PartSet::from_indices(4, [0, top]);
         assert!(free_axes(&w, top, &plates).contains(&"+z"));
@@ -72,17 +72,17 @@ fn a_screw_in_a_tapped_hole_at_the_minor_diameter_unscrews_and_holds_the_block()
     let (block, plate, screw) = (0, 1, 2);
     for facets in [[26, 16], [90, 128]] {
         let w = world(fixtures::tapped_screw(facets), true);
-        let f = w.fits(screw, block);
+        let f = w.overlaps().fits().between(screw, block);
         assert_eq!(f.len(), 1, "{facets:?}: {f:?}");
         assert_eq!((f[0].class, f[0].turns), (FitClass::Thread, Some(screw)), "{facets:?}");
-        assert_eq!(w.fits(screw, plate)[0].class, FitClass::LineToLine);
+        assert_eq!(w.overlaps().fits().between(screw, plate)[0].class, FitClass::LineToLine);
         let all = PartSet::full(3);
         assert_eq!(free_axes(&w, screw, &all), vec!["+z"], "{facets:?}");
-        assert!(matches!(w.linear_removal(screw, &all), Ok(Motion::Screw { direction, .. }) if direction.dot(Vec3::Z) > 0.9999));
+        assert!(matches!(w.removal().linear(screw, &all), Ok(Motion::Screw { direction, .. }) if direction.dot(Vec3::Z) > 0.9999));
         // the clamp plate is held down by the screw's head, and the block cannot slide along a
         // screw turned into it
         assert!(free_axes(&w, plate, &all).is_empty());
-        assert!(w.pair_blocks(block, screw, -Vec3::Z) && w.pair_blocks(block, screw, Vec3::Z));
+        assert!(w.blocking().pair_blocks(block, screw, -Vec3::Z) && w.blocking().pair_blocks(block, screw, Vec3::Z));
         assert!(free_axes(&w, plate, &PartSet::from_indices(3, [block, plate])).contains(&"+z"));
     }
 }
@@ -103,13 +103,13 @@ fn a_pressed_pin_is_pressed_out_along_its_axis_and_never_dragged_sideways() {
     for (facets, interference, expected) in cases {
         {
             let w = world(fixtures::pressed_pin(facets, interference), true);
-            let f = w.fits(1, 0);
+            let f = w.overlaps().fits().between(1, 0);
             assert_eq!(f.len(), 1, "{facets:?} {interference}: {f:?}");
             assert_eq!(f[0].class, expected, "{facets:?} {interference}");
             let free = free_axes(&w, 1, &PartSet::full(2));
             assert_eq!(free, vec!["+z", "-z"], "{facets:?} {interference}");
             for sideways in [Vec3::X, -Vec3::Y, Vec3::new(1.0, 0.0, 1.0).normalize()] {
-                assert!(w.pair_blocks(1, 0, sideways), "{facets:?} {interference}: {sideways:?}");
+                assert!(w.blocking().pair_blocks(1, 0, sideways), "{facets:?} {interference}: {sideways:?}");
             }
         }
     }
@@ -140,7 +140,7 @@ fn a_slide_along_the_line_two_planar_contacts_share_is_tried_a_fraction_of_a_deg
         let w = world(channel(angle), true);
         let all = PartSet::full(5);
         let u = Vec3::new(angle.to_radians().cos(), angle.to_radians().sin(), 0.0);
-        match w.linear_removal(4, &all) {
+        match w.removal().linear(4, &all) {
             Ok(Motion::Linear { direction, .. }) => assert!(direction.dot(u).abs() > 0.99999, "{angle}: {direction:?}"),
             other => panic!("{angle}: the slider slides out along its channel, got {other:?}"),
         }
@@ -148,7 +148,7 @@ fn a_slide_along_the_line_two_planar_contacts_share_is_tried_a_fraction_of_a_deg
         // within a degree of them) are tried
         if angle < 1.0 {
             let w = world(channel(angle), false);
-            assert!(w.linear_removal(4, &all).is_err(), "{angle}");
+            assert!(w.removal().linear(4, &all).is_err(), "{angle}");
         }
     }
 }

@@ -230,8 +230,9 @@ fn edge_attributes_follow_the_contract_order_computed_naively() {
     let config = GraphConfig::default();
     let g = AssemblyGraph::build(&w, &config).unwrap();
     assert_eq!(g.edges(), &[(0, 1), (1, 0)]);
-    let samples: Vec<_> =
-        (0..2).map(|i| asp_geom::graph::sample::sample_triangles(w.mesh(i).vertices(), w.mesh(i).indices(), 2048)).collect();
+    let samples: Vec<_> = (0..2)
+        .map(|i| asp_geom::graph::sample::sample_triangles(w.shapes().mesh(i).vertices(), w.shapes().mesh(i).indices(), 2048))
+        .collect();
     let boxes = [(lo_a, hi_a), (lo_b, hi_b)];
     // Q_i^j, the naive way, as (points, weights, normals)
     let region = |i: usize, j: usize| {
@@ -281,7 +282,7 @@ fn without_a_fixed_part_the_ground_is_the_base_but_no_node() {
         Axis::Z,
     );
     let w = world(a, &WorldConfig::default());
-    assert_eq!(w.ground(), Some(2));
+    assert_eq!(w.shapes().ground(), Some(2));
     let g = graph(&w);
     assert_eq!(g.num_parts(), 2);
     assert_eq!(g.edges(), &[(0, 1), (1, 0)]);
@@ -336,7 +337,7 @@ fn graph_attributes_are_invariant_when_the_model_moves_with_its_up_axis() {
     for a in models {
         let name = a.source.display().to_string();
         let base_world = world(a.clone(), &WorldConfig::default());
-        let (tol, eps) = (base_world.tolerance(), base_world.contact_distance());
+        let (tol, eps) = (base_world.shapes().tolerance(), base_world.contacts().distance());
         let g = graph(&base_world);
         assert!(!g.edges().is_empty(), "{name}");
         for _ in 0..4 {
@@ -356,7 +357,7 @@ fn a_real_model_keeps_its_part_features_when_moved_with_its_up_axis() {
     // the pump (mm, z up): 15 parts of curved, finely meshed surfaces
     let a = pump();
     let base_world = world(a.clone(), &WorldConfig::default());
-    let (tol, eps) = (base_world.tolerance(), base_world.contact_distance());
+    let (tol, eps) = (base_world.shapes().tolerance(), base_world.contacts().distance());
     let g = graph(&base_world);
     let mut rng = ChaCha8Rng::seed_from_u64(12);
     for _ in 0..2 {
@@ -492,7 +493,8 @@ fn every_shipped_model_has_finite_consistent_features() {
         assert_eq!(g.edge_attr_flat().len(), g.num_edges() * 152);
         assert!(g.nodes_flat().iter().chain(g.edge_attr_flat()).all(|v| v.is_finite() && (-1.0 - 1e-5..=1.0 + 1e-5).contains(v)), "{name}");
         // edges are the world's contacts between real parts, both ways, sorted
-        let expect: Vec<(usize, usize)> = (0..n).flat_map(|s| w.contacts(s).iter().filter(move |&t| t < n).map(move |t| (s, t))).collect();
+        let expect: Vec<(usize, usize)> =
+            (0..n).flat_map(|s| w.contacts().of(s).iter().filter(move |&t| t < n).map(move |t| (s, t))).collect();
         assert_eq!(g.edges(), &expect[..], "{name}");
         for &(s, t) in g.edges() {
             assert!(g.edges().binary_search(&(t, s)).is_ok(), "{name}: {s}->{t} without {t}->{s}");

@@ -14,9 +14,9 @@ fn world(a: asp_geom::Assembly, overlaps: OverlapPolicy) -> asp_geom::Result<Wor
 
 /// Every candidate direction along which `part` is free in `state`.
 fn free_directions(w: &World, part: usize, state: &PartSet) -> Vec<Vec3> {
-    let row = w.blocking_row(part);
-    let present = w.with_fixed(state);
-    w.directions().iter().enumerate().filter(|(k, _)| !row[*k].intersects(&present)).map(|(_, d)| *d).collect()
+    let row = w.blocking().row(part);
+    let present = w.contacts().with_fixed(state);
+    w.blocking().directions().iter().enumerate().filter(|(k, _)| !row[*k].intersects(&present)).map(|(_, d)| *d).collect()
 }
 
 #[test]
@@ -27,12 +27,12 @@ fn a_pressed_peg_leaves_along_its_axis_only() {
     // not only the axes: every free candidate direction is the axis
     let free = free_directions(&w, 1, &all);
     assert!(!free.is_empty() && free.iter().all(|d| d.dot(Vec3::Z) > 0.9999), "{free:?}");
-    match w.linear_removal(1, &all).unwrap() {
+    match w.removal().linear(1, &all).unwrap() {
         Motion::Linear { direction, .. } => assert!(direction.dot(Vec3::Z) > 0.9999),
         m => panic!("{m:?}"),
     }
     // the pair is reported: gross (no shrinking separates them), handled strictly, warned once
-    let notes = w.overlap_notes();
+    let notes = w.overlaps().notes();
     assert_eq!(notes.len(), 1, "{notes:?}");
     assert_eq!((notes[0].parts, notes[0].gross, notes[0].handling), ((0, 1), true, asp_geom::overlap::OverlapHandling::Strict));
     assert_eq!(notes[0].kind, OverlapKind::Crossing);
@@ -50,7 +50,7 @@ fn the_lenient_policy_lets_the_peg_slide_sideways_and_error_stops() {
     let w = world(fixtures::pressed_peg(), OverlapPolicy::Lenient).unwrap();
     let free = free_axes(&w, 1, &PartSet::full(2));
     assert!(free.contains(&"+x") && free.contains(&"+z"), "{free:?}");
-    assert_eq!(w.overlap_notes()[0].handling, asp_geom::overlap::OverlapHandling::Ignored);
+    assert_eq!(w.overlaps().notes()[0].handling, asp_geom::overlap::OverlapHandling::Ignored);
     let err = world(fixtures::pressed_peg(), OverlapPolicy::Error).err().expect("error policy").to_string();
     assert!(err.contains("'plate' and 'peg'") && err.contains("overlaps policy"), "{err}");
 }
@@ -63,7 +63,7 @@ fn a_dowel_in_two_boards_comes_out_after_the_upper_board_both_upward() {
     assert_eq!(free_axes(&w, 2, &all), Vec::<&str>::new());
     assert_eq!(free_axes(&w, 1, &all), vec!["+z"]);
     assert_eq!(free_axes(&w, 2, &all.without(1)), vec!["+z"]);
-    let pairs: Vec<(usize, usize)> = w.overlap_notes().iter().map(|n| n.parts).collect();
+    let pairs: Vec<(usize, usize)> = w.overlaps().notes().iter().map(|n| n.parts).collect();
     assert_eq!(pairs, vec![(0, 2), (1, 2)]);
     // and the checker (every place a removal is tested goes through the blocking rows)
     let checker = Checker::new(w, CheckerConfig::default());
@@ -85,7 +85,7 @@ fn a_dowel_drawn_into_a_large_panel_leaves_along_its_axis_only() {
     panel.fixed = true;
     let dowel = fixtures::part("dowel", fixtures::prism(0.37, 0.61, 0.004, 0.003, 0.033, 16), false);
     let w = world(fixtures::assemble("dowel_in_panel", vec![panel, dowel], asp_geom::math::Axis::Z), OverlapPolicy::Strict).unwrap();
-    assert!(w.overlap_notes()[0].gross, "{:?}", w.overlap_notes());
+    assert!(w.overlaps().notes()[0].gross, "{:?}", w.overlaps().notes());
     let all = PartSet::full(2);
     assert_eq!(free_axes(&w, 1, &all), vec!["+z"]);
     let free = free_directions(&w, 1, &all);
@@ -99,7 +99,7 @@ fn a_nested_part_is_reported_and_held() {
     outer.fixed = true;
     let inner = fixtures::box_part("inner", [0.5, 0.5, 0.5], [1.5, 1.5, 1.5]);
     let w = world(fixtures::assemble("nested", vec![outer, inner], asp_geom::math::Axis::Z), OverlapPolicy::Strict).unwrap();
-    let notes = w.overlap_notes();
+    let notes = w.overlaps().notes();
     assert_eq!(notes.len(), 1, "{notes:?}");
     assert_eq!(notes[0].kind, OverlapKind::Nested { inner: 1 });
     assert!(w.warnings().iter().any(|s| s.contains("'inner' lies inside the other")), "{:?}", w.warnings());
@@ -112,7 +112,7 @@ fn coincident_parts_are_reported_and_separate() {
     a.fixed = true;
     let b = fixtures::box_part("b", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]);
     let w = world(fixtures::assemble("coincident", vec![a, b], asp_geom::math::Axis::Z), OverlapPolicy::Strict).unwrap();
-    let notes = w.overlap_notes();
+    let notes = w.overlaps().notes();
     assert_eq!(notes.len(), 1, "{notes:?}");
     assert_eq!(notes[0].kind, OverlapKind::Coincident);
     // a copy moving out of its twin enters no material the pair did not already share
@@ -130,14 +130,18 @@ fn the_lenient_copy_of_a_strict_world_tests_as_a_lenient_world() {
         let strict = world(a.clone(), OverlapPolicy::Strict).unwrap();
         let built = world(a, OverlapPolicy::Lenient).unwrap();
         let copy = strict.lenient();
-        assert_eq!(copy.overlap_policy(), OverlapPolicy::Lenient);
-        assert_eq!(copy.overlap_notes(), built.overlap_notes(), "{name}");
-        assert_eq!(copy.directions(), built.directions(), "{name}");
+        assert_eq!(copy.overlaps().policy(), OverlapPolicy::Lenient);
+        assert_eq!(copy.overlaps().notes(), built.overlaps().notes(), "{name}");
+        assert_eq!(copy.blocking().directions(), built.blocking().directions(), "{name}");
         assert_eq!(copy.config(), built.config(), "{name}");
         for p in 0..copy.num_parts() {
-            assert_eq!(copy.blocking_row(p), built.blocking_row(p), "{name}: part {p}");
+            assert_eq!(copy.blocking().row(p), built.blocking().row(p), "{name}: part {p}");
             for q in 0..copy.num_parts() {
-                assert_eq!((copy.ignores(p, q), copy.is_strict_pair(p, q)), (built.ignores(p, q), built.is_strict_pair(p, q)), "{name}");
+                assert_eq!(
+                    (copy.overlaps().ignores(p, q), copy.overlaps().is_strict(p, q)),
+                    (built.overlaps().ignores(p, q), built.overlaps().is_strict(p, q)),
+                    "{name}"
+                );
             }
         }
     }
@@ -163,7 +167,7 @@ fn a_board_sunk_into_another_lifts_off_along_the_slab_normal_only() {
     for (facets, thickness) in [(16, 0.003), (96, 0.003), (16, 0.010), (96, 0.010)] {
         for turn in [asp_geom::math::Rot::IDENTITY, tilt()] {
             let w = world(fixtures::sunk_boards(facets, thickness, turn), OverlapPolicy::Strict).unwrap();
-            let n = &w.overlap_notes()[0];
+            let n = &w.overlaps().notes()[0];
             assert_eq!(n.class, asp_geom::overlap::OverlapClass::PlanarSlab, "{facets}: {n:?}");
             let normal = n.normal.unwrap();
             let all = PartSet::full(2);
@@ -173,14 +177,14 @@ fn a_board_sunk_into_another_lifts_off_along_the_slab_normal_only() {
             // every candidate within 0.1° of the normal lifts it too: a grid corner of the lower
             // board lies in the plane of the upper's side face, and parry saw that sample's path
             // "cross" the upper's bottom edge 1e-5° off the normal (a false entry, now a graze)
-            for d in w.directions().iter().filter(|d| d.dot(normal) > 0.999_998_5) {
-                assert!(!w.pair_blocks(1, 0, *d), "{facets}, {thickness} m: the lift along {d:?} is refused");
+            for d in w.blocking().directions().iter().filter(|d| d.dot(normal) > 0.999_998_5) {
+                assert!(!w.blocking().pair_blocks(1, 0, *d), "{facets}, {thickness} m: the lift along {d:?} is refused");
             }
             // sideways (along the boards) and down, every way refused
             for d in [turn * Vec3::X, -(turn * Vec3::X), turn * Vec3::Y, -(turn * Vec3::Y), -normal] {
-                assert!(w.pair_blocks(1, 0, d), "{facets}: the upper board slides along {d:?}");
+                assert!(w.blocking().pair_blocks(1, 0, d), "{facets}: the upper board slides along {d:?}");
             }
-            match w.linear_removal(1, &all).unwrap() {
+            match w.removal().linear(1, &all).unwrap() {
                 Motion::Linear { direction, .. } => assert!(direction.dot(normal) > 0.9999, "{direction:?}"),
                 m => panic!("{m:?}"),
             }
@@ -194,7 +198,7 @@ fn a_board_sunk_into_another_lifts_off_along_the_slab_normal_only() {
 fn the_slab_normal_is_a_candidate_direction() {
     let config = WorldConfig { normal_clusters: 0, fasteners: false, ..WorldConfig::default() };
     let w = World::new(fixtures::sunk_boards(16, 0.003, tilt()), &config).unwrap();
-    let normal = w.overlap_notes()[0].normal.unwrap();
+    let normal = w.overlaps().notes()[0].normal.unwrap();
     let free = free_directions(&w, 1, &PartSet::full(2));
     assert!(!free.is_empty() && free.iter().all(|d| d.dot(normal) > 0.9999), "{free:?}");
 }

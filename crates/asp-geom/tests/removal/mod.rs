@@ -13,12 +13,12 @@ fn world(a: asp_geom::Assembly) -> World {
 pub(crate) fn free_axes(w: &World, part: usize, state: &PartSet) -> Vec<&'static str> {
     let names = ["+x", "-x", "+y", "-y", "+z", "-z"];
     let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
-    let row = w.blocking_row(part);
-    let present = w.with_fixed(state);
+    let row = w.blocking().row(part);
+    let present = w.contacts().with_fixed(state);
     axes.iter()
         .zip(names)
         .filter(|(a, _)| {
-            let k = w.directions().iter().position(|d| d.dot(**a) > 0.9999).unwrap();
+            let k = w.blocking().directions().iter().position(|d| d.dot(**a) > 0.9999).unwrap();
             !row[k].intersects(&present)
         })
         .map(|(_, n)| n)
@@ -35,7 +35,7 @@ fn stacked_top_box_leaves_up_or_sideways_never_down() {
     // once the top box is gone the lower one may also leave upward
     assert_eq!(free_axes(&w, 1, &all.without(2)), vec!["+x", "-x", "+y", "-y", "+z"]);
     // and its removal motion clears the remaining bounds
-    match w.linear_removal(2, &all).unwrap() {
+    match w.removal().linear(2, &all).unwrap() {
         Motion::Linear { direction, distance } => {
             // straight up is the shortest way out of the remaining bounds
             assert_eq!(direction, Vec3::Z);
@@ -51,8 +51,8 @@ fn zero_clearance_peg_leaves_only_along_the_hole_axis() {
     let all = PartSet::full(2);
     assert_eq!(free_axes(&w, 1, &all), vec!["+z"]);
     // every other candidate direction (clustered normals) is blocked too
-    let row = w.blocking_row(1);
-    let free: Vec<Vec3> = w.directions().iter().zip(row).filter(|(_, b)| b.is_empty()).map(|(d, _)| *d).collect();
+    let row = w.blocking().row(1);
+    let free: Vec<Vec3> = w.blocking().directions().iter().zip(row).filter(|(_, b)| b.is_empty()).map(|(d, _)| *d).collect();
     assert_eq!(free, vec![Vec3::Z]);
 }
 
@@ -60,20 +60,20 @@ fn zero_clearance_peg_leaves_only_along_the_hole_axis() {
 fn moving_into_a_contact_is_blocked_and_reports_the_blocker() {
     let w = world(fixtures::stacked_boxes());
     // the lower box is blocked along ±z: by the top box and the base
-    let k_up = w.directions().iter().position(|d| *d == Vec3::Z).unwrap();
-    let k_down = w.directions().iter().position(|d| *d == -Vec3::Z).unwrap();
-    assert_eq!(w.blocking_row(1)[k_up].iter().collect::<Vec<_>>(), vec![2]);
-    assert_eq!(w.blocking_row(1)[k_down].iter().collect::<Vec<_>>(), vec![0]);
+    let k_up = w.blocking().directions().iter().position(|d| *d == Vec3::Z).unwrap();
+    let k_down = w.blocking().directions().iter().position(|d| *d == -Vec3::Z).unwrap();
+    assert_eq!(w.blocking().row(1)[k_up].iter().collect::<Vec<_>>(), vec![2]);
+    assert_eq!(w.blocking().row(1)[k_down].iter().collect::<Vec<_>>(), vec![0]);
 }
 
 #[test]
 fn tube_stick_is_locked_by_handle_and_cap() {
     let w = world(fixtures::tube());
     let all = PartSet::full(4);
-    let blockers = w.linear_removal(1, &all).unwrap_err();
+    let blockers = w.removal().linear(1, &all).unwrap_err();
     assert_eq!(blockers.iter().collect::<Vec<_>>(), vec![0, 2, 3]);
-    assert!(w.linear_removal(2, &all).is_ok());
-    assert!(w.linear_removal(3, &all).is_ok());
+    assert!(w.removal().linear(2, &all).is_ok());
+    assert!(w.removal().linear(3, &all).is_ok());
     assert_eq!(free_axes(&w, 1, &PartSet::from_indices(4, [0, 1])), vec!["+z", "-z"]);
 }
 
@@ -81,7 +81,7 @@ fn tube_stick_is_locked_by_handle_and_cap() {
 fn l_shaped_channel_needs_a_path() {
     let w = world(fixtures::l_path());
     let all = PartSet::full(2);
-    assert!(w.linear_removal(1, &all).is_err(), "no straight line leaves the channel");
+    assert!(w.removal().linear(1, &all).is_err(), "no straight line leaves the channel");
     let motion = plan_removal_path(&w, 1, &all, &RrtConfig::default(), 7).expect("RRT finds the L");
     let Motion::Path { poses, pivot } = &motion else { panic!("{motion:?}") };
     assert!(poses.len() >= 3, "an L needs a corner: {poses:?}");
@@ -89,11 +89,11 @@ fn l_shaped_channel_needs_a_path() {
     for w2 in poses.windows(2) {
         for k in 0..=50 {
             let p = interpolate_about(*pivot, &w2[0], &w2[1], k as f32 / 50.0);
-            assert!(w.collision_at(1, &p, &all).is_none(), "collision at {p:?}");
+            assert!(w.removal().collision_at(1, &p, &all).is_none(), "collision at {p:?}");
         }
     }
     let last = poses.last().unwrap();
-    let out = w.aabb(1).transform_by(last);
+    let out = w.shapes().aabb(1).transform_by(last);
     assert!(out.mins.z >= 5.0 - 1e-3 || out.maxs.x <= 0.0 || out.mins.x >= 5.0, "{out:?}");
 }
 
@@ -101,9 +101,9 @@ fn l_shaped_channel_needs_a_path() {
 fn arch_keystone_floats_without_pillars() {
     let w = world(fixtures::arch());
     // keystone on one pillar: linked, stable
-    assert_eq!(w.contact_stability(&PartSet::from_indices(4, [2, 3])), Stability::Stable);
+    assert_eq!(w.contacts().stability(&PartSet::from_indices(4, [2, 3])), Stability::Stable);
     // keystone alone: floating
-    assert_eq!(w.contact_stability(&PartSet::from_indices(4, [3])), Stability::Unstable { floating: PartSet::from_indices(4, [3]) });
+    assert_eq!(w.contacts().stability(&PartSet::from_indices(4, [3])), Stability::Unstable { floating: PartSet::from_indices(4, [3]) });
 }
 
 /// A 0.557 m post on a floor, and a ring of 3 mm wall and zero clearance around its top end,
@@ -139,8 +139,8 @@ fn a_zero_clearance_ring_slides_along_its_post_on_exact_boxes() {
     assert_eq!(free_axes(&w, 2, &all), vec!["+z"]);
     // the post leaves upward through the ring, and never down into the floor
     assert_eq!(free_axes(&w, 1, &all), vec!["+z"]);
-    assert!(w.contacts(2).contains(1) && w.contacts(1).contains(0) && !w.contacts(2).contains(0));
-    assert!(w.overlaps().is_empty());
+    assert!(w.contacts().of(2).contains(1) && w.contacts().of(1).contains(0) && !w.contacts().of(2).contains(0));
+    assert!(w.overlaps().pairs().is_empty());
 }
 
 #[test]
@@ -173,9 +173,9 @@ fn bvh_descent_sweeps_agree_with_the_per_triangle_search() {
         let n = w.num_parts();
         let diag = w.assembly().diagonal();
         for p in 0..n {
-            for q in w.contacts(p).iter().filter(|&q| q != p && q < n) {
-                let (moving, fixed) = w.pair_shapes(p, q);
-                let mut dirs: Vec<Vec3> = w.directions().to_vec();
+            for q in w.contacts().of(p).iter().filter(|&q| q != p && q < n) {
+                let (moving, fixed) = w.blocking().pairs().shapes(p, q);
+                let mut dirs: Vec<Vec3> = w.blocking().directions().to_vec();
                 dirs.extend((0..6).map(|_| {
                     Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize_or_zero()
                 }));
@@ -224,7 +224,7 @@ fn a_sheet_of_zero_thickness_leaves_neither_through_the_floor_nor_through_parts(
     let w = world(a);
     let all = PartSet::full(2);
     assert!(!free_axes(&w, 1, &all).contains(&"-z"), "the sheet goes down through the ground: {:?}", free_axes(&w, 1, &all));
-    match w.linear_removal(1, &all).unwrap() {
+    match w.removal().linear(1, &all).unwrap() {
         Motion::Linear { direction, .. } => assert!(direction.z >= 0.0, "the sheet leaves along {direction:?}"),
         other => panic!("{other:?}"),
     }

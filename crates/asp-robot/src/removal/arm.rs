@@ -85,7 +85,7 @@ impl<'a, W: Borrow<World>> ArmSpace<'a, W> {
     ) -> Self {
         let robot = &planner.cell.robot;
         // every point of the held part lies this close to the tool centre
-        let bb = planner.world().aabb(part);
+        let bb = planner.world().shapes().aabb(part);
         let mut held_reach: f64 = 0.0;
         for i in 0..8 {
             let corner = Vec3::new(
@@ -176,7 +176,7 @@ impl<'a, W: Borrow<World>> ArmSpace<'a, W> {
             return None;
         }
         let Some(need) = clearance else { return Some(0.0) };
-        let held_box = planner.world().aabb(self.part).transform_by(&displacement);
+        let held_box = planner.world().shapes().aabb(self.part).transform_by(&displacement);
         Some(planner.clearance(&placed, &held_box, self.obstacles, need))
     }
 

@@ -141,9 +141,9 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
         let first = spheres.len();
         let part_boxes: Vec<Aabb> = match &planner.held_cuboids[held] {
             Some(boxes) => boxes.iter().map(|c| c.aabb).collect(),
-            None => vec![*world.aabb(held)],
+            None => vec![*world.shapes().aabb(held)],
         };
-        let all = part_boxes.iter().copied().reduce(|a, b| a.merged(&b)).unwrap_or_else(|| *world.aabb(held));
+        let all = part_boxes.iter().copied().reduce(|a, b| a.merged(&b)).unwrap_or_else(|| *world.shapes().aabb(held));
         let bound =
             Sphere { centre: to_body.transform_point(all.center()), radius: all.half_extents().length() + crate::spheres::SPHERE_SLACK };
         for b in &part_boxes {
@@ -156,7 +156,7 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
         let held_shape = shapes.len();
         shapes.push(Shape { body: model.steps.len(), local: Frame::IDENTITY, bound, spheres: first..spheres.len() });
         let ground = obstacles.ground.map(|g| {
-            let b = world.aabb(g);
+            let b = world.shapes().aabb(g);
             GridBox { mins: b.mins.to_array(), maxs: b.maxs.to_array(), part: g as u32, index: u32::MAX }
         });
         // the base never moves: tested once, exactly
@@ -216,7 +216,7 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
         if let Some(g) = &self.ground {
             if g.distance_squared(c) < r * r && !tested.contains(&(u32::MAX - 1)) {
                 tested.push(u32::MAX - 1);
-                if shape.meets(pose, &Pose::IDENTITY, world.mesh(g.part as usize)) {
+                if shape.meets(pose, &Pose::IDENTITY, world.shapes().mesh(g.part as usize)) {
                     return true;
                 }
             }
@@ -232,7 +232,7 @@ impl<'a, W: Borrow<World>> SphereSpace<'a, W> {
                     let c = &boxes[i as usize];
                     shape.meets(pose, &c.centre, &c.cuboid)
                 }
-                _ => shape.meets(pose, &Pose::IDENTITY, world.mesh(part)),
+                _ => shape.meets(pose, &Pose::IDENTITY, world.shapes().mesh(part)),
             }
         })
     }
@@ -503,11 +503,11 @@ mod tests {
         let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
         let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
         let n = world.num_parts();
-        let held = (0..n).find(|&p| !world.fixed().contains(p)).unwrap();
+        let held = (0..n).find(|&p| !world.contacts().fixed().contains(p)).unwrap();
         let grasp = planner.grasps(held)[0].clone();
         let present = PartSet::full(n);
         let obstacles = planner.obstacles(&present, held);
-        let shrunk = world.eroded(held, planner.config.margin.max(world.tolerance()));
+        let shrunk = world.shapes().eroded(held, planner.config.margin.max(world.shapes().tolerance()));
         let space = SphereSpace::new(&planner, held, &shrunk, Pose::from_parts(grasp.position, grasp.orientation), grasp.width, &obstacles);
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         let (mut partly, mut checked) = (0, 0);

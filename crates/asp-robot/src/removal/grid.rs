@@ -1,6 +1,6 @@
 //! The parts as the sphere tests ask for them: "how far is this point from the parts present?"
 //!
-//! [`PartGrid`] holds every part's exact boxes ([`World::boxes`]; a part without them by its
+//! [`PartGrid`] holds every part's exact boxes ([`asp_geom::world::Shapes::boxes`]; a part without them by its
 //! bounding box, a lower bound of its distance, whose exact test is on its mesh) and a uniform
 //! grid over them (the broad phase over the cell). Each grid cell lists the parts whose box
 //! lies within `reach` of it and keeps a lower bound on its distance to every part it does not
@@ -81,7 +81,7 @@ impl PartGrid {
         let mut parts = Vec::new();
         for p in 0..world.num_parts() {
             let first = boxes.len() as u32;
-            match world.boxes(p) {
+            match world.shapes().boxes(p) {
                 Some(bs) => boxes.extend(bs.iter().enumerate().map(|(i, b)| GridBox {
                     mins: b.mins.to_array(),
                     maxs: b.maxs.to_array(),
@@ -89,7 +89,7 @@ impl PartGrid {
                     index: i as u32,
                 })),
                 None => {
-                    let b = world.aabb(p);
+                    let b = world.shapes().aabb(p);
                     boxes.push(GridBox { mins: b.mins.to_array(), maxs: b.maxs.to_array(), part: p as u32, index: u32::MAX });
                 }
             }
@@ -302,7 +302,7 @@ mod tests {
                 let p = Vec3::new(rng.random_range(-0.3..0.7), rng.random_range(-0.3..0.8), rng.random_range(-0.3..0.6));
                 let exact = present
                     .iter()
-                    .map(|q| world.aabb(q))
+                    .map(|q| world.shapes().aabb(q))
                     .map(|b| (p - p.clamp(b.mins, b.maxs)).length_squared())
                     .fold(f32::INFINITY, f32::min);
                 let lb = grid.distance_squared(p.to_array(), present.words());

@@ -3,7 +3,7 @@
 //!
 //! The test is hierarchical, cheapest first:
 //! 1. **Lift**: the part moves [`RemovalConfig::lift`] (5 cm) along its removal direction,
-//!    collision-checked exactly with the world's sweep ([`World::collision_between`]).
+//!    collision-checked exactly with the world's sweep ([`asp_geom::world::Removal::collision_between`]).
 //! 2. **Reachable grasps**: for a grasp of the part ([`crate::part_grasps`]), the gripper
 //!    alone (opened to the grasp's width, placed at the grasp and at the lifted pose; no
 //!    inverse kinematics needed) is collision-free, inverse kinematics of the grasp pose and of
@@ -137,7 +137,7 @@ pub struct RemovalPlanner<W: Borrow<World>> {
     /// at least two joints apart (the gripper and the fingers count as one link with the last
     /// link), except pairs that already touch in the middle of the joint limits.
     self_pairs: Vec<(usize, usize)>,
-    /// Per part, its exact boxes ([`World::boxes`]) as cuboids: tests against them replace the
+    /// Per part, its exact boxes ([`asp_geom::world::Shapes::boxes`]) as cuboids: tests against them replace the
     /// mesh tests (primitive against box instead of against triangles).
     cuboids: Vec<Option<Vec<Placed>>>,
     /// The same shrunk by the held part's margin, for the part in hand.
@@ -159,7 +159,7 @@ struct Placed {
 }
 
 fn cuboids_of(world: &World, p: usize, shrink: f32) -> Option<Vec<Placed>> {
-    let boxes = world.boxes(p)?;
+    let boxes = world.shapes().boxes(p)?;
     Some(
         boxes
             .iter()
@@ -229,7 +229,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
             }
         }
         let w: &World = world.borrow();
-        let held_shrink = config.margin.max(w.tolerance());
+        let held_shrink = config.margin.max(w.shapes().tolerance());
         let cuboids = (0..w.num_parts()).map(|p| cuboids_of(w, p, 0.0)).collect();
         let held_cuboids = (0..w.num_parts()).map(|p| cuboids_of(w, p, held_shrink)).collect();
         let model = ArmModel::new(robot, &arm);
@@ -293,7 +293,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
     pub fn with_arm_check<R>(&self, p: usize, present: &PartSet, grasp: &Grasp, f: impl FnOnce(&ArmCheck<'_, W>) -> R) -> R {
         let world = self.world();
         let obstacles = self.obstacles(present, p);
-        let shrunk = world.eroded(p, self.config.margin.max(world.tolerance()));
+        let shrunk = world.shapes().eroded(p, self.config.margin.max(world.shapes().tolerance()));
         let pose = Pose::from_parts(grasp.position, grasp.orientation);
         let space = |resolution, check| ArmSpace::new(self, p, &shrunk, pose, grasp.width, &obstacles, resolution, check);
         let check = ArmCheck::new(space(self.config.edge_resolution, Check::Spheres), space(self.config.check_resolution, Check::Exact));
@@ -321,10 +321,10 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
     /// The obstacles of a state: the present parts (fixed ones and the ground included) but `held`.
     fn obstacles(&self, present: &PartSet, held: usize) -> Obstacles {
         let world = self.world();
-        let ground = world.ground();
-        let ids: Vec<usize> = world.with_fixed(present).iter().filter(|&q| q != held && Some(q) != ground).collect();
-        let bounds = ids.iter().map(|&o| *world.aabb(o)).reduce(|a, b| a.merged(&b));
-        let ground = ground.filter(|&g| world.with_fixed(present).contains(g) && g != held);
+        let ground = world.shapes().ground();
+        let ids: Vec<usize> = world.contacts().with_fixed(present).iter().filter(|&q| q != held && Some(q) != ground).collect();
+        let bounds = ids.iter().map(|&o| *world.shapes().aabb(o)).reduce(|a, b| a.merged(&b));
+        let ground = ground.filter(|&g| world.contacts().with_fixed(present).contains(g) && g != held);
         let mut bits = vec![0u64; world.num_parts().div_ceil(64).max(1)];
         for &o in ids.iter().filter(|&&o| o < world.num_parts()) {
             bits[o / 64] |= 1 << (o % 64);
@@ -350,7 +350,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
                 }
                 // the base stands on the ground
                 if let Some(g) = obstacles.ground {
-                    if bb.intersects(world.aabb(g)) && prepared.meets(&pose, &Pose::IDENTITY, world.mesh(g)) {
+                    if bb.intersects(world.shapes().aabb(g)) && prepared.meets(&pose, &Pose::IDENTITY, world.shapes().mesh(g)) {
                         return true;
                     }
                 }
@@ -359,12 +359,12 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
                 continue;
             }
             for &o in &obstacles.ids {
-                if !bb.intersects(world.aabb(o)) {
+                if !bb.intersects(world.shapes().aabb(o)) {
                     continue;
                 }
                 let hit = match &self.cuboids[o] {
                     Some(boxes) => boxes.iter().any(|c| bb.intersects(&c.aabb) && prepared.meets(&pose, &c.centre, &c.cuboid)),
-                    None => prepared.meets(&pose, &Pose::IDENTITY, world.mesh(o)),
+                    None => prepared.meets(&pose, &Pose::IDENTITY, world.shapes().mesh(o)),
                 };
                 if hit {
                     return true;
@@ -397,7 +397,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         let to_obstacles = |bb: &Aabb| {
             let mut m = f32::INFINITY;
             if let Some(g) = obstacles.ground {
-                m = m.min(box_gap(bb, world.aabb(g)));
+                m = m.min(box_gap(bb, world.shapes().aabb(g)));
             }
             if let Some(b) = &obstacles.bounds {
                 let d = box_gap(bb, b);
@@ -405,7 +405,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
                     m = m.min(d);
                 } else {
                     for &o in &obstacles.ids {
-                        m = m.min(box_gap(bb, world.aabb(o)));
+                        m = m.min(box_gap(bb, world.shapes().aabb(o)));
                     }
                 }
             }
@@ -461,7 +461,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
             .map(|&o| {
                 let mut bits = vec![0u64; world.num_parts().div_ceil(64).max(1)];
                 bits[o / 64] |= 1 << (o % 64);
-                Obstacles { ids: vec![o], ground: None, bounds: Some(*world.aabb(o)), field: Field::new(bits), floor: false }
+                Obstacles { ids: vec![o], ground: None, bounds: Some(*world.shapes().aabb(o)), field: Field::new(bits), floor: false }
             })
             .collect();
         self.grasps(p)
@@ -488,9 +488,9 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
     /// an obstacle (exact triangle tests).
     fn held_collides(&self, p: usize, shrunk: &TriMesh, pose: &Pose, obstacles: &Obstacles) -> bool {
         let world = self.world();
-        let bb = world.aabb(p).transform_by(pose);
+        let bb = world.shapes().aabb(p).transform_by(pose);
         if let Some(g) = obstacles.ground {
-            if bb.intersects(world.aabb(g)) && asp_geom::sweep::meshes_cross_at(shrunk, pose, world.mesh(g)) {
+            if bb.intersects(world.shapes().aabb(g)) && asp_geom::sweep::meshes_cross_at(shrunk, pose, world.shapes().mesh(g)) {
                 return true;
             }
         }
@@ -507,18 +507,18 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
                 .collect()
         });
         obstacles.ids.iter().any(|&o| {
-            if !bb.intersects(world.aabb(o)) {
+            if !bb.intersects(world.shapes().aabb(o)) {
                 return false;
             }
             match (&held, &self.cuboids[o]) {
                 (Some(mine), Some(theirs)) => mine.iter().any(|(at, abb, cuboid)| {
-                    abb.intersects(world.aabb(o))
+                    abb.intersects(world.shapes().aabb(o))
                         && theirs.iter().any(|c| {
                             abb.intersects(&c.aabb)
                                 && query::intersection_test(at, *cuboid, &c.centre, &c.cuboid).is_ok_and(|i| i.intersecting)
                         })
                 }),
-                _ => asp_geom::sweep::meshes_cross_at(shrunk, pose, world.mesh(o)),
+                _ => asp_geom::sweep::meshes_cross_at(shrunk, pose, world.shapes().mesh(o)),
             }
         })
     }
@@ -586,13 +586,13 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
     /// Fails with [`RobotFailure::Blocked`] naming the part the last lift tried hits.
     pub fn lift_direction(&self, p: usize, present: &PartSet, direction: Option<Vec3>) -> Result<Vec3, RobotFailure> {
         let world = self.world();
-        let bb = world.aabb(p);
+        let bb = world.shapes().aabb(p);
         let pivot = (bb.mins + bb.maxs) * 0.5;
         let up = self.cell.up;
         let mut hit = None;
         for d in [Some(up), direction.filter(|d| d.dot(up) < 1.0 - 1e-6)].into_iter().flatten() {
             let lift = Pose::from_translation(d * self.config.lift);
-            match world.collision_between(p, &Pose::IDENTITY, &lift, pivot, present) {
+            match world.removal().collision_between(p, &Pose::IDENTITY, &lift, pivot, present) {
                 None => return Ok(d),
                 Some(by) => hit = Some(by),
             }

@@ -77,7 +77,7 @@ impl<W: Borrow<World>> RemovalPlanner<W> {
         let lift = Pose::from_translation(direction * self.config.lift);
         let obstacles = self.obstacles(present, p);
         let grasps = self.grasps(p);
-        let shrunk = world.eroded(p, self.config.margin.max(world.tolerance()));
+        let shrunk = world.shapes().eroded(p, self.config.margin.max(world.shapes().tolerance()));
         // The tool centre travels from the grasp (within the position tolerance) through the
         // lifted pose to the drop-off: the sampled polyline is at least as long as the lift plus
         // the straight distance, less twice the tolerance at each of the three ends.
@@ -243,7 +243,7 @@ mod tests {
         }
         let state = PartSet::full(world.num_parts());
         let (mut returned, mut refused) = (0, 0);
-        for p in (0..world.num_parts()).filter(|&p| !world.fixed().contains(p)) {
+        for p in (0..world.num_parts()).filter(|&p| !world.contacts().fixed().contains(p)) {
             let Ok(d) = planner.lift_direction(p, &state, None) else { continue };
             for mode in [Mode::Bounded, Mode::FirstPath] {
                 let before = planner.stats().exact_refused;

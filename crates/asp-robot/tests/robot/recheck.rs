@@ -64,17 +64,17 @@ fn depth_inside(mesh: &TriMesh, x: Vec3) -> f32 {
 /// the verdict is the one of testing every pair (and the test runs in seconds, not minutes).
 pub fn recheck(world: &World, cell: &RobotCell, part: usize, present: &PartSet, r: &RobotRemoval, allowed: f32) -> Result<(), String> {
     let robot = &cell.robot;
-    let obstacles: Vec<usize> = world.with_fixed(present).iter().filter(|&q| q != part).collect();
+    let obstacles: Vec<usize> = world.contacts().with_fixed(present).iter().filter(|&q| q != part).collect();
     // the part is held as it was at the first configuration (the grasp)
     let grasp = robot.tool_pose(&r.joints[0]);
     let base_shapes = robot.links()[0].shapes.len();
     let floor = parry3d::shape::HalfSpace::new(cell.up);
     let floor_pose = Pose::from_translation(cell.up * cell.floor);
-    let held = world.mesh(part);
-    let boxes: Vec<Aabb> = obstacles.iter().map(|&o| world.aabb(o).loosened(allowed)).collect();
+    let held = world.shapes().mesh(part);
+    let boxes: Vec<Aabb> = obstacles.iter().map(|&o| world.shapes().aabb(o).loosened(allowed)).collect();
     // edge points in each part's own frame, made once
     let held_points = edge_points(held, &Pose::IDENTITY, 0.004);
-    let obstacle_points: Vec<Vec<Vec3>> = obstacles.iter().map(|&o| edge_points(world.mesh(o), &Pose::IDENTITY, 0.004)).collect();
+    let obstacle_points: Vec<Vec<Vec3>> = obstacles.iter().map(|&o| edge_points(world.shapes().mesh(o), &Pose::IDENTITY, 0.004)).collect();
     for (w, pair) in r.joints.windows(2).enumerate() {
         let (a, b) = (&pair[0], &pair[1]);
         let max_step = a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
@@ -99,17 +99,19 @@ pub fn recheck(world: &World, cell: &RobotCell, part: usize, present: &PartSet, 
                 }
                 let shape_box = s.compute_aabb(&pose);
                 for (j, &o) in obstacles.iter().enumerate() {
-                    if k < base_shapes && world.ground() == Some(o) {
+                    if k < base_shapes && world.shapes().ground() == Some(o) {
                         continue;
                     }
                     if !boxes[j].intersects(&shape_box) {
                         continue;
                     }
-                    if query::intersection_test(&inner_pose, &*inner, &Pose::IDENTITY, world.mesh(o)).map_or(true, |i| i.intersecting) {
+                    if query::intersection_test(&inner_pose, &*inner, &Pose::IDENTITY, world.shapes().mesh(o))
+                        .map_or(true, |i| i.intersecting)
+                    {
                         return Err(format!("segment {w} sample {i}: robot shape {k} penetrates part {o} by more than {allowed}"));
                     }
                     // a shrunk shape that crosses no face and whose centre is inside lies inside
-                    if depth_inside(world.mesh(o), inner_pose.translation) > 0.0 {
+                    if depth_inside(world.shapes().mesh(o), inner_pose.translation) > 0.0 {
                         return Err(format!("segment {w} sample {i}: robot shape {k} inside part {o}"));
                     }
                 }
@@ -117,12 +119,12 @@ pub fn recheck(world: &World, cell: &RobotCell, part: usize, present: &PartSet, 
             let displacement = robot.tool_pose(&q) * grasp.inverse();
             if i % 4 == 0 || i == n {
                 let inv = displacement.inverse();
-                let held_box = world.aabb(part).transform_by(&displacement).loosened(allowed);
+                let held_box = world.shapes().aabb(part).transform_by(&displacement).loosened(allowed);
                 for (j, &o) in obstacles.iter().enumerate() {
                     if !boxes[j].intersects(&held_box) {
                         continue;
                     }
-                    let om = world.mesh(o);
+                    let om = world.shapes().mesh(o);
                     if held_points.iter().any(|&x| depth_inside(om, displacement.transform_point(x)) > allowed) {
                         return Err(format!("segment {w} sample {i}: the held part enters part {o}"));
                     }

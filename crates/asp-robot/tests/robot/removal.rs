@@ -13,7 +13,7 @@ fn profiles() -> asp_geom::Assembly {
 
 /// The free straight-line direction of `p` in `state`.
 fn lift_direction(world: &World, p: usize, state: &PartSet) -> Option<Vec3> {
-    match world.linear_removal(p, state) {
+    match world.removal().linear(p, state) {
         Ok(Motion::Linear { direction, .. }) => Some(direction),
         _ => None,
     }
@@ -28,7 +28,7 @@ fn a_top_profile_comes_out_and_its_path_rechecks() {
     // the parts that can leave upward in the full frame: top profiles and what rests on them
     let mut planned = 0;
     for p in 0..world.num_parts() {
-        if world.fixed().contains(p) {
+        if world.contacts().fixed().contains(p) {
             continue;
         }
         let Some(d) = lift_direction(&world, p, &state) else { continue };
@@ -66,7 +66,7 @@ fn same_seed_same_removal() {
     let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
     let state = PartSet::full(world.num_parts());
     let p = (0..world.num_parts())
-        .find(|&p| !world.fixed().contains(p) && lift_direction(&world, p, &state).is_some_and(|d| d.z > 0.9))
+        .find(|&p| !world.contacts().fixed().contains(p) && lift_direction(&world, p, &state).is_some_and(|d| d.z > 0.9))
         .unwrap();
     let d = lift_direction(&world, p, &state).unwrap();
     let a = planner.plan(p, &state, d, 11, 2);
@@ -197,7 +197,7 @@ fn the_bounded_grasp_search_finds_the_exhaustive_shortest_path() {
     let full = PartSet::full(frame.num_parts());
     let mut cases: Vec<(&World, &RobotCell, usize, Vec3, u64)> = (1..=3).map(|seed| (&bar, &bar_cell, 1, Vec3::Z, seed)).collect();
     for p in 0..frame.num_parts() {
-        if frame.fixed().contains(p) {
+        if frame.contacts().fixed().contains(p) {
             continue;
         }
         if let Some(d) = lift_direction(&frame, p, &full).filter(|d| d.z > 0.9) {
@@ -236,7 +236,7 @@ fn the_first_path_gives_the_verdict_of_the_full_plan() {
     let (mut ok, mut failed) = (0, 0);
     for k in [1, 2] {
         for p in 0..world.num_parts() {
-            if world.fixed().contains(p) {
+            if world.contacts().fixed().contains(p) {
                 continue;
             }
             let Some(d) = lift_direction(&world, p, &full) else { continue };
@@ -269,7 +269,7 @@ fn clearance_skipping_keeps_the_plans() {
     let state = PartSet::full(world.num_parts());
     let mut planned = 0;
     for p in 0..world.num_parts() {
-        if world.fixed().contains(p) {
+        if world.contacts().fixed().contains(p) {
             continue;
         }
         let Some(d) = lift_direction(&world, p, &state) else { continue };
@@ -345,7 +345,7 @@ fn per_part_planning_time() {
         let cell = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
         let state = PartSet::full(world.num_parts());
         let parts: Vec<(usize, Vec3)> = (0..world.num_parts())
-            .filter(|&p| !world.fixed().contains(p))
+            .filter(|&p| !world.contacts().fixed().contains(p))
             .filter_map(|p| lift_direction(&world, p, &state).map(|d| (p, d)))
             .collect();
         for (variant, config) in &variants {
@@ -410,7 +410,7 @@ fn robot_cell_reach() {
     ] {
         let assembly = asp_gen::ProfileAssembly::generate(&attached(params), seed).unwrap().to_assembly("p");
         let world = World::new(assembly, &WorldConfig::default()).unwrap();
-        let movable: Vec<usize> = (0..world.num_parts()).filter(|&p| !world.fixed().contains(p)).collect();
+        let movable: Vec<usize> = (0..world.num_parts()).filter(|&p| !world.contacts().fixed().contains(p)).collect();
         for &(gap, height) in &bases {
             // the default cell's base, moved: `gap` in front of the model's −x face, `height` up
             let default = RobotCell::for_assembly(world.assembly(), Robot::panda(), None, None);
@@ -486,7 +486,7 @@ fn a_path_the_fine_recheck_refuses_is_planned_again_on_finer_edges() {
     let state = PartSet::full(world.num_parts());
     let mut planned = 0;
     for p in 0..world.num_parts() {
-        if world.fixed().contains(p) {
+        if world.contacts().fixed().contains(p) {
             continue;
         }
         let Some(d) = lift_direction(&world, p, &state).filter(|d| d.z > 0.9) else { continue };

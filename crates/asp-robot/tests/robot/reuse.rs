@@ -23,7 +23,7 @@ fn within(a: &PartSet, b: &PartSet) -> bool {
 fn random_state(world: &World, p: usize, keep: f64, rng: &mut ChaCha8Rng) -> PartSet {
     let mut s = PartSet::full(world.num_parts());
     for q in 0..world.num_parts() {
-        if q != p && !world.fixed().contains(q) && !rng.random_bool(keep) {
+        if q != p && !world.contacts().fixed().contains(q) && !rng.random_bool(keep) {
             s.remove(q);
         }
     }
@@ -38,14 +38,14 @@ fn reused_paths_never_collide_in_the_state_they_serve() {
     let mut rng = ChaCha8Rng::seed_from_u64(24);
     // paths planned in random states of a few parts, each kept with its state
     let mut planned: Vec<(usize, PartSet, RobotRemoval)> = Vec::new();
-    let parts: Vec<usize> = (0..world.num_parts()).filter(|&p| !world.fixed().contains(p)).collect();
+    let parts: Vec<usize> = (0..world.num_parts()).filter(|&p| !world.contacts().fixed().contains(p)).collect();
     for round in 0..48 {
         if planned.len() >= 10 {
             break;
         }
         let p = parts[round % parts.len()];
         let state = random_state(&world, p, 0.5, &mut rng);
-        let Ok(Motion::Linear { direction, .. }) = world.linear_removal(p, &state) else { continue };
+        let Ok(Motion::Linear { direction, .. }) = world.removal().linear(p, &state) else { continue };
         if let Ok(r) = planner.removable(p, &state, direction, round as u64, 1) {
             planned.push((p, state, r));
         }
@@ -67,7 +67,7 @@ fn reused_paths_never_collide_in_the_state_they_serve() {
                 // a random subset of the planning state
                 let mut s = origin.clone();
                 for q in origin.iter() {
-                    if q != *p && !world.fixed().contains(q) && rng.random_bool(0.4) {
+                    if q != *p && !world.contacts().fixed().contains(q) && rng.random_bool(0.4) {
                         s.remove(q);
                     }
                 }

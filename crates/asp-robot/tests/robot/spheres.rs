@@ -36,7 +36,7 @@ fn the_sphere_check_never_misses_an_exact_collision() {
     let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let n = world.num_parts();
-    let movable: Vec<usize> = (0..n).filter(|&p| !world.fixed().contains(p)).collect();
+    let movable: Vec<usize> = (0..n).filter(|&p| !world.contacts().fixed().contains(p)).collect();
     let (mut total, mut both_free, mut sphere_free, mut near) = (0, 0, 0, 0);
     for round in 0..6 {
         // a random state holding the part in hand
@@ -94,7 +94,7 @@ fn the_edge_walk_gives_each_sample_s_verdict_and_never_passes_an_exact_collision
     let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
     let mut rng = ChaCha8Rng::seed_from_u64(21);
     let n = world.num_parts();
-    let movable: Vec<usize> = (0..n).filter(|&p| !world.fixed().contains(p)).collect();
+    let movable: Vec<usize> = (0..n).filter(|&p| !world.contacts().fixed().contains(p)).collect();
     let (mut free_edges, mut blocked_edges, mut samples) = (0, 0, 0);
     for round in 0..4 {
         let held = movable[rng.random_range(0..movable.len())];
@@ -153,7 +153,7 @@ fn the_sphere_check_never_misses_a_self_collision_near_the_parts() {
     let planner = RemovalPlanner::new(&world, cell, RemovalConfig::default());
     let mut rng = ChaCha8Rng::seed_from_u64(8);
     let n = world.num_parts();
-    let held = (0..n).find(|&p| !world.fixed().contains(p)).unwrap();
+    let held = (0..n).find(|&p| !world.contacts().fixed().contains(p)).unwrap();
     let grasp = part_grasps(&world.assembly().parts[held], &GraspConfig::default())[0].clone();
     let present = PartSet::full(n);
     let (mut selfs, mut missed) = (0, 0);

@@ -131,8 +131,8 @@ impl PrecedenceEntry {
             let p = step.part;
             for (b, earlier) in parts.iter().enumerate().take(c) {
                 let partner = earlier.iter().any(|&q| {
-                    world.thread(p, q).is_some_and(|t| t.axis.direction.dot(direction).abs() > 0.9999)
-                        || world.fits(p, q).iter().any(|f| f.turns == Some(p) && f.axis.dot(direction).abs() > 0.9999)
+                    world.overlaps().fits().thread(p, q).is_some_and(|t| t.axis.direction.dot(direction).abs() > 0.9999)
+                        || world.overlaps().fits().between(p, q).iter().any(|f| f.turns == Some(p) && f.axis.dot(direction).abs() > 0.9999)
                 });
                 if partner {
                     add(b, c, PrecedenceReason::Thread, &mut reasons);
@@ -140,13 +140,13 @@ impl PrecedenceEntry {
             }
         }
         // support, in assembly order (levels of earlier steps are known)
-        let fixed = world.fixed().clone();
+        let fixed = world.contacts().fixed().clone();
         let mut level = vec![0usize; k];
         for c in 0..k {
             let touching: Vec<usize> = {
                 let mut t: Vec<usize> = parts[c]
                     .iter()
-                    .flat_map(|&p| world.contacts(p).iter().collect::<Vec<_>>())
+                    .flat_map(|&p| world.contacts().of(p).iter().collect::<Vec<_>>())
                     .filter_map(|q| step_of.get(q).copied().flatten())
                     .filter(|&b| b < c)
                     .collect();
@@ -166,7 +166,7 @@ impl PrecedenceEntry {
                     for &p in &parts[c] {
                         present.insert(p);
                     }
-                    let reached = held.intersection(&present).reached_within(&present, |i| world.contacts(i).iter());
+                    let reached = held.intersection(&present).reached_within(&present, |i| world.contacts().of(i).iter());
                     let unreached: Vec<usize> = parts[c].iter().copied().filter(|&p| !reached.contains(p)).collect();
                     if unreached.is_empty() {
                         break;
@@ -175,7 +175,7 @@ impl PrecedenceEntry {
                         .iter()
                         .copied()
                         .filter(|b| !chosen.contains(b))
-                        .filter(|&b| parts[b].iter().any(|&q| unreached.iter().any(|&p| world.contacts(p).contains(q))))
+                        .filter(|&b| parts[b].iter().any(|&q| unreached.iter().any(|&p| world.contacts().of(p).contains(q))))
                         .min_by_key(|&b| (level[b], std::cmp::Reverse(b)));
                     match best {
                         Some(b) => {
@@ -229,13 +229,13 @@ impl PrecedenceEntry {
                     }
                 }
                 let may = (0..k).filter(|&t| !later[t]).flat_map(|t| parts[t].iter().copied());
-                let state = PartSet::from_indices(n + 1, may.chain(world.fixed().iter().filter(|&q| q < n)));
+                let state = PartSet::from_indices(n + 1, may.chain(world.contacts().fixed().iter().filter(|&q| q < n)));
                 let distance = match &steps[s].motion {
                     Motion::Linear { direction, distance } | Motion::Screw { direction, distance, .. } => {
                         let need = if parts[s].len() == 1 {
-                            world.clearance(parts[s][0], &state, *direction)
+                            world.removal().clearance(parts[s][0], &state, *direction)
                         } else {
-                            world.group_clearance(&PartSet::from_indices(n + 1, parts[s].iter().copied()), &state, *direction)
+                            world.removal().group_clearance(&PartSet::from_indices(n + 1, parts[s].iter().copied()), &state, *direction)
                         };
                         Some(u(need.max(*distance)))
                     }
@@ -294,18 +294,18 @@ impl PrecedenceEntry {
 fn blocks(world: &World, movers: &[usize], motion: &Motion, others: &[usize]) -> bool {
     match motion {
         Motion::Linear { direction, .. } | Motion::Screw { direction, .. } => {
-            let k = world.directions().iter().position(|d| d.dot(*direction) > 0.999_999);
+            let k = world.blocking().directions().iter().position(|d| d.dot(*direction) > 0.999_999);
             movers.iter().any(|&p| {
                 others.iter().any(|&q| match k {
-                    Some(k) => world.blocking_row(p)[k].contains(q),
-                    None => world.pair_blocks(p, q, *direction),
+                    Some(k) => world.blocking().row(p)[k].contains(q),
+                    None => world.blocking().pair_blocks(p, q, *direction),
                 })
             })
         }
         Motion::Path { poses, pivot } => movers.iter().any(|&p| {
             others.iter().any(|&q| {
                 let state = PartSet::from_indices(world.num_parts() + 1, [q]);
-                poses.windows(2).any(|w| world.collision_between(p, &w[0], &w[1], *pivot, &state) == Some(q))
+                poses.windows(2).any(|w| world.removal().collision_between(p, &w[0], &w[1], *pivot, &state) == Some(q))
             })
         }),
     }

@@ -145,7 +145,7 @@ impl CoreWhy {
         let artefact_depth = units.from_metres(ARTEFACT_RELATIVE_DEPTH * world.assembly().diagonal() as f64);
         let n = world.num_parts();
         let core = PartSet::from_indices(n + 1, parts.iter().copied().filter(|&p| p < n));
-        let notes: Vec<_> = world.overlap_notes().iter().filter(|o| core.contains(o.parts.0) && core.contains(o.parts.1)).collect();
+        let notes: Vec<_> = world.overlaps().notes().iter().filter(|o| core.contains(o.parts.0) && core.contains(o.parts.1)).collect();
         let overlaps = notes
             .iter()
             .map(|o| {
@@ -161,7 +161,7 @@ impl CoreWhy {
                 }
             })
             .collect();
-        let directions = world.directions().len();
+        let directions = world.blocking().directions().len();
         let blocks = core.iter().filter(|&p| p != base).map(|p| blocks_of(world, p, &core)).collect();
         let lenient = if notes.iter().any(|o| o.handling == OverlapHandling::Strict) {
             lenient(base, parts)
@@ -176,7 +176,7 @@ impl CoreWhy {
 fn blocks_of(world: &World, p: usize, core: &PartSet) -> CoreBlocks {
     let mut counts: Vec<(usize, usize, usize)> = Vec::new(); // (part, directions, only)
     let mut free = 0;
-    for row in world.blocking_row(p) {
+    for row in world.blocking().row(p) {
         let mut blockers = row.intersection(core);
         blockers.remove(p);
         let alone = blockers.len() == 1;

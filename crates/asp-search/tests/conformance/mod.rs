@@ -82,7 +82,7 @@ fn recheck(case: &Case, label: &str, outcome: &PlanOutcome, gravity: bool) {
     assert!(outcome.removals.iter().all(|s| s.moves.is_empty()), "{label}: the re-check replays no grid moves");
     let world = case.checker.world();
     let rest = if gravity { verify_removals(world, &outcome.removals) } else { verify_removals_in_hand(world, &outcome.removals) };
-    assert!(rest.iter().all(|p| world.fixed().contains(p)), "{label} on {}: parts left: {rest:?}", case.label());
+    assert!(rest.iter().all(|p| world.contacts().fixed().contains(p)), "{label} on {}: parts left: {rest:?}", case.label());
 }
 
 #[test]
@@ -436,7 +436,7 @@ fn the_optimisers_solve_every_straight_line_fixture_and_every_answer_rechecks() 
                 .map(|(&part, motion)| Step { part, motion: motion.clone(), group: None, moves: Vec::new() })
                 .collect();
             let rest = crate::verify::verify_removals(world, &removals);
-            assert!(rest.iter().all(|p| world.fixed().contains(p)), "{label}: parts left: {rest:?}");
+            assert!(rest.iter().all(|p| world.contacts().fixed().contains(p)), "{label}: parts left: {rest:?}");
         }
     }
 

@@ -16,7 +16,8 @@ fn a_bolt_in_a_nut_on_a_plate_comes_apart_by_screwing_and_every_step_rechecks() 
         // the first part off screws (the bolt up out of the nut, or the nut down off the bolt)
         let first = &outcome.removals[0];
         assert!(matches!(first.motion, Motion::Screw { .. }), "{:?}", first.motion);
-        let json = asp_search::report::PlanReport::new(checker.world().assembly(), &outcome, checker.world().tolerance(), &[]).to_json();
+        let json =
+            asp_search::report::PlanReport::new(checker.world().assembly(), &outcome, checker.world().shapes().tolerance(), &[]).to_json();
         assert!(json.contains("\"screw\""), "{json}");
         // without the screw rule: locked
         let world = World::new(fixtures::bolt_and_nut(interference), &WorldConfig { fasteners: false, ..WorldConfig::default() }).unwrap();
@@ -33,7 +34,7 @@ fn the_independent_recheck_refuses_screw_steps_that_push_a_head_into_material_or
     use asp_geom::PartSet;
     let world = World::new(fixtures::bolt_and_nut(0.0001), &WorldConfig::default()).unwrap();
     let (bolt, nut) = (1, 2);
-    let t = world.thread(bolt, nut).unwrap();
+    let t = world.overlaps().fits().thread(bolt, nut).unwrap();
     let screw = |d: Vec3| asp_search::Step::single(bolt, Motion::Screw { axis_point: t.axis.point, direction: d, distance: 0.03 });
     let caught = |state: PartSet, base: PartSet, step: asp_search::Step| {
         let w = &world;
@@ -44,18 +45,18 @@ fn the_independent_recheck_refuses_screw_steps_that_push_a_head_into_material_or
         .map(|e| e.downcast_ref::<String>().cloned().or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string())).unwrap_or_default())
     };
     // unscrewing upward passes, on the plate and nut or on the nut alone
-    assert_eq!(caught(PartSet::full(3), world.fixed().clone(), screw(Vec3::Z)), None);
+    assert_eq!(caught(PartSet::full(3), world.contacts().fixed().clone(), screw(Vec3::Z)), None);
     let on_nut = PartSet::from_indices(4, [nut]);
     assert_eq!(caught(PartSet::from_indices(4, [bolt, nut]), on_nut.clone(), screw(Vec3::Z)), None);
     // screwed downward the head enters the plate (and then the nut below it)
-    let e = caught(PartSet::full(3), world.fixed().clone(), screw(-Vec3::Z)).expect("refused");
+    let e = caught(PartSet::full(3), world.contacts().fixed().clone(), screw(-Vec3::Z)).expect("refused");
     assert!(e.contains("'bolt' hits 'plate'") || e.contains("enters 'nut'"), "{e}");
     // without the plate the head comes down onto the nut: the nut is the bolt's threaded partner,
     // and outside the thread zone the strict rule still holds
     let e = caught(PartSet::from_indices(4, [bolt, nut]), on_nut, screw(-Vec3::Z)).expect("refused");
     assert!(e.contains("strict") && e.contains("'nut'"), "{e}");
     // a screw step off the thread's axis is refused
-    let e = caught(PartSet::full(3), world.fixed().clone(), screw(Vec3::X)).expect("refused");
+    let e = caught(PartSet::full(3), world.contacts().fixed().clone(), screw(Vec3::X)).expect("refused");
     assert!(e.contains("screws off its axis") || e.contains("hits"), "{e}");
 }
 
@@ -116,7 +117,7 @@ fn the_independent_recheck_refuses_a_pin_dragged_sideways_through_its_bore() {
     let step = |d: Vec3| asp_search::Step::single(1, Motion::Linear { direction: d, distance: 0.05 });
     let caught = |s: asp_search::Step| {
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            verify_from(&world, PartSet::full(2), world.fixed(), &[s]);
+            verify_from(&world, PartSet::full(2), world.contacts().fixed(), &[s]);
         }))
         .is_err()
     };

@@ -30,7 +30,7 @@ fn a_ring_locked_around_a_post_locked_in_a_base_is_a_named_core_with_a_partial_p
             assert!(b.iter().all(|q| q == checker.num_parts() || state.contains(q)), "{s:?}");
             assert!(b.iter().any(|q| q != s.part && q < 3), "{s:?}");
         }
-        let report = PlanReport::new(w.assembly(), &outcome, w.tolerance(), &[]);
+        let report = PlanReport::new(w.assembly(), &outcome, w.shapes().tolerance(), &[]);
         assert_eq!(report.status, asp_search::report::PlanStatus::NoPlan);
         assert_eq!(report.partial_assembly_sequence.len(), 1);
         assert_eq!(report.remaining, Some(vec![0, 1, 2]));
@@ -59,7 +59,7 @@ fn with_subassemblies_the_locked_core_leaves_as_one_group_that_cannot_be_taken_a
     // in the plan JSON: one step with its parts, status no_plan and the explanation
     // (base, post and ring never get motions of their own, so the plan is partial,
     // with that group as its one locked core)
-    let report = PlanReport::new(w.assembly(), &outcome, w.tolerance(), &[]);
+    let report = PlanReport::new(w.assembly(), &outcome, w.shapes().tolerance(), &[]);
     assert_eq!(report.status, asp_search::report::PlanStatus::Partial);
     assert_eq!(report.locked_cores.len(), 1);
     assert_eq!(report.locked_cores[0].parts, [0, 1, 2]);

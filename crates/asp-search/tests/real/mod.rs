@@ -125,7 +125,7 @@ fn pump_without_subassemblies_ends_in_no_plan_with_its_stuck_core_explained_and_
     // the independent sweep and leave exactly the core (a no_plan is not an empty plan)
     assert_eq!(outcome.removals.len(), checker.num_parts() - left.len());
     assert_eq!(verify_removals(w, &outcome.removals), *state);
-    let report = asp_search::report::PlanReport::new(w.assembly(), &outcome, w.tolerance(), &[]);
+    let report = asp_search::report::PlanReport::new(w.assembly(), &outcome, w.shapes().tolerance(), &[]);
     assert!(report.assembly_sequence.is_empty());
     let inserted: Vec<usize> = report.partial_assembly_sequence.iter().map(|s| s.part).collect();
     assert_eq!(inserted, outcome.removals.iter().rev().map(|s| s.part).collect::<Vec<_>>());
@@ -189,7 +189,7 @@ fn the_pumps_lift_their_stuck_core_off_as_one_subassembly_built_on_the_body() {
 
         // the report lists the group with its parts and its own plan, every part once in the
         // disassembly order
-        let report = asp_search::report::PlanReport::new(w.assembly(), &outcome, w.tolerance(), &[]);
+        let report = asp_search::report::PlanReport::new(w.assembly(), &outcome, w.shapes().tolerance(), &[]);
         let mut order = report.disassembly_sequence.clone();
         order.sort();
         assert_eq!(order, (0..checker.num_parts()).collect::<Vec<_>>(), "{rel}");
@@ -221,7 +221,7 @@ fn interlocking_cubes_come_apart_in_halves_and_every_step_rechecks() {
     // same way, down to single pieces
     for (rel, pieces) in [("cube20", 20), ("cube81", 81)] {
         let (checker, outcome) = found_with_groups(rel);
-        let report = asp_search::report::PlanReport::new(checker.world().assembly(), &outcome, checker.world().tolerance(), &[]);
+        let report = asp_search::report::PlanReport::new(checker.world().assembly(), &outcome, checker.world().shapes().tolerance(), &[]);
         assert_eq!(report.disassembly_sequence.len(), pieces);
         let found = groups(&outcome.removals);
         assert!(!found.is_empty(), "{rel}");
@@ -262,14 +262,14 @@ fn pump_threaded_bolts_leave_by_screwing_and_every_step_rechecks() {
     let y = asp_geom::math::Vec3::Y;
     let z = asp_geom::math::Vec3::Z;
     for (p, q, axis) in [(bolt1, pump, y), (bolt1, lid, y), (bolt11, nut1, z), (nut1, bolt11, z), (bolt11, pump, z)] {
-        let t = w.thread(p, q).unwrap_or_else(|| panic!("'{}' is threaded in '{}'", w.name(p), w.name(q)));
+        let t = w.overlaps().fits().thread(p, q).unwrap_or_else(|| panic!("'{}' is threaded in '{}'", w.name(p), w.name(q)));
         assert!(t.axis.direction.dot(axis).abs() > 0.9999, "{t:?}");
     }
     // the zones reach the crests (M5: 2.5 mm, M16: 8 mm), not the heads (4.25 and 13.9 mm)
-    assert!((w.thread(bolt1, pump).unwrap().radius - 0.0025).abs() < 0.0002);
-    assert!((w.thread(bolt11, nut1).unwrap().radius - 0.008).abs() < 0.0003);
+    assert!((w.overlaps().fits().thread(bolt1, pump).unwrap().radius - 0.0025).abs() < 0.0002);
+    assert!((w.overlaps().fits().thread(bolt11, nut1).unwrap().radius - 0.008).abs() < 0.0003);
     for p in [pump, lid, backlid] {
-        assert!(w.threads().keys().all(|&(a, _)| a != p), "'{}' is no fastener", w.name(p));
+        assert!(w.overlaps().fits().threads().keys().all(|&(a, _)| a != p), "'{}' is no fastener", w.name(p));
     }
     let (checker, outcome) = plan(w, &Dfs::builder().build());
     assert_eq!(outcome.status, Status::Found);

@@ -13,7 +13,7 @@ use parry3d::shape::{TriMesh, TriMeshFlags};
 use std::collections::HashMap;
 
 fn shrunk(world: &World, p: usize, amount: f32) -> TriMesh {
-    let m = world.mesh(p);
+    let m = world.shapes().mesh(p);
     let (v, t) = eroded_mesh(m.vertices(), m.indices(), amount);
     TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED).unwrap()
 }
@@ -36,13 +36,19 @@ fn penetrates(
 ) -> Option<usize> {
     present
         .iter()
-        .filter(|&q| !(q == p || world.ignores(p, q) || fits.contains_key(&(p, q)) || screw && world.thread(p, q).is_some()))
+        .filter(|&q| {
+            !(q == p
+                || world.overlaps().ignores(p, q)
+                || fits.contains_key(&(p, q))
+                || screw && world.overlaps().fits().thread(p, q).is_some())
+        })
         .find(|&q| {
-            let (k, amount) = world.pair_erosion(p, q);
+            let (k, amount) = world.overlaps().erosion(p, q);
             let shrunk_k = shrunk_cache.entry((k, amount.to_bits())).or_insert_with(|| shrunk(world, k, amount)).clone();
             let id = Pose::IDENTITY;
-            let (shrunk_pose, raw, raw_pose) = if k == p { (*pose, world.mesh(q).clone(), id) } else { (id, world.mesh(p).clone(), *pose) };
-            let closed_raw = world.is_closed(if k == p { q } else { p });
+            let (shrunk_pose, raw, raw_pose) =
+                if k == p { (*pose, world.shapes().mesh(q).clone(), id) } else { (id, world.shapes().mesh(p).clone(), *pose) };
+            let closed_raw = world.shapes().is_closed(if k == p { q } else { p });
             let (bs, br) = (shrunk_k.aabb(&shrunk_pose), raw.aabb(&raw_pose));
             let nests = |a: &parry3d::bounding_volume::Aabb, b: &parry3d::bounding_volume::Aabb| {
                 (0..3).all(|i| a.mins[i] >= b.mins[i] && a.maxs[i] <= b.maxs[i])
@@ -53,7 +59,7 @@ fn penetrates(
             let crossing = if k == p { meshes_cross_at(&shrunk_k, pose, &raw) } else { meshes_cross_at(&raw, pose, &shrunk_k) };
             crossing
                 || (closed_raw && nests(&bs, &br) && raw.contains_point(&raw_pose, shrunk_pose.transform_point(shrunk_k.vertices()[0])))
-                || (world.is_closed(k)
+                || (world.shapes().is_closed(k)
                     && nests(&br, &bs)
                     && shrunk_k.contains_point(&shrunk_pose, raw_pose.transform_point(raw.vertices()[0])))
         })
@@ -63,9 +69,9 @@ fn penetrates(
 /// along the mean of their faces' normals): the strict check's samples, made here rather than by
 /// the planner's sampler.
 fn inner_points(world: &World, p: usize) -> Vec<Vec3> {
-    let m = world.mesh(p);
+    let m = world.shapes().mesh(p);
     let (v, t) = (m.vertices(), m.indices());
-    let depth = world.tolerance();
+    let depth = world.shapes().tolerance();
     let mut normals = vec![Vec3::ZERO; v.len()];
     let mut out = Vec::with_capacity(t.len() + v.len());
     for tri in t {
@@ -100,11 +106,11 @@ pub struct Band {
 /// enter only as deep as the pair overlaps in the input or the band is wide (see
 /// [`Band::max_depth`]).
 fn reported_band(world: &World, p: usize, q: usize, dir: Vec3) -> Option<Band> {
-    let f = world.fits(p, q).iter().find(|f| f.axis.dot(dir).abs() > 0.9999)?;
-    let overlap = world.overlap_notes().iter().find(|n| n.parts == (p.min(q), p.max(q))).map_or(0.0, |n| n.depth);
+    let f = world.overlaps().fits().between(p, q).iter().find(|f| f.axis.dot(dir).abs() > 0.9999)?;
+    let overlap = world.overlaps().notes().iter().find(|n| n.parts == (p.min(q), p.max(q))).map_or(0.0, |n| n.depth);
     // two polygons drawn at one radius enter each other by up to their sagittas, whether or
     // not the input shows it (the band spans them)
-    Some(Band { point: f.point, rings: vec![f.band], max_depth: Some(overlap.max(f.band.1 - f.band.0) + world.tolerance()) })
+    Some(Band { point: f.point, rings: vec![f.band], max_depth: Some(overlap.max(f.band.1 - f.band.0) + world.shapes().tolerance()) })
 }
 
 /// The replay referee's fit band of the pair (`p`, `q`) for a motion along unit `dir`, found
@@ -120,18 +126,18 @@ fn reported_band(world: &World, p: usize, q: usize, dir: Vec3) -> Option<Band> {
 /// ring) is no fit. `None` for every other pair, and for pairs that do not overlap beyond the
 /// tolerance (the shrunk sweep holds them).
 fn fit_band(world: &World, p: usize, q: usize, dir: Vec3, samples: &mut HashMap<usize, Vec<Vec3>>) -> Option<Band> {
-    let tol = world.tolerance();
+    let tol = world.shapes().tolerance();
     let mut shell = Vec::new();
     for (a, b) in [(p, q), (q, p)] {
         // the check's own samples and, as the referee takes them, about 6,000 area-weighted
         // surface points moved inward by the tolerance: the overlap of a fit is a thin shell
         // that centroids of long facets miss
         let mut pts = samples.entry(a).or_insert_with(|| inner_points(world, a)).clone();
-        let m = world.mesh(a);
+        let m = world.shapes().mesh(a);
         let dense = asp_geom::sample::sample_triangles(m.vertices(), m.indices(), 6000);
         pts.extend(dense.points.iter().zip(&dense.normals).map(|(x, n)| *x - *n * tol));
-        let mesh = world.mesh(b);
-        let bb = world.aabb(b);
+        let mesh = world.shapes().mesh(b);
+        let bb = world.shapes().aabb(b);
         for x in pts {
             if (0..3).all(|i| x[i] >= bb.mins[i] - 3.0 * tol && x[i] <= bb.maxs[i] + 3.0 * tol) && mesh.contains_local_point(x) {
                 shell.push(x);
@@ -226,9 +232,9 @@ fn check_strict(
 ) {
     for &p in movers {
         for q in others.iter() {
-            let thread = screw.and_then(|_| world.thread(p, q));
+            let thread = screw.and_then(|_| world.overlaps().fits().thread(p, q));
             let band = fits.get(&(p, q)).cloned();
-            if thread.is_none() && band.is_none() && !world.is_strict_pair(p, q) {
+            if thread.is_none() && band.is_none() && !world.overlaps().is_strict(p, q) {
                 continue;
             }
             if let (Some(t), Some(dir)) = (thread, screw) {
@@ -242,7 +248,7 @@ fn check_strict(
                     pts.retain(|&x| t.axis.radial(x) > t.radius);
                 }
                 // how deep each sample may enter: touching is not entering
-                let half = 0.5 * world.tolerance();
+                let half = 0.5 * world.shapes().tolerance();
                 let mut allowed = vec![half; pts.len()];
                 if let (Some(b), Some(d)) = (&band, dir) {
                     // a coaxial fit carried along its axis: the band's samples (a sample keeps
@@ -266,9 +272,9 @@ fn check_strict(
                 // `a`'s samples in the frame of `b`: the mover's moved by the pose, the other's
                 // by its inverse
                 let place = |pose: &Pose, x: Vec3| if sign > 0.0 { pose.transform_point(x) } else { pose.inverse_transform_point(x) };
-                let mesh = world.mesh(b);
-                let bb = world.aabb(b);
-                let pad = 2.0 * world.tolerance();
+                let mesh = world.shapes().mesh(b);
+                let bb = world.shapes().aabb(b);
+                let pad = 2.0 * world.shapes().tolerance();
                 let near = |x: Vec3| (0..3).all(|i| x[i] >= bb.mins[i] - pad && x[i] <= bb.maxs[i] + pad);
                 // a sample on the other's surface (within half the tolerance) counts as inside
                 // at the start and outside later: touching is not entering
@@ -296,20 +302,25 @@ fn check_strict(
 pub fn verify_plan(world: &World, outcome: &PlanOutcome) {
     assert_eq!(outcome.status, Status::Found, "only found plans are verified");
     let state = verify_removals(world, &outcome.removals);
-    assert!(state.iter().all(|p| world.fixed().contains(p)), "plan leaves non-fixed parts");
+    assert!(state.iter().all(|p| world.contacts().fixed().contains(p)), "plan leaves non-fixed parts");
 }
 
 /// Re-checks removals from the full assembly as [`verify_plan`] does (a whole plan or a partial
 /// disassembly) and returns the state they reach.
 pub fn verify_removals(world: &World, removals: &[asp_search::Step]) -> PartSet {
-    verify_from(world, PartSet::full(world.num_parts()), world.fixed(), removals)
+    verify_from(world, PartSet::full(world.num_parts()), world.contacts().fixed(), removals)
 }
 
 /// Re-checks removals from the full assembly as [`verify_removals`] does, but not the
 /// remainder's stability: the contract of a planner that takes a model apart in the hand (the
 /// grid planner tests no gravity).
 pub fn verify_removals_in_hand(world: &World, removals: &[asp_search::Step]) -> PartSet {
-    Verifier { in_hand: true, ..Verifier::default() }.verify_from(world, PartSet::full(world.num_parts()), world.fixed(), removals)
+    Verifier { in_hand: true, ..Verifier::default() }.verify_from(
+        world,
+        PartSet::full(world.num_parts()),
+        world.contacts().fixed(),
+        removals,
+    )
 }
 
 /// Re-checks `removals` from `state` on the `base` parts: each step's parts (one part, or a
@@ -339,7 +350,7 @@ impl Verifier {
     /// [`verify_removals`] with this verifier's caches.
     #[allow(dead_code)] // asp-app's precedence tests re-check many orders with one verifier
     pub fn verify_removals(&mut self, world: &World, removals: &[asp_search::Step]) -> PartSet {
-        self.verify_from(world, PartSet::full(world.num_parts()), world.fixed(), removals)
+        self.verify_from(world, PartSet::full(world.num_parts()), world.contacts().fixed(), removals)
     }
 
     /// [`verify_from`] with this verifier's caches.
@@ -357,18 +368,21 @@ impl Verifier {
             }
             let bounds = movers
                 .iter()
-                .map(|&p| *world.aabb(p))
+                .map(|&p| *world.shapes().aabb(p))
                 .reduce(|a, b| parry3d::bounding_volume::Aabb::new(a.mins.min(b.mins), a.maxs.max(b.maxs)))
                 .unwrap();
             // steps of a quarter of the thinnest moving part
-            let thinnest = movers.iter().map(|&p| (world.aabb(p).maxs - world.aabb(p).mins).min_element()).fold(f32::INFINITY, f32::min);
-            let h = (thinnest / 4.0).max(world.tolerance());
+            let thinnest = movers
+                .iter()
+                .map(|&p| (world.shapes().aabb(p).maxs - world.shapes().aabb(p).mins).min_element())
+                .fold(f32::INFINITY, f32::min);
+            let h = (thinnest / 4.0).max(world.shapes().tolerance());
             let poses: Vec<Pose> = match &step.motion {
                 Motion::Linear { direction, distance } | Motion::Screw { direction, distance, .. } => {
                     assert!((direction.length() - 1.0).abs() < 1e-4);
                     let count = ((distance / h).ceil() as usize).clamp(8, 400);
                     // and steps of the tolerance over the first 20 tolerances (strict overlaps)
-                    let tol = world.tolerance();
+                    let tol = world.shapes().tolerance();
                     let first = (1..=20).map(|i| i as f32 * tol).filter(|&t| t < *distance);
                     let mut ts: Vec<f32> = (0..=count).map(|i| distance * i as f32 / count as f32).chain(first).collect();
                     ts.sort_by(f32::total_cmp);
@@ -405,7 +419,7 @@ impl Verifier {
             let mut fits = HashMap::new();
             if let Some(d) = dir {
                 for &p in &movers {
-                    for q in unknown.iter().filter(|&q| q < world.num_parts() && world.contacts(p).contains(q)) {
+                    for q in unknown.iter().filter(|&q| q < world.num_parts() && world.contacts().of(p).contains(q)) {
                         if let Some(b) = fit_band(world, p, q, d, &mut self.samples).or_else(|| reported_band(world, p, q, d)) {
                             fits.insert((p, q), b);
                         }
@@ -418,7 +432,7 @@ impl Verifier {
                 // draws it)
                 // any threaded partner present will do (in another order than the plan's, another
                 // of them may be the one present; each has its own fitted axis)
-                let threads: Vec<_> = others.iter().filter_map(|q| world.thread(step.part, q)).collect();
+                let threads: Vec<_> = others.iter().filter_map(|q| world.overlaps().fits().thread(step.part, q)).collect();
                 match threads.first() {
                     Some(_) => assert!(
                         threads.iter().any(|t| t.axis.direction.dot(direction).abs() > 0.9999
@@ -428,7 +442,9 @@ impl Verifier {
                     ),
                     None => assert!(
                         others.iter().any(|q| world
-                            .fits(step.part, q)
+                            .overlaps()
+                            .fits()
+                            .between(step.part, q)
                             .iter()
                             .any(|f| f.turns == Some(step.part) && f.axis.dot(direction).abs() > 0.9999)),
                         "step {k}: '{}' screws with no threaded partner and no fit it turns on along its motion",
@@ -452,7 +468,7 @@ impl Verifier {
             // at the end, the movers' bounds are clear of the other present real parts' bounds
             let end = bounds.transform_by(poses.last().unwrap());
             for q in state.iter().filter(|q| !movers.contains(q)) {
-                let b = world.aabb(q);
+                let b = world.shapes().aabb(q);
                 let overlap = (0..3).all(|i| end.mins[i] < b.maxs[i] - 1e-6 && b.mins[i] < end.maxs[i] - 1e-6);
                 assert!(!overlap, "step {k}: part '{}' still inside the bounds of '{}'", world.name(step.part), world.name(q));
             }
@@ -462,7 +478,7 @@ impl Verifier {
             let mut present = state.clone();
             present.union_with(base);
             if !self.in_hand {
-                assert_eq!(world.contact_stability_among(&present, base), Stability::Stable, "step {k}: remainder unstable");
+                assert_eq!(world.contacts().stability_among(&present, base), Stability::Stable, "step {k}: remainder unstable");
             }
             if let Some(plan) = step.group.as_ref().and_then(|g| g.plan.as_ref()) {
                 let group = step.group.as_ref().unwrap();

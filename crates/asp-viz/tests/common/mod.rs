@@ -11,7 +11,7 @@ pub fn planned(assembly: Assembly) -> Scene {
     let checker = Checker::new(World::new(assembly, &WorldConfig::default()).unwrap(), CheckerConfig::default());
     let outcome = Dfs::builder().build().solve(&Problem::full(&checker), &Budget::default());
     let world = checker.world();
-    let report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
+    let report = PlanReport::new(world.assembly(), &outcome, world.shapes().tolerance(), world.warnings());
     assert_eq!(report.status, asp_search::report::PlanStatus::Found);
     Scene::new(world.assembly().clone(), report, Path::new("fixture")).unwrap()
 }
@@ -49,7 +49,7 @@ pub fn locked_burr() -> Scene {
     let checker = Checker::new(World::new(asp_geom::puzzles::burr_level(), &WorldConfig::default()).unwrap(), CheckerConfig::default());
     let outcome = Dfs::builder().path_planner(false).build().solve(&Problem::full(&checker), &Budget::default());
     let world = checker.world();
-    let report = PlanReport::new(world.assembly(), &outcome, world.tolerance(), world.warnings());
+    let report = PlanReport::new(world.assembly(), &outcome, world.shapes().tolerance(), world.warnings());
     assert_eq!(report.status, asp_search::report::PlanStatus::Partial);
     Scene::new(world.assembly().clone(), report, Path::new("fixture")).unwrap()
 }
