@@ -156,151 +156,23 @@ impl<'de> Deserialize<'de> for Subassemblies {
 }
 
 /// [`Subassemblies`], optional.
-fn subassemblies<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Subassemblies>, D::Error> {
+pub(crate) fn subassemblies<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Subassemblies>, D::Error> {
     Option::<Subassemblies>::deserialize(d)
 }
 
-/// Every setting of a planning run (see the module documentation). Lengths are in model units.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct PlanRequest {
-    // --- loading (the CLI and batches; Python's `asp.load`) ---
-    /// The unit of the model's coordinates: `m`, `cm`, `mm`, `in`, `ft` or metres per unit
-    /// (default: what the file says, else metres).
-    pub unit: Option<String>,
-    /// The up axis: `x`, `y`, `z`, `-x`, `-y`, `-z` (default: what the file says, else +y for
-    /// glTF, +z for OBJ/STL).
-    pub up: Option<String>,
-    /// Base parts that stay in place, by name, on top of those the file marks as fixed.
-    pub fixed: Vec<String>,
-    /// Most triangles a model may have over all its parts (default 20 M; docs/security.md).
-    pub max_triangles: Option<usize>,
-    /// Most parts a model may have (default 10,000).
-    pub max_parts: Option<usize>,
-    /// A STEP file's tessellation: the chord tolerance of each edge and face relative to its
-    /// own size (default 0.001; STEP files only).
-    pub tessellation: Option<f64>,
-    /// Make each separate body of a part's mesh a part of its own, `NAME#1`, `NAME#2`, ...
-    /// (default: a warning names the part, which moves as one).
-    pub split_bodies: Option<bool>,
-    /// Let the model and the robot's URDF read files outside their folders: absolute paths, `..`
-    /// that climbs out, symlinks that point out (default: refused).
-    pub allow_outside_files: Option<bool>,
+pub use crate::settings::PlanRequest;
 
-    // --- the removal test ---
-    /// Contact tolerance: motions may push a part this deep into another (default 1e-4 × the
-    /// model's diagonal).
-    pub tolerance: Option<f64>,
-    /// Parts closer than this are in contact for stability (default 1e-3 × the diagonal).
-    pub contact_distance: Option<f64>,
-    /// Clustered surface-normal directions tried besides the six axes (feasibility search).
-    pub normals: Option<usize>,
-    /// Extra removal directions sampled evenly on the sphere (feasibility search).
-    pub sphere_directions: Option<usize>,
-    /// Parts that overlap in the input.
-    pub overlaps: Option<Overlaps>,
-    /// The feasibility search's stability criterion.
-    pub stability: Option<Stability>,
-    /// Physics stability: how far (fraction of the model's diagonal) a part may move.
-    pub physics_threshold: Option<f64>,
-    /// Try the path planner when no straight line works (`--no-path-planner`: false).
-    pub path_planner: Option<bool>,
-    /// Let groups of parts leave together as rigid subassemblies: `true` (the search finds
-    /// them), `false` (`--no-subassemblies`: single parts only) or `"from-file"` (`--subassemblies
-    /// from-file`: plan each subassembly of the file's product tree on its own, then the level
-    /// above with each as one unit).
-    #[serde(deserialize_with = "subassemblies")]
-    pub subassemblies: Option<Subassemblies>,
-    /// Plan voxel models by grid moves (`--no-grid`: false).
-    pub grid: Option<bool>,
-    /// Path planner iterations per call.
-    pub rrt_iterations: Option<usize>,
-    /// Path planner wall-time cap per call, seconds.
-    pub rrt_time: Option<f64>,
-
-    // --- the feasibility search ---
-    /// The part ordering, by its catalogue name (`auto`, the default, `given`, `shuffled`,
-    /// `random`, `bookkeeping`, `gnn`).
-    pub order: Option<String>,
-    /// The removability model (ONNX) of `order = "gnn"`, and of `auto` where it is learned
-    /// (default: the shipped model of the run's checker).
-    pub model: Option<PathBuf>,
-    /// Bookkeeping on top of the ordering.
-    pub bookkeeping: Option<bool>,
-    /// Add the precedence graph of a found plan to the plan JSON (format 1.12).
-    pub precedence: Option<bool>,
-    /// Seed of every random choice (both searches).
-    pub seed: Option<u64>,
-    /// Stop after this many removal tests.
-    pub max_tests: Option<u64>,
-    /// Stop after this many seconds with the best partial plan (0: no limit; default 60).
-    pub timeout: Option<f64>,
-    /// Groups of parts planned as one part each, on purpose (a purchased motor, a pressed-in
-    /// bearing): by name, each group a comma-separated string or a list of names; a plan that
-    /// moves each group whole is `found`, not `partial` (feasibility search).
-    #[serde(deserialize_with = "groups")]
-    pub unit_group: Vec<Vec<String>>,
-
-    // --- the optimiser (present when `objective` is) ---
-    /// Optimise for these objectives (a comma-separated string or a list).
-    #[serde(deserialize_with = "names")]
-    pub objective: Option<Vec<String>>,
-    /// Search the Pareto front (several objectives need it).
-    pub pareto: Option<bool>,
-    /// MCTS episodes.
-    pub episodes: Option<usize>,
-    /// MCTS iterations per step of an episode.
-    pub budget: Option<usize>,
-    /// Optimiser threads (default: all cores).
-    pub threads: Option<usize>,
-    /// Optimiser wall-time limit, seconds.
-    pub time_limit: Option<f64>,
-    /// Exploration constant of UCT / MOUCB.
-    pub exploration: Option<f64>,
-    /// The local search's share of the search's work (0: off).
-    pub polish: Option<f64>,
-    /// Distance map resolution N_M (odd, 3 to 15).
-    pub resolution: Option<usize>,
-    /// Distance map cap (default: the model's diagonal).
-    pub d_max: Option<f64>,
-    /// The optimiser's gravity check.
-    pub support: Option<Support>,
-    /// Learned Q-functions (ONNX), one per objective in `objective`'s order (a comma-separated
-    /// string or a list).
-    #[serde(deserialize_with = "paths")]
-    pub q: Option<Vec<PathBuf>>,
-    /// The probability of a random removal where `q` guides.
-    pub epsilon: Option<f64>,
-    /// Where `q` guides.
-    pub q_use: Option<QUse>,
-
-    // --- the robot (both searches) ---
-    /// A robot arm that must carry every removal out: a catalogue name (`panda`) or a URDF file.
-    pub robot: Option<String>,
-    /// The robot base's position `[x, y, z]` (or `"x,y,z"`), model frame.
-    #[serde(deserialize_with = "point")]
-    pub robot_base: Option<[f64; 3]>,
-    /// Where the gripper puts removed parts down, `[x, y, z]` (or `"x,y,z"`).
-    #[serde(deserialize_with = "point")]
-    pub drop_off: Option<[f64; 3]>,
-    /// Path plans per grasp (`k`), the shortest kept.
-    pub replans: Option<usize>,
-    /// Grippers in all: up to N-1 placed parts may be held (feasibility search).
-    pub grippers: Option<usize>,
-    /// Where a URDF's `package://NAME/` meshes lie, `NAME=DIR` each.
-    pub package_path: Vec<String>,
+/// Whether `key` belongs to loading a model only (`asp.load` in Python, not `Assembly.plan`).
+pub fn is_load_key(key: &str) -> bool {
+    crate::settings::Setting::get(key).is_some_and(|s| s.applies == crate::settings::Applies::Load)
 }
-
-/// The keys that belong to loading a model only (`asp.load` in Python, not `Assembly.plan`).
-pub const LOAD_KEYS: [&str; 7] = ["unit", "up", "fixed", "max_triangles", "max_parts", "tessellation", "split_bodies"];
 
 impl PlanRequest {
     /// Every key of a request, in alphabetical order.
     pub fn keys() -> Vec<String> {
-        match serde_json::to_value(PlanRequest::default()) {
-            Ok(serde_json::Value::Object(map)) => map.keys().cloned().collect(),
-            _ => Vec::new(),
-        }
+        let mut keys: Vec<String> = crate::settings::SETTINGS.iter().map(|s| s.key.to_string()).collect();
+        keys.sort();
+        keys
     }
 
     /// A request from a JSON object. An unknown key, or a value of the wrong type, is an
@@ -412,7 +284,7 @@ fn want_words(serde: &str) -> &str {
 }
 
 /// A comma-separated string or a list of strings, as a list (blank names dropped).
-fn names<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<String>>, D::Error> {
+pub(crate) fn names<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<String>>, D::Error> {
     #[derive(Deserialize)]
     #[serde(untagged)]
     enum OneOrMany {
@@ -433,7 +305,7 @@ fn names<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<Stri
 
 /// Groups of names: a list whose items are each a comma-separated string or a list of names, or
 /// one comma-separated string (one group).
-fn groups<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Vec<Vec<String>>, D::Error> {
+pub(crate) fn groups<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Vec<Vec<String>>, D::Error> {
     #[derive(Deserialize)]
     #[serde(untagged)]
     enum Group {
@@ -462,12 +334,12 @@ fn groups<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Vec<Vec<String
 }
 
 /// [`names`] as paths.
-fn paths<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<PathBuf>>, D::Error> {
+pub(crate) fn paths<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<PathBuf>>, D::Error> {
     Ok(names(d)?.map(|v| v.into_iter().map(PathBuf::from).collect()))
 }
 
 /// Three numbers, as a list or as `"x,y,z"`.
-fn point<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<[f64; 3]>, D::Error> {
+pub(crate) fn point<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<[f64; 3]>, D::Error> {
     #[derive(Deserialize)]
     #[serde(untagged)]
     enum Point {

@@ -7,11 +7,12 @@ use crate::catalogue::{self, QPolicy, DEFAULT_EPSILON};
 use crate::error::{AppError, Result};
 use crate::pipeline::{OptimiseSettings, PlanSettings, StabilitySetting, DEFAULT_TIMEOUT};
 use crate::request::{Overlaps, PlanRequest, QUse, Stability, Subassemblies, Support};
+use crate::settings::{Applies, SETTINGS};
 use asp_geom::math::{Axis, Vec3};
 use asp_geom::Units;
 use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES, DEFAULT_EXPLORATION, DEFAULT_POLISH};
 use asp_search::MdpExtension;
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::sync::Arc;
 
 /// The physics stability threshold when none is given: the simulation's own default (a part
@@ -20,62 +21,23 @@ pub fn default_physics_threshold() -> f64 {
     asp_geom::PhysicsConfig::default().displacement_fraction as f64
 }
 
-/// The settings only the feasibility (depth-first) search reads, with what the optimiser has
-/// instead (if anything).
-const FEASIBILITY_ONLY: &[(&str, &str)] = &[
-    ("normals", ""),
-    ("sphere_directions", ""),
-    ("stability", "the optimiser's gravity check is `support`"),
-    ("physics_threshold", ""),
-    ("path_planner", ""),
-    ("subassemblies", ""),
-    ("unit_group", ""),
-    ("grid", ""),
-    ("rrt_iterations", ""),
-    ("rrt_time", ""),
-    ("order", ""),
-    ("model", ""),
-    ("bookkeeping", ""),
-    ("precedence", ""),
-    ("max_tests", ""),
-    ("timeout", "the optimiser's limit is `time_limit`"),
-    ("grippers", ""),
-];
-
-/// The settings only the optimiser reads, with what the feasibility search has instead.
-const OPTIMISER_ONLY: &[(&str, &str)] = &[
-    ("pareto", ""),
-    ("episodes", ""),
-    ("budget", ""),
-    ("threads", ""),
-    ("time_limit", "the feasibility search's limit is `timeout`"),
-    ("exploration", ""),
-    ("polish", ""),
-    ("resolution", ""),
-    ("d_max", ""),
-    ("support", "the feasibility search's criterion is `stability`"),
-    ("q", ""),
-    ("epsilon", ""),
-    ("q_use", ""),
-];
-
 /// Each setting does something in the search the request asks for.
 fn check_applies(r: &PlanRequest) -> Result<()> {
     let given = r.given();
     let is_given = |key: &str| given.iter().any(|g| g == key);
-    let (table, search, switch) = if r.optimises() {
-        (FEASIBILITY_ONLY, "the feasibility search", "without `objective`")
+    let (other, search, switch) = if r.optimises() {
+        (Applies::Feasibility, "the feasibility search", "without `objective`")
     } else {
-        (OPTIMISER_ONLY, "the optimiser", "with `objective`")
+        (Applies::Optimiser, "the optimiser", "with `objective`")
     };
-    for (key, instead) in table {
-        if is_given(key) {
+    for setting in SETTINGS.iter().filter(|s| s.applies == other) {
+        if is_given(setting.key) {
             let mut reason = format!("applies to {search} only ({switch})");
-            if !instead.is_empty() {
+            if !setting.instead.is_empty() {
                 reason.push_str("; ");
-                reason.push_str(instead);
+                reason.push_str(setting.instead);
             }
-            return Err(AppError::setting(*key, reason));
+            return Err(AppError::setting(setting.key, reason));
         }
     }
     let needs = |key: &str, on: bool, what: &str| -> Result<()> {
@@ -341,61 +303,10 @@ fn robot_keys(r: &PlanRequest) -> serde_json::Map<String, Value> {
 }
 
 /// Every setting's default, by key, as the searches use them (`null`: none, or derived from the
-/// model: the tolerance is 1e-4 × its diagonal, the threads all cores). Python's
-/// `asp._asp.default_settings()` and the docs show these.
+/// model: the tolerance is 1e-4 × its diagonal, the threads all cores), read off
+/// [`SETTINGS`]. Python's `asp._asp.default_settings()` and the docs show these.
 pub fn defaults() -> serde_json::Map<String, Value> {
-    let d = PlanSettings::default();
-    let defaults: [(&str, Value); 48] = [
-        ("unit", Value::Null),
-        ("up", Value::Null),
-        ("fixed", json!([])),
-        ("max_triangles", json!(asp_geom::io::DEFAULT_MAX_TRIANGLES)),
-        ("max_parts", json!(asp_geom::io::DEFAULT_MAX_PARTS)),
-        ("tessellation", json!(asp_geom::io::step::DEFAULT_RELATIVE)),
-        ("split_bodies", json!(false)),
-        ("allow_outside_files", json!(false)),
-        ("tolerance", Value::Null),
-        ("contact_distance", Value::Null),
-        ("normals", json!(d.normals)),
-        ("sphere_directions", json!(d.sphere_directions)),
-        ("overlaps", json!(Overlaps::Strict.name())),
-        ("stability", json!(Stability::Contact.name())),
-        ("physics_threshold", json!(default_physics_threshold())),
-        ("path_planner", json!(d.path_planner)),
-        ("subassemblies", json!(d.subassemblies)),
-        ("grid", json!(d.grid)),
-        ("unit_group", json!([])),
-        ("rrt_iterations", json!(d.rrt_iterations)),
-        ("rrt_time", json!(d.rrt_time)),
-        ("order", json!(catalogue::ORDERINGS[0].name)),
-        ("model", Value::Null),
-        ("bookkeeping", json!(false)),
-        ("precedence", json!(false)),
-        ("seed", json!(0)),
-        ("max_tests", Value::Null),
-        ("timeout", json!(DEFAULT_TIMEOUT)),
-        ("objective", Value::Null),
-        ("pareto", json!(false)),
-        ("episodes", json!(DEFAULT_EPISODES)),
-        ("budget", json!(DEFAULT_BUDGET)),
-        ("threads", Value::Null),
-        ("time_limit", Value::Null),
-        ("exploration", json!(DEFAULT_EXPLORATION)),
-        ("polish", json!(DEFAULT_POLISH)),
-        ("resolution", json!(asp_geom::distmap::DEFAULT_RESOLUTION)),
-        ("d_max", Value::Null),
-        ("support", json!(Support::Below.name())),
-        ("q", Value::Null),
-        ("epsilon", json!(DEFAULT_EPSILON)),
-        ("q_use", json!(QUse::Rollouts.name())),
-        ("robot", Value::Null),
-        ("robot_base", Value::Null),
-        ("drop_off", Value::Null),
-        ("replans", json!(asp_robot::RemovalConfig::default().replans)),
-        ("grippers", json!(1)),
-        ("package_path", json!([])),
-    ];
-    defaults.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
+    SETTINGS.iter().map(|s| (s.key.to_string(), (s.default)())).collect()
 }
 
 #[cfg(test)]

@@ -64,7 +64,7 @@ fn transitions(a: &TransitionsArgs) -> anyhow::Result<std::process::ExitCode> {
     if a.objective.split(',').filter(|n| !n.trim().is_empty()).count() > 1 {
         extra.insert("pareto".into(), true.into());
     }
-    crate::flags::put!(extra, a, budget, resolution, d_max, support);
+    a.maps.put(&mut extra);
     a.robot.put(&mut extra);
     let mut plan = model_settings(&a.load, extra)?;
     let optimise = plan.optimise.take().context("--objective")?;

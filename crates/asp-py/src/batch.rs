@@ -105,7 +105,7 @@ fn model_settings(dict: &Bound<'_, PyDict>, load: Option<&Bound<'_, PyDict>>) ->
     if let Some(load) = load {
         for key in load.keys() {
             let key = key.to_string();
-            if !asp_app::request::LOAD_KEYS.contains(&key.as_str()) {
+            if !asp_app::request::is_load_key(&key) {
                 return Err(Error::config(format!("load: '{key}' is not a setting of asp.load")));
             }
         }
