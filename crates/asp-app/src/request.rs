@@ -22,8 +22,10 @@ use serde::{Deserialize, Deserializer, Serialize};
 use std::path::PathBuf;
 
 /// A closed set of named values (`overlaps`, `stability`, `support`, `q_use`): the names with
-/// one line of help each, for `--help`, Python's `Literal`s and error messages.
-pub trait Choice: Sized + Copy + 'static {
+/// one line of help each, for `--help`, Python's `Literal`s and error messages. The library's
+/// own enums carry it where they exist (`asp_geom::OverlapPolicy`, `asp_geom::distmap::Support`,
+/// `asp_search::QUse`), so a request holds the value the pipeline uses, with no mirror to match.
+pub trait Choice: Sized + Copy + PartialEq + 'static {
     /// Every value with its name and its one-line help, in the order the docs list them.
     const CHOICES: &'static [(Self, &'static str, &'static str)];
 
@@ -36,75 +38,77 @@ pub trait Choice: Sized + Copy + 'static {
     fn names() -> String {
         Self::CHOICES.iter().map(|(_, n, _)| *n).collect::<Vec<_>>().join(", ")
     }
+
+    /// The value's name.
+    fn name(self) -> &'static str {
+        Self::CHOICES.iter().find(|(v, _, _)| *v == self).map(|(_, n, _)| *n).unwrap_or("?")
+    }
 }
 
+/// Gives a closed set its names and help ([`Choice`]).
 macro_rules! choice {
-    ($(#[$meta:meta])* $name:ident { $($(#[$vmeta:meta])* $variant:ident = $text:literal : $help:literal,)+ }) => {
-        $(#[$meta])*
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-        #[serde(rename_all = "kebab-case")]
-        pub enum $name {
-            $($(#[$vmeta])* #[serde(rename = $text)] $variant,)+
-        }
-
+    ($name:ty { $($variant:ident = $text:expr => $help:literal,)+ }) => {
         impl Choice for $name {
-            const CHOICES: &'static [(Self, &'static str, &'static str)] = &[$(($name::$variant, $text, $help),)+];
-        }
-
-        impl $name {
-            /// The value's name.
-            pub fn name(self) -> &'static str {
-                Self::CHOICES.iter().find(|(v, _, _)| *v == self).map(|(_, n, _)| *n).unwrap_or("?")
-            }
+            const CHOICES: &'static [(Self, &'static str, &'static str)] = &[$((<$name>::$variant, $text, $help),)+];
         }
     };
 }
 
-choice!(
-    /// What to do with parts that overlap in the input (press fits, dowels, screws, slop).
-    Overlaps {
-        /// Separate only along motions that enter no new material of each other.
-        Strict = "strict": "an overlapping pair separates only along motions that enter no new material of each other (a dowel leaves along its axis, never sideways)",
-        /// Shrink one part of the pair; ignore pairs no shrinking separates.
-        Lenient = "lenient": "shrink one part of the pair in their tests; ignore pairs no shrinking separates",
-        /// Shrink small overlaps; an error on pairs no shrinking separates.
-        Error = "error": "shrink small overlaps; stop with an error on pairs no shrinking separates",
-    }
-);
+choice!(asp_geom::OverlapPolicy {
+    Strict = "strict" => "an overlapping pair separates only along motions that enter no new material of each other (a dowel leaves along its axis, never sideways)",
+    Lenient = "lenient" => "shrink one part of the pair in their tests; ignore pairs no shrinking separates",
+    Error = "error" => "shrink small overlaps; stop with an error on pairs no shrinking separates",
+});
 
-choice!(
-    /// The stability criterion of the feasibility search.
-    Stability {
-        /// Linked through contacts to a fixed part.
-        Contact = "contact": "every part linked through contacts to a fixed part",
-        /// Simulated under gravity.
-        Physics = "physics": "simulate what remains under gravity (rapier3d); unstable when a part moves more than `physics_threshold`",
-    }
-);
+/// The stability criterion of the feasibility search. The library's
+/// [`crate::pipeline::StabilitySetting`] carries the physics threshold, a setting of its own
+/// (`physics_threshold`), so the request names the criterion alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stability {
+    /// Linked through contacts to a fixed part.
+    Contact,
+    /// Simulated under gravity.
+    Physics,
+}
 
-choice!(
-    /// The optimiser's gravity check on the distance maps.
-    Support {
-        /// A part or the floor directly beneath each part.
-        Below = "below": "every part rests on a part or the floor directly beneath it (thesis 6.3.2)",
-        /// Linked through contacts.
-        Contact = "contact": "every part linked through contacts to a fixed part or the floor",
-    }
-);
+choice!(Stability {
+    Contact = "contact" => "every part linked through contacts to a fixed part",
+    Physics = "physics" => "simulate what remains under gravity (rapier3d); unstable when a part moves more than `physics_threshold`",
+});
 
-choice!(
-    /// Where learned Q-functions guide the optimiser.
-    QUse {
-        /// ε-greedy rollouts.
-        Rollouts = "rollouts": "ε-greedy rollouts (thesis: one evaluation per rollout step)",
-        /// Q-ordered expansions, random rollouts.
-        Expansions = "expansions": "the Q-values of each state the search adds order its expansions; rollouts stay random (one evaluation per node)",
-        /// Both.
-        Both = "both": "ε-greedy rollouts and Q-ordered expansions",
-        /// PUCT priors at expansions, a greedy seed of the local search, random rollouts.
-        Priors = "priors": "the Q-values of each state the search adds are PUCT priors (expansion order and a bonus in the tree policy), a greedy sequence on them seeds the local search; rollouts stay random (one evaluation per node, cached by state)",
+choice!(asp_geom::distmap::Support {
+    Below = "below" => "every part rests on a part or the floor directly beneath it (thesis 6.3.2)",
+    ContactGraph = "contact" => "every part linked through contacts to a fixed part or the floor",
+});
+
+choice!(asp_search::QUse {
+    Rollouts = asp_search::QUse::NAMES[0] => "ε-greedy rollouts (thesis: one evaluation per rollout step)",
+    Expansions = asp_search::QUse::NAMES[1] => "the Q-values of each state the search adds order its expansions; rollouts stay random (one evaluation per node)",
+    Both = asp_search::QUse::NAMES[2] => "ε-greedy rollouts and Q-ordered expansions",
+    Priors = asp_search::QUse::NAMES[3] => "the Q-values of each state the search adds are PUCT priors (expansion order and a bonus in the tree policy), a greedy sequence on them seeds the local search; rollouts stay random (one evaluation per node, cached by state)",
+});
+
+/// A closed set's value in a request, by its [`Choice`] name (`#[serde(with = "...choice")]`).
+pub(crate) mod choice {
+    use super::Choice;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer, T: Choice>(v: &Option<T>, s: S) -> Result<S::Ok, S::Error> {
+        match v {
+            Some(v) => s.serialize_str(v.name()),
+            None => s.serialize_none(),
+        }
     }
-);
+
+    pub fn deserialize<'de, D: Deserializer<'de>, T: Choice>(d: D) -> Result<Option<T>, D::Error> {
+        match Option::<String>::deserialize(d)? {
+            None => Ok(None),
+            Some(name) => {
+                T::parse(&name).map(Some).ok_or_else(|| serde::de::Error::custom(format!("unknown value '{name}' (use {})", T::names())))
+            }
+        }
+    }
+}
 
 /// The `subassemblies` setting: on, off, or the file's own product tree.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -369,8 +373,8 @@ mod tests {
         assert!(keys.iter().any(|k| k == "time_limit") && keys.iter().any(|k| k == "robot_base"));
         let r = PlanRequest {
             objective: Some(vec!["access".into()]),
-            q_use: Some(QUse::Both),
-            overlaps: Some(Overlaps::Lenient),
+            q_use: Some(asp_search::QUse::Both),
+            overlaps: Some(asp_geom::OverlapPolicy::Lenient),
             robot_base: Some([1.0, 2.0, 3.0]),
             fixed: vec!["base".into()],
             unit_group: vec![vec!["motor".into(), "fan".into()]],
@@ -405,8 +409,8 @@ mod tests {
         assert_eq!(r.q, Some(vec![PathBuf::from("a.onnx"), PathBuf::from("b.onnx")]));
         assert_eq!(r.robot_base, Some([1.0, 2.0, 3.0]));
         assert_eq!(r.timeout, None);
-        assert_eq!(Overlaps::parse("error"), Some(Overlaps::Error));
-        assert_eq!(QUse::names(), "rollouts, expansions, both, priors");
-        assert_eq!(Support::Below.name(), "below");
+        assert_eq!(asp_geom::OverlapPolicy::parse("error"), Some(asp_geom::OverlapPolicy::Error));
+        assert_eq!(asp_search::QUse::names(), "rollouts, expansions, both, priors");
+        assert_eq!(asp_geom::distmap::Support::ContactGraph.name(), "contact");
     }
 }

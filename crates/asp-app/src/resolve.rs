@@ -6,7 +6,7 @@
 use crate::catalogue::{self, QPolicy, DEFAULT_EPSILON};
 use crate::error::{AppError, Result};
 use crate::pipeline::{OptimiseSettings, PlanSettings, StabilitySetting, DEFAULT_TIMEOUT};
-use crate::request::{Overlaps, PlanRequest, QUse, Stability, Subassemblies, Support};
+use crate::request::{PlanRequest, Stability, Subassemblies};
 use crate::settings::{Applies, SETTINGS};
 use asp_geom::math::{Axis, Vec3};
 use asp_geom::Units;
@@ -148,11 +148,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         contact_distance: positive("contact_distance", r.contact_distance)?,
         normals: r.normals.unwrap_or(d.normals),
         sphere_directions: r.sphere_directions.unwrap_or(d.sphere_directions),
-        overlaps: match r.overlaps.unwrap_or(Overlaps::Strict) {
-            Overlaps::Strict => asp_geom::OverlapPolicy::Strict,
-            Overlaps::Lenient => asp_geom::OverlapPolicy::Lenient,
-            Overlaps::Error => asp_geom::OverlapPolicy::Error,
-        },
+        overlaps: r.overlaps.unwrap_or_default(),
         stability,
         order,
         bookkeeping: r.bookkeeping.unwrap_or(false) || (entry.bookkeeping)(checker),
@@ -242,12 +238,7 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
     let policy = match &r.q {
         None => None,
         Some(paths) => {
-            let uses = match r.q_use.unwrap_or(QUse::Rollouts) {
-                QUse::Rollouts => asp_search::QUse::Rollouts,
-                QUse::Expansions => asp_search::QUse::Expansions,
-                QUse::Both => asp_search::QUse::Both,
-                QUse::Priors => asp_search::QUse::Priors,
-            };
+            let uses = r.q_use.unwrap_or_default();
             let objectives: Vec<&str> = names.iter().map(String::as_str).collect();
             let q = QPolicy::new(paths, &objectives, r.epsilon.unwrap_or(DEFAULT_EPSILON), uses)?;
             Some(Arc::new(q) as Arc<dyn catalogue::PolicySource>)
@@ -272,10 +263,7 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
         polish,
         resolution: r.resolution.unwrap_or(asp_geom::distmap::DEFAULT_RESOLUTION),
         d_max: positive("d_max", r.d_max)?,
-        support: match r.support.unwrap_or(Support::Below) {
-            Support::Below => asp_geom::distmap::Support::Below,
-            Support::Contact => asp_geom::distmap::Support::ContactGraph,
-        },
+        support: r.support.unwrap_or_default(),
         extensions,
         policy,
         robot_keys: robot_keys(r),

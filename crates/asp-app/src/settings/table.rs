@@ -4,8 +4,11 @@
 use super::{choices, orderings, settings, Applies::*, Flag::*, Group::*, Kind::*, Setting};
 use crate::catalogue::DEFAULT_EPSILON;
 use crate::pipeline::{PlanSettings, DEFAULT_TIMEOUT};
-use crate::request::{Overlaps, QUse, Stability, Subassemblies, Support};
+use crate::request::{Choice as _, Stability, Subassemblies};
+use asp_geom::distmap::Support;
+use asp_geom::OverlapPolicy as Overlaps;
 use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES, DEFAULT_EXPLORATION, DEFAULT_POLISH};
+use asp_search::QUse;
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -61,10 +64,12 @@ settings! {
         help: "Extra removal directions sampled evenly on the sphere.",
         group: Model, kind: Int, default: || json!(PlanSettings::default().sphere_directions), python: "int",
     }
+    #[serde(with = "crate::request::choice")]
     overlaps: Option<Overlaps> {
         help: "Parts that overlap in the input (press fits, dowels, screws, slop; warned once per pair with the measured depth, listed in the plan's `overlaps`).",
-        applies: Both, group: Model, kind: Choice, choices: choices::<Overlaps>, default: || json!(Overlaps::Strict.name()), python: "Overlaps",
+        applies: Both, group: Model, kind: Choice, choices: choices::<Overlaps>, default: || json!(Overlaps::default().name()), python: "Overlaps",
     }
+    #[serde(with = "crate::request::choice")]
     stability: Option<Stability> {
         help: "The feasibility search's stability criterion.",
         instead: "the optimiser's gravity check is `support`",
@@ -176,10 +181,11 @@ settings! {
         help: "Cap d_max of the distance maps.",
         applies: Optimiser, group: Optimisation, kind: Float, derived: "the model's diagonal", python: "float",
     }
+    #[serde(with = "crate::request::choice")]
     support: Option<Support> {
         help: "The optimiser's gravity check on the distance maps.",
         instead: "the feasibility search's criterion is `stability`",
-        applies: Optimiser, group: Optimisation, kind: Choice, choices: choices::<Support>, default: || json!(Support::Below.name()), python: "Support",
+        applies: Optimiser, group: Optimisation, kind: Choice, choices: choices::<Support>, default: || json!(Support::default().name()), python: "Support",
     }
     #[serde(deserialize_with = "crate::request::paths")]
     q: Option<Vec<PathBuf>> {
@@ -190,9 +196,10 @@ settings! {
         help: "The probability of a random removal in a rollout (or expansion) guided by `q`.",
         needs: "`q`", applies: Optimiser, group: Optimisation, kind: Float, default: || json!(DEFAULT_EPSILON), python: "float",
     }
+    #[serde(with = "crate::request::choice")]
     q_use: Option<QUse> {
         help: "Where `q` guides.",
-        needs: "`q`", applies: Optimiser, group: Optimisation, kind: Choice, choices: choices::<QUse>, default: || json!(QUse::Rollouts.name()), python: "QUse",
+        needs: "`q`", applies: Optimiser, group: Optimisation, kind: Choice, choices: choices::<QUse>, default: || json!(QUse::default().name()), python: "QUse",
     }
 
     // --- the robot (both searches) ---
