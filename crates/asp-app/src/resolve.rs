@@ -115,11 +115,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
     // which checker decides removals: a learned ordering needs a model trained on its labels, and
     // `auto` is learned where that checker's tests are expensive (the arm checks removals in the
     // depth-first search only; an optimiser scores with it)
-    let checker = match (&robot, &stability) {
-        (Some(_), _) if optimise.is_none() => asp_learn::Checker::Robot,
-        (_, StabilitySetting::Physics { .. }) => asp_learn::Checker::Physics,
-        _ => asp_learn::Checker::Default,
-    };
+    let checker = crate::setup::label_checker(checker_extension.as_deref(), &stability);
     let model_error = |e: AppError| match &r.model {
         Some(_) => AppError::setting("model", e.to_string()),
         None => e,
@@ -166,7 +162,6 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         cancel: None,
         checker_extension,
         precedence: r.precedence.unwrap_or(false),
-        checker,
     })
 }
 
@@ -326,10 +321,10 @@ mod tests {
         assert!(!s.bookkeeping && s.order.name() == "given");
         // the arm's checks are expensive too: its own shipped model, with bookkeeping
         let s = resolve(&PlanRequest::from_json(r#"{"robot": "panda"}"#).unwrap()).unwrap();
-        assert!(s.bookkeeping && s.order.name() == "gnn" && s.checker == asp_learn::Checker::Robot);
+        assert!(s.bookkeeping && s.order.name() == "gnn" && s.label_checker() == asp_learn::Checker::Robot);
         // an optimiser scores with the arm rather than checks with it: the cheap case
         let s = resolve(&PlanRequest::from_json(r#"{"robot": "panda", "objective": "robot-path"}"#).unwrap()).unwrap();
-        assert!(!s.bookkeeping && s.order.name() == "given" && s.checker == asp_learn::Checker::Default);
+        assert!(!s.bookkeeping && s.order.name() == "given" && s.label_checker() == asp_learn::Checker::Default);
         let o = resolve(&PlanRequest::from_json(r#"{"objective": "access"}"#).unwrap()).unwrap().optimise.unwrap();
         let od = OptimiseSettings::default();
         assert_eq!(

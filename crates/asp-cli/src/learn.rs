@@ -133,7 +133,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<std::process::ExitCode> {
         if tty {
             eprintln!("[{}/{}] {}", k + 1, models.len(), path.display());
         }
-        let methods = methods(a, &name, settings.checker)?;
+        let methods = methods(a, &name, settings.label_checker())?;
         rows.extend(bench::bench_model(path, &name, &settings, &methods, a.orderings)?);
     }
     let mut stdout = std::io::stdout().lock();

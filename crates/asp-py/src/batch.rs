@@ -277,7 +277,8 @@ pub fn bench_item(
 ) -> PyResult<String> {
     let settings = model_settings(settings, load).map_err(|e| e.into_py(py))?;
     let list = methods.unwrap_or_else(|| bench::default_methods(model.is_some()).to_string());
-    let methods = bench::parse_methods(&list, model.as_deref().map(Path::new), settings.checker).map_err(|e| Error::from(e).into_py(py))?;
+    let methods =
+        bench::parse_methods(&list, model.as_deref().map(Path::new), settings.label_checker()).map_err(|e| Error::from(e).into_py(py))?;
     let rows = py
         .detach(|| bench::bench_model(Path::new(&path), &name, &settings, &methods, orderings))
         .map_err(|e| Error::from(e).into_py(py))?;

@@ -1,6 +1,6 @@
 //! Every setting of a planning run, declared once (as ripgrep declares each flag once).
 //!
-//! One entry of the [`settings!`](crate::settings) table in [`table`] gives a setting its key,
+//! One entry of the `settings!` table in `settings/table.rs` gives a setting its key,
 //! its Rust type (the field of [`PlanRequest`]), its help, its default, its accepted names, the
 //! search it applies to and its command-line spelling. Everything else reads that entry:
 //!
@@ -10,7 +10,8 @@
 //! - [`crate::resolve::defaults`] and the applicability errors of [`crate::resolve()`];
 //! - Python's `asp.settings` (`Literal`s and the `PlanSettings` `TypedDict`) and the keywords and
 //!   docstring of `Assembly.plan`, and the key table of `docs/plan-request.md`: rendered by
-//!   [`render`] and held to the checked-in files by a test (`ASP_REGENERATE=1` rewrites them).
+//!   `settings/render.rs` ([`python_settings`], [`python_plan`], [`docs_keys`]) and held to the
+//!   checked-in files by a test (`ASP_REGENERATE=1` rewrites them).
 //!
 //! What a setting does stays where it is used: [`crate::resolve()`] turns the request into the
 //! pipeline's settings.

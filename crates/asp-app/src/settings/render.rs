@@ -204,7 +204,8 @@ mod tests {
         let root = root();
         let docs_begin = "<!-- BEGIN keys: generated from crates/asp-app/src/settings/table.rs -->\n";
         let docs_end = "<!-- END keys -->\n";
-        let files: [(&str, Box<dyn Fn(&str) -> String>); 3] = [
+        type Render<'a> = Box<dyn Fn(&str) -> String + 'a>;
+        let files: [(&str, Render); 3] = [
             ("py/asp/settings.py", Box::new(|_| python_settings())),
             ("py/asp/assembly.py", Box::new(|f| replaced(f, "    def plan(\n", "        \"\"\"\n", &python_plan()))),
             (

@@ -1,4 +1,4 @@
-//! The settings, one entry each ([`settings!`](super::settings); `docs/plan-request.md` and
+//! The settings, one entry each (`settings!`; `docs/plan-request.md` and
 //! ARCHITECTURE.md, "Adding a setting").
 
 use super::{choices, orderings, settings, Applies::*, Flag::*, Group::*, Kind::*, Setting};
