@@ -7,21 +7,19 @@ import inspect
 import os
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal, Union
+from typing import TYPE_CHECKING, Any, Literal
 
 from asp import _asp, step
 from asp.errors import ConfigError
 from asp.graph import Graph
 from asp.qgraphs import QGraphs
 from asp.result import Plan
-from asp.settings import Order, Overlaps, QUse, Stability, Support, given
+from asp.settings import Order, Overlaps, PathLike, QUse, Stability, Support, given
 
 if TYPE_CHECKING:
     from asp.search import Search
 
 __all__ = ["Assembly", "Part", "load", "plan"]
-
-PathLike = Union[str, "os.PathLike[str]"]
 
 
 @dataclass(frozen=True)
@@ -141,11 +139,7 @@ class Assembly:
     def plan(
         self,
         *,
-        order: Order | None = None,
-        model: PathLike | None = None,
-        bookkeeping: bool | None = None,
-        precedence: bool | None = None,
-        seed: int | None = None,
+        allow_outside_files: bool | None = None,
         tolerance: float | None = None,
         contact_distance: float | None = None,
         normals: int | None = None,
@@ -156,11 +150,16 @@ class Assembly:
         path_planner: bool | None = None,
         subassemblies: bool | Literal["from-file"] | None = None,
         grid: bool | None = None,
-        unit_group: str | Sequence[str | Sequence[str]] | None = None,
         rrt_iterations: int | None = None,
         rrt_time: float | None = None,
+        order: Order | None = None,
+        model: PathLike | None = None,
+        bookkeeping: bool | None = None,
+        precedence: bool | None = None,
+        seed: int | None = None,
         max_tests: int | None = None,
         timeout: float | None = None,
+        unit_group: str | Sequence[str | Sequence[str]] | None = None,
         objective: str | Sequence[str] | None = None,
         pareto: bool | None = None,
         episodes: int | None = None,
@@ -181,100 +180,143 @@ class Assembly:
         replans: int | None = None,
         grippers: int | None = None,
         package_path: Sequence[str] | None = None,
-        allow_outside_files: bool | None = None,
     ) -> Plan:
         """Plans an assembly sequence: the pipeline of ``asp plan``, with the same settings under
         the flags' names (``--max-tests`` is ``max_tests``, ``--no-path-planner`` is
-        ``path_planner=False``). Lengths are in model units. A setting left out (``None``) takes
-        its default (``asp._asp.default_settings()``); a setting of the other search (``timeout``
-        with ``objective``, ``time_limit`` without) raises :class:`ConfigError` naming the one that
-        applies.
+        ``path_planner=False``). Lengths are in model units. A setting left out (``None``) takes its
+        default (``asp._asp.default_settings()``); a setting of the other search (``timeout`` with
+        ``objective``, ``time_limit`` without) raises :class:`ConfigError` naming the one that
+        applies. The keywords and this list are generated from asp's settings table
+        (``crates/asp-app/src/settings/table.rs``).
 
         The feasibility search (without ``objective``):
 
-        :param order: part ordering: ``auto`` (default: ``given`` on the default checker, ``gnn``
-            with bookkeeping under ``stability="physics"`` or a ``robot``, where a removal test is
-            expensive), ``given`` (the model's order), ``shuffled`` (one order drawn from ``seed``
-            and kept: the thesis' vanilla AbD), ``random`` (a fresh order in every state),
-            ``bookkeeping`` (``given`` with bookkeeping), ``gnn`` (the learned ordering).
-        :param model: the removability model (ONNX) of ``order="gnn"``, and of ``auto`` where it
-            is learned (default: the shipped model of the run's checker).
-        :param bookkeeping: skip retesting a part until one of its blockers is gone.
-        :param precedence: add the precedence graph of a found plan (``plan.json``'s
-            ``precedence``: which steps go in before which, the levels of steps that may go in in
-            parallel, the critical path; docs/plan-format.md).
-        :param normals: clustered surface-normal directions tried besides the six axes (10).
-        :param sphere_directions: extra removal directions sampled evenly on the sphere (0).
-        :param stability: ``contact`` (default: linked through contacts to a base part) or
-            ``physics`` (rapier3d simulation).
-        :param physics_threshold: physics stability: how far (fraction of the diagonal) a part
-            may move (0.01).
-        :param path_planner: try the RRT path planner when no straight line works (True).
-        :param subassemblies: let groups of parts leave together as one rigid subassembly when
-            no single part can (True); ``"from-file"`` follows the file's product tree: each
-            subassembly of the file is planned on its own base, then the level above with each as
-            one unit (the plan's ``file_subassemblies`` lists every one with its own plan).
-        :param grid: plan voxel models by grid moves (True).
-        :param unit_group: parts planned as one part each, on purpose (a purchased motor, a
-            pressed-in bearing): a list of groups, each a comma-separated string or a list of
-            part names (one string is one group). A unit goes in whole as a subassembly step whose
-            status is ``"unit"``, and the plan is still ``"found"``; a unit with a fixed part is
-            part of the base.
-        :param rrt_iterations: path planner iterations per call (2000).
-        :param rrt_time: path planner wall-time cap per call, seconds (5).
-        :param max_tests: stop after this many removal tests (status ``budget_exhausted``).
-        :param timeout: stop after this many seconds with the best partial plan (default 60; 0
-            for no limit).
-        :param grippers: grippers in all: up to N-1 placed parts may be held (1).
+        :param normals: Clustered surface-normal directions tried besides the six axes (each with
+            its opposite). Default: 10.
+        :param sphere_directions: Extra removal directions sampled evenly on the sphere. Default: 0.
+        :param stability: The feasibility search's stability criterion. Values: ``contact``: every
+            part linked through contacts to a fixed part; ``physics``: simulate what remains under
+            gravity (rapier3d); unstable when a part moves more than ``physics_threshold``. Default:
+            ``contact``.
+        :param physics_threshold: Physics stability: how far (a fraction of the model's diagonal) a
+            part may move in the simulation before the state counts as unstable. Needs ``stability``
+            physics. Default: 0.01.
+        :param path_planner: Try the path planner (RRT-Connect) when no straight line works; off:
+            straight lines only. Default: True.
+        :param subassemblies: Let groups of parts leave together as one rigid subassembly when no
+            single part can; off: single parts only. ``from-file`` follows the file's product tree:
+            each subassembly of the file (STEP assembly instances, named glTF nodes with children)
+            is planned on its own base, then the level above with each as one unit (the plan's
+            ``file_subassemblies``); it does not combine with ``unit_group``. Default: True.
+        :param grid: Plan voxel models by grid moves (interlocking puzzles whose parts must slide in
+            turn before anything can leave). Default: True.
+        :param rrt_iterations: Path planner iterations per call. Default: 2000.
+        :param rrt_time: Path planner wall-time safety cap per call, seconds (the iteration budget
+            keeps runs reproducible; this only guards against pathological models). Default: 5.0.
+        :param order: The part ordering of the depth-first search. Values: ``auto``: by what a
+            removal test costs: ``given`` where tests are cheap (the default checker), ``gnn`` with
+            bookkeeping where they are expensive (``stability`` physics, or a ``robot`` checking the
+            arm); ``given``: the model's part order; ``shuffled``: one random order drawn from the
+            seed at the start and kept (the thesis' vanilla AbD); ``random``: a fresh random order
+            in every state (from the seed and the state); ``bookkeeping``: the given order with
+            bookkeeping: a blocked part is retested only after a blocker is gone; ``gnn``: parts in
+            order of the removability a graph neural network predicts (``model``), predicted again
+            after each removal (thesis 3.5.3). Default: ``auto``.
+        :param model: The removability model (ONNX, docs/learning.md) of ``order`` gnn, and of
+            ``order`` auto where it is learned. Needs ``order`` gnn, or auto under physics or a
+            ``robot``. Default: the shipped model of the run's checker.
+        :param bookkeeping: Bookkeeping on top of any ordering: a blocked part is retested only
+            after one of its blockers is gone (implied by ``order`` bookkeeping). Default: False.
+        :param precedence: Add the precedence graph of a found plan to the plan JSON: which steps
+            must go in before which (blocking and, conservatively, support), the levels of steps
+            that may go in in parallel and the critical path (docs/plan-format.md, "Precedence").
+            Default: False.
+        :param max_tests: Stop after this many removal tests (status ``budget_exhausted``). Default:
+            none.
+        :param timeout: Stop after this many seconds with the best partial plan (0: no limit).
+            Default: 60.0.
+        :param unit_group: Parts planned as one part each, on purpose (a purchased motor, a
+            pressed-in bearing): a list of groups, each a comma-separated string or a list of part
+            names (one string is one group; on the command line repeat the flag). A unit goes in
+            whole, as a subassembly step whose status is ``unit``, and the plan is still ``found``;
+            a unit with a fixed part is part of the base. At least two parts each, no part in two.
+            Needs ``subassemblies``. Default: none.
+        :param grippers: Grippers in all: up to N-1 parts already in place may be held (by a second
+            gripper or a fixture) while the next part goes in, so states that stand only while held
+            are allowed (the plan's steps say which parts are held). Default: 1.
 
         Both searches:
 
-        :param seed: seed of every random choice (0).
-        :param tolerance: contact tolerance (default 1e-4 × the model's diagonal).
-        :param contact_distance: parts closer than this touch, for stability (default 1e-3 × the
-            diagonal).
-        :param overlaps: parts that overlap in the input (press fits, dowels, screws, slop; warned
-            once per pair with the measured depth, listed in the plan's ``overlaps``):
-            ``strict`` (default: they separate only along motions that enter no new material of
-            each other), ``lenient`` (shrink one of them; ignore pairs no shrinking separates) or
-            ``error`` (raise :class:`LoadError` on pairs no shrinking separates).
-        :param robot: a robot arm that must carry every removal out: ``panda`` (the shipped arm)
-            or a URDF file.
-        :param robot_base: the robot base's position ``(x, y, z)`` in model units (default: on
-            the floor in front of the model).
-        :param drop_off: where removed parts are put down, ``(x, y, z)``.
-        :param replans: path plans per grasp, the shortest kept (4).
-        :param package_path: where the robot URDF's ``package://NAME/`` meshes lie, ``NAME=DIR``
-            each.
-        :param allow_outside_files: let the robot's URDF name meshes outside its folder.
+        :param allow_outside_files: Let the model and the robot's URDF read files outside their
+            folders: absolute paths, ``..`` that climbs out, symlinks that point out
+            (docs/security.md). Default: False.
+        :param tolerance: Contact tolerance: motions may push a part this deep into another.
+            Default: 1e-4 × the model's diagonal.
+        :param contact_distance: Parts closer than this are in contact, for stability. Default: 1e-3
+            × the model's diagonal.
+        :param overlaps: Parts that overlap in the input (press fits, dowels, screws, slop; warned
+            once per pair with the measured depth, listed in the plan's ``overlaps``). Values:
+            ``strict``: an overlapping pair separates only along motions that enter no new material
+            of each other (a dowel leaves along its axis, never sideways); ``lenient``: shrink one
+            part of the pair in their tests; ignore pairs no shrinking separates; ``error``: shrink
+            small overlaps; stop with an error on pairs no shrinking separates. Default: ``strict``.
+        :param seed: Seed of every random choice (random order, path planner, optimisation).
+            Default: 0.
+        :param robot: A robot arm that must carry every removal out: ``panda`` (the shipped
+            Franka-Panda-like arm) or a URDF file. A part counts as removable only when the arm can
+            grasp it, lift it 5 cm along its removal direction and carry it to the drop-off without
+            collision (thesis 5.3). Default: none.
+        :param robot_base: The robot base's position ``x,y,z`` (a list or a comma-separated string),
+            model frame. Needs ``robot``. Default: on the floor, 0.3 m in front of the model's -x
+            side, centred on it.
+        :param drop_off: Where the gripper puts removed parts down, ``x,y,z`` (a list or a
+            comma-separated string), model frame. Needs ``robot``. Default: 0.5 m to the robot's
+            side, 0.4 m above the floor.
+        :param replans: ``k``: path plans per grasp, the shortest kept (simulation steps of the
+            optimiser plan once). Needs ``robot``. Default: 4.
+        :param package_path: Where a URDF's ``package://NAME/`` meshes lie, ``NAME=DIR`` each (on
+            the command line repeat the flag). Needs ``robot``. Default: none.
 
         The optimiser (with ``objective``):
 
-        :param objective: optimise instead (MCTS on distance maps): ``access``, ``dirchange``,
-            ``pathlen``, ``robot-path`` (with ``robot``), comma-separated or a list; several need
-            ``pareto=True``.
-        :param pareto: Pareto-MCTS over the objectives.
-        :param episodes: MCTS episodes (1000).
-        :param budget: MCTS iterations per step (5).
-        :param threads: optimiser threads (default: all cores).
-        :param time_limit: optimiser wall-time limit, seconds.
-        :param exploration: exploration constant of UCT / MOUCB (1/√2).
-        :param polish: local search over the answer's sequences (block moves of 1-3 removals
-            around every sequence the search finds) may take this share of the search's work
-            (0.25); 0 turns it off.
-        :param resolution: distance map resolution N_M (odd, 3 to 15; 9).
-        :param d_max: distance map cap, model units (default the diagonal).
-        :param support: the optimiser's gravity check, ``below`` (default) or ``contact``.
-        :param q: learned Q-functions (ONNX files of ``python -m asp.train q``), one per objective
-            in ``objective``'s order (a comma-separated string or a list): rollouts take the
-            removal with the largest Q-value (the product for several objectives) instead of a
-            random one, except with probability ``epsilon`` (thesis 5.4.5, 6.4.4).
-        :param epsilon: probability of a random removal where ``q`` guides (0.2).
-        :param q_use: where ``q`` guides: ``rollouts`` (default, the thesis: one evaluation per
-            rollout step), ``expansions`` (the Q-values of every state the search adds order its
-            expansions, rollouts stay random: one evaluation per node), ``both``, or ``priors``
-            (the Q-values of every state the search adds are PUCT priors, a greedy sequence on
-            them seeds the local search; rollouts stay random: one evaluation per node).
+        :param objective: Optimise the sequence for these objectives (comma-separated or a list):
+            ``access`` (accessibility of each part, thesis 6.15), ``dirchange`` (shared removal
+            directions, fewer direction changes, 6.16), ``pathlen`` (straight-line removal path
+            length, minimised), ``robot-path`` (the arm's path, with ``robot``). One objective runs
+            MCTS; several need ``pareto``. Default: none.
+        :param pareto: Search the Pareto front of the objectives (Pareto-MCTS) and write every
+            non-dominated sequence to ``pareto_front``. Default: False.
+        :param episodes: MCTS episodes (each walks from the assembled state to a complete sequence).
+            Default: 1000.
+        :param budget: Search budget: MCTS iterations per step of an episode (the thesis uses 5).
+            Default: 5.
+        :param threads: Optimiser threads, each growing its own tree. The same seed and thread count
+            give the same answer. Default: all cores.
+        :param time_limit: Stop the optimiser after this many seconds (the answer then depends on
+            timing). Default: none.
+        :param exploration: Exploration constant c of UCT / MOUCB. Default: 1/√2.
+        :param polish: Local search over the answer's sequences: block moves of 1-3 removals around
+            every sequence the search finds, taking at most this share of the search's work (0:
+            off). Default: 0.25.
+        :param resolution: Distance map resolution N_M (odd, 3 to 15): N_M × N_M directions on the
+            half sphere. Default: 9.
+        :param d_max: Cap d_max of the distance maps. Default: the model's diagonal.
+        :param support: The optimiser's gravity check on the distance maps. Values: ``below``: every
+            part rests on a part or the floor directly beneath it (thesis 6.3.2); ``contact``: every
+            part linked through contacts to a fixed part or the floor. Default: ``below``.
+        :param q: Learned Q-functions (ONNX, ``python -m asp.train q``), one per objective in
+            ``objective``'s order (comma-separated or a list): rollouts take the removal with the
+            largest Q-value (the product of the values for several objectives) instead of a random
+            one, except with probability ``epsilon`` (thesis 5.4.5, 6.4.4). Default: none.
+        :param epsilon: The probability of a random removal in a rollout (or expansion) guided by
+            ``q``. Needs ``q``. Default: 0.2.
+        :param q_use: Where ``q`` guides. Values: ``rollouts``: ε-greedy rollouts (thesis: one
+            evaluation per rollout step); ``expansions``: the Q-values of each state the search adds
+            order its expansions; rollouts stay random (one evaluation per node); ``both``: ε-greedy
+            rollouts and Q-ordered expansions; ``priors``: the Q-values of each state the search
+            adds are PUCT priors (expansion order and a bonus in the tree policy), a greedy sequence
+            on them seeds the local search; rollouts stay random (one evaluation per node, cached by
+            state). Needs ``q``. Default: ``rollouts``.
         :raises ConfigError: a setting is unknown, of the wrong type, out of range or of the
             other search.
         :raises LoadError: the model cannot be planned as given (parts overlapping beyond

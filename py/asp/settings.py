@@ -1,34 +1,38 @@
 """The vocabulary of planning settings: the closed sets as ``Literal`` types and every setting of
 :meth:`asp.Assembly.plan` as a :class:`PlanSettings` ``TypedDict``.
 
-The settings are the keys of asp's plan request (the Rust crate ``asp-app``), the same as the
-command line's flags with ``_`` for ``-``. Their defaults and accepted values live there, once:
-``asp._asp.default_settings()`` and ``asp._asp.choices()`` read them, and a test holds these
-types to them.
+Generated from asp's settings table (``crates/asp-app/src/settings/table.rs``), where each
+setting is declared once: do not edit; a Rust test fails when this file differs and
+``ASP_REGENERATE=1 cargo test --workspace checked_in_settings`` rewrites it. The settings are the
+keys of asp's plan request, the same as the command line's flags with ``_`` for ``-``.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
-from typing import Literal, TypedDict
+from typing import Literal, TypedDict, Union
 
-__all__ = ["Order", "Overlaps", "PlanSettings", "QUse", "Stability", "Support", "given"]
+__all__ = ["given", "Order", "Overlaps", "PathLike", "PlanSettings", "QUse", "Stability", "Support"]
 
-#: Part orderings of the depth-first search (``order=``).
-Order = Literal["auto", "given", "shuffled", "random", "bookkeeping", "gnn"]
-#: What to do with parts that overlap in the input (``overlaps=``).
+#: A path: a string or an ``os.PathLike``.
+PathLike = Union[str, "os.PathLike[str]"]
+#: The values of ``overlaps=``.
 Overlaps = Literal["strict", "lenient", "error"]
-#: The feasibility search's stability criterion (``stability=``).
+#: The values of ``stability=``.
 Stability = Literal["contact", "physics"]
-#: The optimiser's gravity check (``support=``).
+#: The values of ``order=``.
+Order = Literal["auto", "given", "shuffled", "random", "bookkeeping", "gnn"]
+#: The values of ``support=``.
 Support = Literal["below", "contact"]
-#: Where learned Q-functions guide the optimiser (``q_use=``).
+#: The values of ``q_use=``.
 QUse = Literal["rollouts", "expansions", "both", "priors"]
 
 
 class PlanSettings(TypedDict, total=False):
     """Every keyword of :meth:`asp.Assembly.plan` (each optional; see its documentation)."""
 
+    allow_outside_files: bool
     tolerance: float
     contact_distance: float
     normals: int
@@ -39,16 +43,16 @@ class PlanSettings(TypedDict, total=False):
     path_planner: bool
     subassemblies: bool | Literal["from-file"]
     grid: bool
-    unit_group: str | Sequence[str | Sequence[str]]
     rrt_iterations: int
     rrt_time: float
     order: Order
-    model: str
+    model: PathLike
     bookkeeping: bool
     precedence: bool
     seed: int
     max_tests: int
     timeout: float
+    unit_group: str | Sequence[str | Sequence[str]]
     objective: str | Sequence[str]
     pareto: bool
     episodes: int
@@ -60,19 +64,17 @@ class PlanSettings(TypedDict, total=False):
     resolution: int
     d_max: float
     support: Support
-    q: str | Sequence[str]
+    q: PathLike | Sequence[PathLike]
     epsilon: float
     q_use: QUse
     robot: str
-    robot_base: str | tuple[float, float, float] | list[float]
-    drop_off: str | tuple[float, float, float] | list[float]
+    robot_base: str | Sequence[float]
+    drop_off: str | Sequence[float]
     replans: int
     grippers: int
     package_path: Sequence[str]
-    allow_outside_files: bool
 
 
 def given(settings: dict) -> dict:
     """The settings that were given (``None`` means "the default": left out)."""
     return {k: v for k, v in settings.items() if v is not None}
-

@@ -43,7 +43,7 @@ pub fn default_methods(learned: bool) -> &'static str {
 /// `given`, `gnn`, ...), each optionally `+bk`. An ordering that reads a model (`gnn`) gets
 /// `model` (the shipped one of `checker` when `None`), loaded only when the list names it; a
 /// model trained on another checker's labels than `checker` (the benchmark's
-/// [`PlanSettings::checker`]) is an error.
+/// [`PlanSettings::label_checker`]) is an error.
 pub fn parse_methods(list: &str, model: Option<&Path>, checker: asp_learn::Checker) -> Result<Vec<Method>> {
     let mut out = Vec::new();
     for name in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {

@@ -94,7 +94,7 @@ pub struct Collected {
     /// Runs per model.
     pub runs: usize,
     /// The checker whose tests labelled the states (`default`, `physics`; see
-    /// [`PlanSettings::checker`]). A data set written before this key labels for `default`.
+    /// [`PlanSettings::label_checker`]). A data set written before this key labels for `default`.
     pub checker: String,
     /// The models.
     pub assemblies: Vec<CollectedModel>,
@@ -140,19 +140,11 @@ struct StateLine {
 /// arm must also take each part out), else the physics simulation under the physics stability
 /// check, else the default checker.
 pub fn label_checker(plan: &PlanSettings) -> Result<asp_learn::Checker> {
-    if plan.checker == asp_learn::Checker::Robot {
-        if plan.checker_extension.is_none() {
-            return Err(AppError::config("the robot checker needs a robot (the settings name none)"));
-        }
-        return Ok(asp_learn::Checker::Robot);
-    }
-    if plan.checker_extension.is_some() {
+    let checker = plan.label_checker();
+    if checker != asp_learn::Checker::Robot && plan.checker_extension.is_some() {
         return Err(AppError::setting("grippers", "removability labels are collected with one gripper (or a robot), not with held parts"));
     }
-    Ok(match plan.stability {
-        pipeline::StabilitySetting::Physics { .. } => asp_learn::Checker::Physics,
-        pipeline::StabilitySetting::Contact => asp_learn::Checker::Default,
-    })
+    Ok(checker)
 }
 
 /// The label of every present, non-fixed part of `state` under `checker` (the run's: the

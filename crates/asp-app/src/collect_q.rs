@@ -14,7 +14,6 @@
 use crate::collect::{self, io_error, ModelItem};
 use crate::error::{AppError, Result};
 use crate::pipeline::{self, OptimiseSettings, PlanSettings};
-use asp_geom::distmap::Support;
 use asp_search::mcts::DEFAULT_RECORD_LIMIT;
 use asp_search::qgraph::{direction_history, QGraphConfig};
 use asp_search::Mdp;
@@ -316,11 +315,7 @@ fn model_entry(
             objective: problem.objective_names().join(","),
             resolution: maps.hemisphere().resolution(),
             d_max: o.d_max,
-            support: match o.support {
-                Support::Below => "below",
-                Support::ContactGraph => "contact",
-            }
-            .into(),
+            support: crate::request::Choice::name(o.support).into(),
             tolerance: plan.tolerance,
             contact_distance: plan.contact_distance,
             overlaps: plan.overlaps.name().into(),

@@ -14,6 +14,7 @@ mod optimise;
 pub mod pipeline;
 pub mod request;
 pub mod resolve;
+pub mod settings;
 mod setup;
 mod stage;
 mod stages;

@@ -22,8 +22,10 @@ use serde::{Deserialize, Deserializer, Serialize};
 use std::path::PathBuf;
 
 /// A closed set of named values (`overlaps`, `stability`, `support`, `q_use`): the names with
-/// one line of help each, for `--help`, Python's `Literal`s and error messages.
-pub trait Choice: Sized + Copy + 'static {
+/// one line of help each, for `--help`, Python's `Literal`s and error messages. The library's
+/// own enums carry it where they exist (`asp_geom::OverlapPolicy`, `asp_geom::distmap::Support`,
+/// `asp_search::QUse`), so a request holds the value the pipeline uses, with no mirror to match.
+pub trait Choice: Sized + Copy + PartialEq + 'static {
     /// Every value with its name and its one-line help, in the order the docs list them.
     const CHOICES: &'static [(Self, &'static str, &'static str)];
 
@@ -36,75 +38,77 @@ pub trait Choice: Sized + Copy + 'static {
     fn names() -> String {
         Self::CHOICES.iter().map(|(_, n, _)| *n).collect::<Vec<_>>().join(", ")
     }
+
+    /// The value's name.
+    fn name(self) -> &'static str {
+        Self::CHOICES.iter().find(|(v, _, _)| *v == self).map(|(_, n, _)| *n).unwrap_or("?")
+    }
 }
 
+/// Gives a closed set its names and help ([`Choice`]).
 macro_rules! choice {
-    ($(#[$meta:meta])* $name:ident { $($(#[$vmeta:meta])* $variant:ident = $text:literal : $help:literal,)+ }) => {
-        $(#[$meta])*
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-        #[serde(rename_all = "kebab-case")]
-        pub enum $name {
-            $($(#[$vmeta])* #[serde(rename = $text)] $variant,)+
-        }
-
+    ($name:ty { $($variant:ident = $text:expr => $help:literal,)+ }) => {
         impl Choice for $name {
-            const CHOICES: &'static [(Self, &'static str, &'static str)] = &[$(($name::$variant, $text, $help),)+];
-        }
-
-        impl $name {
-            /// The value's name.
-            pub fn name(self) -> &'static str {
-                Self::CHOICES.iter().find(|(v, _, _)| *v == self).map(|(_, n, _)| *n).unwrap_or("?")
-            }
+            const CHOICES: &'static [(Self, &'static str, &'static str)] = &[$((<$name>::$variant, $text, $help),)+];
         }
     };
 }
 
-choice!(
-    /// What to do with parts that overlap in the input (press fits, dowels, screws, slop).
-    Overlaps {
-        /// Separate only along motions that enter no new material of each other.
-        Strict = "strict": "an overlapping pair separates only along motions that enter no new material of each other (a dowel leaves along its axis, never sideways)",
-        /// Shrink one part of the pair; ignore pairs no shrinking separates.
-        Lenient = "lenient": "shrink one part of the pair in their tests; ignore pairs no shrinking separates",
-        /// Shrink small overlaps; an error on pairs no shrinking separates.
-        Error = "error": "shrink small overlaps; stop with an error on pairs no shrinking separates",
-    }
-);
+choice!(asp_geom::OverlapPolicy {
+    Strict = "strict" => "an overlapping pair separates only along motions that enter no new material of each other (a dowel leaves along its axis, never sideways)",
+    Lenient = "lenient" => "shrink one part of the pair in their tests; ignore pairs no shrinking separates",
+    Error = "error" => "shrink small overlaps; stop with an error on pairs no shrinking separates",
+});
 
-choice!(
-    /// The stability criterion of the feasibility search.
-    Stability {
-        /// Linked through contacts to a fixed part.
-        Contact = "contact": "every part linked through contacts to a fixed part",
-        /// Simulated under gravity.
-        Physics = "physics": "simulate what remains under gravity (rapier3d); unstable when a part moves more than `physics_threshold`",
-    }
-);
+/// The stability criterion of the feasibility search. The library's
+/// [`crate::pipeline::StabilitySetting`] carries the physics threshold, a setting of its own
+/// (`physics_threshold`), so the request names the criterion alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stability {
+    /// Linked through contacts to a fixed part.
+    Contact,
+    /// Simulated under gravity.
+    Physics,
+}
 
-choice!(
-    /// The optimiser's gravity check on the distance maps.
-    Support {
-        /// A part or the floor directly beneath each part.
-        Below = "below": "every part rests on a part or the floor directly beneath it (thesis 6.3.2)",
-        /// Linked through contacts.
-        Contact = "contact": "every part linked through contacts to a fixed part or the floor",
-    }
-);
+choice!(Stability {
+    Contact = "contact" => "every part linked through contacts to a fixed part",
+    Physics = "physics" => "simulate what remains under gravity (rapier3d); unstable when a part moves more than `physics_threshold`",
+});
 
-choice!(
-    /// Where learned Q-functions guide the optimiser.
-    QUse {
-        /// ε-greedy rollouts.
-        Rollouts = "rollouts": "ε-greedy rollouts (thesis: one evaluation per rollout step)",
-        /// Q-ordered expansions, random rollouts.
-        Expansions = "expansions": "the Q-values of each state the search adds order its expansions; rollouts stay random (one evaluation per node)",
-        /// Both.
-        Both = "both": "ε-greedy rollouts and Q-ordered expansions",
-        /// PUCT priors at expansions, a greedy seed of the local search, random rollouts.
-        Priors = "priors": "the Q-values of each state the search adds are PUCT priors (expansion order and a bonus in the tree policy), a greedy sequence on them seeds the local search; rollouts stay random (one evaluation per node, cached by state)",
+choice!(asp_geom::distmap::Support {
+    Below = "below" => "every part rests on a part or the floor directly beneath it (thesis 6.3.2)",
+    ContactGraph = "contact" => "every part linked through contacts to a fixed part or the floor",
+});
+
+choice!(asp_search::QUse {
+    Rollouts = asp_search::QUse::NAMES[0] => "ε-greedy rollouts (thesis: one evaluation per rollout step)",
+    Expansions = asp_search::QUse::NAMES[1] => "the Q-values of each state the search adds order its expansions; rollouts stay random (one evaluation per node)",
+    Both = asp_search::QUse::NAMES[2] => "ε-greedy rollouts and Q-ordered expansions",
+    Priors = asp_search::QUse::NAMES[3] => "the Q-values of each state the search adds are PUCT priors (expansion order and a bonus in the tree policy), a greedy sequence on them seeds the local search; rollouts stay random (one evaluation per node, cached by state)",
+});
+
+/// A closed set's value in a request, by its [`Choice`] name (`#[serde(with = "...choice")]`).
+pub(crate) mod choice {
+    use super::Choice;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer, T: Choice>(v: &Option<T>, s: S) -> Result<S::Ok, S::Error> {
+        match v {
+            Some(v) => s.serialize_str(v.name()),
+            None => s.serialize_none(),
+        }
     }
-);
+
+    pub fn deserialize<'de, D: Deserializer<'de>, T: Choice>(d: D) -> Result<Option<T>, D::Error> {
+        match Option::<String>::deserialize(d)? {
+            None => Ok(None),
+            Some(name) => {
+                T::parse(&name).map(Some).ok_or_else(|| serde::de::Error::custom(format!("unknown value '{name}' (use {})", T::names())))
+            }
+        }
+    }
+}
 
 /// The `subassemblies` setting: on, off, or the file's own product tree.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -156,151 +160,23 @@ impl<'de> Deserialize<'de> for Subassemblies {
 }
 
 /// [`Subassemblies`], optional.
-fn subassemblies<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Subassemblies>, D::Error> {
+pub(crate) fn subassemblies<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Subassemblies>, D::Error> {
     Option::<Subassemblies>::deserialize(d)
 }
 
-/// Every setting of a planning run (see the module documentation). Lengths are in model units.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct PlanRequest {
-    // --- loading (the CLI and batches; Python's `asp.load`) ---
-    /// The unit of the model's coordinates: `m`, `cm`, `mm`, `in`, `ft` or metres per unit
-    /// (default: what the file says, else metres).
-    pub unit: Option<String>,
-    /// The up axis: `x`, `y`, `z`, `-x`, `-y`, `-z` (default: what the file says, else +y for
-    /// glTF, +z for OBJ/STL).
-    pub up: Option<String>,
-    /// Base parts that stay in place, by name, on top of those the file marks as fixed.
-    pub fixed: Vec<String>,
-    /// Most triangles a model may have over all its parts (default 20 M; docs/security.md).
-    pub max_triangles: Option<usize>,
-    /// Most parts a model may have (default 10,000).
-    pub max_parts: Option<usize>,
-    /// A STEP file's tessellation: the chord tolerance of each edge and face relative to its
-    /// own size (default 0.001; STEP files only).
-    pub tessellation: Option<f64>,
-    /// Make each separate body of a part's mesh a part of its own, `NAME#1`, `NAME#2`, ...
-    /// (default: a warning names the part, which moves as one).
-    pub split_bodies: Option<bool>,
-    /// Let the model and the robot's URDF read files outside their folders: absolute paths, `..`
-    /// that climbs out, symlinks that point out (default: refused).
-    pub allow_outside_files: Option<bool>,
+pub use crate::settings::PlanRequest;
 
-    // --- the removal test ---
-    /// Contact tolerance: motions may push a part this deep into another (default 1e-4 × the
-    /// model's diagonal).
-    pub tolerance: Option<f64>,
-    /// Parts closer than this are in contact for stability (default 1e-3 × the diagonal).
-    pub contact_distance: Option<f64>,
-    /// Clustered surface-normal directions tried besides the six axes (feasibility search).
-    pub normals: Option<usize>,
-    /// Extra removal directions sampled evenly on the sphere (feasibility search).
-    pub sphere_directions: Option<usize>,
-    /// Parts that overlap in the input.
-    pub overlaps: Option<Overlaps>,
-    /// The feasibility search's stability criterion.
-    pub stability: Option<Stability>,
-    /// Physics stability: how far (fraction of the model's diagonal) a part may move.
-    pub physics_threshold: Option<f64>,
-    /// Try the path planner when no straight line works (`--no-path-planner`: false).
-    pub path_planner: Option<bool>,
-    /// Let groups of parts leave together as rigid subassemblies: `true` (the search finds
-    /// them), `false` (`--no-subassemblies`: single parts only) or `"from-file"` (`--subassemblies
-    /// from-file`: plan each subassembly of the file's product tree on its own, then the level
-    /// above with each as one unit).
-    #[serde(deserialize_with = "subassemblies")]
-    pub subassemblies: Option<Subassemblies>,
-    /// Plan voxel models by grid moves (`--no-grid`: false).
-    pub grid: Option<bool>,
-    /// Path planner iterations per call.
-    pub rrt_iterations: Option<usize>,
-    /// Path planner wall-time cap per call, seconds.
-    pub rrt_time: Option<f64>,
-
-    // --- the feasibility search ---
-    /// The part ordering, by its catalogue name (`auto`, the default, `given`, `shuffled`,
-    /// `random`, `bookkeeping`, `gnn`).
-    pub order: Option<String>,
-    /// The removability model (ONNX) of `order = "gnn"`, and of `auto` where it is learned
-    /// (default: the shipped model of the run's checker).
-    pub model: Option<PathBuf>,
-    /// Bookkeeping on top of the ordering.
-    pub bookkeeping: Option<bool>,
-    /// Add the precedence graph of a found plan to the plan JSON (format 1.12).
-    pub precedence: Option<bool>,
-    /// Seed of every random choice (both searches).
-    pub seed: Option<u64>,
-    /// Stop after this many removal tests.
-    pub max_tests: Option<u64>,
-    /// Stop after this many seconds with the best partial plan (0: no limit; default 60).
-    pub timeout: Option<f64>,
-    /// Groups of parts planned as one part each, on purpose (a purchased motor, a pressed-in
-    /// bearing): by name, each group a comma-separated string or a list of names; a plan that
-    /// moves each group whole is `found`, not `partial` (feasibility search).
-    #[serde(deserialize_with = "groups")]
-    pub unit_group: Vec<Vec<String>>,
-
-    // --- the optimiser (present when `objective` is) ---
-    /// Optimise for these objectives (a comma-separated string or a list).
-    #[serde(deserialize_with = "names")]
-    pub objective: Option<Vec<String>>,
-    /// Search the Pareto front (several objectives need it).
-    pub pareto: Option<bool>,
-    /// MCTS episodes.
-    pub episodes: Option<usize>,
-    /// MCTS iterations per step of an episode.
-    pub budget: Option<usize>,
-    /// Optimiser threads (default: all cores).
-    pub threads: Option<usize>,
-    /// Optimiser wall-time limit, seconds.
-    pub time_limit: Option<f64>,
-    /// Exploration constant of UCT / MOUCB.
-    pub exploration: Option<f64>,
-    /// The local search's share of the search's work (0: off).
-    pub polish: Option<f64>,
-    /// Distance map resolution N_M (odd, 3 to 15).
-    pub resolution: Option<usize>,
-    /// Distance map cap (default: the model's diagonal).
-    pub d_max: Option<f64>,
-    /// The optimiser's gravity check.
-    pub support: Option<Support>,
-    /// Learned Q-functions (ONNX), one per objective in `objective`'s order (a comma-separated
-    /// string or a list).
-    #[serde(deserialize_with = "paths")]
-    pub q: Option<Vec<PathBuf>>,
-    /// The probability of a random removal where `q` guides.
-    pub epsilon: Option<f64>,
-    /// Where `q` guides.
-    pub q_use: Option<QUse>,
-
-    // --- the robot (both searches) ---
-    /// A robot arm that must carry every removal out: a catalogue name (`panda`) or a URDF file.
-    pub robot: Option<String>,
-    /// The robot base's position `[x, y, z]` (or `"x,y,z"`), model frame.
-    #[serde(deserialize_with = "point")]
-    pub robot_base: Option<[f64; 3]>,
-    /// Where the gripper puts removed parts down, `[x, y, z]` (or `"x,y,z"`).
-    #[serde(deserialize_with = "point")]
-    pub drop_off: Option<[f64; 3]>,
-    /// Path plans per grasp (`k`), the shortest kept.
-    pub replans: Option<usize>,
-    /// Grippers in all: up to N-1 placed parts may be held (feasibility search).
-    pub grippers: Option<usize>,
-    /// Where a URDF's `package://NAME/` meshes lie, `NAME=DIR` each.
-    pub package_path: Vec<String>,
+/// Whether `key` belongs to loading a model only (`asp.load` in Python, not `Assembly.plan`).
+pub fn is_load_key(key: &str) -> bool {
+    crate::settings::Setting::get(key).is_some_and(|s| s.applies == crate::settings::Applies::Load)
 }
-
-/// The keys that belong to loading a model only (`asp.load` in Python, not `Assembly.plan`).
-pub const LOAD_KEYS: [&str; 7] = ["unit", "up", "fixed", "max_triangles", "max_parts", "tessellation", "split_bodies"];
 
 impl PlanRequest {
     /// Every key of a request, in alphabetical order.
     pub fn keys() -> Vec<String> {
-        match serde_json::to_value(PlanRequest::default()) {
-            Ok(serde_json::Value::Object(map)) => map.keys().cloned().collect(),
-            _ => Vec::new(),
-        }
+        let mut keys: Vec<String> = crate::settings::SETTINGS.iter().map(|s| s.key.to_string()).collect();
+        keys.sort();
+        keys
     }
 
     /// A request from a JSON object. An unknown key, or a value of the wrong type, is an
@@ -412,7 +288,7 @@ fn want_words(serde: &str) -> &str {
 }
 
 /// A comma-separated string or a list of strings, as a list (blank names dropped).
-fn names<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<String>>, D::Error> {
+pub(crate) fn names<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<String>>, D::Error> {
     #[derive(Deserialize)]
     #[serde(untagged)]
     enum OneOrMany {
@@ -433,7 +309,7 @@ fn names<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<Stri
 
 /// Groups of names: a list whose items are each a comma-separated string or a list of names, or
 /// one comma-separated string (one group).
-fn groups<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Vec<Vec<String>>, D::Error> {
+pub(crate) fn groups<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Vec<Vec<String>>, D::Error> {
     #[derive(Deserialize)]
     #[serde(untagged)]
     enum Group {
@@ -462,12 +338,12 @@ fn groups<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Vec<Vec<String
 }
 
 /// [`names`] as paths.
-fn paths<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<PathBuf>>, D::Error> {
+pub(crate) fn paths<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<Vec<PathBuf>>, D::Error> {
     Ok(names(d)?.map(|v| v.into_iter().map(PathBuf::from).collect()))
 }
 
 /// Three numbers, as a list or as `"x,y,z"`.
-fn point<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<[f64; 3]>, D::Error> {
+pub(crate) fn point<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<[f64; 3]>, D::Error> {
     #[derive(Deserialize)]
     #[serde(untagged)]
     enum Point {
@@ -497,8 +373,8 @@ mod tests {
         assert!(keys.iter().any(|k| k == "time_limit") && keys.iter().any(|k| k == "robot_base"));
         let r = PlanRequest {
             objective: Some(vec!["access".into()]),
-            q_use: Some(QUse::Both),
-            overlaps: Some(Overlaps::Lenient),
+            q_use: Some(asp_search::QUse::Both),
+            overlaps: Some(asp_geom::OverlapPolicy::Lenient),
             robot_base: Some([1.0, 2.0, 3.0]),
             fixed: vec!["base".into()],
             unit_group: vec![vec!["motor".into(), "fan".into()]],
@@ -533,8 +409,8 @@ mod tests {
         assert_eq!(r.q, Some(vec![PathBuf::from("a.onnx"), PathBuf::from("b.onnx")]));
         assert_eq!(r.robot_base, Some([1.0, 2.0, 3.0]));
         assert_eq!(r.timeout, None);
-        assert_eq!(Overlaps::parse("error"), Some(Overlaps::Error));
-        assert_eq!(QUse::names(), "rollouts, expansions, both, priors");
-        assert_eq!(Support::Below.name(), "below");
+        assert_eq!(asp_geom::OverlapPolicy::parse("error"), Some(asp_geom::OverlapPolicy::Error));
+        assert_eq!(asp_search::QUse::names(), "rollouts, expansions, both, priors");
+        assert_eq!(asp_geom::distmap::Support::ContactGraph.name(), "contact");
     }
 }

@@ -6,12 +6,13 @@
 use crate::catalogue::{self, QPolicy, DEFAULT_EPSILON};
 use crate::error::{AppError, Result};
 use crate::pipeline::{OptimiseSettings, PlanSettings, StabilitySetting, DEFAULT_TIMEOUT};
-use crate::request::{Overlaps, PlanRequest, QUse, Stability, Subassemblies, Support};
+use crate::request::{PlanRequest, Stability, Subassemblies};
+use crate::settings::{Applies, SETTINGS};
 use asp_geom::math::{Axis, Vec3};
 use asp_geom::Units;
 use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES, DEFAULT_EXPLORATION, DEFAULT_POLISH};
 use asp_search::MdpExtension;
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::sync::Arc;
 
 /// The physics stability threshold when none is given: the simulation's own default (a part
@@ -20,62 +21,23 @@ pub fn default_physics_threshold() -> f64 {
     asp_geom::PhysicsConfig::default().displacement_fraction as f64
 }
 
-/// The settings only the feasibility (depth-first) search reads, with what the optimiser has
-/// instead (if anything).
-const FEASIBILITY_ONLY: &[(&str, &str)] = &[
-    ("normals", ""),
-    ("sphere_directions", ""),
-    ("stability", "the optimiser's gravity check is `support`"),
-    ("physics_threshold", ""),
-    ("path_planner", ""),
-    ("subassemblies", ""),
-    ("unit_group", ""),
-    ("grid", ""),
-    ("rrt_iterations", ""),
-    ("rrt_time", ""),
-    ("order", ""),
-    ("model", ""),
-    ("bookkeeping", ""),
-    ("precedence", ""),
-    ("max_tests", ""),
-    ("timeout", "the optimiser's limit is `time_limit`"),
-    ("grippers", ""),
-];
-
-/// The settings only the optimiser reads, with what the feasibility search has instead.
-const OPTIMISER_ONLY: &[(&str, &str)] = &[
-    ("pareto", ""),
-    ("episodes", ""),
-    ("budget", ""),
-    ("threads", ""),
-    ("time_limit", "the feasibility search's limit is `timeout`"),
-    ("exploration", ""),
-    ("polish", ""),
-    ("resolution", ""),
-    ("d_max", ""),
-    ("support", "the feasibility search's criterion is `stability`"),
-    ("q", ""),
-    ("epsilon", ""),
-    ("q_use", ""),
-];
-
 /// Each setting does something in the search the request asks for.
 fn check_applies(r: &PlanRequest) -> Result<()> {
     let given = r.given();
     let is_given = |key: &str| given.iter().any(|g| g == key);
-    let (table, search, switch) = if r.optimises() {
-        (FEASIBILITY_ONLY, "the feasibility search", "without `objective`")
+    let (other, search, switch) = if r.optimises() {
+        (Applies::Feasibility, "the feasibility search", "without `objective`")
     } else {
-        (OPTIMISER_ONLY, "the optimiser", "with `objective`")
+        (Applies::Optimiser, "the optimiser", "with `objective`")
     };
-    for (key, instead) in table {
-        if is_given(key) {
+    for setting in SETTINGS.iter().filter(|s| s.applies == other) {
+        if is_given(setting.key) {
             let mut reason = format!("applies to {search} only ({switch})");
-            if !instead.is_empty() {
+            if !setting.instead.is_empty() {
                 reason.push_str("; ");
-                reason.push_str(instead);
+                reason.push_str(setting.instead);
             }
-            return Err(AppError::setting(*key, reason));
+            return Err(AppError::setting(setting.key, reason));
         }
     }
     let needs = |key: &str, on: bool, what: &str| -> Result<()> {
@@ -153,11 +115,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
     // which checker decides removals: a learned ordering needs a model trained on its labels, and
     // `auto` is learned where that checker's tests are expensive (the arm checks removals in the
     // depth-first search only; an optimiser scores with it)
-    let checker = match (&robot, &stability) {
-        (Some(_), _) if optimise.is_none() => asp_learn::Checker::Robot,
-        (_, StabilitySetting::Physics { .. }) => asp_learn::Checker::Physics,
-        _ => asp_learn::Checker::Default,
-    };
+    let checker = crate::setup::label_checker(checker_extension.as_deref(), &stability);
     let model_error = |e: AppError| match &r.model {
         Some(_) => AppError::setting("model", e.to_string()),
         None => e,
@@ -186,11 +144,7 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         contact_distance: positive("contact_distance", r.contact_distance)?,
         normals: r.normals.unwrap_or(d.normals),
         sphere_directions: r.sphere_directions.unwrap_or(d.sphere_directions),
-        overlaps: match r.overlaps.unwrap_or(Overlaps::Strict) {
-            Overlaps::Strict => asp_geom::OverlapPolicy::Strict,
-            Overlaps::Lenient => asp_geom::OverlapPolicy::Lenient,
-            Overlaps::Error => asp_geom::OverlapPolicy::Error,
-        },
+        overlaps: r.overlaps.unwrap_or_default(),
         stability,
         order,
         bookkeeping: r.bookkeeping.unwrap_or(false) || (entry.bookkeeping)(checker),
@@ -208,7 +162,6 @@ pub fn resolve(r: &PlanRequest) -> Result<PlanSettings> {
         cancel: None,
         checker_extension,
         precedence: r.precedence.unwrap_or(false),
-        checker,
     })
 }
 
@@ -280,12 +233,7 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
     let policy = match &r.q {
         None => None,
         Some(paths) => {
-            let uses = match r.q_use.unwrap_or(QUse::Rollouts) {
-                QUse::Rollouts => asp_search::QUse::Rollouts,
-                QUse::Expansions => asp_search::QUse::Expansions,
-                QUse::Both => asp_search::QUse::Both,
-                QUse::Priors => asp_search::QUse::Priors,
-            };
+            let uses = r.q_use.unwrap_or_default();
             let objectives: Vec<&str> = names.iter().map(String::as_str).collect();
             let q = QPolicy::new(paths, &objectives, r.epsilon.unwrap_or(DEFAULT_EPSILON), uses)?;
             Some(Arc::new(q) as Arc<dyn catalogue::PolicySource>)
@@ -310,10 +258,7 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
         polish,
         resolution: r.resolution.unwrap_or(asp_geom::distmap::DEFAULT_RESOLUTION),
         d_max: positive("d_max", r.d_max)?,
-        support: match r.support.unwrap_or(Support::Below) {
-            Support::Below => asp_geom::distmap::Support::Below,
-            Support::Contact => asp_geom::distmap::Support::ContactGraph,
-        },
+        support: r.support.unwrap_or_default(),
         extensions,
         policy,
         robot_keys: robot_keys(r),
@@ -341,61 +286,10 @@ fn robot_keys(r: &PlanRequest) -> serde_json::Map<String, Value> {
 }
 
 /// Every setting's default, by key, as the searches use them (`null`: none, or derived from the
-/// model: the tolerance is 1e-4 × its diagonal, the threads all cores). Python's
-/// `asp._asp.default_settings()` and the docs show these.
+/// model: the tolerance is 1e-4 × its diagonal, the threads all cores), read off
+/// [`SETTINGS`]. Python's `asp._asp.default_settings()` and the docs show these.
 pub fn defaults() -> serde_json::Map<String, Value> {
-    let d = PlanSettings::default();
-    let defaults: [(&str, Value); 48] = [
-        ("unit", Value::Null),
-        ("up", Value::Null),
-        ("fixed", json!([])),
-        ("max_triangles", json!(asp_geom::io::DEFAULT_MAX_TRIANGLES)),
-        ("max_parts", json!(asp_geom::io::DEFAULT_MAX_PARTS)),
-        ("tessellation", json!(asp_geom::io::step::DEFAULT_RELATIVE)),
-        ("split_bodies", json!(false)),
-        ("allow_outside_files", json!(false)),
-        ("tolerance", Value::Null),
-        ("contact_distance", Value::Null),
-        ("normals", json!(d.normals)),
-        ("sphere_directions", json!(d.sphere_directions)),
-        ("overlaps", json!(Overlaps::Strict.name())),
-        ("stability", json!(Stability::Contact.name())),
-        ("physics_threshold", json!(default_physics_threshold())),
-        ("path_planner", json!(d.path_planner)),
-        ("subassemblies", json!(d.subassemblies)),
-        ("grid", json!(d.grid)),
-        ("unit_group", json!([])),
-        ("rrt_iterations", json!(d.rrt_iterations)),
-        ("rrt_time", json!(d.rrt_time)),
-        ("order", json!(catalogue::ORDERINGS[0].name)),
-        ("model", Value::Null),
-        ("bookkeeping", json!(false)),
-        ("precedence", json!(false)),
-        ("seed", json!(0)),
-        ("max_tests", Value::Null),
-        ("timeout", json!(DEFAULT_TIMEOUT)),
-        ("objective", Value::Null),
-        ("pareto", json!(false)),
-        ("episodes", json!(DEFAULT_EPISODES)),
-        ("budget", json!(DEFAULT_BUDGET)),
-        ("threads", Value::Null),
-        ("time_limit", Value::Null),
-        ("exploration", json!(DEFAULT_EXPLORATION)),
-        ("polish", json!(DEFAULT_POLISH)),
-        ("resolution", json!(asp_geom::distmap::DEFAULT_RESOLUTION)),
-        ("d_max", Value::Null),
-        ("support", json!(Support::Below.name())),
-        ("q", Value::Null),
-        ("epsilon", json!(DEFAULT_EPSILON)),
-        ("q_use", json!(QUse::Rollouts.name())),
-        ("robot", Value::Null),
-        ("robot_base", Value::Null),
-        ("drop_off", Value::Null),
-        ("replans", json!(asp_robot::RemovalConfig::default().replans)),
-        ("grippers", json!(1)),
-        ("package_path", json!([])),
-    ];
-    defaults.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
+    SETTINGS.iter().map(|s| (s.key.to_string(), (s.default)())).collect()
 }
 
 #[cfg(test)]
@@ -427,10 +321,10 @@ mod tests {
         assert!(!s.bookkeeping && s.order.name() == "given");
         // the arm's checks are expensive too: its own shipped model, with bookkeeping
         let s = resolve(&PlanRequest::from_json(r#"{"robot": "panda"}"#).unwrap()).unwrap();
-        assert!(s.bookkeeping && s.order.name() == "gnn" && s.checker == asp_learn::Checker::Robot);
+        assert!(s.bookkeeping && s.order.name() == "gnn" && s.label_checker() == asp_learn::Checker::Robot);
         // an optimiser scores with the arm rather than checks with it: the cheap case
         let s = resolve(&PlanRequest::from_json(r#"{"robot": "panda", "objective": "robot-path"}"#).unwrap()).unwrap();
-        assert!(!s.bookkeeping && s.order.name() == "given" && s.checker == asp_learn::Checker::Default);
+        assert!(!s.bookkeeping && s.order.name() == "given" && s.label_checker() == asp_learn::Checker::Default);
         let o = resolve(&PlanRequest::from_json(r#"{"objective": "access"}"#).unwrap()).unwrap().optimise.unwrap();
         let od = OptimiseSettings::default();
         assert_eq!(

@@ -110,12 +110,27 @@ pub struct PlanSettings {
     pub checker_extension: Option<Arc<dyn CheckerExtension>>,
     /// Add the precedence graph of a found plan to its report ([`PrecedenceEntry`](asp_search::report::PrecedenceEntry)).
     pub precedence: bool,
+}
+
+impl PlanSettings {
     /// Which checker decides removals (`robot` with a robot in the feasibility search, else
     /// `physics` under the physics stability check, else `default`): the labels `asp collect
     /// removability` records under these settings, and the checker a removability model must
-    /// have been trained on to order this run's search. [`crate::resolve::resolve`] sets it from the same request as
-    /// `stability` and the robot.
-    pub checker: asp_learn::Checker,
+    /// have been trained on to order this run's search. Derived from the checker extension and
+    /// `stability`, so it cannot disagree with them.
+    pub fn label_checker(&self) -> asp_learn::Checker {
+        label_checker(self.checker_extension.as_deref(), &self.stability)
+    }
+}
+
+/// [`PlanSettings::label_checker`] of its parts (also what [`crate::resolve()`] orders by, before
+/// the settings exist).
+pub(crate) fn label_checker(extension: Option<&dyn CheckerExtension>, stability: &StabilitySetting) -> asp_learn::Checker {
+    match (extension, stability) {
+        (Some(e), _) if e.checks_arm() => asp_learn::Checker::Robot,
+        (_, StabilitySetting::Physics { .. }) => asp_learn::Checker::Physics,
+        _ => asp_learn::Checker::Default,
+    }
 }
 
 impl Default for PlanSettings {
@@ -150,7 +165,6 @@ impl Default for PlanSettings {
             cancel: None,
             checker_extension: None,
             precedence: false,
-            checker: asp_learn::Checker::Default,
         }
     }
 }

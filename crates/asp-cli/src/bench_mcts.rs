@@ -31,7 +31,7 @@ pub fn run(a: &MctsArgs) -> anyhow::Result<std::process::ExitCode> {
     if a.objective.split(',').filter(|n| !n.trim().is_empty()).count() > 1 {
         extra.insert("pareto".into(), true.into());
     }
-    crate::flags::put!(extra, a, budget, exploration, polish, resolution, d_max, support);
+    a.maps.put(&mut extra);
     let mut plan = crate::request::model_settings(&a.load, extra)?;
     let optimise = plan.optimise.take().context("--objective")?;
     let mut settings = Vec::new();

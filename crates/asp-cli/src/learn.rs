@@ -64,7 +64,7 @@ fn transitions(a: &TransitionsArgs) -> anyhow::Result<std::process::ExitCode> {
     if a.objective.split(',').filter(|n| !n.trim().is_empty()).count() > 1 {
         extra.insert("pareto".into(), true.into());
     }
-    crate::flags::put!(extra, a, budget, resolution, d_max, support);
+    a.maps.put(&mut extra);
     a.robot.put(&mut extra);
     let mut plan = model_settings(&a.load, extra)?;
     let optimise = plan.optimise.take().context("--objective")?;
@@ -133,7 +133,7 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<std::process::ExitCode> {
         if tty {
             eprintln!("[{}/{}] {}", k + 1, models.len(), path.display());
         }
-        let methods = methods(a, &name, settings.checker)?;
+        let methods = methods(a, &name, settings.label_checker())?;
         rows.extend(bench::bench_model(path, &name, &settings, &methods, a.orderings)?);
     }
     let mut stdout = std::io::stdout().lock();

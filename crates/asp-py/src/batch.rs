@@ -105,7 +105,7 @@ fn model_settings(dict: &Bound<'_, PyDict>, load: Option<&Bound<'_, PyDict>>) ->
     if let Some(load) = load {
         for key in load.keys() {
             let key = key.to_string();
-            if !asp_app::request::LOAD_KEYS.contains(&key.as_str()) {
+            if !asp_app::request::is_load_key(&key) {
                 return Err(Error::config(format!("load: '{key}' is not a setting of asp.load")));
             }
         }
@@ -277,7 +277,8 @@ pub fn bench_item(
 ) -> PyResult<String> {
     let settings = model_settings(settings, load).map_err(|e| e.into_py(py))?;
     let list = methods.unwrap_or_else(|| bench::default_methods(model.is_some()).to_string());
-    let methods = bench::parse_methods(&list, model.as_deref().map(Path::new), settings.checker).map_err(|e| Error::from(e).into_py(py))?;
+    let methods =
+        bench::parse_methods(&list, model.as_deref().map(Path::new), settings.label_checker()).map_err(|e| Error::from(e).into_py(py))?;
     let rows = py
         .detach(|| bench::bench_model(Path::new(&path), &name, &settings, &methods, orderings))
         .map_err(|e| Error::from(e).into_py(py))?;

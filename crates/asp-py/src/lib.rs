@@ -40,19 +40,8 @@ fn order_names() -> Vec<&'static str> {
 /// the order the docs list them: what `asp.settings`' `Literal` types must list.
 #[pyfunction]
 fn choices() -> std::collections::BTreeMap<&'static str, Vec<&'static str>> {
-    use asp_app::request::{Choice, Overlaps, QUse, Stability, Support};
-    fn names<T: Choice>() -> Vec<&'static str> {
-        T::CHOICES.iter().map(|(_, n, _)| *n).collect()
-    }
-    [
-        ("order", settings::order_names()),
-        ("overlaps", names::<Overlaps>()),
-        ("stability", names::<Stability>()),
-        ("support", names::<Support>()),
-        ("q_use", names::<QUse>()),
-    ]
-    .into_iter()
-    .collect()
+    use asp_app::settings::{Kind, SETTINGS};
+    SETTINGS.iter().filter(|s| s.kind == Kind::Choice).map(|s| (s.key, (s.choices)().into_iter().map(|(n, _)| n).collect())).collect()
 }
 
 /// The plan JSON `json` as `asp plan` prints it (`Plan.table()`): the table and, for optimising

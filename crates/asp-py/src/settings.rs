@@ -85,7 +85,7 @@ fn dict_json(dict: &Bound<'_, PyDict>) -> Result<Map<String, Value>, Error> {
 pub fn request(dict: &Bound<'_, PyDict>, load: bool) -> Result<PlanRequest, Error> {
     let map = dict_json(dict)?;
     if !load {
-        if let Some(key) = map.keys().find(|k| asp_app::request::LOAD_KEYS.contains(&k.as_str())) {
+        if let Some(key) = map.keys().find(|k| asp_app::request::is_load_key(k)) {
             return Err(Error::config(format!("'{key}' is a setting of asp.load")));
         }
     }
@@ -208,7 +208,7 @@ pub fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
     let json = py.import("json")?;
     for (key, value) in asp_app::resolve::defaults() {
-        if asp_app::request::LOAD_KEYS.contains(&key.as_str()) {
+        if asp_app::request::is_load_key(&key) {
             continue;
         }
         d.set_item(key, json.call_method1("loads", (value.to_string(),))?)?;

@@ -113,6 +113,10 @@ pub struct CellSetup {
 }
 
 impl CheckerExtension for CellSetup {
+    fn checks_arm(&self) -> bool {
+        self.robot.is_some()
+    }
+
     fn solve(
         &self,
         checker: &Checker,

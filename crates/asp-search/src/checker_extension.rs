@@ -21,4 +21,10 @@ pub trait CheckerExtension: Send + Sync + std::fmt::Debug {
         seed: u64,
         search: &mut dyn FnMut(&dyn asp_geom::FeasibilityChecker) -> Result<PlanOutcome>,
     ) -> Result<(PlanOutcome, Option<ExtensionReport>)>;
+
+    /// Whether the decorated checker has a robot arm check every removal (the run's removals
+    /// are then the robot checker's, whose labels a removability model must be trained on).
+    fn checks_arm(&self) -> bool {
+        false
+    }
 }

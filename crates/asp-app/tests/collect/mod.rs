@@ -131,11 +131,11 @@ fn labels_record_the_checker_and_why_each_part_failed() {
     let full = lines.iter().find(|l| parts_of(l, "present") == [0, 1, 2, 3]).unwrap();
     assert_eq!(parts_of(full, "removable"), [1, 2, 3], "the contact graph lets either pillar go");
     assert!(parts_of(full, "gravity").is_empty());
-    // the robot's checker without a robot: refused, not labelled as the default checker (the
-    // robot's labels: tests/robot)
-    let robot = PlanSettings { checker: asp_learn::Checker::Robot, ..PlanSettings::default() };
-    let settings = CollectSettings { runs: 1, plan: robot, ..CollectSettings::default() };
-    let err = collect(std::slice::from_ref(&path), &dir.path().join("robot"), &settings, &|_| {}).unwrap_err().to_string();
-    assert!(err.contains("needs a robot") && !err.contains('\n'), "{err}");
-    assert!(!dir.path().join("robot").join("index.json").exists());
+    // held parts without a robot: refused, not labelled as the default checker (the robot's
+    // labels: tests/robot)
+    let held = asp_app::resolve(&asp_app::PlanRequest::from_json(r#"{"grippers": 2}"#).unwrap()).unwrap();
+    let settings = CollectSettings { runs: 1, plan: held, ..CollectSettings::default() };
+    let err = collect(std::slice::from_ref(&path), &dir.path().join("held"), &settings, &|_| {}).unwrap_err().to_string();
+    assert!(err.contains("one gripper") && !err.contains('\n'), "{err}");
+    assert!(!dir.path().join("held").join("index.json").exists());
 }

@@ -396,7 +396,7 @@ fn request(rng: &mut ChaCha8Rng, diagonal: f64) -> (PlanRequest, String) {
             format!("order {}", o.name)
         }
         9 => {
-            r.overlaps = Some(if rng.random_bool(0.5) { asp_app::request::Overlaps::Lenient } else { asp_app::request::Overlaps::Error });
+            r.overlaps = Some(if rng.random_bool(0.5) { asp_geom::OverlapPolicy::Lenient } else { asp_geom::OverlapPolicy::Error });
             format!("overlaps {}", r.overlaps.unwrap().name())
         }
         10 => {
@@ -435,7 +435,8 @@ fn request(rng: &mut ChaCha8Rng, diagonal: f64) -> (PlanRequest, String) {
             r.threads = Some(1);
             r.resolution = Some([3, 5][rng.random_range(0..2)]);
             r.time_limit = Some(5.0);
-            r.support = Some(if rng.random_bool(0.5) { asp_app::request::Support::Below } else { asp_app::request::Support::Contact });
+            r.support =
+                Some(if rng.random_bool(0.5) { asp_geom::distmap::Support::Below } else { asp_geom::distmap::Support::ContactGraph });
             format!("{} {}", if pareto { "pareto-mcts" } else { "mcts" }, objective.join(","))
         }
     };

@@ -94,7 +94,7 @@ fn a_model_of_another_checker_is_refused_and_the_shipped_one_follows_the_checker
     // the same file under physics: accepted, by `gnn` and by `auto`
     for order in ["gnn", "auto"] {
         let s = asp_app::resolve::resolve(&request(serde_json::json!({"order": order, "model": p, "stability": "physics"}))).unwrap();
-        assert_eq!((s.order.name(), s.checker), ("gnn".to_string(), asp_learn::Checker::Physics));
+        assert_eq!((s.order.name(), s.label_checker()), ("gnn".to_string(), asp_learn::Checker::Physics));
     }
     // a file without `asp.checker` is the default checker's: refused under physics and the robot
     let plain = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../asp-learn/tests/data/random_gnn.onnx");
@@ -116,8 +116,8 @@ fn a_model_of_another_checker_is_refused_and_the_shipped_one_follows_the_checker
         (serde_json::json!({"order": "gnn", "robot": "panda"}), asp_learn::Checker::Robot),
     ] {
         let s = asp_app::resolve::resolve(&request(json.clone())).unwrap();
-        assert_eq!(s.checker, checker, "{json}");
-        let source = asp_app::catalogue::gnn_source(None, s.checker).unwrap();
+        assert_eq!(s.label_checker(), checker, "{json}");
+        let source = asp_app::catalogue::gnn_source(None, s.label_checker()).unwrap();
         assert_eq!(source.model().path(), format!("{} (shipped)", asp_learn::shipped_model(checker).file));
         // every checker has its own shipped model
         assert_eq!(source.model().checker(), checker, "{json}");

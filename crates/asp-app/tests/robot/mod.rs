@@ -387,7 +387,7 @@ fn removability_labels_are_collected_under_the_robot_with_the_arms_reasons() {
     let path = dir.path().join("near_and_far.glb");
     asp_geom::io::write_glb(&near_and_far(), &path).unwrap();
     let plan = resolved(r#"{"robot": "panda", "robot_base": [-0.4, 0.0, 0.0]}"#);
-    assert_eq!(plan.checker, asp_learn::Checker::Robot);
+    assert_eq!(plan.label_checker(), asp_learn::Checker::Robot);
     let settings = CollectSettings { runs: 2, seed: 4, plan, ..CollectSettings::default() };
     let out = dir.path().join("rem");
     let index = collect(std::slice::from_ref(&path), &out, &settings, &|_| {}).unwrap();

@@ -1,7 +1,7 @@
 //! The flags of `asp collect` and `asp bench` (learned guidance, thesis chapters 3, 5 and 6).
 
+use super::settings::{MapsGroup, SettingArgs};
 use super::ModelArgs;
-use asp_app::request::Support;
 use clap::{Args, Subcommand};
 use std::path::PathBuf;
 
@@ -40,21 +40,13 @@ pub struct TransitionsArgs {
     /// MCTS episodes per model (one search per model, one thread).
     #[arg(long, default_value_t = asp_app::collect_q::DEFAULT_EPISODES)]
     pub episodes: usize,
-    /// Search budget: MCTS iterations per step of an episode (the thesis uses 5).
-    #[arg(long)]
-    pub budget: Option<usize>,
     /// Base seed (the search of model m uses a seed derived from it and m).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Distance map resolution N_M (odd, 3 to 15): N_M × N_M directions on the half sphere.
-    #[arg(long)]
-    pub resolution: Option<usize>,
-    /// Cap d_max of the distance maps, model units [default: the model's diagonal].
-    #[arg(long)]
-    pub d_max: Option<f64>,
-    /// The gravity check of the optimiser.
-    #[arg(long, value_parser = super::choice::<Support>())]
-    pub support: Option<Support>,
+    /// The optimiser's settings of the distance maps and the search (`--budget`, `--resolution`,
+    /// ...), as on `asp plan`.
+    #[command(flatten)]
+    pub maps: SettingArgs<MapsGroup>,
     /// The most transitions recorded per model (its search goes on without recording beyond it).
     #[arg(long, default_value_t = asp_search::mcts::DEFAULT_RECORD_LIMIT)]
     pub max_transitions: usize,
@@ -185,24 +177,10 @@ pub struct MctsArgs {
     /// Search threads per run.
     #[arg(long, default_value_t = 1)]
     pub threads: usize,
-    /// Search budget: MCTS iterations per step.
-    #[arg(long)]
-    pub budget: Option<usize>,
-    /// Exploration constant c of UCT / MOUCB.
-    #[arg(long)]
-    pub exploration: Option<f64>,
-    /// The local search's share of each search's work (`asp plan --polish`; 0: off).
-    #[arg(long, value_name = "SHARE")]
-    pub polish: Option<f64>,
-    /// Distance map resolution N_M.
-    #[arg(long)]
-    pub resolution: Option<usize>,
-    /// Cap of the distance maps, model units (default: the model's diagonal).
-    #[arg(long)]
-    pub d_max: Option<f64>,
-    /// The gravity check of the optimiser.
-    #[arg(long, value_parser = super::choice::<Support>())]
-    pub support: Option<Support>,
+    /// The optimiser's settings of the distance maps and the search (`--budget`, `--resolution`,
+    /// ...), as on `asp plan`.
+    #[command(flatten)]
+    pub maps: SettingArgs<MapsGroup>,
     /// Also write the rows as JSON.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,

@@ -22,6 +22,7 @@ mod learn;
 mod model;
 mod plan;
 mod robot;
+pub mod settings;
 
 pub use check::CheckSeqArgs;
 pub use learn::{BenchArgs, BenchKind, CollectArgs, CollectKind, FeasibleArgs, MctsArgs, TransitionsArgs};
@@ -29,8 +30,6 @@ pub use model::ModelArgs;
 pub use plan::{PlanArgs, PlanRobotArgs};
 pub use robot::{CellArgs, CheckArgs, RobotAction, RobotArgs};
 
-use asp_app::request::Choice;
-use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// Plan in which order, and along which motions, a product can be put together.
@@ -70,21 +69,10 @@ pub enum Command {
 
 /// The flag of a request key: `max_tests` is `--max-tests`, the switches are `--no-...`.
 pub fn flag(key: &str) -> String {
-    match key {
-        "path_planner" | "subassemblies" | "grid" => format!("--no-{}", key.replace('_', "-")),
-        other => format!("--{}", other.replace('_', "-")),
+    match asp_app::settings::Setting::get(key) {
+        Some(setting) => setting.flag_name(),
+        None => format!("--{}", key.replace('_', "-")),
     }
-}
-
-/// The value parser of a closed setting: its names with their help, for `--help` and errors.
-pub fn choice<T: Choice + Send + Sync + Clone>() -> impl TypedValueParser<Value = T> {
-    PossibleValuesParser::new(T::CHOICES.iter().map(|(_, name, help)| PossibleValue::new(*name).help(*help)))
-        .map(|name| T::parse(&name).expect("clap checked the name"))
-}
-
-/// The value parser of `--order`: the catalogue's orderings with their help.
-pub fn order() -> PossibleValuesParser {
-    PossibleValuesParser::new(asp_app::catalogue::ORDERINGS.iter().map(|o| PossibleValue::new(o.name).help(o.help)))
 }
 
 /// `help` with the request's default of `key` appended, as clap shows defaults.
