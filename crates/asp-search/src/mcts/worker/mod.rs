@@ -347,17 +347,24 @@ impl<'p, V: Variant> Worker<'p, V> {
             self.sequence.push(p as u16);
         }
         if self.sim.is_complete() {
-            self.bounds.update(&ret[..m]);
-            let seq = &self.sequence;
-            if let Some(p) = &mut self.polisher {
-                p.seed(&ret[..m], seq);
-            }
-            if self.archive.insert(&ret[..m], || seq.clone()) {
-                self.archive_changed = true;
-                self.found.push((ret[..m].to_vec(), self.start.elapsed().as_secs_f64(), 0));
-            }
+            self.complete_sequence(&ret[..m], 0);
         }
         Ok(())
+    }
+
+    /// The current `sequence`, complete with returns `ret`: the bounds take its values, the
+    /// local search its start, and the archive it when no sequence dominates it (recorded as
+    /// found after `iterations` of the episode).
+    fn complete_sequence(&mut self, ret: &[f64], iterations: u64) {
+        self.bounds.update(ret);
+        let seq = &self.sequence;
+        if let Some(p) = &mut self.polisher {
+            p.seed(ret, seq);
+        }
+        if self.archive.insert(ret, || seq.clone()) {
+            self.archive_changed = true;
+            self.found.push((ret.to_vec(), self.start.elapsed().as_secs_f64(), iterations));
+        }
     }
 
     /// The edge the tree policy takes at the end of a search step (to any child that is not

@@ -225,16 +225,7 @@ impl<'p, V: Variant> Worker<'p, V> {
         }
         let complete = self.sim.is_complete();
         if complete {
-            self.bounds.update(&ret[..m]);
-            let seq = &self.sequence;
-            if let Some(p) = &mut self.polisher {
-                p.seed(&ret[..m], seq);
-            }
-            if self.archive.insert(&ret[..m], || seq.clone()) {
-                self.archive_changed = true;
-                let seconds = self.start.elapsed().as_secs_f64();
-                self.found.push((ret[..m].to_vec(), seconds, self.episode_iterations + 1));
-            }
+            self.complete_sequence(&ret[..m], self.episode_iterations + 1);
         } else {
             self.stats.dead_rollouts += 1;
         }
