@@ -1,11 +1,6 @@
 //! Integration tests of asp-app (one binary; modules in subfolders).
 
-#[path = "../../asp-search/tests/fixtures/mod.rs"]
-#[allow(dead_code)]
-mod fixtures;
-#[path = "../../asp-search/tests/verify/mod.rs"]
-#[allow(dead_code)]
-mod verify;
+use asp_check::{fixtures, verify};
 
 mod check;
 mod collect;

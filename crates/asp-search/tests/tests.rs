@@ -1,9 +1,10 @@
 //! Integration tests of asp-search (one binary; modules in subfolders).
 
+use asp_check::{fixtures, verify};
+
 mod conformance;
 mod exact;
 mod fasteners;
-mod fixtures;
 mod grid;
 mod groups;
 mod hypervolume;
@@ -13,4 +14,3 @@ mod pareto;
 mod qgraph;
 mod real;
 mod seams;
-mod verify;

@@ -20,7 +20,7 @@
 //! table; and a `found` plan of the depth-first search (straight lines, paths, subassemblies, no
 //! grippers, contact stability) on parts that are closed surfaces several tolerances thick, with a
 //! tolerance that `f32` coordinates resolve, passes
-//! the independent re-check of `asp-search/tests/verify`. The run is deterministic:
+//! the independent re-check of `asp_check::verify`. The run is deterministic:
 //! `ASP_FUZZ_CASES` (default [`DEFAULT_CASES`]) and `ASP_FUZZ_SEED` (default 28) choose more or
 //! other cases, `ASP_FUZZ_CASE=N` runs case N alone and prints its model, request and plan.
 //!

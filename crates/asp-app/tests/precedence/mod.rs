@@ -1,6 +1,6 @@
 //! `asp plan --precedence` (plan format 1.12): every order the precedence graph allows is
 //! feasible with the plan's own motions (the graph's travel per step), by the independent
-//! re-check of `asp-search/tests/verify`.
+//! re-check of `asp_check::verify`.
 
 use crate::fuzz::{removals, removals_scaled};
 use crate::verify::verify_removals;

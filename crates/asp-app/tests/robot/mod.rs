@@ -11,9 +11,7 @@ use asp_geom::{Assembly, Grasp, PartSet, World, WorldConfig};
 use asp_robot::{CellSetup, RobotCell, RobotExtension, RobotRemoval, RobotSetup};
 use asp_search::report::PlanReport;
 
-#[path = "../../../asp-robot/tests/robot/recheck.rs"]
-mod recheck;
-use recheck::recheck;
+use asp_check::robot::recheck;
 
 /// Four blocks on a fixed plate in front of the robot: two side by side, one on each.
 fn blocks() -> Assembly {

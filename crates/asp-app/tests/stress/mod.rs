@@ -2,7 +2,7 @@
 //! legs on two or four sides, carcasses of panels joined by dowels (holes modelled or dowels
 //! drawn into solid panels), plates clamped by threaded bolts and nuts — are taken apart
 //! completely (`found`), and every plan passes the independent re-check of
-//! `asp-search/tests/verify` (point containment at sampled poses: no part enters material of a
+//! `asp_check::verify` (point containment at sampled poses: no part enters material of a
 //! present part it did not already overlap).
 
 use crate::fuzz::removals;

@@ -1,8 +1,9 @@
+use asp_check::robot as recheck;
+
 mod fk;
 mod grasp;
 mod ik;
 mod load;
-mod recheck;
 mod removal;
 mod reuse;
 mod spheres;

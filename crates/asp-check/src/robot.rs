@@ -1,5 +1,5 @@
-//! The independent re-check of a robot removal, shared by asp-robot's tests and asp-app's (which
-//! include this file by path): no robot code is trusted by it.
+//! The independent re-check of a robot removal, shared by asp-robot's tests and asp-app's: no
+//! robot code is trusted by it.
 
 use asp_geom::math::{Aabb, Pose, Vec3};
 use asp_geom::{PartSet, World};
