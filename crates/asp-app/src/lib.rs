@@ -20,13 +20,15 @@ mod stage;
 mod stages;
 pub mod stepped;
 pub mod tree;
+pub mod values;
 pub mod why;
 
 pub use catalogue::{PolicySource, QPolicy};
 pub use error::{AppError, Result};
 pub use pipeline::{OptimiseSettings, PlanResult, PlanSettings};
-pub use request::{Choice, PlanRequest};
+pub use request::PlanRequest;
 pub use resolve::resolve;
+pub use values::Choice;
 
 use asp_search::{Progress, StopToken};
 use std::path::Path;

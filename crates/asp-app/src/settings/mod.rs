@@ -22,7 +22,7 @@ mod table;
 pub use render::{docs_keys, python_plan, python_settings, REGENERATE};
 pub use table::{PlanRequest, SETTINGS};
 
-use crate::request::Choice;
+use crate::values::Choice;
 use serde_json::Value;
 
 /// Which search reads a setting: a setting of the other search is an error naming what applies.

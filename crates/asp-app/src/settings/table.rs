@@ -4,7 +4,7 @@
 use super::{choices, orderings, settings, Applies::*, Flag::*, Group::*, Kind::*, Setting};
 use crate::catalogue::DEFAULT_EPSILON;
 use crate::pipeline::{PlanSettings, DEFAULT_TIMEOUT};
-use crate::request::{Choice as _, Stability, Subassemblies};
+use crate::values::{Choice as _, Stability, Subassemblies};
 use asp_geom::distmap::Support;
 use asp_geom::OverlapPolicy as Overlaps;
 use asp_search::mcts::{DEFAULT_BUDGET, DEFAULT_EPISODES, DEFAULT_EXPLORATION, DEFAULT_POLISH};
@@ -64,12 +64,12 @@ settings! {
         help: "Extra removal directions sampled evenly on the sphere.",
         group: Model, kind: Int, default: || json!(PlanSettings::default().sphere_directions), python: "int",
     }
-    #[serde(with = "crate::request::choice")]
+    #[serde(with = "crate::values::choice")]
     overlaps: Option<Overlaps> {
         help: "Parts that overlap in the input (press fits, dowels, screws, slop; warned once per pair with the measured depth, listed in the plan's `overlaps`).",
         applies: Both, group: Model, kind: Choice, choices: choices::<Overlaps>, default: || json!(Overlaps::default().name()), python: "Overlaps",
     }
-    #[serde(with = "crate::request::choice")]
+    #[serde(with = "crate::values::choice")]
     stability: Option<Stability> {
         help: "The feasibility search's stability criterion.",
         instead: "the optimiser's gravity check is `support`",
@@ -83,7 +83,7 @@ settings! {
         help: "Try the path planner (RRT-Connect) when no straight line works; off: straight lines only.",
         group: Model, kind: Bool, flag: Off, default: || json!(PlanSettings::default().path_planner), python: "bool",
     }
-    #[serde(deserialize_with = "crate::request::subassemblies")]
+    #[serde(deserialize_with = "crate::values::subassemblies")]
     subassemblies: Option<Subassemblies> {
         help: "Let groups of parts leave together as one rigid subassembly when no single part can; off: single parts only. `from-file` follows the file's product tree: each subassembly of the file (STEP assembly instances, named glTF nodes with children) is planned on its own base, then the level above with each as one unit (the plan's `file_subassemblies`); it does not combine with `unit_group`.",
         group: Model, kind: Bool, flag: OffOrMode(Subassemblies::FROM_FILE), value_name: "MODE",
@@ -132,14 +132,14 @@ settings! {
         instead: "the optimiser's limit is `time_limit`",
         kind: Float, default: || json!(DEFAULT_TIMEOUT), python: "float",
     }
-    #[serde(deserialize_with = "crate::request::groups")]
+    #[serde(deserialize_with = "crate::values::groups")]
     unit_group: Vec<Vec<String>> {
         help: "Parts planned as one part each, on purpose (a purchased motor, a pressed-in bearing): a list of groups, each a comma-separated string or a list of part names (one string is one group; on the command line repeat the flag). A unit goes in whole, as a subassembly step whose status is `unit`, and the plan is still `found`; a unit with a fixed part is part of the base. At least two parts each, no part in two.",
         needs: "`subassemblies`", flag: Repeat, value_name: "NAME,NAME...", default: || json!([]), python: "str | Sequence[str | Sequence[str]]",
     }
 
     // --- the optimiser (present when `objective` is) ---
-    #[serde(deserialize_with = "crate::request::names")]
+    #[serde(deserialize_with = "crate::values::names")]
     objective: Option<Vec<String>> {
         help: "Optimise the sequence for these objectives (comma-separated or a list): `access` (accessibility of each part, thesis 6.15), `dirchange` (shared removal directions, fewer direction changes, 6.16), `pathlen` (straight-line removal path length, minimised), `robot-path` (the arm's path, with `robot`). One objective runs MCTS; several need `pareto`.",
         applies: Optimiser, group: Optimisation, value_name: "LIST", python: "str | Sequence[str]",
@@ -181,13 +181,13 @@ settings! {
         help: "Cap d_max of the distance maps.",
         applies: Optimiser, group: Optimisation, kind: Float, derived: "the model's diagonal", python: "float",
     }
-    #[serde(with = "crate::request::choice")]
+    #[serde(with = "crate::values::choice")]
     support: Option<Support> {
         help: "The optimiser's gravity check on the distance maps.",
         instead: "the feasibility search's criterion is `stability`",
         applies: Optimiser, group: Optimisation, kind: Choice, choices: choices::<Support>, default: || json!(Support::default().name()), python: "Support",
     }
-    #[serde(deserialize_with = "crate::request::paths")]
+    #[serde(deserialize_with = "crate::values::paths")]
     q: Option<Vec<PathBuf>> {
         help: "Learned Q-functions (ONNX, `python -m asp.train q`), one per objective in `objective`'s order (comma-separated or a list): rollouts take the removal with the largest Q-value (the product of the values for several objectives) instead of a random one, except with probability `epsilon` (thesis 5.4.5, 6.4.4).",
         applies: Optimiser, group: Optimisation, value_name: "MODELS", python: "PathLike | Sequence[PathLike]",
@@ -196,7 +196,7 @@ settings! {
         help: "The probability of a random removal in a rollout (or expansion) guided by `q`.",
         needs: "`q`", applies: Optimiser, group: Optimisation, kind: Float, default: || json!(DEFAULT_EPSILON), python: "float",
     }
-    #[serde(with = "crate::request::choice")]
+    #[serde(with = "crate::values::choice")]
     q_use: Option<QUse> {
         help: "Where `q` guides.",
         needs: "`q`", applies: Optimiser, group: Optimisation, kind: Choice, choices: choices::<QUse>, default: || json!(QUse::default().name()), python: "QUse",
@@ -207,13 +207,13 @@ settings! {
         help: "A robot arm that must carry every removal out: `panda` (the shipped Franka-Panda-like arm) or a URDF file. A part counts as removable only when the arm can grasp it, lift it 5 cm along its removal direction and carry it to the drop-off without collision (thesis 5.3).",
         applies: Both, group: Robot, value_name: "panda|FILE.urdf",
     }
-    #[serde(deserialize_with = "crate::request::point")]
+    #[serde(deserialize_with = "crate::values::point")]
     robot_base: Option<[f64; 3]> {
         help: "The robot base's position `x,y,z` (a list or a comma-separated string), model frame.",
         needs: "`robot`", applies: Both, group: Robot, value_name: "X,Y,Z",
         derived: "on the floor, 0.3 m in front of the model's -x side, centred on it", python: "str | Sequence[float]",
     }
-    #[serde(deserialize_with = "crate::request::point")]
+    #[serde(deserialize_with = "crate::values::point")]
     drop_off: Option<[f64; 3]> {
         help: "Where the gripper puts removed parts down, `x,y,z` (a list or a comma-separated string), model frame.",
         needs: "`robot`", applies: Both, group: Robot, value_name: "X,Y,Z",
