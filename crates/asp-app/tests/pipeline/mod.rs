@@ -536,7 +536,7 @@ fn a_core_that_comes_apart_on_its_own_is_planned_as_a_model_of_its_own() {
     assert!(!straight, "the block goes in along its L: {json}");
 }
 
-/// Issue 38, end to end: two holed boards sunk 1.5 mm into each other, off the axes, at coarse
+/// End to end: two holed boards sunk 1.5 mm into each other, off the axes, at coarse
 /// and fine tessellation, plan `found` with the upper board lifted along the slab's normal; the
 /// plan lists the pair as a `planar_slab` 1.5 mm deep with its normal (the table says so too),
 /// and a board stabbed 8 mm into another as `interpenetration`.

@@ -157,7 +157,7 @@ fn tilt() -> asp_geom::math::Rot {
     asp_geom::math::Rot::from_axis_angle(Vec3::new(1.0, 2.0, 0.5).normalize(), 0.3)
 }
 
-/// Issue 38, depth overstated and false entries: a board sunk 1.5 mm into another along planar
+/// Depth overstated and false entries: a board sunk 1.5 mm into another along planar
 /// faces (a gross pair, tested by the strict rule alone) lifts off along the slab's normal,
 /// whatever the holes' tessellation and on or off the axes; sideways, and down into the lower
 /// board, it is refused. Samples at the sliver fans' centroids and vertices around the holes
