@@ -305,9 +305,11 @@ class Assembly:
             part rests on a part or the floor directly beneath it (thesis 6.3.2); ``contact``: every
             part linked through contacts to a fixed part or the floor. Default: ``below``.
         :param q: Learned Q-functions (ONNX, ``python -m asp.train q``), one per objective in
-            ``objective``'s order (comma-separated or a list): rollouts take the removal with the
-            largest Q-value (the product of the values for several objectives) instead of a random
-            one, except with probability ``epsilon`` (thesis 5.4.5, 6.4.4). Default: none.
+            ``objective``'s order (comma-separated or a list), or ``shipped``: the Q-functions
+            shipped with asp for ``access``, ``dirchange`` and ``pathlen`` (in place of one model
+            or, alone, of all). Rollouts take the removal with the largest Q-value (the product of
+            the values for several objectives) instead of a random one, except with probability
+            ``epsilon`` (thesis 5.4.5, 6.4.4). Default: none.
         :param epsilon: The probability of a random removal in a rollout (or expansion) guided by
             ``q``. Needs ``q``. Default: 0.2.
         :param q_use: Where ``q`` guides. Values: ``rollouts``: ε-greedy rollouts (thesis: one

@@ -12,4 +12,4 @@ pub use ordering::{
     shipped_model, GnnFactory, GnnOrdering, GnnSource, ShippedModel, SHIPPED_MODEL, SHIPPED_MODELS, SHIPPED_PHYSICS_MODEL,
     SHIPPED_ROBOT_MODEL,
 };
-pub use qfunction::{epsilon_greedy, epsilon_greedy_models, open_q_models, OnnxQ, QProduct};
+pub use qfunction::{epsilon_greedy, epsilon_greedy_models, open_q_models, shipped_q, OnnxQ, QProduct, SHIPPED_Q, SHIPPED_Q_NAME};

@@ -472,7 +472,14 @@ pub fn epsilon_greedy(
 /// The Q models at `paths`, one per objective in `objectives`' order, opened and checked to be
 /// Q models (their objectives and directions are checked by [`epsilon_greedy_models`], when the
 /// maps are known).
+///
+/// A path spelled [`SHIPPED_Q_NAME`] (`shipped`) stands for the shipped Q of the objective in its
+/// place ([`SHIPPED_Q`]); `shipped` alone stands for the shipped Q of every objective.
 pub fn open_q_models(paths: &[impl AsRef<Path>], objectives: &[&str]) -> Result<Vec<Arc<GraphModel>>> {
+    let is_shipped = |p: &Path| p.as_os_str() == SHIPPED_Q_NAME;
+    if paths.len() == 1 && is_shipped(paths[0].as_ref()) && objectives.len() > 1 {
+        return objectives.iter().map(|o| shipped_q(o).map(Arc::new)).collect();
+    }
     if paths.len() != objectives.len() {
         let names = paths.iter().map(|p| p.as_ref().display().to_string()).collect::<Vec<_>>().join(",");
         return Err(LearnError::Mismatch {
@@ -485,7 +492,39 @@ pub fn open_q_models(paths: &[impl AsRef<Path>], objectives: &[&str]) -> Result<
             ),
         });
     }
-    paths.iter().map(|p| GraphModel::open_kind(p, ModelKind::Q).map(Arc::new)).collect()
+    paths
+        .iter()
+        .zip(objectives)
+        .map(|(p, o)| if is_shipped(p.as_ref()) { shipped_q(o) } else { GraphModel::open_kind(p, ModelKind::Q) }.map(Arc::new))
+        .collect()
+}
+
+/// The word that names the shipped Q-functions where a Q model's path is asked for.
+pub const SHIPPED_Q_NAME: &str = "shipped";
+
+/// The shipped Q-functions of the sequence objectives: (objective, file in the repository, the
+/// ONNX bytes). Students (width 16, one layer) distilled from teachers trained on 11 generated
+/// assemblies; `scripts/train-q-sequence` rebuilds them byte for byte (docs/learning.md,
+/// "Shipped Q-functions"). The robot's is a file, `models/q-robot-path.onnx`, not built in.
+pub const SHIPPED_Q: &[(&str, &str, &[u8])] = &[
+    ("access", "models/q-access.onnx", include_bytes!("../../../models/q-access.onnx")),
+    ("dirchange", "models/q-dirchange.onnx", include_bytes!("../../../models/q-dirchange.onnx")),
+    ("pathlen", "models/q-pathlen.onnx", include_bytes!("../../../models/q-pathlen.onnx")),
+];
+
+/// The shipped Q-function of `objective` (see [`SHIPPED_Q`]), or an error naming those there are.
+pub fn shipped_q(objective: &str) -> Result<GraphModel> {
+    let Some((_, file, bytes)) = SHIPPED_Q.iter().find(|(o, _, _)| *o == objective) else {
+        let names: Vec<&str> = SHIPPED_Q.iter().map(|(o, _, _)| *o).collect();
+        return Err(LearnError::Mismatch {
+            path: SHIPPED_Q_NAME.into(),
+            mismatch: format!(
+                "no Q-function is shipped for objective '{objective}' (shipped: {}; the robot's is the file models/q-robot-path.onnx)",
+                names.join(", ")
+            ),
+        });
+    };
+    GraphModel::from_bytes_kind(bytes, &format!("{SHIPPED_Q_NAME}:{file}"), ModelKind::Q)
 }
 
 /// [`epsilon_greedy`] over models opened by [`open_q_models`].
@@ -529,5 +568,28 @@ mod tests {
         assert_eq!(parse_features("asp-q/1 directions=81"), None);
         assert_eq!(parse_features("asp-q/1 directions=81 neighbours=0"), None);
         assert_eq!(parse_features("asp-q/1 directions=x neighbours=8"), None);
+    }
+
+    /// `shipped` stands for the built-in model of each objective in its place, alone for all of
+    /// them; each built-in model loads as the Q of its own objective on the default maps (81
+    /// directions) and scores through the Rust forward pass.
+    #[test]
+    fn shipped_names_the_built_in_q_of_each_objective() {
+        let objectives = ["access", "dirchange", "pathlen"];
+        let all = open_q_models(&[SHIPPED_Q_NAME], &objectives).unwrap();
+        assert_eq!(all.len(), 3);
+        for (model, objective) in all.iter().zip(objectives) {
+            let q = OnnxQ::new(model.clone(), 81).unwrap();
+            assert_eq!(q.objective(), objective);
+            assert_eq!(model.path(), format!("shipped:models/q-{objective}.onnx"));
+            assert!(q.rust_forward().is_ok(), "{objective}: {:?}", q.rust_forward());
+        }
+        // in place of one file of a list: the objective of that place
+        let one = open_q_models(&["shipped"], &["dirchange"]).unwrap();
+        assert_eq!(OnnxQ::new(one[0].clone(), 81).unwrap().objective(), "dirchange");
+        let e = open_q_models(&["no/such/q_access.onnx", "shipped"], &["access", "dirchange"]).unwrap_err().to_string();
+        assert!(e.contains("no/such/q_access.onnx"), "{e}");
+        let e = open_q_models(&["shipped"], &["robot-path"]).unwrap_err().to_string();
+        assert!(e.contains("no Q-function is shipped for objective 'robot-path'") && e.contains("access, dirchange, pathlen"), "{e}");
     }
 }

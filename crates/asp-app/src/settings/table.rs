@@ -189,7 +189,7 @@ settings! {
     }
     #[serde(deserialize_with = "crate::values::paths")]
     q: Option<Vec<PathBuf>> {
-        help: "Learned Q-functions (ONNX, `python -m asp.train q`), one per objective in `objective`'s order (comma-separated or a list): rollouts take the removal with the largest Q-value (the product of the values for several objectives) instead of a random one, except with probability `epsilon` (thesis 5.4.5, 6.4.4).",
+        help: "Learned Q-functions (ONNX, `python -m asp.train q`), one per objective in `objective`'s order (comma-separated or a list), or `shipped`: the Q-functions shipped with asp for `access`, `dirchange` and `pathlen` (in place of one model or, alone, of all). Rollouts take the removal with the largest Q-value (the product of the values for several objectives) instead of a random one, except with probability `epsilon` (thesis 5.4.5, 6.4.4).",
         applies: Optimiser, group: Optimisation, value_name: "MODELS", python: "PathLike | Sequence[PathLike]",
     }
     epsilon: Option<f64> {

@@ -387,12 +387,12 @@ fn the_plan_says_which_guidance_ran() {
     let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../asp-learn/tests/data/random_q_access.onnx");
     let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(3);
     let cube = asp_gen::SomaCube::random(3, &mut rng).unwrap().to_assembly(0.05, "soma3");
-    let run = |policy: Option<QPolicy>| {
+    let run_at = |policy: Option<QPolicy>, resolution: usize| {
         let o = OptimiseSettings {
             objectives: vec!["access".into()],
             episodes: 5,
             threads: Some(1),
-            resolution: 5,
+            resolution,
             policy: policy.map(|p| Arc::new(p) as Arc<dyn asp_app::PolicySource>),
             ..OptimiseSettings::default()
         };
@@ -401,12 +401,17 @@ fn the_plan_says_which_guidance_ran() {
         assert!(r.found(), "{}", r.report.to_json());
         r.report.optimisation.unwrap().guidance
     };
+    let run = |policy| run_at(policy, 5);
     assert_eq!(run(None), None);
     for (uses, epsilon) in [(asp_search::QUse::Priors, None), (asp_search::QUse::Rollouts, Some(0.2))] {
         let q = QPolicy::new(std::slice::from_ref(&model), &["access"], 0.2, uses).unwrap();
         let want = GuidanceEntry { kind: "q".into(), models: vec![model.display().to_string()], q_use: uses.name().into(), epsilon };
         assert_eq!(run(Some(q)), Some(want));
     }
+    // the shipped Q, by name, on the maps it was trained on: the plan names the built-in file
+    let q = QPolicy::new(&["shipped".into()], &["access"], 0.2, asp_search::QUse::Priors).unwrap();
+    let want = GuidanceEntry { kind: "q".into(), models: vec!["shipped:models/q-access.onnx".into()], q_use: "priors".into(), epsilon: None };
+    assert_eq!(run_at(Some(q), 9), Some(want));
 }
 
 /// A rolling bearing in a housing on a shaft: its balls never leave their grooves, so taken part
