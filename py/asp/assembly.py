@@ -307,9 +307,14 @@ class Assembly:
         :param q: Learned Q-functions (ONNX, ``python -m asp.train q``), one per objective in
             ``objective``'s order (comma-separated or a list), or ``shipped``: the Q-functions
             shipped with asp for ``access``, ``dirchange`` and ``pathlen`` (in place of one model
-            or, alone, of all). Rollouts take the removal with the largest Q-value (the product of
-            the values for several objectives) instead of a random one, except with probability
-            ``epsilon`` (thesis 5.4.5, 6.4.4). Default: none.
+            or, alone, of all), or ``none``: no learned guidance. Where ``q_use`` says, rollouts
+            take the removal with the largest Q-value (the product of the values for several
+            objectives) instead of a random one, except with probability ``epsilon`` (thesis 5.4.5,
+            6.4.4). Without ``q``, an optimisation whose objectives all have a shipped Q, on maps of
+            resolution 9, starts from the shipped Q-functions' greedy sequences and then searches as
+            vanilla does (``q_use`` ``seed``; docs/benchmarks.md, "Guidance at equal wall time");
+            ``q`` none turns that off. Default: `shipped` with `q_use` `seed` for access, dirchange
+            and pathlen at resolution 9; none otherwise.
         :param epsilon: The probability of a random removal in a rollout (or expansion) guided by
             ``q``. Needs ``q``. Default: 0.2.
         :param q_use: Where ``q`` guides. Values: ``rollouts``: ε-greedy rollouts (thesis: one
@@ -318,7 +323,10 @@ class Assembly:
             rollouts and Q-ordered expansions; ``priors``: the Q-values of each state the search
             adds are PUCT priors (expansion order and a bonus in the tree policy), a greedy sequence
             on them seeds the local search; rollouts stay random (one evaluation per node, cached by
-            state). Needs ``q``. Default: ``rollouts``.
+            state); ``seed``: greedy sequences on the Q-values (their product and each objective's
+            own) go to the front and seed the local search before the first episode; the search
+            itself stays vanilla (one evaluation per step of those sequences, none after). Needs
+            ``q``. Default: ``rollouts``.
         :raises ConfigError: a setting is unknown, of the wrong type, out of range or of the
             other search.
         :raises LoadError: the model cannot be planned as given (parts overlapping beyond

@@ -26,7 +26,7 @@ Order = Literal["auto", "given", "shuffled", "random", "bookkeeping", "gnn"]
 #: The values of ``support=``.
 Support = Literal["below", "contact"]
 #: The values of ``q_use=``.
-QUse = Literal["rollouts", "expansions", "both", "priors"]
+QUse = Literal["rollouts", "expansions", "both", "priors", "seed"]
 
 
 class PlanSettings(TypedDict, total=False):

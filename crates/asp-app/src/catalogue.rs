@@ -223,6 +223,28 @@ pub const POLICIES: &[PolicyEntry] = &[
 /// The probability of a random removal where learned Q-functions guide (thesis 5.4.5: 0.2).
 pub const DEFAULT_EPSILON: f64 = 0.2;
 
+/// The word of `q` that turns learned guidance off (the search without Q-functions, also
+/// where [`default_guidance`] would guide).
+pub const NO_Q: &str = "none";
+
+/// The guidance an optimisation without `q` gets: greedy seeds on the shipped Q-functions
+/// ([`asp_search::QUse::Seed`]: before the first episode, then the vanilla search) when every
+/// objective has one (`access`, `dirchange`, `pathlen`) and the maps have the resolution they
+/// were trained on (9); otherwise none. The seeds leave the tree search as vanilla's of the same
+/// seed (they draw no random numbers and do not move the tree's bounds): the front holds
+/// vanilla's sequences and theirs (the local search, `polish`, shares its work among both), at
+/// the cost of a few greedy sequences of forward passes. The
+/// rule comes from measurement, not from timings at run time (docs/benchmarks.md, "Guidance at
+/// equal wall time"): PUCT priors, guided rollouts and online learning lost to vanilla at equal
+/// time on held-out 41- to 106-part assemblies, seeds did not.
+pub fn default_guidance(objectives: &[&str], resolution: usize) -> Result<Option<QPolicy>> {
+    let shipped = |o: &&str| asp_learn::SHIPPED_Q.iter().any(|(name, _, _)| name == o);
+    if resolution != asp_geom::distmap::DEFAULT_RESOLUTION || objectives.is_empty() || !objectives.iter().all(shipped) {
+        return Ok(None);
+    }
+    QPolicy::new(&[PathBuf::from(asp_learn::SHIPPED_Q_NAME)], objectives, DEFAULT_EPSILON, asp_search::QUse::Seed).map(Some)
+}
+
 /// The ε-greedy policy over learned Q-functions, one per objective of the problem in its order.
 /// The files are opened and checked to be Q models when it is made; their objectives and
 /// direction counts are checked against the problem in [`PolicySource::prepare`].

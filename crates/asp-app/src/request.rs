@@ -193,7 +193,7 @@ mod tests {
         assert_eq!(r.robot_base, Some([1.0, 2.0, 3.0]));
         assert_eq!(r.timeout, None);
         assert_eq!(asp_geom::OverlapPolicy::parse("error"), Some(asp_geom::OverlapPolicy::Error));
-        assert_eq!(asp_search::QUse::names(), "rollouts, expansions, both, priors");
+        assert_eq!(asp_search::QUse::names(), "rollouts, expansions, both, priors, seed");
         assert_eq!(asp_geom::distmap::Support::ContactGraph.name(), "contact");
     }
 }

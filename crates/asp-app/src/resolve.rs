@@ -230,11 +230,20 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
     if names.len() > 1 && !pareto {
         return Err(AppError::setting("objective", format!("{list}: several objectives need `pareto` (or give one objective)")));
     }
+    let resolution = r.resolution.unwrap_or(asp_geom::distmap::DEFAULT_RESOLUTION);
+    let objectives: Vec<&str> = names.iter().map(String::as_str).collect();
     let policy = match &r.q {
-        None => None,
+        Some(paths) if paths.len() == 1 && paths[0].as_os_str() == catalogue::NO_Q => {
+            if let Some(key) =
+                [("q_use", r.q_use.is_some()), ("epsilon", r.epsilon.is_some())].iter().find_map(|(k, set)| set.then_some(*k))
+            {
+                return Err(AppError::setting(key, format!("needs Q-functions; `q` {} turns them off", catalogue::NO_Q)));
+            }
+            None
+        }
+        None => catalogue::default_guidance(&objectives, resolution)?.map(|q| Arc::new(q) as Arc<dyn catalogue::PolicySource>),
         Some(paths) => {
             let uses = r.q_use.unwrap_or_default();
-            let objectives: Vec<&str> = names.iter().map(String::as_str).collect();
             let q = QPolicy::new(paths, &objectives, r.epsilon.unwrap_or(DEFAULT_EPSILON), uses)?;
             Some(Arc::new(q) as Arc<dyn catalogue::PolicySource>)
         }
@@ -256,7 +265,7 @@ fn optimise(r: &PlanRequest, extensions: Vec<Arc<dyn MdpExtension>>) -> Result<O
         time_limit: positive("time_limit", r.time_limit)?,
         exploration,
         polish,
-        resolution: r.resolution.unwrap_or(asp_geom::distmap::DEFAULT_RESOLUTION),
+        resolution,
         d_max: positive("d_max", r.d_max)?,
         support: r.support.unwrap_or_default(),
         extensions,
@@ -405,5 +414,26 @@ mod tests {
         assert!(s.bookkeeping && s.order.name() == "given");
         let s = resolve(&PlanRequest::from_json(r#"{"robot": "panda", "grippers": 2}"#).unwrap()).unwrap();
         assert!(s.checker_extension.is_some());
+    }
+
+    /// Without `q`, objectives that all have a shipped Q on maps of their resolution get the
+    /// shipped seeds; `q` none, another resolution or an objective without one get no guidance.
+    #[test]
+    fn the_default_guidance_is_the_shipped_seeds_where_they_apply() {
+        let guidance = |json: &str| {
+            let s = resolve(&PlanRequest::from_json(json).unwrap()).unwrap();
+            s.optimise.unwrap().policy.and_then(|p| p.guidance())
+        };
+        let g = guidance(r#"{"objective": "access,dirchange", "pareto": true}"#).expect("the default seeds");
+        assert_eq!(g.models, ["shipped:models/q-access.onnx", "shipped:models/q-dirchange.onnx"]);
+        assert_eq!((g.q_use.as_str(), g.epsilon), ("seed", None));
+        assert_eq!(guidance(r#"{"objective": "pathlen"}"#).unwrap().models, ["shipped:models/q-pathlen.onnx"]);
+        assert!(guidance(r#"{"objective": "access,dirchange", "pareto": true, "q": "none"}"#).is_none());
+        assert!(guidance(r#"{"objective": "access", "resolution": 7}"#).is_none());
+        assert!(guidance(r#"{"objective": "access,robot-path", "pareto": true, "robot": "panda"}"#).is_none());
+        // given models keep their q_use
+        let g = guidance(r#"{"objective": "access", "q": "shipped", "q_use": "priors"}"#).unwrap();
+        assert_eq!(g.q_use, "priors");
+        assert_eq!(err(r#"{"objective": "access", "q": "none", "q_use": "priors"}"#), "q_use: needs Q-functions; `q` none turns them off");
     }
 }

@@ -72,6 +72,7 @@ choice!(asp_search::QUse {
     Expansions = asp_search::QUse::NAMES[1] => "the Q-values of each state the search adds order its expansions; rollouts stay random (one evaluation per node)",
     Both = asp_search::QUse::NAMES[2] => "ε-greedy rollouts and Q-ordered expansions",
     Priors = asp_search::QUse::NAMES[3] => "the Q-values of each state the search adds are PUCT priors (expansion order and a bonus in the tree policy), a greedy sequence on them seeds the local search; rollouts stay random (one evaluation per node, cached by state)",
+    Seed = asp_search::QUse::NAMES[4] => "greedy sequences on the Q-values (their product and each objective's own) go to the front and seed the local search before the first episode; the search itself stays vanilla (one evaluation per step of those sequences, none after)",
 });
 
 /// A closed set's value in a request, by its [`Choice`] name (`#[serde(with = "...choice")]`).

@@ -38,12 +38,13 @@ pub fn run(a: &MctsArgs) -> anyhow::Result<std::process::ExitCode> {
     for name in a.settings.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         settings.push(match name {
             "vanilla" => MctsSetting::vanilla(),
-            "pretrained" | "pretrained-expansions" | "pretrained-both" | "pretrained-priors" => {
+            "pretrained" | "pretrained-expansions" | "pretrained-both" | "pretrained-priors" | "pretrained-seed" => {
                 let Some(models) = &a.q else { bail!("--settings {}: {name} needs --q MODELS", a.settings) };
                 let uses = match name {
                     "pretrained" => asp_search::QUse::Rollouts,
                     "pretrained-expansions" => asp_search::QUse::Expansions,
                     "pretrained-priors" => asp_search::QUse::Priors,
+                    "pretrained-seed" => asp_search::QUse::Seed,
                     _ => asp_search::QUse::Both,
                 };
                 let paths: Vec<std::path::PathBuf> = models.split(',').map(str::trim).filter(|p| !p.is_empty()).map(Into::into).collect();
@@ -60,7 +61,7 @@ pub fn run(a: &MctsArgs) -> anyhow::Result<std::process::ExitCode> {
                 a.seconds
             ),
             other => bail!(
-                "--settings: unknown setting '{other}' (vanilla, pretrained, pretrained-expansions, pretrained-both, pretrained-priors here; online and retrained from Python: python -m asp.train bench-mcts)"
+                "--settings: unknown setting '{other}' (vanilla, pretrained, pretrained-expansions, pretrained-both, pretrained-priors, pretrained-seed here; online and retrained from Python: python -m asp.train bench-mcts)"
             ),
         });
     }

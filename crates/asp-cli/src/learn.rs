@@ -64,6 +64,8 @@ fn transitions(a: &TransitionsArgs) -> anyhow::Result<std::process::ExitCode> {
     if a.objective.split(',').filter(|n| !n.trim().is_empty()).count() > 1 {
         extra.insert("pareto".into(), true.into());
     }
+    // the thesis' data: the vanilla search's transitions, without the default guidance's seeds
+    extra.insert("q".into(), asp_app::catalogue::NO_Q.into());
     a.maps.put(&mut extra);
     a.robot.put(&mut extra);
     let mut plan = model_settings(&a.load, extra)?;

@@ -126,11 +126,17 @@ pub trait PolicyWorker {
     }
 
     /// The index into `actions` (the feasible removals of `ctx`'s state, never empty) of the
-    /// removal this policy ranks first, without randomness, or `None` when it ranks none
-    /// (default). A search whose policy ranks asks it, before its first episode, for one greedy
-    /// sequence from the assembled state and gives it to its local search (`--polish`) as a seed.
-    fn greedy(&mut self, _ctx: &mut PolicyContext<'_, '_>, _actions: &[usize]) -> Result<Option<usize>> {
+    /// removal this policy ranks first by its ranking `which` (`0..`[`greedy_rankings`](Self::greedy_rankings)),
+    /// without randomness, or `None` when it ranks none (default). A search whose policy ranks
+    /// asks it, before its first episode, for one greedy sequence per ranking from the assembled
+    /// state, offers each to its archive and gives it to its local search (`--polish`) as a seed.
+    fn greedy(&mut self, _ctx: &mut PolicyContext<'_, '_>, _actions: &[usize], _which: usize) -> Result<Option<usize>> {
         Ok(None)
+    }
+
+    /// How many rankings [`greedy`](Self::greedy) has (default 1).
+    fn greedy_rankings(&self) -> usize {
+        1
     }
 }
 
@@ -211,6 +217,11 @@ pub enum QUse {
     /// `w` = [`DEFAULT_PRIOR_WEIGHT`] unless the search sets one; rollouts stay random, and a
     /// greedy sequence on the Q-values seeds the local search. One evaluation per node.
     Priors,
+    /// Seeds only: before the first episode, greedy sequences on the Q-values (on their
+    /// product and, with several objectives, on each objective's own) go to the archive and
+    /// seed the local search; the search itself stays vanilla (random expansions and
+    /// rollouts). Evaluations: one per step of each seed sequence, then none.
+    Seed,
 }
 
 /// The PUCT weight of [`QUse::Priors`] (the scale of UCT's exploration term for a
@@ -219,7 +230,7 @@ pub const DEFAULT_PRIOR_WEIGHT: f64 = 1.0;
 
 impl QUse {
     /// The names, as the command line and Python take them.
-    pub const NAMES: [&'static str; 4] = ["rollouts", "expansions", "both", "priors"];
+    pub const NAMES: [&'static str; 5] = ["rollouts", "expansions", "both", "priors", "seed"];
 
     fn rollouts(self) -> bool {
         matches!(self, QUse::Rollouts | QUse::Both)
@@ -244,7 +255,8 @@ impl std::str::FromStr for QUse {
             "expansions" => Ok(QUse::Expansions),
             "both" => Ok(QUse::Both),
             "priors" => Ok(QUse::Priors),
-            other => Err(SearchError::config(format!("unknown Q use '{other}' (rollouts, expansions, both or priors)"))),
+            "seed" => Ok(QUse::Seed),
+            other => Err(SearchError::config(format!("unknown Q use '{other}' (rollouts, expansions, both, priors or seed)"))),
         }
     }
 }
@@ -378,12 +390,29 @@ impl PolicyWorker for EpsilonGreedyWorker<'_> {
         (self.uses == QUse::Priors).then_some(DEFAULT_PRIOR_WEIGHT)
     }
 
-    fn greedy(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize]) -> Result<Option<usize>> {
-        if self.uses != QUse::Priors {
+    fn greedy(&mut self, ctx: &mut PolicyContext<'_, '_>, actions: &[usize], which: usize) -> Result<Option<usize>> {
+        if !matches!(self.uses, QUse::Priors | QUse::Seed) {
             return Ok(None);
         }
-        self.evaluate(ctx, actions)?;
-        Ok(Some(argmax(&self.product)))
+        if which == 0 {
+            self.evaluate(ctx, actions)?;
+            return Ok(Some(argmax(&self.product)));
+        }
+        // ranking k > 0: objective k - 1's Q alone
+        let Some(q) = self.q.get_mut(which - 1) else { return Ok(None) };
+        self.values.resize(actions.len(), 0.0);
+        q.q_values(ctx, actions, &mut self.values[..actions.len()])?;
+        Ok(Some(argmax(&self.values[..actions.len()])))
+    }
+
+    /// Priors: the product's ranking. Seed: the product's and, with several objectives, each
+    /// objective's own (the ends of a front the product's sequence lies between).
+    fn greedy_rankings(&self) -> usize {
+        if self.uses == QUse::Seed && self.q.len() > 1 {
+            1 + self.q.len()
+        } else {
+            1
+        }
     }
 
     /// The Q-value products, normalised to sum 1 (uniform when they are all 0 or not finite).

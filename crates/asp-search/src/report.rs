@@ -25,7 +25,7 @@ pub use precedence::{PrecedenceEdge, PrecedenceEntry, PrecedenceReason, Preceden
 
 /// The version of the plan format this build writes. Minor bumps add keys; major bumps change
 /// or remove them.
-pub const FORMAT_VERSION: &str = "1.14";
+pub const FORMAT_VERSION: &str = "1.15";
 
 /// A whole plan file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -417,8 +417,8 @@ pub struct GuidanceEntry {
     /// The Q model files, one per objective in the objectives' order, as given.
     pub models: Vec<String>,
     /// Where the Q-values guided the search: `rollouts` (ε-greedy rollouts), `expansions`
-    /// (they order expansions), `both`, or `priors` (PUCT priors at expansions and a greedy
-    /// seed of the local search; rollouts random).
+    /// (they order expansions), `both`, `priors` (PUCT priors at expansions and a greedy
+    /// seed of the local search; rollouts random) or `seed` (greedy seeds only, then vanilla).
     pub q_use: String,
     /// The probability of a random removal in guided rollouts (`rollouts` and `both` only).
     #[serde(default, skip_serializing_if = "Option::is_none")]

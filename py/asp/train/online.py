@@ -151,9 +151,10 @@ def run_online(
         resolution=config.resolution,
         episodes=config.episodes,
         time_limit=config.seconds,
-        epsilon=config.epsilon,
-        q_use=config.q_use,
-        q=",".join(os.fspath(p) for p in pretrained) if pretrained else None,
+        epsilon=config.epsilon if pretrained else None,  # the trained models get them by set_q
+        q_use=config.q_use if pretrained else None,
+        # without pretrained models the first episodes are the vanilla search's (no default seeds)
+        q=",".join(os.fspath(p) for p in pretrained) if pretrained else "none",
     )
     search = assembly.search(record=True, **settings)
     index = search.index
@@ -346,6 +347,7 @@ def bench_mcts(
                     if setting in ("vanilla", "pretrained"):
                         kw = PlanSettings(objective=objectives, pareto=len(objectives) > 1, seed=run, threads=1, time_limit=last,
                                           episodes=10**12, budget=base.budget, resolution=base.resolution)
+                        kw["q"] = "none"  # vanilla: no learned guidance, not even asp's default
                         if setting == "pretrained":
                             kw["q"] = list(q or [])
                             if base.epsilon is not None:

@@ -189,8 +189,9 @@ settings! {
     }
     #[serde(deserialize_with = "crate::values::paths")]
     q: Option<Vec<PathBuf>> {
-        help: "Learned Q-functions (ONNX, `python -m asp.train q`), one per objective in `objective`'s order (comma-separated or a list), or `shipped`: the Q-functions shipped with asp for `access`, `dirchange` and `pathlen` (in place of one model or, alone, of all). Rollouts take the removal with the largest Q-value (the product of the values for several objectives) instead of a random one, except with probability `epsilon` (thesis 5.4.5, 6.4.4).",
+        help: "Learned Q-functions (ONNX, `python -m asp.train q`), one per objective in `objective`'s order (comma-separated or a list), or `shipped`: the Q-functions shipped with asp for `access`, `dirchange` and `pathlen` (in place of one model or, alone, of all), or `none`: no learned guidance. Where `q_use` says, rollouts take the removal with the largest Q-value (the product of the values for several objectives) instead of a random one, except with probability `epsilon` (thesis 5.4.5, 6.4.4). Without `q`, an optimisation whose objectives all have a shipped Q, on maps of resolution 9, starts from the shipped Q-functions' greedy sequences and then searches as vanilla does (`q_use` `seed`; docs/benchmarks.md, \"Guidance at equal wall time\"); `q` none turns that off.",
         applies: Optimiser, group: Optimisation, value_name: "MODELS", python: "PathLike | Sequence[PathLike]",
+        derived: "`shipped` with `q_use` `seed` for access, dirchange and pathlen at resolution 9; none otherwise",
     }
     epsilon: Option<f64> {
         help: "The probability of a random removal in a rollout (or expansion) guided by `q`.",

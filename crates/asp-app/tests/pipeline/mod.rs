@@ -410,7 +410,8 @@ fn the_plan_says_which_guidance_ran() {
     }
     // the shipped Q, by name, on the maps it was trained on: the plan names the built-in file
     let q = QPolicy::new(&["shipped".into()], &["access"], 0.2, asp_search::QUse::Priors).unwrap();
-    let want = GuidanceEntry { kind: "q".into(), models: vec!["shipped:models/q-access.onnx".into()], q_use: "priors".into(), epsilon: None };
+    let want =
+        GuidanceEntry { kind: "q".into(), models: vec!["shipped:models/q-access.onnx".into()], q_use: "priors".into(), epsilon: None };
     assert_eq!(run_at(Some(q), 9), Some(want));
 }
 

@@ -46,7 +46,10 @@ fn a_json_request_plans_like_hand_built_settings() {
 
     let request = PlanRequest::from_json(r#"{"up": "z", "objective": ["access"], "episodes": 40, "threads": 1, "seed": 2}"#).unwrap();
     let by_request = asp_app::plan_file(&table, &request, Hooks::default()).unwrap();
-    let o = OptimiseSettings { objectives: vec!["access".into()], episodes: 40, threads: Some(1), ..OptimiseSettings::default() };
+    // without `q`, the request gets the default guidance (the shipped seeds)
+    let policy = asp_app::catalogue::default_guidance(&["access"], 9).unwrap().map(|q| std::sync::Arc::new(q) as _);
+    assert!(policy.is_some());
+    let o = OptimiseSettings { objectives: vec!["access".into()], episodes: 40, threads: Some(1), policy, ..OptimiseSettings::default() };
     let settings = PlanSettings { up: Some(asp_geom::math::Axis::Z), seed: 2, optimise: Some(o), ..PlanSettings::default() };
     let by_hand = pipeline::plan_file(&table, &settings, None).unwrap();
     assert_eq!(untimed(&by_request.report.to_json()), untimed(&by_hand.report.to_json()));

@@ -158,8 +158,9 @@ pub struct MctsArgs {
     pub objective: String,
     /// Settings, comma-separated: `vanilla` (random rollouts), `pretrained` (ε-greedy
     /// rollouts on the `--q` models), `pretrained-expansions` (the `--q` models order the
-    /// expansions, rollouts stay random), `pretrained-both` and `pretrained-priors` (PUCT priors
-    /// at expansions and a greedy seed of the local search, random rollouts).
+    /// expansions, rollouts stay random), `pretrained-both`, `pretrained-priors` (PUCT priors
+    /// at expansions and a greedy seed of the local search, random rollouts) and
+    /// `pretrained-seed` (greedy seeds only, then the vanilla search).
     #[arg(long, value_name = "LIST", default_value = "vanilla,pretrained")]
     pub settings: String,
     /// Q models (ONNX), one per objective in `--objective`'s order, for `pretrained`.

@@ -77,7 +77,7 @@ fn plan_precedence_adds_the_graph_and_writes_dot() {
     let o = asp(&["plan", model.to_str().unwrap(), "--precedence-dot", dot.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let plan: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
-    assert_eq!(plan["format_version"], "1.14");
+    assert_eq!(plan["format_version"], "1.15");
     let g = &plan["precedence"];
     assert_eq!(g["stability"]["conservative"], true);
     assert_eq!(g["steps"].as_array().unwrap().len(), 3);

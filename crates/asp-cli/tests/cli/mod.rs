@@ -38,7 +38,7 @@ fn plans_a_fixture_prints_a_table_and_writes_the_json() {
     assert!(table.contains("found"), "{table}");
     assert!(table.contains("stick") && table.contains("handle") && table.contains("cap"), "{table}");
     let plan = json(&out);
-    assert_eq!(plan["format_version"], "1.14");
+    assert_eq!(plan["format_version"], "1.15");
     assert_eq!(plan["stats"]["checker"], "collision_world");
     assert_eq!(plan["status"], "found");
     assert_eq!(plan["up"], "+z");
@@ -462,7 +462,7 @@ fn plans_an_interlocking_burr_by_grid_moves() {
     let table = String::from_utf8(o.stdout).unwrap();
     assert!(table.contains("grid plan") && table.contains("move piece"), "{table}");
     let plan = json(&out);
-    assert_eq!(plan["format_version"], "1.14");
+    assert_eq!(plan["format_version"], "1.15");
     assert_eq!(plan["status"], "found");
     assert_eq!(plan["grid"]["reason"], "needs_moves");
     assert_eq!(plan["grid"]["first_separation_moves"], asp_geom::puzzles::BURR_LEVEL_MOVES);

@@ -236,6 +236,88 @@ fn q_priors_seed_the_search_with_the_greedy_sequence() {
     assert!(out.trace[0].iterations > 0, "{:?}", out.trace[0]);
 }
 
+/// A Q-function that values every removal alike and counts its evaluations.
+#[derive(Debug, Default)]
+struct Flat(std::sync::atomic::AtomicUsize);
+
+impl asp_search::QFunction for Flat {
+    fn q_values(&self, _: &mut asp_search::PolicyContext<'_, '_>, _: &[usize], out: &mut [f64]) -> asp_search::Result<()> {
+        self.0.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        out.fill(1.0);
+        Ok(())
+    }
+}
+
+/// `seed`: before the first iteration one greedy sequence per ranking (the product of the
+/// Q-values, then each objective's own) goes to the front; after them the Q-functions are
+/// never asked again and expansions and rollouts are random.
+#[test]
+fn q_seed_offers_each_ranking_s_greedy_sequence_then_searches_at_random() {
+    use asp_geom::distmap::MapState;
+    use asp_search::hypervolume::dominates;
+    use asp_search::policy::{EpsilonGreedy, QUse};
+    use asp_search::{ParetoMcts, StepKind};
+    use std::sync::atomic::Ordering;
+    use std::sync::Arc;
+    let cube = soma(3, 2);
+    let maps = maps(&cube, 5);
+    let p = problem(&maps, "access,dirchange");
+    // the greedy sequences: largest feasible index first (the product's ranking and the first
+    // objective's), and the first feasible removal (the flat second objective's: ties go first)
+    let greedy = |pick: fn(&[usize]) -> usize| {
+        let mut state = MapState::new(p.maps());
+        let (mut actions, mut seq) = (Vec::new(), Vec::new());
+        loop {
+            state.feasible_actions(&mut actions);
+            if actions.is_empty() {
+                break;
+            }
+            let a = pick(&actions);
+            state.remove(a);
+            seq.push(a);
+        }
+        assert!(state.is_complete() && seq.len() >= 5, "{seq:?}");
+        seq
+    };
+    let largest_first = greedy(|a| *a.iter().max().unwrap());
+    let first = greedy(|a| a[0]);
+    assert_ne!(largest_first, first);
+    let (largest, flat) = (Arc::new(LargestIndex::default()), Arc::new(Flat::default()));
+    let policy = EpsilonGreedy::new(0.0, vec![largest.clone(), flat.clone()]).unwrap().using(QUse::Seed);
+    let run = |policy: Option<Arc<EpsilonGreedy>>, polish: f64, episodes: usize, budget: usize| {
+        let mut b = ParetoMcts::builder().seed(3).episodes(episodes).budget(budget).polish(polish).record_transitions(true);
+        if let Some(policy) = policy {
+            b = b.policy(policy);
+        }
+        b.build().unwrap().solve(&p).unwrap()
+    };
+    let policy = Arc::new(policy);
+    let out = run(Some(policy.clone()), 0.25, 3, 2);
+    assert_eq!(out.trace[0].iterations, 0, "{:?}", out.trace[0]);
+    // each seed is on the front or dominated by what is
+    for seq in [&largest_first, &first] {
+        let (values, _) = p.evaluate(seq).unwrap();
+        assert!(
+            out.solutions.iter().any(|s| s.values == values || dominates(&s.values, &values)),
+            "{seq:?} ({values:?}) is neither on nor below the front"
+        );
+    }
+    // one evaluation per step of the seeds that use each function, none after
+    assert_eq!(largest.0.load(Ordering::Relaxed), 2 * largest_first.len());
+    assert_eq!(flat.0.load(Ordering::Relaxed), largest_first.len() + first.len());
+    let chosen: Vec<_> = out.transitions.iter().filter(|t| t.actions.len() > 1 && t.kind == StepKind::Simulation).collect();
+    assert!(!chosen.is_empty() && !chosen.iter().all(|t| t.action == *t.actions.iter().max().unwrap()), "rollouts stay random");
+    // the seeds leave the tree search as it was: the same steps as vanilla's of the same seed,
+    // so (without the local search) a front that holds vanilla's and the seeds' sequences
+    let (seeded, vanilla) = (run(Some(policy), 0.0, 40, 5), run(None, 0.0, 40, 5));
+    let steps = |o: &asp_search::SearchOutcome| o.transitions.iter().map(|t| (t.episode, t.kind, t.action)).collect::<Vec<_>>();
+    assert!(steps(&seeded) == steps(&vanilla), "the seeded tree search took other steps than vanilla's");
+    assert_eq!((seeded.stats.iterations, seeded.stats.tree_nodes), (vanilla.stats.iterations, vanilla.stats.tree_nodes));
+    for v in &vanilla.solutions {
+        assert!(seeded.solutions.iter().any(|s| s.values == v.values || dominates(&s.values, &v.values)), "{:?} lost", v.values);
+    }
+}
+
 /// A random rollout policy whose first choice on each thread waits (up to 20 s) until every
 /// thread has made its first choice: it sees whether the search threads run at the same time
 /// (`alone`: some thread waited in vain).

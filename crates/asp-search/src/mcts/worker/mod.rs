@@ -315,10 +315,21 @@ impl<'p, V: Variant> Worker<'p, V> {
         (self.priors && w > 0.0).then_some(w)
     }
 
-    /// One greedy sequence of the policy from the assembled state (when it ranks removals:
-    /// [`PolicyWorker::greedy`]), offered to the archive and, as a seed, to the local search.
-    /// Deterministic: it draws nothing from the search's random stream.
-    fn greedy_seed(&mut self, policy: &mut dyn PolicyWorker) -> Result<()> {
+    /// One greedy sequence of the policy per ranking from the assembled state (when it ranks
+    /// removals: [`PolicyWorker::greedy`]), each offered to the archive and, as a seed, to the
+    /// local search. It leaves the tree search as it was: it draws nothing from the search's
+    /// random stream and does not widen the bounds that normalise the tree's returns, so with
+    /// random rollouts and expansions (`QUse::Seed`) the tree grows exactly as vanilla's of the
+    /// same seed and the archive holds vanilla's sequences and the seeds'.
+    fn greedy_seeds(&mut self, policy: &mut dyn PolicyWorker) -> Result<()> {
+        for which in 0..policy.greedy_rankings() {
+            self.greedy_seed(policy, which)?;
+        }
+        Ok(())
+    }
+
+    /// The greedy sequence of ranking `which` (see [`greedy_seeds`](Self::greedy_seeds)).
+    fn greedy_seed(&mut self, policy: &mut dyn PolicyWorker, which: usize) -> Result<()> {
         let m = self.m;
         let root = &self.tree.sets[0];
         self.sim.reset_with_free(&root.present, &root.free);
@@ -334,7 +345,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             }
             let pick = {
                 let mut ctx = PolicyContext { state: &mut self.sim, memory: &self.memory, problem: self.problem };
-                policy.greedy(&mut ctx, &actions)?
+                policy.greedy(&mut ctx, &actions, which)?
             };
             let Some(k) = pick else { return Ok(()) };
             let Some(&p) = actions.get(k) else {
@@ -347,7 +358,14 @@ impl<'p, V: Variant> Worker<'p, V> {
             self.sequence.push(p as u16);
         }
         if self.sim.is_complete() {
-            self.complete_sequence(&ret[..m], 0);
+            let (ret, seq) = (&ret[..m], &self.sequence);
+            if let Some(p) = &mut self.polisher {
+                p.seed(ret, seq);
+            }
+            if self.archive.insert(ret, || seq.clone()) {
+                self.archive_changed = true;
+                self.found.push((ret.to_vec(), self.start.elapsed().as_secs_f64(), 0));
+            }
         }
         Ok(())
     }

@@ -65,7 +65,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             return self.fail(e);
         }
         if self.stats.iterations == 0 && !self.root_finished() {
-            if let Err(e) = self.greedy_seed(&mut *policy) {
+            if let Err(e) = self.greedy_seeds(&mut *policy) {
                 return self.fail(e);
             }
         }
