@@ -358,14 +358,7 @@ impl<'p, V: Variant> Worker<'p, V> {
             self.sequence.push(p as u16);
         }
         if self.sim.is_complete() {
-            let (ret, seq) = (&ret[..m], &self.sequence);
-            if let Some(p) = &mut self.polisher {
-                p.seed(ret, seq);
-            }
-            if self.archive.insert(ret, || seq.clone()) {
-                self.archive_changed = true;
-                self.found.push((ret.to_vec(), self.start.elapsed().as_secs_f64(), 0));
-            }
+            self.offer_sequence(&ret[..m], 0); // not to the bounds: the tree stays vanilla's
         }
         Ok(())
     }
@@ -375,6 +368,12 @@ impl<'p, V: Variant> Worker<'p, V> {
     /// found after `iterations` of the episode).
     fn complete_sequence(&mut self, ret: &[f64], iterations: u64) {
         self.bounds.update(ret);
+        self.offer_sequence(ret, iterations);
+    }
+
+    /// The current `sequence`, complete with returns `ret`, to the local search and the archive
+    /// (without the bounds: [`complete_sequence`](Self::complete_sequence)).
+    fn offer_sequence(&mut self, ret: &[f64], iterations: u64) {
         let seq = &self.sequence;
         if let Some(p) = &mut self.polisher {
             p.seed(ret, seq);
