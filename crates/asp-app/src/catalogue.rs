@@ -231,9 +231,9 @@ pub const NO_Q: &str = "none";
 /// ([`asp_search::QUse::Seed`]: before the first episode, then the vanilla search) when every
 /// objective has one (`access`, `dirchange`, `pathlen`) and the maps have the resolution they
 /// were trained on (9); otherwise none. The seeds leave the tree search as vanilla's of the same
-/// seed (they draw no random numbers and do not move the tree's bounds): the front holds
-/// vanilla's sequences and theirs (the local search, `polish`, shares its work among both), at
-/// the cost of a few greedy sequences of forward passes. The
+/// seed (they draw no random numbers and do not move the tree's bounds); they join the archive
+/// and the local search (`polish`), which shares its work among them and vanilla's sequences,
+/// at the cost of a few greedy sequences of forward passes. The
 /// rule comes from measurement, not from timings at run time (docs/benchmarks.md, "Guidance at
 /// equal wall time"): PUCT priors, guided rollouts and online learning lost to vanilla at equal
 /// time on held-out 41- to 106-part assemblies, seeds did not.

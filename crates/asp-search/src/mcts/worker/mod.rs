@@ -320,7 +320,7 @@ impl<'p, V: Variant> Worker<'p, V> {
     /// local search. It leaves the tree search as it was: it draws nothing from the search's
     /// random stream and does not widen the bounds that normalise the tree's returns, so with
     /// random rollouts and expansions (`QUse::Seed`) the tree grows exactly as vanilla's of the
-    /// same seed and the archive holds vanilla's sequences and the seeds'.
+    /// same seed (the local search, which also searches around the seeds, may not).
     fn greedy_seeds(&mut self, policy: &mut dyn PolicyWorker) -> Result<()> {
         for which in 0..policy.greedy_rankings() {
             self.greedy_seed(policy, which)?;
